@@ -1,0 +1,30 @@
+#pragma once
+/// @file commands.hpp
+/// The chainsim subcommands as plain functions (cases/main.cpp only parses the command line).
+/// Each returns the process exit code and throws InputError / NumericalError on failure.
+#include <iosfwd>
+#include <string>
+
+#include "cases/reduced_models.hpp"
+
+namespace chainsim {
+
+/// `chainsim reduced falling|folded|sliding ...`
+struct ReducedCommandOptions {
+  std::string problem;   ///< "falling" | "folded" | "sliding"
+  ReducedSetup setup;    ///< problem is filled in from `problem`
+  std::string out;       ///< output directory; "" = results/reduced/<problem>
+  bool json = false;     ///< print the summary as one JSON object on stdout
+};
+int run_reduced_command(ReducedCommandOptions options, std::ostream& out);
+
+/// `chainsim canonical --out DIR`: the main job. The three canonical problems with default
+/// parameters (series + summary), a summary table, and the data behind the paper's figures
+/// (fall time against f, η(ξ) and P/P0(ξ) for several f, each with its exact reference).
+struct CanonicalCommandOptions {
+  std::string out = "results";
+  bool json = false;
+};
+int run_canonical_command(const CanonicalCommandOptions& options, std::ostream& out);
+
+}  // namespace chainsim

@@ -1,0 +1,325 @@
+// The reduced models of DESIGN.md §2, integrated by ARKODE; see reduced_models.hpp.
+#include "reduced_models.hpp"
+
+#include <chrono>
+#include <cmath>
+
+#include <fmt/format.h>
+
+#include "cases/exact_solutions.hpp"
+#include "solver/errors.hpp"
+
+namespace chainsim {
+
+Problem parse_problem(const std::string& name, const std::string& what) {
+  if (name == "falling") return Problem::kFalling;
+  if (name == "folded") return Problem::kFolded;
+  if (name == "sliding") return Problem::kSliding;
+  throw InputError(fmt::format("{} = \"{}\" is not a known problem: allowed falling, folded, sliding", what, name));
+}
+
+std::string to_string(Problem problem) {
+  switch (problem) {
+    case Problem::kFalling: return "falling";
+    case Problem::kFolded: return "folded";
+    case Problem::kSliding: return "sliding";
+  }
+  return "?";
+}
+
+void ChainParameters::validate() const {
+  require_positive("--length", length);
+  require_positive("--density", density);
+  require_positive("--gravity", gravity);
+  require_in_range("--f", dissipation, 0.0, 1.0);
+}
+
+double ChainParameters::t0() const { return std::sqrt(2.0 * length / gravity); }
+double ChainParameters::P0() const { return density * length * gravity; }
+
+IntegratorOptions ReducedSetup::default_integrator() {
+  IntegratorOptions o;
+  o.method = "erk8";
+  o.rtol = 1e-13;
+  o.atol = 1e-15;
+  return o;
+}
+
+double ReducedSetup::initial_eta() const {
+  if (eta0) return *eta0;
+  return problem == Problem::kFalling ? 1.0 : 0.0;
+}
+
+void ReducedSetup::validate() const {
+  chain.validate();
+  require_in_range("--eps", eps, 0.0, 1.0, Bound::kOpen, Bound::kOpen);
+  const double e0 = initial_eta();
+  switch (problem) {
+    case Problem::kFalling:
+      require_in_range("--eta0", e0, eps, 1.0, Bound::kOpen, Bound::kClosed);
+      break;
+    case Problem::kFolded:
+      require_in_range("--eta0", e0, 0.0, 1.0 - eps, Bound::kClosed, Bound::kOpen);
+      break;
+    case Problem::kSliding:
+      require_in_range("--eta0", e0, 0.0, 1.0, Bound::kClosed, Bound::kOpen);
+      break;
+  }
+  if (problem == Problem::kFolded)
+    require_in_range("--force", force, 0.0, INFINITY);
+  else if (force != 0.0)
+    throw InputError(fmt::format("--force = {:g} applies to the folded chain only (the {} chain has no loaded end): "
+                                 "allowed force = 0",
+                                 force, to_string(problem)));
+  require_positive("--t-max", t_max_over_t0);
+  integrator.validate();
+}
+
+namespace {
+
+/// Mechanical quantities of a reduced model at one state (SI units).
+struct Snapshot {
+  double y = 0, yd = 0, ydd = 0;
+  double P = 0;        ///< dynamic weight (N)
+  double K = 0, V = 0; ///< kinetic and potential energy (J)
+  double W_shock = 0;  ///< power at the internal shock (W), <= 0
+  double W_heap = 0;   ///< power of the external shock at the heap (W)
+  double W_force = 0;  ///< power of the end force F (W)
+};
+
+/// The ODE for one problem: state (y, ẏ, E_shock, E_heap, E_force), where E_k = ∫ W_k dt.
+class ReducedOde : public OdeSystem {
+ public:
+  explicit ReducedOde(const ReducedSetup& s)
+      : s_(s), l_(s.chain.length), lam_(s.chain.density), g_(s.chain.gravity), f_(s.chain.dissipation) {}
+
+  int size() const override { return 5; }
+
+  /// ÿ from the equation of motion; throws RecoverableError outside the model's domain.
+  double acceleration(double y, double yd) const {
+    const double sq = yd * yd, sgn_sq = yd * std::abs(yd);  // ẏ² and sgn(ẏ) ẏ²
+    switch (s_.problem) {
+      case Problem::kFalling:
+        if (!(y > 0)) throw RecoverableError("falling chain: y <= 0");
+        return -g_ - (sq + f_ * sgn_sq) / y;
+      case Problem::kFolded:
+        if (!(l_ - y > 0)) throw RecoverableError("folded chain: y >= l");
+        return (g_ * (l_ - y) + sq - f_ * sgn_sq - s_.force / lam_) / (2.0 * (l_ - y));
+      case Problem::kSliding:
+        if (!(y > 0)) throw RecoverableError("sliding chain: y <= 0");
+        return g_ - (sq + f_ * sgn_sq) / y;
+    }
+    return 0;
+  }
+
+  Snapshot snapshot(double y, double yd) const {
+    Snapshot q;
+    q.y = y;
+    q.yd = yd;
+    q.ydd = acceleration(y, yd);
+    const double sq = yd * yd, sgn_sq = yd * std::abs(yd), cube_abs = sq * std::abs(yd);
+    switch (s_.problem) {
+      case Problem::kFalling:
+        // Table reaction Φ0 = λẏ² − τ⁻ with τ⁻ = λ(1 + f sgn ẏ)ẏ²; P = Φ0 + weight on the table.
+        q.P = -f_ * lam_ * sgn_sq + lam_ * g_ * (l_ - y);
+        q.K = 0.5 * lam_ * y * sq;
+        q.V = 0.5 * lam_ * g_ * y * y;
+        q.W_shock = -f_ * lam_ * cube_abs;  // D = ½ f λ |ṡ0| |[v]|², ṡ0 = ẏ, |[v]|² = 2ẏ²
+        q.W_heap = -0.5 * lam_ * yd * sq;   // W*⁺
+        break;
+      case Problem::kFolded:
+        q.P = lam_ * (sq + f_ * sgn_sq) + lam_ * g_ * y;
+        q.K = 2.0 * lam_ * (l_ - y) * sq;
+        q.V = -0.5 * lam_ * g_ * y * y - 0.5 * lam_ * g_ * (l_ - y) * (3.0 * y - l_);
+        q.W_shock = -2.0 * lam_ * f_ * cube_abs;
+        q.W_force = -2.0 * s_.force * yd;
+        break;
+      case Problem::kSliding:
+        q.P = f_ * lam_ * sgn_sq + lam_ * g_ * (l_ - y);
+        q.K = 0.5 * lam_ * y * sq;
+        q.V = -0.5 * lam_ * g_ * y * y;
+        q.W_shock = -f_ * lam_ * cube_abs;
+        q.W_heap = -0.5 * lam_ * yd * sq;  // W*⁻
+        break;
+    }
+    return q;
+  }
+
+  void rhs(double, const Eigen::Ref<const Eigen::VectorXd>& u, Eigen::Ref<Eigen::VectorXd> du) override {
+    const Snapshot q = snapshot(u[0], u[1]);
+    du << q.yd, q.ydd, q.W_shock, q.W_heap, q.W_force;
+  }
+
+  int num_events() const override { return s_.problem == Problem::kFolded ? (s_.force > 0 ? 3 : 2) : 1; }
+
+  void events(double, const Eigen::Ref<const Eigen::VectorXd>& u, Eigen::Ref<Eigen::VectorXd> g) override {
+    switch (s_.problem) {
+      case Problem::kFalling: g[0] = u[0] - s_.eps * l_; break;
+      case Problem::kSliding: g[0] = u[0] - l_; break;
+      case Problem::kFolded:
+        g[0] = u[0] - (1.0 - s_.eps) * l_;  // the free end reaches the cutoff
+        g[1] = u[0];                        // the bight reaches the fixed end
+        if (s_.force > 0) g[2] = u[1];      // turning point: sgn ẏ switches the model's branch
+        break;
+    }
+  }
+
+  std::vector<int> event_directions() const override {
+    switch (s_.problem) {
+      case Problem::kFalling: return {-1};
+      case Problem::kSliding: return {+1};
+      case Problem::kFolded: return s_.force > 0 ? std::vector<int>{+1, -1, 0} : std::vector<int>{+1, -1};
+    }
+    return {};
+  }
+
+  Eigen::VectorXd state_scale() const override {
+    const double speed = std::sqrt(g_ * l_), energy = lam_ * g_ * l_ * l_;
+    Eigen::VectorXd scale(5);
+    scale << l_, speed, energy, energy, energy;
+    return scale;
+  }
+
+ private:
+  const ReducedSetup& s_;
+  double l_, lam_, g_, f_;
+};
+
+}  // namespace
+
+std::vector<std::string> series_columns() {
+  return {"t", "y", "ydot", "yddot", "P", "K", "V", "W_shock", "W_heap", "W_force", "E_shock", "E_heap",
+          "E_force", "ledger", "xi", "eta", "eta_p", "eta_pp", "P_over_P0", "K_over_P0l", "V_over_P0l"};
+}
+
+ReducedRun solve_reduced(const ReducedSetup& setup) {
+  setup.validate();
+  const auto wall_start = std::chrono::steady_clock::now();
+  const ChainParameters& c = setup.chain;
+  const double l = c.length, g = c.gravity, f = c.dissipation, t0 = c.t0(), P0 = c.P0();
+  const double eta0 = setup.initial_eta();
+
+  // 1. Initial state: at rest, except the sliding chain from η0 = 0, which starts on its
+  //    non-trivial branch y = a t²/2 at η = kSlidingStartEta (see reduced_models.hpp).
+  double t_start = 0.0;
+  Eigen::VectorXd u0 = Eigen::VectorXd::Zero(5);
+  u0[0] = eta0 * l;
+  const bool sliding_branch = setup.problem == Problem::kSliding && eta0 == 0.0;
+  if (sliding_branch) {
+    const double a = g / (3.0 + 2.0 * f);
+    u0[0] = kSlidingStartEta * l;
+    t_start = std::sqrt(2.0 * u0[0] / a);
+    u0[1] = a * t_start;
+  }
+
+  // 2. Integrator: record every accepted step, with steps no longer than t0/500 by default.
+  ReducedOde ode(setup);
+  IntegratorOptions opts = setup.integrator;
+  if (opts.max_step == 0) opts.max_step = t0 / 500.0;
+  Integrator integrator(ode, t_start, u0, opts);
+
+  ReducedRun run{CsvTable(series_columns()), {}};
+  const Snapshot q0 = ode.snapshot(u0[0], u0[1]);
+  const double E0 = q0.K + q0.V;
+  double ledger_max = 0, energy_scale = 0;
+  auto record = [&](double t, const Eigen::VectorXd& u) {
+    const Snapshot q = ode.snapshot(u[0], u[1]);
+    const double ledger = q.K + q.V - E0 - (u[2] + u[3] + u[4]);
+    ledger_max = std::max(ledger_max, std::abs(ledger));
+    energy_scale = std::max(energy_scale, std::abs(q.K) + std::abs(q.V) + std::abs(u[2]) + std::abs(u[3]) +
+                                              std::abs(u[4]));
+    const double speed_scale = l / t0, energy_unit = P0 * l;
+    run.series.add_row({t, q.y, q.yd, q.ydd, q.P, q.K, q.V, q.W_shock, q.W_heap, q.W_force, u[2], u[3], u[4],
+                        ledger, t / t0, q.y / l, q.yd / speed_scale, q.ydd * t0 * t0 / l, q.P / P0,
+                        q.K / energy_unit, q.V / energy_unit});
+  };
+  record(t_start, u0);
+
+  // 3. Advance step by step until a stop event (or the safety time).
+  const double t_max = t_start + setup.t_max_over_t0 * t0;
+  std::string stop_reason = "t_max";
+  int turning_points = 0;
+  for (;;) {
+    const auto outcome = integrator.advance(t_max, /*one_step=*/true);
+    record(integrator.time(), integrator.state());
+    if (outcome == Integrator::Outcome::kReachedTarget) break;
+    if (outcome != Integrator::Outcome::kEvent) continue;
+    const auto& ev = integrator.events_found();
+    if (ev[0] != 0) {
+      stop_reason = setup.problem == Problem::kSliding ? "chain_fully_hanging" : "cutoff";
+      break;
+    }
+    if (setup.problem == Problem::kFolded && ev[1] != 0) {
+      stop_reason = "front_reached_fixed_end";
+      break;
+    }
+    if (setup.problem == Problem::kFolded && ev.size() > 2 && ev[2] != 0) {
+      ++turning_points;  // restart so the next step starts on the new branch of sgn ẏ
+      Eigen::VectorXd u = integrator.state();
+      u[1] = 0.0;
+      integrator.restart(integrator.time(), u);
+    }
+  }
+
+  // 4. Summary, with the exact references where the problem has one.
+  const double t_stop = integrator.time();
+  const Eigen::VectorXd& u = integrator.state();
+  const Snapshot q = ode.snapshot(u[0], u[1]);
+  if (!std::isfinite(q.P) || !std::isfinite(q.yd))
+    throw NumericalError(fmt::format("non-finite state at t = {:.9g} s (y = {:g}, ydot = {:g})", t_stop, q.y, q.yd),
+                         t_stop);
+  const double eta_stop = q.y / l;
+  nlohmann::json ref = nullptr;
+  double xi_ref = NAN, P_ref = NAN, fall_ref = NAN;
+  switch (setup.problem) {
+    case Problem::kFalling:
+      xi_ref = exact::falling_xi(f, eta_stop, eta0);
+      P_ref = exact::falling_P(f, eta_stop, eta0);
+      fall_ref = exact::falling_fall_time(f, eta0);
+      break;
+    case Problem::kFolded:
+      if (setup.force == 0.0) {
+        xi_ref = exact::folded_xi(f, eta_stop, eta0);
+        P_ref = exact::folded_P(f, eta_stop, eta0);
+        fall_ref = exact::folded_fall_time(f, eta0);
+      }
+      break;
+    case Problem::kSliding:
+      xi_ref = exact::sliding_xi(f, std::min(eta_stop, 1.0), eta0);
+      P_ref = exact::sliding_P(f, std::min(eta_stop, 1.0), eta0);
+      fall_ref = exact::sliding_fall_time(f, eta0);
+      break;
+  }
+  auto num_or_null = [](double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr); };
+  const bool has_ref = std::isfinite(xi_ref) && stop_reason != "t_max";
+  const double wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
+  run.summary = {
+      {"problem", to_string(setup.problem)},
+      {"model", "reduced"},
+      {"parameters",
+       {{"length", l}, {"density", c.density}, {"gravity", g}, {"f", f}, {"eps", setup.eps}, {"eta0", eta0},
+        {"force", setup.force}}},
+      {"t0", t0},
+      {"P0", P0},
+      {"stop_reason", stop_reason},
+      {"t_start", t_start},
+      {"t_stop", t_stop},
+      {"t_stop_over_t0", t_stop / t0},
+      {"eta_stop", eta_stop},
+      {"P_stop", q.P},
+      {"P_stop_over_P0", q.P / P0},
+      {"t_fall_over_t0", num_or_null(fall_ref)},
+      {"t_stop_over_t0_exact", has_ref ? num_or_null(xi_ref) : nullptr},
+      {"P_stop_over_P0_exact", has_ref ? num_or_null(P_ref) : nullptr},
+      {"rel_err_t_stop", has_ref ? num_or_null(std::abs(t_stop / t0 - xi_ref) / xi_ref) : nullptr},
+      {"rel_err_P_stop", has_ref ? num_or_null(std::abs(q.P / P0 - P_ref) / std::abs(P_ref)) : nullptr},
+      {"energy_residual", energy_scale > 0 ? ledger_max / energy_scale : 0.0},
+      {"turning_points", turning_points},
+      {"samples", run.series.rows()},
+      {"integrator", to_json(integrator.stats())},
+      {"wall_s", wall_s},
+  };
+  return run;
+}
+
+}  // namespace chainsim

@@ -1,0 +1,42 @@
+#!/usr/bin/env bash
+# chainsim quick start: installs what is missing (Debian 12 packages), builds, then
+#   demo  runs the main job: the three canonical chain problems, a summary table and the figures
+#   test  runs the whole test suite (CTest + Catch2)
+# Usage: bash scripts/quickstart.sh demo [OUTDIR]     (default OUTDIR: results)
+#        bash scripts/quickstart.sh test
+set -euo pipefail
+cd "$(dirname "$0")/.."
+
+job=${1:-}
+case "$job" in
+  demo|test) ;;
+  *) echo "usage: bash scripts/quickstart.sh demo [OUTDIR] | test" >&2; exit 2 ;;
+esac
+
+# 1. Packages (all from Debian's archive). dpkg -s is quick, so a ready machine skips apt entirely.
+packages=(cmake make g++ libeigen3-dev libsuitesparse-dev libsundials-dev catch2 libcli11-dev
+          libtomlplusplus-dev nlohmann-json3-dev libfmt-dev libboost-dev python3-matplotlib python3-numpy)
+missing=()
+for p in "${packages[@]}"; do dpkg -s "$p" >/dev/null 2>&1 || missing+=("$p"); done
+if [ ${#missing[@]} -gt 0 ]; then
+  echo "== installing: ${missing[*]}"
+  sudo=""
+  [ "$(id -u)" -eq 0 ] || sudo="sudo"
+  $sudo apt-get update -qq
+  DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
+fi
+
+# 2. Build (Release).
+jobs=$(nproc 2>/dev/null || echo 2)
+cmake -S . -B build -DCMAKE_BUILD_TYPE=Release >/dev/null
+cmake --build build -j "$jobs"
+
+# 3. The job.
+if [ "$job" = demo ]; then
+  out=${2:-results}
+  ./build/chainsim canonical --out "$out"
+  # Debian's python3 has matplotlib; a python3 earlier on PATH may not.
+  /usr/bin/python3 scripts/plot_canonical.py "$out"
+else
+  ctest --test-dir build --output-on-failure -j "$jobs"
+fi

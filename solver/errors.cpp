@@ -1,0 +1,48 @@
+#include "errors.hpp"
+
+#include <cmath>
+
+#include <fmt/format.h>
+
+namespace chainsim {
+
+namespace {
+std::string bare_name(std::string_view name) {
+  // "--f" -> "f", "string.length" -> "length": the symbol used in the range expression.
+  auto pos = name.find_last_of(".-");
+  return std::string(pos == std::string_view::npos ? name : name.substr(pos + 1));
+}
+}  // namespace
+
+void require_in_range(std::string_view name, double value, double lo, double hi, Bound lo_bound,
+                      Bound hi_bound) {
+  const bool lo_ok = lo_bound == Bound::kClosed ? value >= lo : value > lo;
+  const bool hi_ok = hi_bound == Bound::kClosed ? value <= hi : value < hi;
+  if (std::isfinite(value) && lo_ok && hi_ok) return;
+  const std::string sym = bare_name(name);
+  std::string range;
+  if (std::isfinite(lo) && std::isfinite(hi))
+    range = fmt::format("{:g} {} {} {} {:g}", lo, lo_bound == Bound::kClosed ? "<=" : "<", sym,
+                        hi_bound == Bound::kClosed ? "<=" : "<", hi);
+  else if (std::isfinite(lo))
+    range = fmt::format("{} {} {:g}", sym, lo_bound == Bound::kClosed ? ">=" : ">", lo);
+  else
+    range = fmt::format("{} {} {:g}", sym, hi_bound == Bound::kClosed ? "<=" : "<", hi);
+  throw InputError(fmt::format("{} = {:g} is out of range: allowed {}", name, value, range));
+}
+
+void require_positive(std::string_view name, double value) {
+  require_in_range(name, value, 0.0, INFINITY, Bound::kOpen, Bound::kOpen);
+}
+
+void require_finite(std::string_view name, double value) {
+  if (!std::isfinite(value))
+    throw InputError(fmt::format("{} = {:g} is not a finite number", name, value));
+}
+
+void verify_failed(const char* condition, const char* file, int line, const std::string& msg) {
+  throw Error(fmt::format("internal error (please report): {} [{} failed at {}:{}]", msg, condition,
+                          file, line));
+}
+
+}  // namespace chainsim

@@ -1,0 +1,327 @@
+// The only translation unit that includes ARKODE: see integrator.hpp.
+#include "integrator.hpp"
+
+#include <exception>
+#include <map>
+
+#include <arkode/arkode_arkstep.h>
+#include <arkode/arkode_butcher_dirk.h>
+#include <arkode/arkode_butcher_erk.h>
+#include <fmt/format.h>
+#include <nvector/nvector_serial.h>
+#include <sunlinsol/sunlinsol_dense.h>
+#include <sunmatrix/sunmatrix_dense.h>
+
+#include "errors.hpp"
+
+namespace chainsim {
+
+namespace {
+
+struct Alias {
+  const char* table;
+  const char* description;
+};
+
+const std::map<std::string, Alias>& aliases() {
+  static const std::map<std::string, Alias> table = {
+      {"erk8", {"ARKODE_FEHLBERG_13_7_8", "explicit, order 8 (Fehlberg 13 stages)"}},
+      {"erk6", {"ARKODE_VERNER_8_5_6", "explicit, order 6 (Verner 8 stages)"}},
+      {"erk5", {"ARKODE_DORMAND_PRINCE_7_4_5", "explicit, order 5 (Dormand-Prince)"}},
+      {"erk4", {"ARKODE_ZONNEVELD_5_3_4", "explicit, order 4 (Zonneveld)"}},
+      {"erk3", {"ARKODE_BOGACKI_SHAMPINE_4_2_3", "explicit, order 3 (Bogacki-Shampine)"}},
+      {"dirk5", {"ARKODE_KVAERNO_7_4_5", "implicit, order 5 (Kvaerno ESDIRK)"}},
+      {"dirk4", {"ARKODE_ARK436L2SA_DIRK_6_3_4", "implicit, order 4 (ARK4(3)6L[2]SA ESDIRK)"}},
+      {"dirk3", {"ARKODE_ARK324L2SA_DIRK_4_2_3", "implicit, order 3 (ARK3(2)4L[2]SA ESDIRK)"}},
+      {"dirk2", {"ARKODE_SDIRK_2_1_2", "implicit, order 2 (SDIRK)"}},
+  };
+  return table;
+}
+
+std::string table_name(const std::string& method) {
+  auto it = aliases().find(method);
+  return it == aliases().end() ? method : it->second.table;
+}
+
+/// Loads an ERK or DIRK table by name; exactly one of the outputs is non-null on success.
+void load_table(const std::string& name, ARKodeButcherTable& erk, ARKodeButcherTable& dirk) {
+  erk = nullptr;
+  dirk = nullptr;
+  if (name.find("DIRK") != std::string::npos || name.find("KVAERNO") != std::string::npos ||
+      name.find("CASH_5") != std::string::npos || name.find("BILLINGTON") != std::string::npos ||
+      name.find("TRBDF2") != std::string::npos)
+    dirk = ARKodeButcherTable_LoadDIRKByName(name.c_str());
+  else
+    erk = ARKodeButcherTable_LoadERKByName(name.c_str());
+}
+
+std::string valid_methods() {
+  std::string list;
+  for (const auto& [alias, entry] : aliases()) list += (list.empty() ? "" : ", ") + alias;
+  return list + ", or an ARKODE_* Butcher table name";
+}
+
+}  // namespace
+
+std::vector<std::pair<std::string, std::string>> method_aliases() {
+  std::vector<std::pair<std::string, std::string>> out;
+  for (const auto& [alias, entry] : aliases())
+    out.emplace_back(alias, fmt::format("{} ({})", entry.description, entry.table));
+  return out;
+}
+
+void IntegratorOptions::validate() const {
+  ARKodeButcherTable erk = nullptr, dirk = nullptr;
+  load_table(table_name(method), erk, dirk);
+  const bool ok = erk || dirk;
+  ARKodeButcherTable_Free(erk);
+  ARKodeButcherTable_Free(dirk);
+  if (!ok)
+    throw InputError(fmt::format("method = \"{}\" is not a known integration method: allowed {}", method,
+                                 valid_methods()));
+  require_in_range("rtol", rtol, 1e-14, 1e-2);
+  require_positive("atol", atol);
+  require_in_range("max_step", max_step, 0.0, INFINITY);
+  require_in_range("initial_step", initial_step, 0.0, INFINITY);
+  if (max_steps < 1)
+    throw InputError(fmt::format("max_steps = {} is out of range: allowed max_steps >= 1", max_steps));
+}
+
+// ------------------------------------------------------------------------------------------------
+struct Integrator::Impl {
+  OdeSystem& system;
+  SUNContext ctx = nullptr;
+  void* mem = nullptr;
+  N_Vector y = nullptr;
+  SUNMatrix jac = nullptr;
+  SUNLinearSolver ls = nullptr;
+  bool implicit = false;
+  double rtol = 0, atol = 0;
+  std::string table;
+  int order = 0;
+  long recoverable_failures = 0;
+  std::exception_ptr pending;  // exception thrown inside a callback, re-thrown after ARKStepEvolve
+  std::string last_error;      // ARKODE's own message for the last failure
+
+  explicit Impl(OdeSystem& s) : system(s) {}
+  ~Impl() {
+    if (mem) ARKStepFree(&mem);
+    if (ls) SUNLinSolFree(ls);
+    if (jac) SUNMatDestroy(jac);
+    if (y) N_VDestroy(y);
+    if (ctx) SUNContext_Free(&ctx);
+  }
+
+  void check(int flag, const char* call) const {
+    if (flag < 0)
+      throw Error(fmt::format("internal error: {} failed with {} ({})", call, flag,
+                              ARKStepGetReturnFlagName(flag)));
+  }
+
+  /// Scalar tolerances, or atol * state_scale() per component when the system provides a scale.
+  /// Must be called again after a resize.
+  void apply_tolerances() {
+    const Eigen::VectorXd scale = system.state_scale();
+    if (scale.size() == 0) {
+      check(ARKStepSStolerances(mem, rtol, atol), "ARKStepSStolerances");
+      return;
+    }
+    CHAINSIM_VERIFY(scale.size() == N_VGetLength(y) && (scale.array() > 0).all(),
+                    "state_scale() must give one positive entry per state component");
+    N_Vector abstol = N_VClone(y);
+    Eigen::Map<Eigen::VectorXd>(N_VGetArrayPointer(abstol), scale.size()) = atol * scale;
+    const int flag = ARKStepSVtolerances(mem, rtol, abstol);
+    N_VDestroy(abstol);
+    check(flag, "ARKStepSVtolerances");
+  }
+
+  void attach_dense_solver() {
+    if (ls) SUNLinSolFree(ls);
+    if (jac) SUNMatDestroy(jac);
+    const sunindextype n = N_VGetLength(y);
+    jac = SUNDenseMatrix(n, n, ctx);
+    ls = SUNLinSol_Dense(y, jac, ctx);
+    check(ARKStepSetLinearSolver(mem, ls, jac), "ARKStepSetLinearSolver");
+  }
+
+  static int rhs(sunrealtype t, N_Vector y, N_Vector ydot, void* data) {
+    auto* self = static_cast<Impl*>(data);
+    const long n = N_VGetLength(y);
+    Eigen::Map<const Eigen::VectorXd> ym(N_VGetArrayPointer(y), n);
+    Eigen::Map<Eigen::VectorXd> dm(N_VGetArrayPointer(ydot), n);
+    try {
+      self->system.rhs(t, ym, dm);
+      if (!dm.allFinite()) {
+        ++self->recoverable_failures;
+        return 1;  // a non-finite trial stage: let ARKODE retry with a smaller step
+      }
+      return 0;
+    } catch (const RecoverableError&) {
+      ++self->recoverable_failures;
+      return 1;
+    } catch (...) {
+      self->pending = std::current_exception();
+      return -1;
+    }
+  }
+
+  static int roots(sunrealtype t, N_Vector y, sunrealtype* g, void* data) {
+    auto* self = static_cast<Impl*>(data);
+    const long n = N_VGetLength(y);
+    Eigen::Map<const Eigen::VectorXd> ym(N_VGetArrayPointer(y), n);
+    Eigen::Map<Eigen::VectorXd> gm(g, self->system.num_events());
+    try {
+      self->system.events(t, ym, gm);
+      return 0;
+    } catch (...) {
+      self->pending = std::current_exception();
+      return -1;
+    }
+  }
+
+  static void error_handler(int, const char* module, const char* function, char* msg, void* data) {
+    static_cast<Impl*>(data)->last_error = fmt::format("{}: {}: {}", module, function, msg);
+  }
+};
+
+Integrator::Integrator(OdeSystem& system, double t0, const Eigen::VectorXd& y0,
+                       const IntegratorOptions& options)
+    : impl_(std::make_unique<Impl>(system)), t_(t0), y_(y0) {
+  options.validate();
+  CHAINSIM_VERIFY(y0.size() == system.size(), "initial state has the wrong length");
+  Impl& d = *impl_;
+  if (SUNContext_Create(nullptr, &d.ctx) != 0) throw Error("SUNContext_Create failed");
+  d.y = N_VNew_Serial(y0.size(), d.ctx);
+  Eigen::Map<Eigen::VectorXd>(N_VGetArrayPointer(d.y), y0.size()) = y0;
+
+  d.table = table_name(options.method);
+  ARKodeButcherTable erk = nullptr, dirk = nullptr;
+  load_table(d.table, erk, dirk);
+  d.implicit = dirk != nullptr;
+  ARKodeButcherTable table = d.implicit ? dirk : erk;
+  d.order = table->q;
+  d.mem = d.implicit ? ARKStepCreate(nullptr, Impl::rhs, t0, d.y, d.ctx)
+                     : ARKStepCreate(Impl::rhs, nullptr, t0, d.y, d.ctx);
+  if (!d.mem) throw Error("ARKStepCreate failed");
+  const int flag = d.implicit ? ARKStepSetTables(d.mem, table->q, table->p, dirk, nullptr)
+                              : ARKStepSetTables(d.mem, table->q, table->p, nullptr, erk);
+  ARKodeButcherTable_Free(erk);
+  ARKodeButcherTable_Free(dirk);
+  d.check(flag, "ARKStepSetTables");
+  d.check(ARKStepSetUserData(d.mem, &d), "ARKStepSetUserData");
+  d.check(ARKStepSetErrHandlerFn(d.mem, Impl::error_handler, &d), "ARKStepSetErrHandlerFn");
+  d.rtol = options.rtol;
+  d.atol = options.atol;
+  d.apply_tolerances();
+  d.check(ARKStepSetMaxNumSteps(d.mem, options.max_steps), "ARKStepSetMaxNumSteps");
+  if (options.max_step > 0) d.check(ARKStepSetMaxStep(d.mem, options.max_step), "ARKStepSetMaxStep");
+  if (options.initial_step > 0)
+    d.check(ARKStepSetInitStep(d.mem, options.initial_step), "ARKStepSetInitStep");
+  if (d.implicit) d.attach_dense_solver();
+
+  const int nev = system.num_events();
+  if (nev > 0) {
+    d.check(ARKStepRootInit(d.mem, nev, Impl::roots), "ARKStepRootInit");
+    std::vector<int> dirs = system.event_directions();
+    if (!dirs.empty()) {
+      CHAINSIM_VERIFY(static_cast<int>(dirs.size()) == nev, "one event direction per event function");
+      d.check(ARKStepSetRootDirection(d.mem, dirs.data()), "ARKStepSetRootDirection");
+    }
+    d.check(ARKStepSetNoInactiveRootWarn(d.mem), "ARKStepSetNoInactiveRootWarn");
+    events_found_.assign(nev, 0);
+  }
+}
+
+Integrator::~Integrator() = default;
+
+Integrator::Outcome Integrator::advance(double t_target, bool one_step) {
+  Impl& d = *impl_;
+  CHAINSIM_VERIFY(t_target >= t_, "the integrator only moves forward in time");
+  if (t_target == t_) return Outcome::kReachedTarget;
+  d.check(ARKStepSetStopTime(d.mem, t_target), "ARKStepSetStopTime");
+  sunrealtype tret = t_;
+  d.pending = nullptr;
+  d.last_error.clear();
+  const int flag = ARKStepEvolve(d.mem, t_target, d.y, &tret, one_step ? ARK_ONE_STEP : ARK_NORMAL);
+  if (d.pending) std::rethrow_exception(d.pending);
+  if (flag < 0)
+    throw NumericalError(fmt::format("time integration failed at t = {:.9g} s with {}{}{}", tret,
+                                     ARKStepGetReturnFlagName(flag), d.last_error.empty() ? "" : ": ",
+                                     d.last_error),
+                         tret);
+  t_ = tret;
+  y_ = Eigen::Map<Eigen::VectorXd>(N_VGetArrayPointer(d.y), N_VGetLength(d.y));
+  if (flag == ARK_ROOT_RETURN) {
+    d.check(ARKStepGetRootInfo(d.mem, events_found_.data()), "ARKStepGetRootInfo");
+    return Outcome::kEvent;
+  }
+  if (flag == ARK_TSTOP_RETURN || t_ >= t_target) {
+    t_ = t_target;
+    return Outcome::kReachedTarget;
+  }
+  return Outcome::kStep;
+}
+
+Eigen::VectorXd Integrator::interpolate(double t, int k) const {
+  N_Vector out = N_VClone(impl_->y);
+  const int flag = ARKStepGetDky(impl_->mem, t, k, out);
+  Eigen::VectorXd result = Eigen::Map<Eigen::VectorXd>(N_VGetArrayPointer(out), N_VGetLength(out));
+  N_VDestroy(out);
+  impl_->check(flag, "ARKStepGetDky");
+  return result;
+}
+
+void Integrator::restart(double t, const Eigen::VectorXd& y) {
+  Impl& d = *impl_;
+  CHAINSIM_VERIFY(y.size() == N_VGetLength(d.y), "restart() keeps the state length; use resize()");
+  Eigen::Map<Eigen::VectorXd>(N_VGetArrayPointer(d.y), y.size()) = y;
+  d.check(ARKStepReset(d.mem, t, d.y), "ARKStepReset");
+  t_ = t;
+  y_ = y;
+}
+
+void Integrator::resize(double t, const Eigen::VectorXd& y) {
+  Impl& d = *impl_;
+  CHAINSIM_VERIFY(y.size() == d.system.size(), "resize() needs the system to report the new size");
+  N_Vector ynew = N_VNew_Serial(y.size(), d.ctx);
+  Eigen::Map<Eigen::VectorXd>(N_VGetArrayPointer(ynew), y.size()) = y;
+  const int flag = ARKStepResize(d.mem, ynew, 1.0, t, nullptr, nullptr);
+  N_VDestroy(d.y);
+  d.y = ynew;
+  d.check(flag, "ARKStepResize");
+  d.apply_tolerances();
+  if (d.implicit) d.attach_dense_solver();
+  t_ = t;
+  y_ = y;
+}
+
+IntegratorStats Integrator::stats() const {
+  const Impl& d = *impl_;
+  IntegratorStats s;
+  long nfe = 0, nfi = 0;
+  ARKStepGetNumSteps(d.mem, &s.steps);
+  ARKStepGetNumStepAttempts(d.mem, &s.step_attempts);
+  ARKStepGetNumErrTestFails(d.mem, &s.error_test_fails);
+  ARKStepGetNumRhsEvals(d.mem, &nfe, &nfi);
+  s.rhs_evals = nfe + nfi;
+  if (d.system.num_events() > 0) ARKStepGetNumGEvals(d.mem, &s.event_evals);
+  if (d.implicit) {
+    long nfe_ls = 0;
+    ARKStepGetNumNonlinSolvIters(d.mem, &s.nonlin_iters);
+    ARKStepGetNumNonlinSolvConvFails(d.mem, &s.nonlin_conv_fails);
+    ARKStepGetNumJacEvals(d.mem, &s.jac_evals);
+    ARKStepGetNumLinSolvSetups(d.mem, &s.lin_setups);
+    ARKStepGetNumLinRhsEvals(d.mem, &nfe_ls);
+    s.rhs_evals += nfe_ls;  // difference-quotient Jacobian columns
+  }
+  sunrealtype h = 0;
+  ARKStepGetLastStep(d.mem, &h);
+  s.last_step = h;
+  s.recoverable_failures = d.recoverable_failures;
+  s.method = d.table;
+  s.order = d.order;
+  s.implicit = d.implicit;
+  return s;
+}
+
+}  // namespace chainsim

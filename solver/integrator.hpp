@@ -1,0 +1,124 @@
+#pragma once
+/// @file integrator.hpp
+/// A thin, exception-safe front end to SUNDIALS ARKODE (ARKStep) for every ODE chainsim solves.
+///
+/// The reduced chain models and the string solver both describe themselves as an OdeSystem; the
+/// Integrator advances it with an adaptive Runge–Kutta method (explicit ERK by default, or a
+/// diagonally implicit DIRK with a dense difference-quotient Jacobian), finds the zeros of the
+/// system's event functions with ARKODE's rootfinding, and reports ARKODE's run statistics.
+///
+/// integrator.cpp is the only file that includes <arkode/...>: moving to SUNDIALS 7 touches one file.
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+namespace chainsim {
+
+/// The ODE  y' = F(t, y)  plus optional event functions g_k(t, y) whose zeros ARKODE locates.
+class OdeSystem {
+ public:
+  virtual ~OdeSystem() = default;
+  /// Length of the state vector.
+  virtual int size() const = 0;
+  /// ydot = F(t, y). Throw RecoverableError for a trial state the model cannot evaluate
+  /// (ARKODE retries with a smaller step); any other exception aborts the integration.
+  virtual void rhs(double t, const Eigen::Ref<const Eigen::VectorXd>& y,
+                   Eigen::Ref<Eigen::VectorXd> ydot) = 0;
+  /// Number of event functions (0: no rootfinding is registered at all).
+  virtual int num_events() const { return 0; }
+  /// g[k] = g_k(t, y) for k < num_events().
+  virtual void events(double /*t*/, const Eigen::Ref<const Eigen::VectorXd>& /*y*/,
+                      Eigen::Ref<Eigen::VectorXd> /*g*/) {}
+  /// Direction of the zero crossings to report per event: +1 increasing, -1 decreasing, 0 both.
+  virtual std::vector<int> event_directions() const { return {}; }
+  /// Natural magnitude of each state component (e.g. the length for a position, a reference
+  /// speed for a velocity). The absolute tolerance of component i is atol * scale[i], so atol is
+  /// dimensionless and results do not depend on the choice of units. Empty = all ones.
+  virtual Eigen::VectorXd state_scale() const { return {}; }
+};
+
+/// How the integrator advances the ODE. validate() throws InputError naming the bad field.
+struct IntegratorOptions {
+  /// ARKODE Butcher table by name (ARKODE_ERK_* explicit, ARKODE_*DIRK* implicit), or one of the
+  /// short aliases listed by method_aliases(): "erk8" (Fehlberg 13-7-8, default), "erk6" (Verner
+  /// 8-5-6), "erk5" (Dormand–Prince 7-4-5), "erk4" (Zonneveld 5-3-4), "erk3" (Bogacki–Shampine),
+  /// "dirk5" (Kvaerno 7-4-5), "dirk4" (ARK 4-3-6 DIRK), "dirk3" (ARK 3-2-4 DIRK), "dirk2" (SDIRK 2-1-2).
+  std::string method = "erk8";
+  double rtol = 1e-10;   ///< relative tolerance, in [1e-14, 1e-2]
+  double atol = 1e-12;   ///< absolute tolerance relative to OdeSystem::state_scale(), > 0
+  double max_step = 0;   ///< largest step (s); 0 = no limit
+  double initial_step = 0;  ///< first step (s); 0 = ARKODE's estimate
+  long max_steps = 500000;  ///< steps allowed per advance() call before it gives up
+  void validate() const;
+};
+
+/// Short names of the built-in methods, e.g. "erk8", with a one-line description each.
+std::vector<std::pair<std::string, std::string>> method_aliases();
+
+/// ARKODE's counters for one integration (cumulative over re-initialisations).
+struct IntegratorStats {
+  long steps = 0;             ///< accepted steps
+  long step_attempts = 0;     ///< accepted + rejected
+  long error_test_fails = 0;  ///< steps rejected by the error test
+  long rhs_evals = 0;         ///< evaluations of F (explicit + implicit stages)
+  long event_evals = 0;       ///< evaluations of the event functions
+  long nonlin_iters = 0;      ///< Newton iterations (implicit methods only)
+  long nonlin_conv_fails = 0;
+  long jac_evals = 0;         ///< Jacobian evaluations (implicit methods only)
+  long lin_setups = 0;
+  long recoverable_failures = 0;  ///< RHS calls that asked for a smaller step
+  double last_step = 0;       ///< size of the last accepted step (s)
+  std::string method;         ///< the Butcher table used
+  int order = 0;              ///< its order
+  bool implicit = false;
+};
+
+/// Advances one OdeSystem from (t0, y0). Not copyable; owns its ARKODE memory.
+class Integrator {
+ public:
+  Integrator(OdeSystem& system, double t0, const Eigen::VectorXd& y0, const IntegratorOptions& options);
+  ~Integrator();
+  Integrator(const Integrator&) = delete;
+  Integrator& operator=(const Integrator&) = delete;
+
+  enum class Outcome {
+    kReachedTarget,  ///< t == t_target
+    kEvent,          ///< stopped at a zero of an event function; see events_found()
+    kStep,           ///< one internal step taken (one_step mode), t < t_target
+  };
+
+  /// Advance towards t_target (never past it). In one_step mode return after each internal step,
+  /// which lets a caller record the adaptive steps. Throws NumericalError when ARKODE fails (the
+  /// message carries ARKODE's flag name and the time reached).
+  Outcome advance(double t_target, bool one_step = false);
+
+  /// Current time and state of the integrator.
+  double time() const { return t_; }
+  const Eigen::VectorXd& state() const { return y_; }
+
+  /// After Outcome::kEvent: for each event function, +1/-1 if it crossed zero increasing/decreasing, else 0.
+  const std::vector<int>& events_found() const { return events_found_; }
+
+  /// Interpolated state (k = 0) or its k-th derivative at time t inside the last step (dense output).
+  Eigen::VectorXd interpolate(double t, int k = 0) const;
+
+  /// Restart from (t, y) with the same system size: used after a discontinuity (e.g. a
+  /// sign change of a velocity that switches the model's branch).
+  void restart(double t, const Eigen::VectorXd& y);
+
+  /// Continue with a state of a different length (the OdeSystem's size() must already report it).
+  void resize(double t, const Eigen::VectorXd& y);
+
+  IntegratorStats stats() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+  double t_;
+  Eigen::VectorXd y_;
+  std::vector<int> events_found_;
+};
+
+}  // namespace chainsim

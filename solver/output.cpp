@@ -1,0 +1,99 @@
+#include "output.hpp"
+
+#include <cmath>
+#include <system_error>
+
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+
+#include "errors.hpp"
+
+namespace chainsim {
+
+AtomicFile::AtomicFile(std::filesystem::path target) : target_(std::move(target)) {
+  temp_ = target_;
+  temp_.replace_filename("." + target_.filename().string() + ".tmp");
+  out_.open(temp_, std::ios::out | std::ios::trunc);
+  if (!out_) throw InputError(fmt::format("cannot write the output file '{}'", temp_.string()));
+}
+
+AtomicFile::~AtomicFile() {
+  if (committed_) return;
+  out_.close();
+  std::error_code ec;
+  std::filesystem::remove(temp_, ec);
+}
+
+void AtomicFile::commit() {
+  out_.flush();
+  const bool ok = static_cast<bool>(out_);
+  out_.close();
+  if (!ok) throw Error(fmt::format("writing '{}' failed (disk full?)", temp_.string()));
+  std::error_code ec;
+  std::filesystem::rename(temp_, target_, ec);
+  if (ec)
+    throw Error(fmt::format("cannot move '{}' to '{}': {}", temp_.string(), target_.string(), ec.message()));
+  committed_ = true;
+}
+
+void CsvTable::add_row(const std::vector<double>& row) {
+  CHAINSIM_VERIFY(row.size() == columns_.size(), "CSV row length differs from the header");
+  data_.push_back(row);
+}
+
+std::vector<double> CsvTable::column(const std::string& name) const {
+  for (std::size_t j = 0; j < columns_.size(); ++j) {
+    if (columns_[j] != name) continue;
+    std::vector<double> out;
+    out.reserve(data_.size());
+    for (const auto& row : data_) out.push_back(row[j]);
+    return out;
+  }
+  throw Error(fmt::format("internal error: no CSV column '{}'", name));
+}
+
+void CsvTable::write(const std::filesystem::path& path, int significant_digits) const {
+  AtomicFile file(path);
+  auto& out = file.stream();
+  for (std::size_t j = 0; j < columns_.size(); ++j) out << (j ? "," : "") << columns_[j];
+  out << '\n';
+  for (const auto& row : data_) {
+    for (std::size_t j = 0; j < row.size(); ++j)
+      out << (j ? "," : "") << fmt::format("{:.{}g}", row[j], significant_digits);
+    out << '\n';
+  }
+  file.commit();
+}
+
+void write_json(const std::filesystem::path& path, const nlohmann::json& doc) {
+  AtomicFile file(path);
+  file.stream() << doc.dump(2) << '\n';
+  file.commit();
+}
+
+void ensure_directory(const std::filesystem::path& dir) {
+  std::error_code ec;
+  std::filesystem::create_directories(dir, ec);
+  if (ec || !std::filesystem::is_directory(dir))
+    throw InputError(fmt::format("--out = '{}' cannot be used as an output directory: {}", dir.string(),
+                                 ec ? ec.message() : "not a directory"));
+}
+
+nlohmann::json to_json(const IntegratorStats& s) {
+  return {{"method", s.method},
+          {"order", s.order},
+          {"implicit", s.implicit},
+          {"steps", s.steps},
+          {"step_attempts", s.step_attempts},
+          {"error_test_fails", s.error_test_fails},
+          {"rhs_evals", s.rhs_evals},
+          {"event_evals", s.event_evals},
+          {"nonlin_iters", s.nonlin_iters},
+          {"nonlin_conv_fails", s.nonlin_conv_fails},
+          {"jac_evals", s.jac_evals},
+          {"lin_setups", s.lin_setups},
+          {"recoverable_failures", s.recoverable_failures},
+          {"last_step", s.last_step}};
+}
+
+}  // namespace chainsim

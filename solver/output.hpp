@@ -1,0 +1,63 @@
+#pragma once
+/// @file output.hpp
+/// Output files that are either complete or absent.
+///
+/// Every file chainsim writes goes through AtomicFile: the content is written to a hidden
+/// temporary file beside the target and renamed over it only by commit(). A run that stops early
+/// (an exception, a signal) leaves at most a stray ".tmp" file, never a half-written CSV that looks
+/// complete.
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json_fwd.hpp>
+
+#include "integrator.hpp"
+
+namespace chainsim {
+
+class AtomicFile {
+ public:
+  explicit AtomicFile(std::filesystem::path target);
+  ~AtomicFile();  ///< removes the temporary file unless commit() succeeded
+  AtomicFile(const AtomicFile&) = delete;
+  AtomicFile& operator=(const AtomicFile&) = delete;
+
+  std::ostream& stream() { return out_; }
+  /// Flushes, closes and renames the temporary file onto the target. Throws Error on I/O failure.
+  void commit();
+
+ private:
+  std::filesystem::path target_, temp_;
+  std::ofstream out_;
+  bool committed_ = false;
+};
+
+/// A CSV table built in memory and written atomically: one header row, then numeric rows.
+class CsvTable {
+ public:
+  explicit CsvTable(std::vector<std::string> columns) : columns_(std::move(columns)) {}
+  /// Appends a row; it must have one value per column.
+  void add_row(const std::vector<double>& row);
+  std::size_t rows() const { return data_.size(); }
+  const std::vector<std::string>& columns() const { return columns_; }
+  /// Column by name (throws Error if absent).
+  std::vector<double> column(const std::string& name) const;
+  void write(const std::filesystem::path& path, int significant_digits = 17) const;
+
+ private:
+  std::vector<std::string> columns_;
+  std::vector<std::vector<double>> data_;
+};
+
+/// Writes a JSON document atomically, pretty-printed.
+void write_json(const std::filesystem::path& path, const nlohmann::json& doc);
+
+/// Creates `dir` (and parents) or throws InputError naming the directory and the OS error.
+void ensure_directory(const std::filesystem::path& dir);
+
+/// ARKODE's statistics as a JSON object (keys as in IntegratorStats).
+nlohmann::json to_json(const IntegratorStats& stats);
+
+}  // namespace chainsim

@@ -1,0 +1,86 @@
+// The chainsim executable: exit codes, error messages and the --json summary.
+#include <array>
+#include <cstdio>
+#include <filesystem>
+#include <string>
+
+#include <catch2/catch.hpp>
+#include <nlohmann/json.hpp>
+
+namespace {
+
+struct Result {
+  int status;
+  std::string output;  // stdout and stderr
+};
+
+Result run(const std::string& args) {
+  const std::string cmd = std::string(CHAINSIM_BINARY) + " " + args + " 2>&1";
+  FILE* pipe = popen(cmd.c_str(), "r");
+  REQUIRE(pipe);
+  std::string out;
+  std::array<char, 4096> buf{};
+  while (std::fgets(buf.data(), buf.size(), pipe)) out += buf.data();
+  const int status = pclose(pipe);
+  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, out};
+}
+
+std::string temp_dir(const std::string& name) {
+  auto dir = std::filesystem::temp_directory_path() / ("chainsim_test_" + name);
+  std::filesystem::remove_all(dir);
+  return dir.string();
+}
+
+}  // namespace
+
+TEST_CASE("chainsim reduced --json prints the summary keys", "[unit][cli]") {
+  const std::string out = temp_dir("cli_json");
+  const Result r = run("reduced falling --json --out " + out);
+  REQUIRE(r.status == 0);
+  const auto j = nlohmann::json::parse(r.output);
+  for (const char* key : {"t_stop_over_t0", "eta_stop", "P_stop_over_P0", "t_fall_over_t0", "energy_residual"})
+    CHECK(j.contains(key));
+  CHECK(std::filesystem::exists(out + "/series.csv"));
+  CHECK(std::filesystem::exists(out + "/summary.json"));
+  // No temporary files are left behind.
+  for (const auto& entry : std::filesystem::directory_iterator(out))
+    CHECK(entry.path().extension() != ".tmp");
+}
+
+TEST_CASE("bad command lines exit non-zero naming the option, the value and the range", "[unit][cli]") {
+  const std::string out = " --out " + temp_dir("cli_bad");
+  struct Case {
+    const char* args;
+    const char* message;
+  };
+  const Case cases[] = {
+      {"reduced falling --f 1.5", "chainsim: error: --f = 1.5 is out of range: allowed 0 <= f <= 1"},
+      {"reduced falling --f -0.1", "chainsim: error: --f = -0.1 is out of range: allowed 0 <= f <= 1"},
+      {"reduced folded --length -2", "chainsim: error: --length = -2 is out of range: allowed length > 0"},
+      {"reduced falling --eps 0", "chainsim: error: --eps = 0 is out of range: allowed 0 < eps < 1"},
+      {"reduced falling --eps 1.2", "chainsim: error: --eps = 1.2 is out of range: allowed 0 < eps < 1"},
+      {"reduced hanging",
+       "chainsim: error: problem = \"hanging\" is not a known problem: allowed falling, folded, sliding"},
+      {"reduced sliding --force 1", "chainsim: error: --force = 1 applies to the folded chain only"},
+      {"reduced falling --method rk99", "chainsim: error: method = \"rk99\" is not a known integration method"},
+  };
+  for (const Case& c : cases) {
+    CAPTURE(c.args);
+    const Result r = run(std::string(c.args) + out);
+    CHECK(r.status == 2);
+    CHECK_THAT(r.output, Catch::Matchers::StartsWith(c.message));
+  }
+  // A malformed number is caught by the parser with the option's name.
+  const Result r = run("reduced falling --f abc" + out);
+  CHECK(r.status != 0);
+  CHECK_THAT(r.output, Catch::Matchers::Contains("--f"));
+}
+
+TEST_CASE("every command has --help", "[unit][cli]") {
+  for (const char* cmd : {"", "reduced", "canonical", "run"}) {
+    CAPTURE(cmd);
+    const Result r = run(std::string(cmd) + " --help");
+    CHECK(r.status == 0);
+    CHECK_THAT(r.output, Catch::Matchers::Contains("Usage"));
+  }
+}
