@@ -22,6 +22,7 @@ void add_integrator_options(CLI::App& cmd, IntegratorOptions& o) {
       ->capture_default_str();
   cmd.add_option("--rtol", o.rtol, "relative tolerance, 1e-14 <= rtol <= 1e-2")->capture_default_str();
   cmd.add_option("--atol", o.atol, "absolute tolerance, relative to the state's natural scale")->capture_default_str();
+  cmd.add_option("--max-step", o.max_step, "largest time step (s); 0 = the command's default")->capture_default_str();
 }
 
 }  // namespace

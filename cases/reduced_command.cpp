@@ -97,9 +97,10 @@ int run_canonical_command(const CanonicalCommandOptions& options, std::ostream& 
   ensure_directory(root);
 
   // 1. The three problems with default parameters: series, summaries, and one table.
-  CsvTable table({"problem_id", "f", "eta0", "eps", "t_stop_over_t0", "t_stop_over_t0_exact", "rel_err_t_stop",
+  CsvTable table({"f", "eta0", "eps", "t_stop_over_t0", "t_stop_over_t0_exact", "rel_err_t_stop",
                   "eta_stop", "P_stop_over_P0", "P_stop_over_P0_exact", "rel_err_P_stop", "t_fall_over_t0",
-                  "energy_residual", "steps", "wall_s"});
+                  "energy_residual", "steps", "wall_s"},
+                 "problem");
   nlohmann::json summaries = nlohmann::json::array();
   const Problem problems[] = {Problem::kFalling, Problem::kFolded, Problem::kSliding};
   for (Problem p : problems) {
@@ -109,7 +110,7 @@ int run_canonical_command(const CanonicalCommandOptions& options, std::ostream& 
     write_run(run, root / to_string(p));
     const auto& s = run.summary;
     auto num = [](const nlohmann::json& v) { return v.is_number() ? v.get<double>() : NAN; };
-    table.add_row({static_cast<double>(p), setup.chain.dissipation, setup.initial_eta(), setup.eps,
+    table.add_row(to_string(p), {setup.chain.dissipation, setup.initial_eta(), setup.eps,
                    num(s["t_stop_over_t0"]), num(s["t_stop_over_t0_exact"]), num(s["rel_err_t_stop"]),
                    num(s["eta_stop"]), num(s["P_stop_over_P0"]), num(s["P_stop_over_P0_exact"]),
                    num(s["rel_err_P_stop"]), num(s["t_fall_over_t0"]), num(s["energy_residual"]),

@@ -1,7 +1,9 @@
 // The only translation unit that includes ARKODE: see integrator.hpp.
 #include "integrator.hpp"
 
+#include <cmath>
 #include <exception>
+#include <limits>
 #include <map>
 
 #include <arkode/arkode_arkstep.h>
@@ -43,16 +45,34 @@ std::string table_name(const std::string& method) {
   return it == aliases().end() ? method : it->second.table;
 }
 
-/// Loads an ERK or DIRK table by name; exactly one of the outputs is non-null on success.
+// The Butcher tables of SUNDIALS 6.4 (arkode_butcher_erk.h, arkode_butcher_dirk.h). Names are
+// checked here first: ARKODE's own lookup prints to stderr for an unknown name.
+constexpr const char* kErkTables[] = {
+    "ARKODE_HEUN_EULER_2_1_2", "ARKODE_BOGACKI_SHAMPINE_4_2_3", "ARKODE_ARK324L2SA_ERK_4_2_3",
+    "ARKODE_ZONNEVELD_5_3_4", "ARKODE_ARK436L2SA_ERK_6_3_4", "ARKODE_SAYFY_ABURUB_6_3_4", "ARKODE_CASH_KARP_6_4_5",
+    "ARKODE_FEHLBERG_6_4_5", "ARKODE_DORMAND_PRINCE_7_4_5", "ARKODE_ARK548L2SA_ERK_8_4_5", "ARKODE_VERNER_8_5_6",
+    "ARKODE_FEHLBERG_13_7_8", "ARKODE_KNOTH_WOLKE_3_3", "ARKODE_ARK437L2SA_ERK_7_3_4",
+    "ARKODE_ARK548L2SAb_ERK_8_4_5"};
+constexpr const char* kDirkTables[] = {
+    "ARKODE_SDIRK_2_1_2", "ARKODE_BILLINGTON_3_3_2", "ARKODE_TRBDF2_3_3_2", "ARKODE_KVAERNO_4_2_3",
+    "ARKODE_ARK324L2SA_DIRK_4_2_3", "ARKODE_CASH_5_2_4", "ARKODE_CASH_5_3_4", "ARKODE_SDIRK_5_3_4",
+    "ARKODE_KVAERNO_5_3_4", "ARKODE_ARK436L2SA_DIRK_6_3_4", "ARKODE_KVAERNO_7_4_5", "ARKODE_ARK548L2SA_DIRK_8_4_5",
+    "ARKODE_ARK437L2SA_DIRK_7_3_4", "ARKODE_ARK548L2SAb_DIRK_8_4_5", "ARKODE_ESDIRK324L2SA_4_2_3",
+    "ARKODE_ESDIRK325L2SA_5_2_3", "ARKODE_ESDIRK32I5L2SA_5_2_3", "ARKODE_ESDIRK436L2SA_6_3_4",
+    "ARKODE_ESDIRK43I6L2SA_6_3_4", "ARKODE_QESDIRK436L2SA_6_3_4", "ARKODE_ESDIRK437L2SA_7_3_4",
+    "ARKODE_ESDIRK547L2SA_7_4_5", "ARKODE_ESDIRK547L2SA2_7_4_5"};
+
+template <std::size_t N>
+bool listed(const std::string& name, const char* const (&names)[N]) {
+  for (const char* n : names)
+    if (name == n) return true;
+  return false;
+}
+
+/// Loads an ERK or DIRK table by name; both outputs are null for an unknown name.
 void load_table(const std::string& name, ARKodeButcherTable& erk, ARKodeButcherTable& dirk) {
-  erk = nullptr;
-  dirk = nullptr;
-  if (name.find("DIRK") != std::string::npos || name.find("KVAERNO") != std::string::npos ||
-      name.find("CASH_5") != std::string::npos || name.find("BILLINGTON") != std::string::npos ||
-      name.find("TRBDF2") != std::string::npos)
-    dirk = ARKodeButcherTable_LoadDIRKByName(name.c_str());
-  else
-    erk = ARKodeButcherTable_LoadERKByName(name.c_str());
+  erk = listed(name, kErkTables) ? ARKodeButcherTable_LoadERKByName(name.c_str()) : nullptr;
+  dirk = listed(name, kDirkTables) ? ARKodeButcherTable_LoadDIRKByName(name.c_str()) : nullptr;
 }
 
 std::string valid_methods() {
@@ -234,10 +254,9 @@ Integrator::Integrator(OdeSystem& system, double t0, const Eigen::VectorXd& y0,
 
 Integrator::~Integrator() = default;
 
-Integrator::Outcome Integrator::advance(double t_target, bool one_step) {
+// One ARKStepEvolve call towards t_target (never past it); throws on failure. Returns ARKODE's flag.
+int Integrator::evolve(double t_target, bool one_step) {
   Impl& d = *impl_;
-  CHAINSIM_VERIFY(t_target >= t_, "the integrator only moves forward in time");
-  if (t_target == t_) return Outcome::kReachedTarget;
   d.check(ARKStepSetStopTime(d.mem, t_target), "ARKStepSetStopTime");
   sunrealtype tret = t_;
   d.pending = nullptr;
@@ -249,17 +268,66 @@ Integrator::Outcome Integrator::advance(double t_target, bool one_step) {
                                      ARKStepGetReturnFlagName(flag), d.last_error.empty() ? "" : ": ",
                                      d.last_error),
                          tret);
-  t_ = tret;
+  t_ = flag == ARK_TSTOP_RETURN ? t_target : tret;
   y_ = Eigen::Map<Eigen::VectorXd>(N_VGetArrayPointer(d.y), N_VGetLength(d.y));
-  if (flag == ARK_ROOT_RETURN) {
-    d.check(ARKStepGetRootInfo(d.mem, events_found_.data()), "ARKStepGetRootInfo");
-    return Outcome::kEvent;
+  return flag;
+}
+
+Integrator::Outcome Integrator::advance(double t_target, bool one_step) {
+  CHAINSIM_VERIFY(t_target >= t_, "the integrator only moves forward in time");
+  // Invariant: on entry (t_, y_) is a state the method computed (the end of a step, a restart,
+  // or a polished event), never an interpolated one; it is kept as the start of the next step.
+  for (;;) {
+    if (t_ >= t_target) return Outcome::kReachedTarget;
+    const double t_step_start = t_;
+    const Eigen::VectorXd y_step_start = y_;
+    const int flag = evolve(t_target, /*one_step=*/true);
+    if (flag == ARK_ROOT_RETURN) {
+      impl_->check(ARKStepGetRootInfo(impl_->mem, events_found_.data()), "ARKStepGetRootInfo");
+      polish_event(t_step_start, y_step_start);
+      return Outcome::kEvent;
+    }
+    if (flag == ARK_TSTOP_RETURN || t_ >= t_target) {
+      t_ = t_target;
+      return Outcome::kReachedTarget;
+    }
+    if (one_step) return Outcome::kStep;
   }
-  if (flag == ARK_TSTOP_RETURN || t_ >= t_target) {
-    t_ = t_target;
-    return Outcome::kReachedTarget;
+}
+
+// ARKODE locates a root on its interpolant, whose error (degree <= 5, often cubic) is far larger
+// than the step's own error for high-order methods. Polish: integrate again from the start of the
+// step that holds the root, with rootfinding off, to the root's time, and correct that time with
+// Newton steps on g(t) along the flow, dg/dt = ∇g · F, until g vanishes to rounding.
+void Integrator::polish_event(double t_step_start, const Eigen::VectorXd& y_step_start) {
+  Impl& d = *impl_;
+  int k = 0;
+  while (k < static_cast<int>(events_found_.size()) && events_found_[k] == 0) ++k;
+  CHAINSIM_VERIFY(k < static_cast<int>(events_found_.size()), "a root return names an event");
+  const int nev = d.system.num_events();
+  d.check(ARKStepRootInit(d.mem, 0, nullptr), "ARKStepRootInit");
+
+  Eigen::VectorXd g(nev), g_ahead(nev), ydot(y_.size());
+  double t_event = t_;
+  for (int iteration = 0; iteration < 4; ++iteration) {
+    restart(t_step_start, y_step_start);
+    while (t_ < t_event) evolve(t_event, /*one_step=*/false);
+    d.system.events(t_, y_, g);
+    d.system.rhs(t_, y_, ydot);
+    const double dt_probe = 1e-6 * std::max(t_event - t_step_start, 1e-300);
+    d.system.events(t_ + dt_probe, y_ + dt_probe * ydot, g_ahead);
+    const double slope = (g_ahead[k] - g[k]) / dt_probe;
+    if (!(slope != 0.0) || !std::isfinite(slope)) break;
+    const double t_next = std::max(t_event - g[k] / slope, t_step_start);
+    if (std::abs(t_next - t_event) <= 8 * std::numeric_limits<double>::epsilon() * std::max(1.0, std::abs(t_event)))
+      break;
+    t_event = t_next;
   }
-  return Outcome::kStep;
+
+  d.check(ARKStepRootInit(d.mem, nev, Impl::roots), "ARKStepRootInit");
+  std::vector<int> dirs = d.system.event_directions();
+  if (!dirs.empty()) d.check(ARKStepSetRootDirection(d.mem, dirs.data()), "ARKStepSetRootDirection");
+  d.check(ARKStepSetNoInactiveRootWarn(d.mem), "ARKStepSetNoInactiveRootWarn");
 }
 
 Eigen::VectorXd Integrator::interpolate(double t, int k) const {

@@ -99,6 +99,8 @@ class Integrator {
   const Eigen::VectorXd& state() const { return y_; }
 
   /// After Outcome::kEvent: for each event function, +1/-1 if it crossed zero increasing/decreasing, else 0.
+  /// The event's time and state are polished to the method's accuracy (not the interpolant's):
+  /// the step holding the root is recomputed up to the root, found by Newton iteration on g.
   const std::vector<int>& events_found() const { return events_found_; }
 
   /// Interpolated state (k = 0) or its k-th derivative at time t inside the last step (dense output).
@@ -114,6 +116,9 @@ class Integrator {
   IntegratorStats stats() const;
 
  private:
+  int evolve(double t_target, bool one_step);
+  void polish_event(double t_step_start, const Eigen::VectorXd& y_step_start);
+
   struct Impl;
   std::unique_ptr<Impl> impl_;
   double t_;

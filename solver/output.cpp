@@ -37,7 +37,16 @@ void AtomicFile::commit() {
 }
 
 void CsvTable::add_row(const std::vector<double>& row) {
+  CHAINSIM_VERIFY(label_column_.empty(), "this CSV table needs a label in every row");
   CHAINSIM_VERIFY(row.size() == columns_.size(), "CSV row length differs from the header");
+  data_.push_back(row);
+}
+
+void CsvTable::add_row(const std::string& label, const std::vector<double>& row) {
+  CHAINSIM_VERIFY(!label_column_.empty(), "this CSV table has no label column");
+  CHAINSIM_VERIFY(row.size() == columns_.size(), "CSV row length differs from the header");
+  CHAINSIM_VERIFY(label.find_first_of(",\"\n") == std::string::npos, "CSV labels hold no commas or quotes");
+  labels_.push_back(label);
   data_.push_back(row);
 }
 
@@ -55,11 +64,14 @@ std::vector<double> CsvTable::column(const std::string& name) const {
 void CsvTable::write(const std::filesystem::path& path, int significant_digits) const {
   AtomicFile file(path);
   auto& out = file.stream();
+  const bool labelled = !label_column_.empty();
+  if (labelled) out << label_column_ << ',';
   for (std::size_t j = 0; j < columns_.size(); ++j) out << (j ? "," : "") << columns_[j];
   out << '\n';
-  for (const auto& row : data_) {
-    for (std::size_t j = 0; j < row.size(); ++j)
-      out << (j ? "," : "") << fmt::format("{:.{}g}", row[j], significant_digits);
+  for (std::size_t i = 0; i < data_.size(); ++i) {
+    if (labelled) out << labels_[i] << ',';
+    for (std::size_t j = 0; j < data_[i].size(); ++j)
+      out << (j ? "," : "") << fmt::format("{:.{}g}", data_[i][j], significant_digits);
     out << '\n';
   }
   file.commit();

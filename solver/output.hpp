@@ -34,12 +34,16 @@ class AtomicFile {
   bool committed_ = false;
 };
 
-/// A CSV table built in memory and written atomically: one header row, then numeric rows.
+/// A CSV table built in memory and written atomically: one header row, then numeric rows, each
+/// optionally led by a text label (e.g. the problem's name) when a label column is named.
 class CsvTable {
  public:
-  explicit CsvTable(std::vector<std::string> columns) : columns_(std::move(columns)) {}
+  explicit CsvTable(std::vector<std::string> columns, std::string label_column = "")
+      : columns_(std::move(columns)), label_column_(std::move(label_column)) {}
   /// Appends a row; it must have one value per column.
   void add_row(const std::vector<double>& row);
+  /// Appends a labelled row (only for a table constructed with a label column).
+  void add_row(const std::string& label, const std::vector<double>& row);
   std::size_t rows() const { return data_.size(); }
   const std::vector<std::string>& columns() const { return columns_; }
   /// Column by name (throws Error if absent).
@@ -48,6 +52,8 @@ class CsvTable {
 
  private:
   std::vector<std::string> columns_;
+  std::string label_column_;
+  std::vector<std::string> labels_;
   std::vector<std::vector<double>> data_;
 };
 

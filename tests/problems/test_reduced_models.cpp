@@ -21,7 +21,7 @@ namespace {
 constexpr double kStopTimeRelTol = 1e-9;
 constexpr double kStopForceRelTol = 1e-7;
 // The integrated ledger K + V − E0 − ∫ΣW is a time-integration error: a few rtol of the energy scale.
-constexpr double kEnergyResidualTol = 1e-10;
+constexpr double kEnergyResidualTol = 1e-11;
 // Scaled results of two runs in different units differ only by rounding and tolerance effects.
 constexpr double kUnitsRelTol = 1e-10;
 
@@ -76,7 +76,9 @@ TEST_CASE("reduced ODEs meet the exact quadratures at the stop event", "[problem
   CHECK(s["stop_reason"] != "t_max");
   CHECK_THAT(s["eta_stop"].get<double>(), WithinAbs(eta_end, 1e-10));
   CHECK_THAT(s["t_stop_over_t0"].get<double>(), WithinRel(exact_xi(problem, f, eta_end, eta0), kStopTimeRelTol));
-  CHECK_THAT(s["P_stop_over_P0"].get<double>(), WithinRel(exact_P(problem, f, eta_end, eta0), kStopForceRelTol));
+  // P/P0 is O(1) and vanishes at the end of the sliding chain with f = 0: relative to max(|P|, P0).
+  const double P_ref = exact_P(problem, f, eta_end, eta0);
+  CHECK_THAT(s["P_stop_over_P0"].get<double>(), WithinAbs(P_ref, kStopForceRelTol * std::max(1.0, std::abs(P_ref))));
   CHECK(s["energy_residual"].get<double>() < kEnergyResidualTol);
 
   // P/P0 along the whole run against the exact P at the same η (the force is steep near the stop).
@@ -85,7 +87,7 @@ TEST_CASE("reduced ODEs meet the exact quadratures at the stop event", "[problem
   double worst = 0;
   for (std::size_t k = 0; k < eta.size(); ++k) {
     const double ref = exact_P(problem, f, std::clamp(eta[k], std::min(eta0, eta_end), std::max(eta0, eta_end)), eta0);
-    worst = std::max(worst, std::abs(P[k] - ref) / std::abs(ref));
+    worst = std::max(worst, std::abs(P[k] - ref) / std::max(1.0, std::abs(ref)));
   }
   CHECK(worst < kStopForceRelTol);
 }
@@ -114,14 +116,15 @@ TEST_CASE("folded chain with an end force: first integrals between turning point
   //   du/dz + k u / z = F/(λ z) − g   ⇒   u = F/(λ k) − g z/(k + 1) + C z^(−k),
   // with C fixed by u = 0 at the phase's turning point z_a.
   const double f = GENERATE(0.3, 0.83);
-  const double force = 4.0;  // N: y* = 1 − 4/9.81 ≈ 0.59 m
+  // Turning needs C < 0 at release, F > λ g k/(k+1) with k = 1 − f (4.04 N for f = 0.3).
+  const double force = 5.0;  // N: y* = l − F/(λg) ≈ 0.49 m
   CAPTURE(f);
   ReducedSetup setup = make(Problem::kFolded, f, 0.0);
   setup.force = force;
-  setup.t_max_over_t0 = 6.0;
+  setup.t_max_over_t0 = 15.0;
   const ReducedRun run = solve_reduced(setup);
   const auto& s = run.summary;
-  REQUIRE(s["turning_points"].get<int>() >= 3);
+  REQUIRE(s["turning_points"].get<int>() >= 4);
   CHECK(s["energy_residual"].get<double>() < kEnergyResidualTol);
 
   const double l = 1.0, lam = 1.0, g = 9.81;
@@ -131,10 +134,10 @@ TEST_CASE("folded chain with an end force: first integrals between turning point
   double sgn = 1.0;
   double worst = 0;
   for (std::size_t k = 1; k < y.size(); ++k) {
-    if (yd[k] == 0.0 || (yd[k] > 0) != (sgn > 0)) {  // a turning point: a new phase starts here
-      z_a = l - y[k];
+    if (std::abs(yd[k]) < 1e-12) continue;  // the turning point itself (ẏ = 0 up to rounding)
+    if ((yd[k] > 0) != (sgn > 0)) {          // first sample of a new phase: the previous one is its turning point
+      z_a = l - y[k - 1];
       sgn = -sgn;
-      continue;
     }
     const double kk = 1.0 - f * sgn, z = l - y[k];
     const double C = std::pow(z_a, kk) * (g * z_a / (kk + 1.0) - force / (lam * kk));
