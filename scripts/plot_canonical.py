@@ -6,6 +6,7 @@ Writes DIR/figures/*.png. Solid lines: the reduced ODE integrated by ARKODE; mar
 lines: the exact quadratures (cases/exact_solutions). Needs Debian's python3-matplotlib.
 """
 import csv
+import math
 import os
 import sys
 
@@ -61,15 +62,15 @@ def problem_figure(data_dir, out_dir, problem, f_eta, f_P, logP, title):
     ax1.set_ylabel("$y/\\ell$")
     ax1.grid(alpha=0.3)
     ax1.legend(fontsize=7)
+    # The paper draws the folded chain's weight as ln(1 + P/P0) (its caption: P_f = 3 P0 <-> ln 4).
+    transform = (lambda p: math.log1p(p)) if logP else (lambda p: p)
     for f in f_P:
         ode, ref = curve_pair(data_dir, problem, f)
-        line, = ax2.plot(ode["xi"], ode["P_over_P0"], "-", label=f"ODE $f={f:g}$")
-        ax2.plot(ref["xi"][::12], ref["P_over_P0"][::12], "o", ms=3, mfc="none", color=line.get_color(),
-                 label=f"quadrature $f={f:g}$")
-    if logP:
-        ax2.set_yscale("log")
+        line, = ax2.plot(ode["xi"], [transform(p) for p in ode["P_over_P0"]], "-", label=f"ODE $f={f:g}$")
+        ax2.plot(ref["xi"][::12], [transform(p) for p in ref["P_over_P0"][::12]], "o", ms=3, mfc="none",
+                 color=line.get_color(), label=f"quadrature $f={f:g}$")
     ax2.set_xlabel("$t/t_0$")
-    ax2.set_ylabel("$P/P_0$")
+    ax2.set_ylabel("$\\ln(1+P/P_0)$" if logP else "$P/P_0$")
     ax2.grid(alpha=0.3, which="both")
     ax2.legend(fontsize=7)
     fig.suptitle(title)

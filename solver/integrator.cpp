@@ -122,6 +122,7 @@ struct Integrator::Impl {
   long recoverable_failures = 0;
   std::exception_ptr pending;  // exception thrown inside a callback, re-thrown after ARKStepEvolve
   std::string last_error;      // ARKODE's own message for the last failure
+  std::string last_recoverable;  // what the model said when it last refused a trial state
 
   explicit Impl(OdeSystem& s) : system(s) {}
   ~Impl() {
@@ -173,11 +174,13 @@ struct Integrator::Impl {
       self->system.rhs(t, ym, dm);
       if (!dm.allFinite()) {
         ++self->recoverable_failures;
+        self->last_recoverable = "the right-hand side is not finite";
         return 1;  // a non-finite trial stage: let ARKODE retry with a smaller step
       }
       return 0;
-    } catch (const RecoverableError&) {
+    } catch (const RecoverableError& e) {
       ++self->recoverable_failures;
+      self->last_recoverable = e.what();
       return 1;
     } catch (...) {
       self->pending = std::current_exception();
@@ -263,6 +266,7 @@ int Integrator::evolve(double t_target, bool one_step) {
   d.last_error.clear();
   const int flag = ARKStepEvolve(d.mem, t_target, d.y, &tret, one_step ? ARK_ONE_STEP : ARK_NORMAL);
   if (d.pending) std::rethrow_exception(d.pending);
+  if (flag == ARK_UNREC_RHSFUNC_ERR) return flag;  // advance() retries from the step's start
   if (flag < 0)
     throw NumericalError(fmt::format("time integration failed at t = {:.9g} s with {}{}{}", tret,
                                      ARKStepGetReturnFlagName(flag), d.last_error.empty() ? "" : ": ",
@@ -277,11 +281,32 @@ Integrator::Outcome Integrator::advance(double t_target, bool one_step) {
   CHAINSIM_VERIFY(t_target >= t_, "the integrator only moves forward in time");
   // Invariant: on entry (t_, y_) is a state the method computed (the end of a step, a restart,
   // or a polished event), never an interpolated one; it is kept as the start of the next step.
+  // ARKODE's explicit stages do not recover when the right-hand side refuses a trial state (a
+  // RecoverableError, e.g. a stage that overshoots y = 0 near a singular stop): restart from the
+  // start of the step with a step four times smaller, up to kMaxRetries times.
+  constexpr int kMaxRetries = 30;
+  int retries = 0;
+  double h_retry = 0;
   for (;;) {
     if (t_ >= t_target) return Outcome::kReachedTarget;
     const double t_step_start = t_;
     const Eigen::VectorXd y_step_start = y_;
     const int flag = evolve(t_target, /*one_step=*/true);
+    if (flag == ARK_UNREC_RHSFUNC_ERR) {
+      if (h_retry == 0) ARKStepGetLastStep(impl_->mem, &h_retry);
+      h_retry *= 0.25;
+      if (++retries > kMaxRetries || !(h_retry > 0))
+        throw NumericalError(fmt::format("time integration stalled at t = {:.12g} s: the model refused every trial "
+                                         "state down to a step of {:.3g} s ({})",
+                                         t_step_start, h_retry, impl_->last_recoverable),
+                             t_step_start);
+      restart(t_step_start, y_step_start);
+      impl_->check(ARKStepSetInitStep(impl_->mem, h_retry), "ARKStepSetInitStep");
+      continue;
+    }
+    if (retries > 0) impl_->check(ARKStepSetInitStep(impl_->mem, 0.0), "ARKStepSetInitStep");  // estimate again
+    retries = 0;
+    h_retry = 0;
     if (flag == ARK_ROOT_RETURN) {
       impl_->check(ARKStepGetRootInfo(impl_->mem, events_found_.data()), "ARKStepGetRootInfo");
       polish_event(t_step_start, y_step_start);

@@ -71,7 +71,9 @@ void CsvTable::write(const std::filesystem::path& path, int significant_digits) 
   for (std::size_t i = 0; i < data_.size(); ++i) {
     if (labelled) out << labels_[i] << ',';
     for (std::size_t j = 0; j < data_[i].size(); ++j)
-      out << (j ? "," : "") << fmt::format("{:.{}g}", data_[i][j], significant_digits);
+      out << (j ? "," : "")
+          << (significant_digits > 0 ? fmt::format("{:.{}g}", data_[i][j], significant_digits)
+                                     : fmt::format("{}", data_[i][j]));
     out << '\n';
   }
   file.commit();

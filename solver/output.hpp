@@ -48,7 +48,8 @@ class CsvTable {
   const std::vector<std::string>& columns() const { return columns_; }
   /// Column by name (throws Error if absent).
   std::vector<double> column(const std::string& name) const;
-  void write(const std::filesystem::path& path, int significant_digits = 17) const;
+  /// significant_digits = 0: the shortest text that reads back to the same double.
+  void write(const std::filesystem::path& path, int significant_digits = 0) const;
 
  private:
   std::vector<std::string> columns_;
