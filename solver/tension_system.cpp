@@ -1,0 +1,432 @@
+// The sparse tension system and its backends: see tension_system.hpp.
+#include "tension_system.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+
+#include <Eigen/SparseCore>
+#include <Eigen/SparseLU>
+#include <fmt/format.h>
+
+#ifdef CHAINSIM_WITH_KLU
+#include <klu.h>
+#endif
+
+#include "errors.hpp"
+#include "junction.hpp"
+
+namespace chainsim {
+
+namespace {
+
+/// A pivot smaller than this times the largest |diagonal entry| of the matrix counts as zero: the
+/// system is singular to working precision.
+constexpr double kSingularPivot = 1e-13;
+
+// ----------------------------------------------------------------------------------------------
+// Tridiagonal backend: Thomas' algorithm per arc, cyclic arcs by Sherman–Morrison.
+// The matrix is (negative) definite on an arc, so elimination without pivoting is stable.
+class TridiagonalBackend final : public TensionBackend {
+ public:
+  std::string name() const override { return "tridiagonal"; }
+
+  void analyze(const SparsePattern& pattern, const std::vector<ArcBlock>& arcs) override {
+    arcs_ = arcs;
+    const int n = pattern.n;
+    int expected = 0;
+    diag_.assign(n, -1);
+    lower_.assign(n, -1);
+    upper_.assign(n, -1);
+    corner_lo_.assign(arcs.size(), -1);
+    corner_up_.assign(arcs.size(), -1);
+    int covered = 0;
+    for (std::size_t k = 0; k < arcs.size(); ++k) {
+      const ArcBlock& arc = arcs[k];
+      const int f = arc.first_unknown, m = arc.num_links;
+      covered += m;
+      for (int i = 0; i < m; ++i) {
+        diag_[f + i] = pattern.find(f + i, f + i);
+        if (i > 0) lower_[f + i] = pattern.find(f + i, f + i - 1);
+        if (i + 1 < m) upper_[f + i] = pattern.find(f + i, f + i + 1);
+      }
+      expected += m + 2 * (m - 1);
+      if (arc.closed && m >= 3) {
+        corner_lo_[k] = pattern.find(f + m - 1, f);  // A(last, first)
+        corner_up_[k] = pattern.find(f, f + m - 1);  // A(first, last)
+        expected += 2;
+      }
+    }
+    if (covered != n || pattern.nnz() != expected)
+      throw InputError(
+          "the tridiagonal tension backend solves arcs only; this system has junction rows coupling arcs: "
+          "use backend = \"klu\" or \"eigen\"");
+    const int max_links = arcs.empty() ? 0 : std::max_element(arcs.begin(), arcs.end(), [](auto& a, auto& b) {
+                                               return a.num_links < b.num_links;
+                                             })->num_links;
+    cp_.resize(static_cast<std::size_t>(max_links));
+    z_.resize(static_cast<std::size_t>(max_links));
+    bb_.resize(static_cast<std::size_t>(max_links));
+  }
+
+  SolveStatus factor_solve(const double* values, double* rhs) override {
+    for (std::size_t k = 0; k < arcs_.size(); ++k) {
+      const ArcBlock& arc = arcs_[k];
+      SolveStatus status = arc.closed && arc.num_links >= 3
+                               ? cyclic(values, rhs, arc, corner_lo_[k], corner_up_[k])
+                               : thomas(values, rhs, arc.first_unknown, arc.num_links, nullptr, nullptr);
+      if (!status.ok) return status;
+    }
+    return {};
+  }
+
+ private:
+  /// Solves the tridiagonal block [f, f+m) with diagonal `bmod` (if given, else from values) for the
+  /// right side r (in place); if `second` is given, applies the same elimination to it.
+  SolveStatus thomas(const double* A, double* r, int f, int m, const double* bmod, double* second) {
+    double scale = 0;
+    for (int i = 0; i < m; ++i) scale = std::max(scale, std::abs(A[diag_[f + i]]));
+    const double tiny = kSingularPivot * scale;
+    double piv = bmod ? bmod[0] : A[diag_[f]];
+    if (!(std::abs(piv) > tiny)) return {false, f, piv, "Thomas elimination"};
+    cp_[0] = m > 1 ? A[upper_[f]] / piv : 0.0;
+    r[f] /= piv;
+    if (second) second[0] /= piv;
+    for (int i = 1; i < m; ++i) {
+      const double a = A[lower_[f + i]];
+      const double b = bmod ? bmod[i] : A[diag_[f + i]];
+      piv = b - a * cp_[static_cast<std::size_t>(i - 1)];
+      if (!(std::abs(piv) > tiny)) return {false, f + i, piv, "Thomas elimination"};
+      cp_[static_cast<std::size_t>(i)] = i + 1 < m ? A[upper_[f + i]] / piv : 0.0;
+      r[f + i] = (r[f + i] - a * r[f + i - 1]) / piv;
+      if (second) second[i] = (second[i] - a * second[i - 1]) / piv;
+    }
+    for (int i = m - 2; i >= 0; --i) {
+      r[f + i] -= cp_[static_cast<std::size_t>(i)] * r[f + i + 1];
+      if (second) second[i] -= cp_[static_cast<std::size_t>(i)] * second[i + 1];
+    }
+    return {};
+  }
+
+  /// Cyclic tridiagonal block by Sherman–Morrison: A = B + u vᵀ with u = (γ, 0, …, 0, α),
+  /// v = (1, 0, …, 0, β/γ), α = A(last, first), β = A(first, last), γ = −A(0, 0).
+  SolveStatus cyclic(const double* A, double* r, const ArcBlock& arc, int slot_lo, int slot_up) {
+    const int f = arc.first_unknown, m = arc.num_links;
+    const double alpha = A[slot_lo], beta = A[slot_up];
+    const double gamma = -A[diag_[f]];
+    if (!(std::abs(gamma) > 0)) return {false, f, A[diag_[f]], "cyclic elimination"};
+    for (int i = 0; i < m; ++i) bb_[static_cast<std::size_t>(i)] = A[diag_[f + i]];
+    bb_[0] -= gamma;
+    bb_[static_cast<std::size_t>(m - 1)] -= alpha * beta / gamma;
+    std::fill(z_.begin(), z_.begin() + m, 0.0);
+    z_[0] = gamma;
+    z_[static_cast<std::size_t>(m - 1)] = alpha;
+    SolveStatus status = thomas(A, r, f, m, bb_.data(), z_.data());
+    if (!status.ok) return status;
+    const double denom = 1.0 + z_[0] + beta * z_[static_cast<std::size_t>(m - 1)] / gamma;
+    const double factor_scale = 1.0 + std::abs(z_[0]) + std::abs(beta * z_[static_cast<std::size_t>(m - 1)] / gamma);
+    if (!(std::abs(denom) > kSingularPivot * factor_scale))
+      return {false, f + m - 1, denom, "Sherman-Morrison correction of the closed arc"};
+    const double fact = (r[f] + beta * r[f + m - 1] / gamma) / denom;
+    for (int i = 0; i < m; ++i) r[f + i] -= fact * z_[static_cast<std::size_t>(i)];
+    return {};
+  }
+
+  std::vector<ArcBlock> arcs_;
+  std::vector<int> diag_, lower_, upper_, corner_lo_, corner_up_;
+  std::vector<double> cp_, z_, bb_;
+};
+
+// ----------------------------------------------------------------------------------------------
+// Eigen SparseLU: analyzePattern once, factorize every call.
+class EigenBackend final : public TensionBackend {
+ public:
+  std::string name() const override { return "eigen"; }
+
+  void analyze(const SparsePattern& pattern, const std::vector<ArcBlock>&) override {
+    std::vector<Eigen::Triplet<double>> triplets;
+    for (int c = 0; c < pattern.n; ++c)
+      for (int k = pattern.col_ptr[c]; k < pattern.col_ptr[c + 1]; ++k)
+        triplets.emplace_back(pattern.row_index[k], c, 1.0);
+    matrix_.resize(pattern.n, pattern.n);
+    matrix_.setFromTriplets(triplets.begin(), triplets.end());
+    matrix_.makeCompressed();
+    CHAINSIM_VERIFY(matrix_.nonZeros() == pattern.nnz() &&
+                        std::equal(pattern.row_index.begin(), pattern.row_index.end(), matrix_.innerIndexPtr()),
+                    "Eigen's compressed storage differs from the tension pattern");
+    lu_.analyzePattern(matrix_);
+    x_.resize(pattern.n);
+  }
+
+  SolveStatus factor_solve(const double* values, double* rhs) override {
+    std::copy(values, values + matrix_.nonZeros(), matrix_.valuePtr());
+    lu_.factorize(matrix_);
+    if (lu_.info() != Eigen::Success) {
+      SolveStatus s{false, -1, 0.0, "Eigen SparseLU: " + lu_.lastErrorMessage()};
+      return s;
+    }
+    Eigen::Map<Eigen::VectorXd> b(rhs, matrix_.rows());
+    x_ = lu_.solve(b);
+    b = x_;
+    return {};
+  }
+
+ private:
+  Eigen::SparseMatrix<double> matrix_;
+  Eigen::SparseLU<Eigen::SparseMatrix<double>, Eigen::COLAMDOrdering<int>> lu_;
+  Eigen::VectorXd x_;
+};
+
+#ifdef CHAINSIM_WITH_KLU
+// ----------------------------------------------------------------------------------------------
+// SuiteSparse KLU: klu_analyze once (BTF + AMD), klu_factor on the first call, then klu_refactor
+// (same pivot sequence, numeric only). A refactorization whose reciprocal pivot growth looks bad is
+// redone with a fresh klu_factor (new pivoting) before the matrix is declared singular.
+class KluBackend final : public TensionBackend {
+ public:
+  KluBackend() { klu_defaults(&common_); }
+  ~KluBackend() override { release(); }
+  std::string name() const override { return "klu"; }
+
+  void analyze(const SparsePattern& pattern, const std::vector<ArcBlock>&) override {
+    release();
+    n_ = pattern.n;
+    ap_ = pattern.col_ptr;
+    ai_ = pattern.row_index;
+    symbolic_ = klu_analyze(n_, ap_.data(), ai_.data(), &common_);
+    if (!symbolic_) throw Error(fmt::format("internal error: klu_analyze failed (status {})", common_.status));
+  }
+
+  SolveStatus factor_solve(const double* values, double* rhs) override {
+    auto* ax = const_cast<double*>(values);  // KLU's C interface is not const-correct; it does not write Ax
+    bool ok = false;
+    if (numeric_) {
+      ok = klu_refactor(ap_.data(), ai_.data(), ax, symbolic_, numeric_, &common_) && well_conditioned();
+      if (!ok) klu_free_numeric(&numeric_, &common_);
+    }
+    if (!numeric_) {
+      numeric_ = klu_factor(ap_.data(), ai_.data(), ax, symbolic_, &common_);
+      ok = numeric_ != nullptr && well_conditioned();
+    }
+    if (!ok) return singular_status();
+    if (!klu_solve(symbolic_, numeric_, n_, 1, rhs, &common_))
+      return {false, -1, 0.0, fmt::format("klu_solve failed (status {})", common_.status)};
+    return {};
+  }
+
+ private:
+  bool well_conditioned() {
+    if (common_.status != KLU_OK) return false;
+    if (!klu_rcond(symbolic_, numeric_, &common_)) return false;
+    return common_.rcond > kSingularPivot;
+  }
+
+  SolveStatus singular_status() {
+    SolveStatus s{false, -1, 0.0, fmt::format("KLU (status {}, rcond {:.3g})", common_.status, common_.rcond)};
+    if (numeric_ && numeric_->Udiag) {
+      // Smallest |U(k,k)|; column k of the permuted matrix is column Q[k] of A.
+      const auto* udiag = static_cast<const double*>(numeric_->Udiag);
+      int worst = 0;
+      for (int k = 1; k < n_; ++k)
+        if (std::abs(udiag[k]) < std::abs(udiag[worst])) worst = k;
+      s.unknown = symbolic_->Q ? symbolic_->Q[worst] : worst;
+      s.pivot = udiag[worst];
+    } else if (common_.singular_col >= 0 && common_.singular_col < n_) {
+      s.unknown = common_.singular_col;
+    }
+    if (numeric_) klu_free_numeric(&numeric_, &common_);
+    return s;
+  }
+
+  void release() {
+    if (numeric_) klu_free_numeric(&numeric_, &common_);
+    if (symbolic_) klu_free_symbolic(&symbolic_, &common_);
+  }
+
+  klu_common common_{};
+  klu_symbolic* symbolic_ = nullptr;
+  klu_numeric* numeric_ = nullptr;
+  int n_ = 0;
+  std::vector<int> ap_, ai_;
+};
+#endif
+
+}  // namespace
+
+// ------------------------------------------------------------------------------------------------
+int SparsePattern::find(int row, int col) const {
+  if (col < 0 || col >= n) return -1;
+  auto begin = row_index.begin() + col_ptr[col], end = row_index.begin() + col_ptr[col + 1];
+  auto it = std::lower_bound(begin, end, row);
+  return it != end && *it == row ? static_cast<int>(it - row_index.begin()) : -1;
+}
+
+std::vector<std::string> tension_backend_names() {
+#ifdef CHAINSIM_WITH_KLU
+  return {"tridiagonal", "klu", "eigen"};
+#else
+  return {"tridiagonal", "eigen"};
+#endif
+}
+
+std::unique_ptr<TensionBackend> make_tension_backend(const std::string& name) {
+  if (name == "tridiagonal") return std::make_unique<TridiagonalBackend>();
+  if (name == "eigen") return std::make_unique<EigenBackend>();
+#ifdef CHAINSIM_WITH_KLU
+  if (name == "klu") return std::make_unique<KluBackend>();
+#else
+  if (name == "klu")
+    throw InputError("backend = \"klu\" is not available: chainsim was built with CHAINSIM_WITH_KLU=OFF; "
+                     "use \"tridiagonal\" or \"eigen\"");
+#endif
+  std::string list;
+  for (const auto& b : tension_backend_names()) list += (list.empty() ? "" : ", ") + b;
+  throw InputError(fmt::format("backend = \"{}\" is not a tension solver: allowed auto, {}", name, list));
+}
+
+int TensionPatternBuilder::link_unknown(int arc, int link) const {
+  CHAINSIM_VERIFY(arc >= 0 && arc < static_cast<int>(arcs_.size()), "arc index out of range");
+  const ArcBlock& a = arcs_[static_cast<std::size_t>(arc)];
+  CHAINSIM_VERIFY(link >= 0 && link < a.num_links, "link index out of range");
+  return a.first_unknown + link;
+}
+
+TensionSystem::TensionSystem(const std::vector<int>& arc_links, const std::vector<bool>& arc_closed,
+                             std::vector<Junction*> junctions, const std::string& backend)
+    : junctions_(std::move(junctions)) {
+  CHAINSIM_VERIFY(arc_links.size() == arc_closed.size() && !arc_links.empty(), "one closed flag per arc");
+  // 1. Unknowns: arcs first (contiguous link blocks), then the junctions' own unknowns.
+  int n = 0;
+  for (std::size_t k = 0; k < arc_links.size(); ++k) {
+    CHAINSIM_VERIFY(arc_links[k] >= 1 && (!arc_closed[k] || arc_links[k] >= 3), "arc too short");
+    arcs_.push_back(ArcBlock{n, arc_links[k], arc_closed[k]});
+    n += arc_links[k];
+  }
+  // 2. Pattern: tridiagonal (cyclic) blocks plus junction entries.
+  std::vector<std::pair<int, int>> entries;
+  for (const ArcBlock& arc : arcs_) {
+    const int f = arc.first_unknown, m = arc.num_links;
+    for (int i = 0; i < m; ++i) {
+      entries.emplace_back(f + i, f + i);
+      if (i + 1 < m) {
+        entries.emplace_back(f + i, f + i + 1);
+        entries.emplace_back(f + i + 1, f + i);
+      }
+    }
+    if (arc.closed) {
+      entries.emplace_back(f, f + m - 1);
+      entries.emplace_back(f + m - 1, f);
+    }
+  }
+  for (Junction* junction : junctions_) {
+    CHAINSIM_VERIFY(junction != nullptr, "null junction");
+    TensionPatternBuilder builder(arcs_, n);
+    junction->declare_entries(builder);
+    junction_offset_.push_back(n);
+    n += junction->num_unknowns();
+    for (auto [r, c] : builder.extra_) {
+      CHAINSIM_VERIFY(r >= 0 && c >= 0, "junction entry out of range");
+      entries.emplace_back(r, c);
+    }
+    // Every junction unknown needs its diagonal slot (possibly zero) so the pattern is square-complete.
+    for (int k = 0; k < junction->num_unknowns(); ++k)
+      entries.emplace_back(junction_offset_.back() + k, junction_offset_.back() + k);
+  }
+  for (auto [r, c] : entries) CHAINSIM_VERIFY(r < n && c < n, "junction entry beyond the unknowns");
+  std::sort(entries.begin(), entries.end(), [](auto& a, auto& b) {
+    return a.second != b.second ? a.second < b.second : a.first < b.first;
+  });
+  entries.erase(std::unique(entries.begin(), entries.end()), entries.end());
+  pattern_.n = n;
+  pattern_.col_ptr.assign(static_cast<std::size_t>(n) + 1, 0);
+  for (auto [r, c] : entries) {
+    ++pattern_.col_ptr[static_cast<std::size_t>(c) + 1];
+    pattern_.row_index.push_back(r);
+  }
+  std::partial_sum(pattern_.col_ptr.begin(), pattern_.col_ptr.end(), pattern_.col_ptr.begin());
+  values_.assign(entries.size(), 0.0);
+  rhs_ = Eigen::VectorXd::Zero(n);
+  solution_ = Eigen::VectorXd::Zero(n);
+
+  // 3. Slots of the arc entries, so the model writes values without searching.
+  diag_slot_.assign(n, -1);
+  next_slot_.assign(n, -1);
+  prev_slot_of_next_.assign(n, -1);
+  for (int u = 0; u < n; ++u) diag_slot_[u] = pattern_.find(u, u);
+  for (const ArcBlock& arc : arcs_) {
+    const int f = arc.first_unknown, m = arc.num_links;
+    for (int i = 0; i < m; ++i) {
+      if (i + 1 == m && !arc.closed) break;
+      const int next = i + 1 < m ? f + i + 1 : f;
+      next_slot_[f + i] = pattern_.find(f + i, next);
+      prev_slot_of_next_[f + i] = pattern_.find(next, f + i);
+    }
+  }
+  for (Junction* junction : junctions_) junction->bind(*this);
+
+  // 4. Backend: symbolic analysis once.
+  backend_name_ = backend;
+  if (backend == "auto") {
+    backend_name_ = junctions_.empty() ? "tridiagonal" : "klu";
+#ifndef CHAINSIM_WITH_KLU
+    if (backend_name_ == "klu") backend_name_ = "eigen";
+#endif
+  }
+  backend_ = make_tension_backend(backend_name_);
+  backend_->analyze(pattern_, arcs_);
+}
+
+TensionSystem::~TensionSystem() = default;
+
+void TensionSystem::zero() {
+  std::fill(values_.begin(), values_.end(), 0.0);
+  rhs_.setZero();
+}
+
+int TensionSystem::slot(int row, int col) const {
+  const int s = pattern_.find(row, col);
+  CHAINSIM_VERIFY(s >= 0, fmt::format("entry ({}, {}) was not declared in the tension pattern", row, col));
+  return s;
+}
+
+void TensionSystem::add_junction_rows(double t) {
+  for (Junction* junction : junctions_) junction->add_rows(t, *this);
+}
+
+const Eigen::VectorXd& TensionSystem::solve(double t) {
+  ++solves_;
+  solution_ = rhs_;
+  const SolveStatus status = backend_->factor_solve(values_.data(), solution_.data());
+  if (!status.ok)
+    throw NumericalError(fmt::format("the tension system is singular at t = {:.9g} s: {} has pivot {:.3g} ({}); "
+                                     "the string cannot move as its constraints require (taut between "
+                                     "prescribed points, or folded onto itself)",
+                                     t, status.unknown >= 0 ? describe(status.unknown) : "an unknown", status.pivot,
+                                     status.detail),
+                         t);
+  if (!solution_.allFinite()) {
+    int bad = 0;
+    while (bad < solution_.size() && std::isfinite(solution_[bad])) ++bad;
+    throw NumericalError(fmt::format("the tension solve returned a non-finite value at t = {:.9g} s for {}", t,
+                                     describe(bad)),
+                         t);
+  }
+  for (Junction* junction : junctions_) junction->read_solution(*this);
+  return solution_;
+}
+
+std::string TensionSystem::describe(int unknown) const {
+  for (std::size_t k = 0; k < arcs_.size(); ++k) {
+    const ArcBlock& a = arcs_[k];
+    if (unknown >= a.first_unknown && unknown < a.first_unknown + a.num_links)
+      return fmt::format("link {} of arc {}", unknown - a.first_unknown, k);
+  }
+  for (std::size_t k = 0; k < junctions_.size(); ++k) {
+    const int off = junction_offset_[k];
+    if (unknown >= off && unknown < off + junctions_[k]->num_unknowns())
+      return fmt::format("unknown {} of junction '{}'", unknown - off, junctions_[k]->name());
+  }
+  return fmt::format("unknown {}", unknown);
+}
+
+}  // namespace chainsim

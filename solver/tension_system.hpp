@@ -1,0 +1,165 @@
+#pragma once
+/// @file tension_system.hpp
+/// The discrete tension equation: one sparse linear system per right-hand side (DESIGN.md §1, §3).
+///
+/// Unknowns. Every arc owns a contiguous block of link tensions T_j (N), in link order; junctions
+/// (solver/junction.hpp: internal shocks, table contact, reservoirs, later) append their own unknowns
+/// after all arc blocks and may add entries that couple several arcs.
+///
+/// Rows. Differentiating the link constraint |x_{j+1} − x_j|² = h_j² twice in time and substituting
+/// the momentum balance m_i a_i = F_i + T_i e_i − T_{i−1} e_{i−1} gives, per link j (nodes a = j,
+/// b = j+1), the symmetric tridiagonal row (cyclic on a closed arc)
+///
+///   T_{j−1} w_a (e_{j−1}·e_j) − T_j (w_a + w_b) + T_{j+1} w_b (e_j·e_{j+1})
+///       = −|Δv_j|²/l_j − e_j·(b_b − b_a) − (2α Δx_j·Δv_j + β² (|Δx_j|² − h_j²)/2)/l_j
+///
+/// with w_i = 1/m_i and b_i = F_i/m_i for a free node, and w_i = 0, b_i = a_end(t) for a node whose
+/// motion is prescribed (fixed or driven: infinite mass). The last term is Baumgarte's stabilisation
+/// (α = β = 0 reproduces the exact second derivative of the constraint). The matrix is −G W Gᵀ,
+/// G the constraint Jacobian (row j: −e_jᵀ at node a, +e_jᵀ at node b): negative definite whenever
+/// the links can move, so no pivoting is needed on an arc.
+///
+/// Assembly. The pattern (compressed sparse columns) is built once in the constructor; each call
+/// writes values into it (zero(), add_diagonal(), set_coupling(), junction entries) and solve()
+/// refactors numerically through a TensionBackend:
+///   - "tridiagonal": Thomas' algorithm per arc, Sherman–Morrison for a closed (cyclic) arc; arcs only,
+///   - "klu":         SuiteSparse KLU, klu_analyze once, klu_factor then klu_refactor each call,
+///   - "eigen":       Eigen's SparseLU, analyzePattern once, factorize each call (the fallback when
+///                    chainsim is built with CHAINSIM_WITH_KLU=OFF),
+///   - "auto":        tridiagonal when no junction couples arcs, else klu (eigen without KLU).
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+namespace chainsim {
+
+class Junction;
+
+/// One arc's block of link unknowns.
+struct ArcBlock {
+  int first_unknown = 0;  ///< index of its first link's tension
+  int num_links = 0;
+  bool closed = false;    ///< cyclic block: the last link couples to the first
+};
+
+/// A square sparse pattern in compressed sparse column form (0-based, sorted rows per column).
+struct SparsePattern {
+  int n = 0;
+  std::vector<int> col_ptr;    ///< size n+1
+  std::vector<int> row_index;  ///< size nnz
+  int nnz() const { return static_cast<int>(row_index.size()); }
+  /// Position of entry (row, col) in the value array, or -1 if it is not in the pattern.
+  int find(int row, int col) const;
+};
+
+/// Outcome of one factor-and-solve.
+struct SolveStatus {
+  bool ok = true;
+  int unknown = -1;    ///< when !ok: the unknown (column) where the factorization broke down
+  double pivot = 0;    ///< when !ok: the offending pivot value
+  std::string detail;  ///< backend-specific note
+};
+
+/// A sparse direct solver that keeps its symbolic analysis between calls.
+class TensionBackend {
+ public:
+  virtual ~TensionBackend() = default;
+  virtual std::string name() const = 0;
+  /// Symbolic phase, called once with the pattern and the arc blocks it contains.
+  virtual void analyze(const SparsePattern& pattern, const std::vector<ArcBlock>& arcs) = 0;
+  /// Numeric factorization of A (values in pattern order) and solve of A x = b; `rhs` holds b on entry
+  /// and x on return. Reports a singular (or numerically singular) matrix instead of throwing.
+  virtual SolveStatus factor_solve(const double* values, double* rhs) = 0;
+};
+
+/// Backends compiled into this build ("tridiagonal", "eigen", and "klu" when CHAINSIM_WITH_KLU).
+std::vector<std::string> tension_backend_names();
+/// A backend by name; throws InputError (listing the valid names) for an unknown one.
+std::unique_ptr<TensionBackend> make_tension_backend(const std::string& name);
+
+/// Collects the pattern: arcs' tridiagonal blocks plus what junctions declare.
+class TensionPatternBuilder {
+ public:
+  TensionPatternBuilder(const std::vector<ArcBlock>& arcs, int first_junction_unknown)
+      : arcs_(arcs), next_unknown_(first_junction_unknown) {}
+  /// Unknown index of link `link` (0-based within the arc) of arc `arc`.
+  int link_unknown(int arc, int link) const;
+  /// First unknown owned by the junction being declared (valid inside Junction::declare_entries).
+  int first_own_unknown() const { return next_unknown_; }
+  /// Declares that entry (row, col) will receive values.
+  void add_entry(int row, int col) { extra_.emplace_back(row, col); }
+
+ private:
+  friend class TensionSystem;
+  const std::vector<ArcBlock>& arcs_;
+  int next_unknown_;
+  std::vector<std::pair<int, int>> extra_;
+};
+
+/// The sparse tension system of one string model.
+class TensionSystem {
+ public:
+  /// `arc_links[k]`, `arc_closed[k]` describe arc k (its links get consecutive unknowns); junctions
+  /// (may be empty; not owned, must outlive the system) add unknowns and entries. `backend`: see the
+  /// file comment. Throws InputError for an unknown backend or a tridiagonal backend with junctions.
+  TensionSystem(const std::vector<int>& arc_links, const std::vector<bool>& arc_closed,
+                std::vector<Junction*> junctions = {}, const std::string& backend = "auto");
+  ~TensionSystem();
+  TensionSystem(const TensionSystem&) = delete;
+  TensionSystem& operator=(const TensionSystem&) = delete;
+
+  int size() const { return pattern_.n; }
+  const std::vector<ArcBlock>& arcs() const { return arcs_; }
+  const SparsePattern& pattern() const { return pattern_; }
+  const std::string& backend_name() const { return backend_name_; }
+
+  // --- numeric assembly (every right-hand side) ---------------------------------------------
+  /// Sets every matrix value and the right side to zero.
+  void zero();
+  /// A(u, u) += value.
+  void add_diagonal(int u, double value) { values_[diag_slot_[u]] += value; }
+  /// Sets the symmetric coupling A(u, v) = A(v, u) = value between link u and the next link v of its
+  /// arc (the first link, for the last link of a closed arc).
+  void set_coupling(int u, double value) {
+    values_[next_slot_[u]] = value;
+    values_[prev_slot_of_next_[u]] = value;
+  }
+  /// Right side b(u).
+  double& rhs(int u) { return rhs_[u]; }
+  /// Position of entry (row, col) in the value array (junctions look their slots up once).
+  int slot(int row, int col) const;
+  /// Value at a slot found by slot().
+  double& value(int slot) { return values_[static_cast<std::size_t>(slot)]; }
+  const std::vector<double>& values() const { return values_; }
+  const Eigen::VectorXd& rhs_vector() const { return rhs_; }
+
+  /// Lets every junction add its rows (call after the arcs' rows are assembled).
+  void add_junction_rows(double t);
+
+  /// Factors and solves A T = b. Throws NumericalError naming the link (or junction unknown), the
+  /// pivot and the time t when the matrix is singular, or when the solution is not finite.
+  const Eigen::VectorXd& solve(double t);
+  /// The last solution.
+  const Eigen::VectorXd& solution() const { return solution_; }
+  /// Number of factor-and-solve calls so far.
+  long num_solves() const { return solves_; }
+
+  /// "link 12 of arc 0" or "unknown 1 of junction 'shock'".
+  std::string describe(int unknown) const;
+
+ private:
+  std::vector<ArcBlock> arcs_;
+  std::vector<Junction*> junctions_;
+  std::vector<int> junction_offset_;
+  SparsePattern pattern_;
+  std::vector<double> values_;
+  std::vector<int> diag_slot_, next_slot_, prev_slot_of_next_;
+  Eigen::VectorXd rhs_, solution_;
+  std::unique_ptr<TensionBackend> backend_;
+  std::string backend_name_;
+  long solves_ = 0;
+};
+
+}  // namespace chainsim

@@ -1,0 +1,33 @@
+#pragma once
+/// @file vtk_output.hpp
+/// ParaView-readable output: one VTK XML PolyData file (.vtp) per frame and a .pvd collection that
+/// lists them with their times, so ParaView plays the run as a time series.
+///
+/// A string frame is a set of line cells, one per link (so per-link data such as the tension is
+/// cell data); node data (velocity, …) is point data. Points are always 3D for VTK: a 2D string is
+/// written with z = 0. Files are ASCII and written through AtomicFile.
+#include <filesystem>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include <Eigen/Core>
+
+namespace chainsim {
+
+struct VtkPolyline {
+  Eigen::Matrix3Xd points;                    ///< one column per node (m)
+  std::vector<std::pair<int, int>> segments;  ///< node pairs, one per link
+  /// Named point data: rows = components (1 or 3), one column per point.
+  std::vector<std::pair<std::string, Eigen::MatrixXd>> point_data;
+  /// Named cell data: rows = components, one column per segment.
+  std::vector<std::pair<std::string, Eigen::MatrixXd>> cell_data;
+};
+
+/// Writes one frame as a VTK XML PolyData file.
+void write_vtp(const std::filesystem::path& path, const VtkPolyline& line);
+
+/// Writes the ParaView collection: (time in s, file name relative to the .pvd) per frame.
+void write_pvd(const std::filesystem::path& path, const std::vector<std::pair<double, std::string>>& frames);
+
+}  // namespace chainsim
