@@ -29,7 +29,11 @@ fi
 # 2. Build (Release).
 jobs=$(nproc 2>/dev/null || echo 2)
 cmake -S . -B build -DCMAKE_BUILD_TYPE=Release >/dev/null
-cmake --build build -j "$jobs"
+if [ "$job" = demo ]; then
+  cmake --build build -j "$jobs" --target chainsim
+else
+  cmake --build build -j "$jobs"
+fi
 
 # 3. The job.
 if [ "$job" = demo ]; then
