@@ -1,0 +1,96 @@
+#pragma once
+/// @file jump_conditions.hpp
+/// The jump conditions at a shock (DESIGN.md §1; model.md §2–3) as pure pointwise functions of
+/// the states on the two sides. No mesh, no time integration: the front-tracking junctions build
+/// their rows from these, and the tests check them against hand-derived states.
+///
+/// Conventions. s is the material coordinate; "+" is the side of larger s, "−" the side of smaller
+/// s; [ψ] = ψ⁺ − ψ⁻. ṡ0 is the speed of the front in the material (m/s); t± the unit tangents,
+/// v± the velocities, τ± the tensions on the two sides; λ the linear density; f ∈ [0, 1] the
+/// shock's dissipation parameter (`dissipation`).
+///
+///   kinematic compatibility   v0 = v⁺ + ṡ0 t⁺ = v⁻ + ṡ0 t⁻        ⇔  [v] = −ṡ0 [t]
+///   momentum balance          [τ t] + F0 + λ ṡ0 [v] = 0            (F0: force concentrated at x0)
+///   tension jump (energy)     [τ] = −½ f λ sgn(ṡ0) |[v]|²
+///   dissipated power          D = ½ f λ |ṡ0| |[v]|² ≥ 0,   W_s = −D
+///
+/// External shock at a quiescent heap (a string moving along itself, v = v t, v uniform):
+///   Φ*± = ±(τ*± − λ v²) t*±,   W*± = ±(τ*± − ½ λ v²) v
+/// (+: the string runs into the heap at its + end; −: it is drawn out of the heap at its − end).
+///
+/// Reversing the orientation of s (s → ℓ − s) flips t and ṡ0 and swaps the sides; every formula
+/// here is invariant under that change (tested).
+#include <cmath>
+
+#include <Eigen/Core>
+
+namespace chainsim::jump {
+
+template <int dim>
+using Vector = Eigen::Matrix<double, dim, 1>;
+
+/// The state of the string on one side of a front.
+template <int dim>
+struct Side {
+  Vector<dim> tangent;   ///< unit tangent t (points towards larger s)
+  Vector<dim> velocity;  ///< v (m/s)
+  double tension = 0;    ///< τ (N)
+};
+
+inline double sign(double x) { return (x > 0) - (x < 0); }
+
+/// [v] = −ṡ0 [t]: the velocity jump kinematic compatibility allows for given tangents.
+template <int dim>
+Vector<dim> velocity_jump(const Vector<dim>& t_minus, const Vector<dim>& t_plus, double s0_dot) {
+  return -s0_dot * (t_plus - t_minus);
+}
+
+/// v0 = v⁺ + ṡ0 t⁺: the velocity of the singular point itself (not of any material point).
+template <int dim>
+Vector<dim> front_velocity(const Side<dim>& plus, double s0_dot) {
+  return plus.velocity + s0_dot * plus.tangent;
+}
+
+/// |v⁺ + ṡ0 t⁺ − v⁻ − ṡ0 t⁻|: zero when the two sides are kinematically compatible (m/s).
+template <int dim>
+double compatibility_residual(const Side<dim>& minus, const Side<dim>& plus, double s0_dot) {
+  return (plus.velocity + s0_dot * plus.tangent - minus.velocity - s0_dot * minus.tangent).norm();
+}
+
+/// [τ] = −½ f λ sgn(ṡ0) |[v]|² (N).
+inline double tension_jump(double dissipation, double density, double s0_dot, double jump_v_squared) {
+  return -0.5 * dissipation * density * sign(s0_dot) * jump_v_squared;
+}
+
+/// D = ½ f λ |ṡ0| |[v]|² (W): the power the shock dissipates; the shock's power is W_s = −D.
+inline double dissipation_rate(double dissipation, double density, double s0_dot, double jump_v_squared) {
+  return 0.5 * dissipation * density * std::abs(s0_dot) * jump_v_squared;
+}
+
+/// [τ t] + F0 + λ ṡ0 [v] (N): zero when the momentum balance at the front holds.
+template <int dim>
+Vector<dim> momentum_residual(const Side<dim>& minus, const Side<dim>& plus, const Vector<dim>& concentrated_force,
+                              double density, double s0_dot) {
+  return plus.tension * plus.tangent - minus.tension * minus.tangent + concentrated_force +
+         density * s0_dot * (plus.velocity - minus.velocity);
+}
+
+/// F0 = −[τ t] − λ ṡ0 [v]: the concentrated force (e.g. a table's reaction) the front needs (N).
+template <int dim>
+Vector<dim> required_force(const Side<dim>& minus, const Side<dim>& plus, double density, double s0_dot) {
+  return -momentum_residual(minus, plus, Vector<dim>::Zero().eval(), density, s0_dot);
+}
+
+/// Φ*± = ±(τ* − λ v²) t*: the force a quiescent heap exerts on a string moving along itself with
+/// speed v (m/s) at the external shock; `into_heap` selects + (the string runs into the heap).
+template <int dim>
+Vector<dim> heap_force(bool into_heap, double tension, double density, double speed, const Vector<dim>& tangent) {
+  return (into_heap ? 1.0 : -1.0) * (tension - density * speed * speed) * tangent;
+}
+
+/// W*± = ±(τ* − ½ λ v²) v: the power the heap supplies at the external shock (W; negative: a loss).
+inline double heap_power(bool into_heap, double tension, double density, double speed) {
+  return (into_heap ? 1.0 : -1.0) * (tension - 0.5 * density * speed * speed) * speed;
+}
+
+}  // namespace chainsim::jump

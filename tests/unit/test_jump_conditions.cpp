@@ -1,0 +1,117 @@
+// shocks/jump_conditions.hpp against states derived by hand from the paper's three problems,
+// a moving front, and the reversal of the orientation of s.
+#include <catch2/catch.hpp>
+
+#include "shocks/jump_conditions.hpp"
+
+using namespace chainsim::jump;
+using Catch::Matchers::WithinAbs;
+using V2 = Vector<2>;
+using V3 = Vector<3>;
+
+namespace {
+constexpr double kExact = 1e-13;  // every check below is algebra on O(1) numbers: rounding only
+const V2 ex(1.0, 0.0), ey(0.0, 1.0);
+}  // namespace
+
+TEST_CASE("falling chain at the table: standing front, reaction f lambda ydot^2", "[unit][shocks]") {
+  // s runs from the free end down to the table: t⁻ = −e_y (falling part), t⁺ = e_x (towards the heap).
+  // The chain moves along itself with speed v = −ẏ > 0, so ṡ0 = ẏ and the front stands still.
+  const double lam = 0.7, f = 0.83, ydot = -2.3, v = -ydot;
+  Side<2> minus{-ey, v * (-ey), (1.0 - f) * lam * ydot * ydot};
+  Side<2> plus{ex, v * ex, lam * ydot * ydot};
+  const double s0dot = ydot;
+  CHECK_THAT(compatibility_residual(minus, plus, s0dot), WithinAbs(0.0, kExact));
+  CHECK_THAT(front_velocity(plus, s0dot).norm(), WithinAbs(0.0, kExact));
+  const V2 jv = velocity_jump<2>(minus.tangent, plus.tangent, s0dot);
+  CHECK_THAT((jv - (plus.velocity - minus.velocity)).norm(), WithinAbs(0.0, kExact));
+  CHECK_THAT(jv.squaredNorm(), WithinAbs(2 * ydot * ydot, kExact));
+  // [τ] = τ⁺ − τ⁻ = f λ ẏ²  (paper: τ⁻ = (1 − f) λ ẏ², τ⁺ = λ ẏ²)
+  CHECK_THAT(tension_jump(f, lam, s0dot, jv.squaredNorm()), WithinAbs(plus.tension - minus.tension, kExact));
+  // The table's reaction Φ0 e_y = f λ ẏ² e_y balances the momentum at x0.
+  const V2 F0 = required_force(minus, plus, lam, s0dot);
+  CHECK_THAT((F0 - f * lam * ydot * ydot * ey).norm(), WithinAbs(0.0, kExact));
+  CHECK_THAT(momentum_residual(minus, plus, F0, lam, s0dot).norm(), WithinAbs(0.0, kExact));
+  // W_s = −D = f λ ẏ³ (ẏ < 0), and the heap (+ side, τ* = τ⁺ = λ v²) feels no force, supplies −½ λ ẏ³.
+  CHECK_THAT(-dissipation_rate(f, lam, s0dot, jv.squaredNorm()), WithinAbs(f * lam * ydot * ydot * ydot, kExact));
+  CHECK_THAT(heap_force<2>(true, plus.tension, lam, v, ex).norm(), WithinAbs(0.0, kExact));
+  CHECK_THAT(heap_power(true, plus.tension, lam, v), WithinAbs(-0.5 * lam * ydot * ydot * ydot, kExact));
+}
+
+TEST_CASE("folded chain at the bight: moving front, tau+ + tau- = 2 lambda ydot^2", "[unit][shocks]") {
+  // s from the fixed end: resting arm t⁻ = −e_y (v⁻ = 0), moving arm t⁺ = +e_y with v⁺ = −2ẏ e_y; ṡ0 = ẏ.
+  const double lam = 1.3, f = 0.4;
+  for (double ydot : {1.7, -0.9}) {
+    CAPTURE(ydot);
+    const double s = ydot > 0 ? 1.0 : -1.0;
+    Side<2> minus{-ey, V2::Zero(), lam * (1 + f * s) * ydot * ydot};
+    Side<2> plus{ey, -2 * ydot * ey, lam * (1 - f * s) * ydot * ydot};
+    const double s0dot = ydot;
+    CHECK_THAT(compatibility_residual(minus, plus, s0dot), WithinAbs(0.0, kExact));
+    // The bight moves at −ẏ e_y (half the free end's speed).
+    CHECK_THAT((front_velocity(plus, s0dot) + ydot * ey).norm(), WithinAbs(0.0, kExact));
+    const double jv2 = (plus.velocity - minus.velocity).squaredNorm();
+    CHECK_THAT(jv2, WithinAbs(4 * ydot * ydot, kExact));
+    CHECK_THAT(tension_jump(f, lam, s0dot, jv2), WithinAbs(-2 * lam * f * s * ydot * ydot, kExact));
+    CHECK_THAT(tension_jump(f, lam, s0dot, jv2), WithinAbs(plus.tension - minus.tension, kExact));
+    // No concentrated force at the bight: the paper's tensions balance the momentum.
+    CHECK_THAT(momentum_residual(minus, plus, V2(V2::Zero()), lam, s0dot).norm(), WithinAbs(0.0, kExact));
+    CHECK_THAT(-dissipation_rate(f, lam, s0dot, jv2), WithinAbs(-2 * lam * f * s * ydot * ydot * ydot, kExact));
+  }
+}
+
+TEST_CASE("sliding chain at the hole: [tau] = f lambda sgn(ydot) ydot^2, heap feels no force", "[unit][shocks]") {
+  // s from the heap to the hanging end: t⁻ = e_x (on the table), t⁺ = −e_y (hanging); ṡ0 = −ẏ.
+  const double lam = 2.0, f = 0.83, ydot = 1.4;
+  Side<2> minus{ex, ydot * ex, lam * ydot * ydot};
+  Side<2> plus{-ey, -ydot * ey, lam * ydot * ydot * (1 + f)};
+  const double s0dot = -ydot;
+  CHECK_THAT(compatibility_residual(minus, plus, s0dot), WithinAbs(0.0, kExact));
+  const double jv2 = (plus.velocity - minus.velocity).squaredNorm();
+  CHECK_THAT(tension_jump(f, lam, s0dot, jv2), WithinAbs(f * lam * ydot * ydot, kExact));
+  // The plane's reaction Φ0 = τ⁺ − λ ẏ² = f λ ẏ² upward.
+  const V2 F0 = required_force(minus, plus, lam, s0dot);
+  CHECK_THAT((F0 - f * lam * ydot * ydot * ey).norm(), WithinAbs(0.0, kExact));
+  // Heap on the − side, τ*⁻ = τ⁻ = λ ẏ²: no force, W*⁻ = −½ λ ẏ³; W_s = −f λ ẏ³.
+  CHECK_THAT(heap_force<2>(false, minus.tension, lam, ydot, ex).norm(), WithinAbs(0.0, kExact));
+  CHECK_THAT(heap_power(false, minus.tension, lam, ydot), WithinAbs(-0.5 * lam * ydot * ydot * ydot, kExact));
+  CHECK_THAT(-dissipation_rate(f, lam, s0dot, jv2), WithinAbs(-f * lam * ydot * ydot * ydot, kExact));
+}
+
+TEST_CASE("the jump conditions do not depend on the orientation of s", "[unit][shocks]") {
+  // A general moving kink in 3D: given the − side and ṡ0, build the compatible + side, its tension
+  // from the energy condition and F0 from the momentum balance; then describe the same shock with s
+  // reversed (t → −t, ṡ0 → −ṡ0, sides swapped) and check every condition still holds.
+  const double lam = 0.9, f = 0.6;
+  const V3 tm = V3(1.0, 2.0, -0.5).normalized(), tp = V3(-0.3, 1.0, 2.0).normalized();
+  for (double s0dot : {0.8, -1.1}) {
+    CAPTURE(s0dot);
+    Side<3> minus{tm, V3(0.2, -1.0, 0.4), 3.0};
+    Side<3> plus{tp, minus.velocity + velocity_jump<3>(tm, tp, s0dot), 0.0};
+    const double jv2 = (plus.velocity - minus.velocity).squaredNorm();
+    plus.tension = minus.tension + tension_jump(f, lam, s0dot, jv2);
+    const V3 F0 = required_force(minus, plus, lam, s0dot);
+    CHECK_THAT(momentum_residual(minus, plus, F0, lam, s0dot).norm(), WithinAbs(0.0, kExact));
+
+    const Side<3> minus_r{-plus.tangent, plus.velocity, plus.tension};
+    const Side<3> plus_r{-minus.tangent, minus.velocity, minus.tension};
+    CHECK_THAT(compatibility_residual(minus_r, plus_r, -s0dot), WithinAbs(0.0, kExact));
+    const double jv2_r = (plus_r.velocity - minus_r.velocity).squaredNorm();
+    CHECK_THAT(plus_r.tension - minus_r.tension, WithinAbs(tension_jump(f, lam, -s0dot, jv2_r), kExact));
+    CHECK_THAT(momentum_residual(minus_r, plus_r, F0, lam, -s0dot).norm(), WithinAbs(0.0, kExact));
+    CHECK_THAT(dissipation_rate(f, lam, -s0dot, jv2_r), WithinAbs(dissipation_rate(f, lam, s0dot, jv2), kExact));
+    // The front itself moves the same way in both descriptions.
+    CHECK_THAT((front_velocity(plus_r, -s0dot) - front_velocity(plus, s0dot)).norm(), WithinAbs(0.0, kExact));
+  }
+}
+
+TEST_CASE("energy: the dissipation equals the power lost across the front", "[unit][shocks]") {
+  // The identity behind the tension jump (model.md §2.3): ṡ0 [τ] = −D, so the shock dissipates
+  // exactly D = ½ f λ |ṡ0| |[v]|² whatever the sign of ṡ0, and a standing front (ṡ0 = 0) nothing.
+  const double lam = 1.1, f = 0.75, jv2 = 3.7;
+  for (double s0dot : {2.0, -2.0, 0.0}) {
+    CAPTURE(s0dot);
+    CHECK_THAT(s0dot * tension_jump(f, lam, s0dot, jv2), WithinAbs(-dissipation_rate(f, lam, s0dot, jv2), kExact));
+  }
+  CHECK(dissipation_rate(0.0, lam, 2.0, jv2) == 0.0);  // f = 0: an elastic shock dissipates nothing
+}
