@@ -63,11 +63,13 @@ class Chain {
       throw InputError(fmt::format("a {} string needs at least {} links, got {}", closed_ ? "closed" : "open",
                                    closed_ ? 3 : 1, h_.size()));
     length_ = 0;
+    s_.assign(h_.size() + 1, 0.0);
     for (double h : h_) {
       if (!(h > 0) || !std::isfinite(h))
         throw InputError(fmt::format("link length = {:g} is out of range: allowed h > 0", h));
       length_ += h;
     }
+    for (std::size_t j = 0; j < h_.size(); ++j) s_[j + 1] = s_[j] + h_[j];
     const int n = num_nodes();
     mass_ = Eigen::VectorXd::Zero(n);
     for (int j = 0; j < num_links(); ++j) {
@@ -105,11 +107,7 @@ class Chain {
   int link_end(int j) const { return j + 1 == num_nodes() ? 0 : j + 1; }
 
   /// Material coordinate s_i of node i (m from node 0 along the string).
-  double node_coordinate(int i) const {
-    double s = 0;
-    for (int j = 0; j < i; ++j) s += h_[static_cast<std::size_t>(j)];
-    return s;
-  }
+  double node_coordinate(int i) const { return s_[static_cast<std::size_t>(i)]; }
   /// Material coordinate of the midpoint of link j (m).
   double link_midpoint(int j) const { return node_coordinate(j) + 0.5 * link_length(j); }
 
@@ -136,6 +134,7 @@ class Chain {
   std::vector<double> h_;
   bool closed_;
   double length_ = 0;
+  std::vector<double> s_;  // s_[i]: material coordinate of node i (s_[n] = ℓ on a closed chain)
   Eigen::VectorXd mass_;
   Points<dim> x_, v_;
   std::vector<Arc> arcs_;

@@ -14,8 +14,10 @@ namespace {
 /// A link shorter than this fraction of its material length is a trial state the model cannot use
 /// (the unit vector e_j is undefined): ARKODE retries with a smaller step.
 constexpr double kCollapsedLink = 1e-6;
-/// The initial projection stops when every link length is right to this relative accuracy.
+/// The initial projection stops when every link length is right to this relative accuracy, or when
+/// Newton's method stalls (round-off of coordinates large against h) below kProjectionStall.
 constexpr double kProjectionTolerance = 1e-14;
+constexpr double kProjectionStall = 1e-10;
 constexpr int kProjectionIterations = 60;
 }  // namespace
 
@@ -220,12 +222,14 @@ double StringModel<dim>::make_consistent(double t0) {
   double violation = 0;
   try {
     int iteration = 0;
+    double previous = INFINITY;
     for (;; ++iteration) {
       links(x, v);
       violation = 0;
       for (int j = 0; j < L; ++j)
         violation = std::max(violation, std::abs(l_[j] - chain_.link_length(j)) / chain_.link_length(j));
-      if (violation <= kProjectionTolerance) break;
+      if (violation <= kProjectionTolerance || (violation < kProjectionStall && violation > 0.5 * previous)) break;
+      previous = violation;
       if (iteration == kProjectionIterations || !std::isfinite(violation))
         throw InputError(fmt::format(
             "the initial shape cannot be fitted to the link lengths: after {} projection steps a link is still "

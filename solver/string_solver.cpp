@@ -114,6 +114,12 @@ const RunSummary& StringSolver<dim>::run() {
       }
       record(t_out, integrator->state());
     }
+  } catch (const RecoverableError& e) {
+    // Only a trial stage may be retried: at an accepted state the model cannot go on.
+    finish("failed");
+    const double t = integrator ? integrator->time() : t0;
+    summary_.error = fmt::format("the string degenerated at t = {:.9g} s: {}", t, e.what());
+    throw NumericalError(summary_.error, t);
   } catch (const Error& e) {
     finish("failed");
     summary_.error = e.what();

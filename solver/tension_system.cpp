@@ -20,8 +20,8 @@ namespace chainsim {
 
 namespace {
 
-/// A pivot smaller than this times the largest |diagonal entry| of the matrix counts as zero: the
-/// system is singular to working precision.
+/// A pivot smaller than this times its row's |diagonal entry| (tridiagonal), or a reciprocal pivot
+/// growth below it (KLU), counts as zero: the system is singular to working precision.
 constexpr double kSingularPivot = 1e-13;
 
 // ----------------------------------------------------------------------------------------------
@@ -84,22 +84,22 @@ class TridiagonalBackend final : public TensionBackend {
   /// Solves the tridiagonal block [f, f+m) with diagonal `bmod` (if given, else from values) for the
   /// right side r (in place); if `second` is given, applies the same elimination to it.
   SolveStatus thomas(const double* A, double* r, int f, int m, const double* bmod, double* second) {
-    double scale = 0;
-    for (int i = 0; i < m; ++i) scale = std::max(scale, std::abs(A[diag_[f + i]]));
-    const double tiny = kSingularPivot * scale;
+    // A pivot that cancels its row's diagonal to round-off means a singular matrix.
     double piv = bmod ? bmod[0] : A[diag_[f]];
-    if (!(std::abs(piv) > tiny)) return {false, f, piv, "Thomas elimination"};
-    cp_[0] = m > 1 ? A[upper_[f]] / piv : 0.0;
-    r[f] /= piv;
-    if (second) second[0] /= piv;
+    if (!(std::abs(piv) > kSingularPivot * std::abs(A[diag_[f]]))) return {false, f, piv, "Thomas elimination"};
+    double inv = 1.0 / piv;
+    cp_[0] = m > 1 ? A[upper_[f]] * inv : 0.0;
+    r[f] *= inv;
+    if (second) second[0] *= inv;
     for (int i = 1; i < m; ++i) {
       const double a = A[lower_[f + i]];
       const double b = bmod ? bmod[i] : A[diag_[f + i]];
       piv = b - a * cp_[static_cast<std::size_t>(i - 1)];
-      if (!(std::abs(piv) > tiny)) return {false, f + i, piv, "Thomas elimination"};
-      cp_[static_cast<std::size_t>(i)] = i + 1 < m ? A[upper_[f + i]] / piv : 0.0;
-      r[f + i] = (r[f + i] - a * r[f + i - 1]) / piv;
-      if (second) second[i] = (second[i] - a * second[i - 1]) / piv;
+      if (!(std::abs(piv) > kSingularPivot * std::abs(b))) return {false, f + i, piv, "Thomas elimination"};
+      inv = 1.0 / piv;
+      cp_[static_cast<std::size_t>(i)] = i + 1 < m ? A[upper_[f + i]] * inv : 0.0;
+      r[f + i] = (r[f + i] - a * r[f + i - 1]) * inv;
+      if (second) second[i] = (second[i] - a * second[i - 1]) * inv;
     }
     for (int i = m - 2; i >= 0; --i) {
       r[f + i] -= cp_[static_cast<std::size_t>(i)] * r[f + i + 1];

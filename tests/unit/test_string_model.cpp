@@ -1,0 +1,118 @@
+// solver/string_model.hpp: the ODE layout, the initial projection onto the constraints, the power
+// of the applied forces, and the model's input checks.
+#include <cmath>
+
+#include <catch2/catch.hpp>
+
+#include "mesh/discretize.hpp"
+#include "solver/errors.hpp"
+#include "solver/string_model.hpp"
+
+using namespace chainsim;
+using Catch::Matchers::Contains;
+using Catch::Matchers::WithinAbs;
+using Catch::Matchers::WithinRel;
+
+namespace {
+constexpr double kPi = 3.14159265358979323846;
+/// Newton's projection stops at ~1e-14 relative link error (round-off of the coordinates).
+constexpr double kProjected = 1e-13;
+/// Round-off of O(n) sums.
+constexpr double kRoundOff = 1e-12;
+}  // namespace
+
+TEST_CASE("the initial projection makes a regular polygon of a sampled circle", "[unit][model]") {
+  const int n = 12;
+  Chain<2> chain = discretize(*circle_curve<2>(Vec<2>(0, 0), 1.0, Vec<2>(1, 0), Vec<2>(0, 1)), 2 * kPi, 1.0, n, true);
+  // Nodes on the circle have chords 2 sin(π/n) < h = 2π/n: the projection expands the polygon.
+  CHECK(chain.max_length_violation() > 1e-3);
+  StringModel<2> model(std::move(chain), {}, {}, {});
+  const double moved = model.make_consistent(0.0);
+  const double h = 2 * kPi / n, r = h / (2 * std::sin(kPi / n));
+  CHECK_THAT(moved, WithinRel(r - 1.0, 1e-9));
+  CHECK(model.chain().max_length_violation() < kProjected);
+  for (int i = 0; i < n; ++i) CHECK_THAT(model.chain().positions().col(i).norm(), WithinRel(r, kProjected));
+}
+
+TEST_CASE("the projection keeps prescribed nodes and removes the velocities that stretch links", "[unit][model]") {
+  // A sagging polyline between fixed points with arbitrary velocities.
+  Points<2> v(2, 3);
+  v << 0.0, 0.5, 1.0, 0.0, -0.6, 0.0;
+  const double length = 2 * std::sqrt(0.25 + 0.36);
+  Chain<2> chain = discretize(*polyline_curve<2>(v), length, 1.0, 9, false);
+  for (int i = 0; i < chain.num_nodes(); ++i) chain.velocities().col(i) = Vec<2>(std::cos(3.0 * i), std::sin(5.0 * i));
+  const Vec<2> driven_velocity(0.2, 0.3);
+  std::vector<PrescribedNode<2>> ends = {{0, std::make_shared<FixedPoint<2>>(Vec<2>(0, 0))},
+                                         {9, std::make_shared<LinearPath<2>>(Vec<2>(1, 0), driven_velocity)}};
+  StringModel<2> model(std::move(chain), {}, ends, {});
+  model.make_consistent(0.0);
+  const auto& c = model.chain();
+  CHECK(c.positions().col(0) == Vec<2>(0, 0));
+  CHECK(c.positions().col(9) == Vec<2>(1, 0));
+  CHECK(c.velocities().col(0) == Vec<2>(0, 0));
+  CHECK(c.velocities().col(9) == driven_velocity);
+  CHECK(c.max_length_violation() < kProjected);
+  for (int j = 0; j < c.num_links(); ++j) {
+    const Vec<2> dx = c.positions().col(j + 1) - c.positions().col(j);
+    const Vec<2> dv = c.velocities().col(j + 1) - c.velocities().col(j);
+    CHECK_THAT(dx.normalized().dot(dv), WithinAbs(0.0, kRoundOff));
+  }
+  // The ODE state holds the free nodes only, plus W_applied.
+  CHECK(model.num_free_nodes() == 8);
+  CHECK(model.size() == 2 * 2 * 8 + 1);
+  const Eigen::VectorXd y = model.state_from_chain();
+  Points<2> x, vel;
+  model.unpack(0.5, y, x, vel);
+  CHECK((x.col(9) - Vec<2>(1.1, 0.15)).norm() < kRoundOff);  // the driven node on its path at t = 0.5
+  CHECK(x.col(4) == c.positions().col(4));
+}
+
+TEST_CASE("the power booked in W_applied: drag, loads and drivers, not gravity", "[unit][model]") {
+  Chain<3> chain = Chain<3>::uniform(2.0, 1.0, 4, false);
+  for (int i = 0; i <= 4; ++i) {
+    chain.positions().col(i) = Vec<3>(0.25 * i, 0.0, 0.0);
+    chain.velocities().col(i) = Vec<3>(0.0, 0.1 * i, 0.0);  // a rigid rotation about node 0: consistent
+  }
+  std::vector<std::unique_ptr<Force<3>>> forces;
+  forces.push_back(std::make_unique<Gravity<3>>(Vec<3>(0, 0, -9.81)));
+  forces.push_back(std::make_unique<Drag<3>>(0.5));
+  forces.push_back(std::make_unique<EndLoad<3>>(4, Vec<3>(0.0, 1.0, 0.0)));
+  std::vector<PrescribedNode<3>> fixed = {{0, std::make_shared<FixedPoint<3>>(Vec<3>(0, 0, 0))}};
+  StringModel<3> model(std::move(chain), std::move(forces), fixed, {});
+  const auto& c = model.chain();
+  const double power = model.evaluate(0.0, c.positions(), c.velocities());
+  // Drag: −c Σ m_i |v_i|² over the free nodes; load: F·v_end; the fixed node does no work.
+  double drag = 0;
+  for (int i = 1; i <= 4; ++i) drag -= 0.5 * c.mass(i) * c.velocities().col(i).squaredNorm();
+  CHECK_THAT(power, WithinRel(drag + 1.0 * 0.4, kRoundOff));
+  // Momentum balance of every free node: m a = F + T_i e_i − T_{i−1} e_{i−1}.
+  const Eigen::VectorXd& T = model.tensions();
+  for (int i = 1; i <= 4; ++i) {
+    Vec<3> f = c.mass(i) * Vec<3>(0, 0, -9.81) - 0.5 * c.mass(i) * c.velocities().col(i);
+    if (i == 4) f += Vec<3>(0, 1, 0);
+    if (i < 4) f += T[i] * Vec<3>(1, 0, 0);
+    f -= T[i - 1] * Vec<3>(1, 0, 0);
+    CHECK((c.mass(i) * model.accelerations().col(i) - f).norm() < kRoundOff);
+  }
+}
+
+TEST_CASE("the model refuses inconsistent set-ups", "[unit][model]") {
+  auto chain = [] {
+    Chain<2> c = Chain<2>::uniform(1.0, 1.0, 1, false);
+    c.positions().col(1) = Vec<2>(1, 0);
+    return c;
+  };
+  std::vector<PrescribedNode<2>> both = {{0, std::make_shared<FixedPoint<2>>(Vec<2>(0, 0))},
+                                         {1, std::make_shared<FixedPoint<2>>(Vec<2>(1, 0))}};
+  CHECK_THROWS_WITH(StringModel<2>(chain(), {}, both, {}), Contains("link 0 joins two prescribed nodes"));
+  std::vector<std::unique_ptr<Force<2>>> load;
+  load.push_back(std::make_unique<EndLoad<2>>(0, Vec<2>(1, 0)));
+  std::vector<PrescribedNode<2>> first = {{0, std::make_shared<FixedPoint<2>>(Vec<2>(0, 0))}};
+  CHECK_THROWS_WITH(StringModel<2>(chain(), std::move(load), first, {}), Contains("both loaded and prescribed"));
+  StringModelOptions bad;
+  bad.backend = "cholmod";
+  CHECK_THROWS_WITH(StringModel<2>(chain(), {}, {}, bad), Contains("backend = \"cholmod\""));
+  bad.backend = "auto";
+  bad.stabilization_time = -1;
+  CHECK_THROWS_WITH(StringModel<2>(chain(), {}, {}, bad), Contains("stabilization_time"));
+}
