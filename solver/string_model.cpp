@@ -310,7 +310,12 @@ void StringModel<dim>::check_slack(double t, const Eigen::Ref<const Eigen::Vecto
   unpack(t, y, x_, v_);
   evaluate(t, x_, v_);
   const Eigen::VectorXd& T = system_->solution();
-  const double scale = T.cwiseAbs().maxCoeff();
+  // Compare with a physical tension scale too, so that a string whose exact tension is zero (free
+  // fall, uniform motion) is not reported slack for round-off: λ (|g| ℓ + max |v|²).
+  double v2_max = 0;
+  for (int i = 0; i < v_.cols(); ++i) v2_max = std::max(v2_max, v_.col(i).squaredNorm());
+  const double physical = chain_.density() * (gravity().norm() * chain_.length() + v2_max);
+  const double scale = std::max(T.cwiseAbs().maxCoeff(), physical);
   int worst = 0;
   for (int j = 1; j < T.size(); ++j)
     if (T[j] < T[worst]) worst = j;

@@ -43,6 +43,16 @@ template <int dim>
 StringSolver<dim>::StringSolver(StringModel<dim>& model, const StringSolverOptions& options)
     : model_(model), options_(options) {
   options_.validate();
+  // Frames are kept in memory until the outputs are written: bound them (about 40 bytes per node
+  // and frame, so the limit is under 1 GB) rather than let a typo exhaust the machine.
+  constexpr double kMaxNodeFrames = 2e7;
+  const double frames = std::floor(options_.t_end / options_.output_interval) + 2;
+  const double node_frames = frames * model_.chain().num_nodes();
+  if (node_frames > kMaxNodeFrames)
+    throw InputError(fmt::format("solver.output_interval = {:g} s with solver.t_end = {:g} s asks for {:.3g} frames of "
+                                 "{} nodes ({:.3g} node-frames): allowed at most {:.0e}; raise output_interval",
+                                 options_.output_interval, options_.t_end, frames, model_.chain().num_nodes(),
+                                 node_frames, kMaxNodeFrames));
 }
 
 template <int dim>

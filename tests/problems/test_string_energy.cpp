@@ -37,11 +37,12 @@ RunSummary run(StringModel<2>& model, double rtol, double t_end, double output_i
   return solver.run();
 }
 
-/// Relative energy error of a conservative run is bounded by this multiple of rtol (ERK8 with
-/// local error control: the global error over ~10 periods stays within ~10–100 local tolerances).
-constexpr double kEnergyPerRtol = 100.0;
-/// Constraint violation |l − h| / h is bounded by this multiple of rtol (Baumgarte keeps it there).
-constexpr double kConstraintPerRtol = 10.0;
+/// Relative energy error of a run is bounded by this multiple of rtol: measured 0.003–0.007 for the
+/// conservative swinging chain at rtol 1e-6…1e-10 (ERK8), so 0.1 leaves a margin of ~15.
+constexpr double kEnergyPerRtol = 0.1;
+/// Constraint violation |l − h| / h is bounded by this multiple of rtol: measured 0.8e-3–1.6e-3
+/// (Baumgarte keeps it at the tolerance level), so 0.02 leaves a margin of ~12.
+constexpr double kConstraintPerRtol = 0.02;
 
 }  // namespace
 
@@ -110,10 +111,14 @@ TEST_CASE("Baumgarte stabilisation keeps the constraint drift at the tolerance l
               "", "first 10%", "last 10%", "Baumgarte tau_b = 0.03", stabilised.early, stabilised.late,
               "no stabilisation", free_drift.early, free_drift.late);
   std::fflush(stdout);
-  /// Bounded: the late window may not exceed the early one by more than this factor.
+  /// Bounded: the late window may not exceed the early one by more than this factor (measured 1.3).
   constexpr double kNoGrowth = 3.0;
-  CHECK(stabilised.late < kNoGrowth * stabilised.early + kConstraintPerRtol * rtol);
-  CHECK(stabilised.late < kConstraintPerRtol * rtol);
+  CHECK(stabilised.late < kNoGrowth * stabilised.early);
+  // Without stabilisation the drift grows (measured 7.4e-7 late vs 1.2e-10 stabilised): the
+  // stabilisation is what keeps it bounded, not a loose bound.
+  constexpr double kStabilisationGain = 100.0;
+  CHECK(free_drift.late > kStabilisationGain * stabilised.late);
+  CHECK(free_drift.late > 10.0 * free_drift.early);
 }
 
 TEST_CASE("a shaken end: the ledger closes with the driver's work", "[problems][string]") {
@@ -225,4 +230,32 @@ TEST_CASE("implicit (DIRK) methods run the string too", "[problems][string]") {
     CHECK(s.relative_energy_drift() < 100 * kEnergyPerRtol * 1e-7);
     CHECK(s.max_constraint_violation < 100 * kConstraintPerRtol * 1e-7);
   }
+}
+
+TEST_CASE("zero exact tension is not slack: a free string falling under gravity", "[problems][string]") {
+  // Every node falls with g, the exact tension is 0: round-off tensions (~1e-16 N) are no slack.
+  Chain<2> chain = Chain<2>::uniform(0.5, 1.0, 20, false);
+  for (int i = 0; i <= 20; ++i) chain.positions().col(i) = Vec<2>(i / 20.0, 0.3 * std::sin(i / 5.0));
+  std::vector<std::unique_ptr<Force<2>>> forces;
+  forces.push_back(std::make_unique<Gravity<2>>(Vec<2>(0.0, -kG)));
+  StringModelOptions mo;
+  mo.check_slack = true;
+  StringModel<2> model(std::move(chain), std::move(forces), {}, mo);
+  StringSolverOptions so;
+  so.t_end = 0.5;
+  StringSolver<2> solver(model, so);
+  const RunSummary& s = solver.run();
+  CHECK(s.status == "completed");
+  // Free fall: the ledger closes with no applied work.
+  CHECK(s.relative_energy_drift() < kEnergyPerRtol * so.integrator.rtol);
+}
+
+TEST_CASE("an output request too large for memory is refused before the run", "[problems][string]") {
+  auto model = swinging_chain(10, 0.1 * std::sqrt(1.0 / kG));
+  StringSolverOptions so;
+  so.t_end = 1e6;
+  so.output_interval = 1e-9;
+  CHECK_THROWS_WITH(StringSolver<2>(*model, so),
+                    Contains("solver.output_interval = 1e-09 s with solver.t_end = 1e+06 s") &&
+                        Contains("allowed at most 2e+07"));
 }
