@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include <fmt/format.h>
 
@@ -219,6 +220,12 @@ double StringModel<dim>::make_consistent(double t0) {
       target.col(b) += w_[b] * nu[j] * e_.col(j);
     }
   };
+  // Coordinates far from the origin, or links far shorter than the coordinates, limit how well a
+  // link length can be represented at all: stall detection starts at that round-off level.
+  double h_min = INFINITY;
+  for (int j = 0; j < L; ++j) h_min = std::min(h_min, chain_.link_length(j));
+  const double roundoff = 64 * std::numeric_limits<double>::epsilon() * x.cwiseAbs().maxCoeff() / h_min;
+  const double stall = std::max(kProjectionStall, roundoff);
   double violation = 0;
   try {
     int iteration = 0;
@@ -228,7 +235,7 @@ double StringModel<dim>::make_consistent(double t0) {
       violation = 0;
       for (int j = 0; j < L; ++j)
         violation = std::max(violation, std::abs(l_[j] - chain_.link_length(j)) / chain_.link_length(j));
-      if (violation <= kProjectionTolerance || (violation < kProjectionStall && violation > 0.5 * previous)) break;
+      if (violation <= kProjectionTolerance || (violation < stall && violation > 0.5 * previous)) break;
       previous = violation;
       if (iteration == kProjectionIterations || !std::isfinite(violation))
         throw InputError(fmt::format(

@@ -175,7 +175,11 @@ void StringSolver<dim>::write_outputs(const std::filesystem::path& dir, bool vtk
   stats["dimension"] = dim;
   stats["stabilization_time"] = model_.options().stabilization_time;
   write_json(dir / "stats.json", stats);
-  // 3. ParaView frames.
+  // 3. ParaView frames. Frames of an earlier run in the same directory are removed first, so the
+  //    directory never mixes two runs (the .pvd index lists only this run's frames anyway).
+  std::error_code ec;
+  std::filesystem::remove_all(dir / "frames", ec);
+  std::filesystem::remove(dir / "string.pvd", ec);
   if (!vtk) return;
   ensure_directory(dir / "frames");
   std::vector<std::pair<double, std::string>> index;
