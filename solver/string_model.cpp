@@ -33,6 +33,9 @@ StringModel<dim>::StringModel(Chain<dim> chain, std::vector<std::unique_ptr<Forc
                               std::vector<PrescribedNode<dim>> prescribed, const StringModelOptions& options)
     : chain_(std::move(chain)), forces_(std::move(forces)), prescribed_(std::move(prescribed)), options_(options) {
   options_.validate();
+  // The rows below number link j as unknown j and close the loop through chain_.closed(): one arc.
+  // The shock module assembles per arc (ArcBlock) when it splits chains at fronts.
+  CHAINSIM_VERIFY(chain_.arcs().size() == 1, "StringModel assembles a single arc");
   const int n = chain_.num_nodes(), L = chain_.num_links();
   // 1. Which nodes are prescribed.
   path_of_.assign(static_cast<std::size_t>(n), -1);
