@@ -2,6 +2,7 @@
 #include <array>
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
 #include <string>
 
 #include <catch2/catch.hpp>
@@ -83,4 +84,29 @@ TEST_CASE("every command has --help", "[unit][cli]") {
     CHECK(r.status == 0);
     CHECK_THAT(r.output, Catch::Matchers::Contains("Usage"));
   }
+}
+
+TEST_CASE("chainsim run: a numerical failure exits 3, says what and when, and writes complete outputs", "[unit][cli]") {
+  // A straight string at rest, fixed at one end, its free end pushed back towards the fixed end with
+  // 1 N: the tension would be −1 N everywhere, which an inextensible string cannot carry.
+  const std::string dir = temp_dir("cli_slack");
+  std::filesystem::create_directories(dir);
+  const std::string scene = dir + "/pushed.toml";
+  {
+    std::FILE* f = std::fopen(scene.c_str(), "w");
+    REQUIRE(f);
+    std::fputs("[string]\nnodes = 11\n[shape]\nkind = \"polyline\"\npoints = [[0.0, 0.0], [1.0, 0.0]]\n"
+               "[ends]\nstart = \"fixed\"\nend = { kind = \"loaded\", force = [-1.0, 0.0] }\n"
+               "[solver]\nt_end = 1.0\ncheck_slack = true\n",
+               f);
+    std::fclose(f);
+  }
+  const Result r = run("run " + scene + " --out " + dir + "/out");
+  CHECK(r.status == 3);
+  CHECK_THAT(r.output, Catch::Matchers::StartsWith("chainsim: numerical failure: slack at t = 0 s"));
+  std::ifstream stats(dir + "/out/stats.json");
+  REQUIRE(stats);
+  const auto j = nlohmann::json::parse(stats);
+  CHECK(j["status"] == "failed");
+  CHECK_THAT(j["error"].get<std::string>(), Catch::Matchers::Contains("slack"));
 }
