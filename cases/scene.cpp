@@ -18,7 +18,6 @@ namespace chainsim {
 
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 
 // ================================================================================================
 // 1. Parsing: a checked view of one TOML table.

@@ -28,6 +28,9 @@
 
 namespace chainsim {
 
+/// π, for the shapes and their tests.
+inline constexpr double kPi = 3.14159265358979323846;
+
 /// A point or vector in R^dim.
 template <int dim>
 using Vec = Eigen::Matrix<double, dim, 1>;

@@ -14,7 +14,6 @@ namespace chainsim {
 
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 
 // mesh sits below solver (mesh <- solver) and so cannot link errors.cpp: it throws the header-only
 // InputError through these local checks, worded like solver's require_in_range().

@@ -14,7 +14,6 @@
 
 namespace chainsim::testing {
 
-constexpr double kPi = 3.14159265358979323846;
 constexpr double kG = 9.81;
 
 /// A chain of length `length` hanging from a fixed node 0 at the origin along −y, with `links`

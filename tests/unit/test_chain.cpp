@@ -18,7 +18,6 @@ namespace {
 constexpr double kRoundOff = 1e-13;
 /// Nodes placed on an analytic curve: the curve's own evaluation error.
 constexpr double kOnCurve = 1e-12;
-constexpr double kPi = 3.14159265358979323846;
 }  // namespace
 
 TEST_CASE("lumped masses sum to the chain's mass", "[unit][mesh]") {

@@ -14,7 +14,6 @@ using Catch::Matchers::WithinAbs;
 using Catch::Matchers::WithinRel;
 
 namespace {
-constexpr double kPi = 3.14159265358979323846;
 /// Newton's projection stops at ~1e-14 relative link error (round-off of the coordinates).
 constexpr double kProjected = 1e-13;
 /// Round-off of O(n) sums.
