@@ -1,0 +1,52 @@
+#pragma once
+/// @file canonical_string.hpp
+/// The paper's three chain problems solved with the string solver (shocks/front_model.hpp), in the
+/// paper's geometry (2D, x horizontal, y up, g = −g e_y) or in a general variant:
+///
+///   falling  the part above the table (material s ∈ [0, y], free end at s = 0 on top) ends at the
+///            heap point x0 = 0 on the table; the heap holds s > y. Variant: released tilted by
+///            `tilt_deg` from the vertical (it pivots about x0 while it runs into the heap).
+///   folded   node 0 fixed at the origin; the resting arm hangs to the fold at depth y; the moving
+///            arm goes up from the fold to the free end (loaded by F e_y). Variant: the moving arm
+///            released tilted by `tilt_deg` (ends apart: it swings while it falls).
+///   sliding  the heap on the table feeds the string through the hole x0 = 0; the hanging part
+///            s ∈ [ℓ − y, ℓ] (free end at s = ℓ). Variant: the hanging part released tilted by
+///            `tilt_deg` (it swings while it slides). η0 = 0 starts on the exact branch
+///            y = a t²/2 (a = g/(3 + 2f)) at y = 2 h.
+///
+/// η = y/ℓ, P = the vertical force of all supports (table/plane with the heap, or the fixed end).
+#include <optional>
+
+#include <nlohmann/json.hpp>
+
+#include "cases/reduced_models.hpp"
+#include "shocks/front_solver.hpp"
+
+namespace chainsim {
+
+struct StringCaseSetup {
+  Problem problem = Problem::kFalling;
+  ChainParameters chain;
+  int nodes = 101;                ///< nodes of the whole string (N + 1), >= 4
+  double eps = 0.01;              ///< cutoff (as ReducedSetup)
+  std::optional<double> eta0;     ///< as ReducedSetup (defaults: falling 1, folded 0, sliding 0)
+  double force = 0;               ///< folded: upward end force F (N)
+  double tilt_deg = 0;            ///< general variant (see the file comment); 0 = the paper's geometry
+  double t_max_over_t0 = 50.0;    ///< safety stop
+  IntegratorOptions integrator = default_integrator();
+  static IntegratorOptions default_integrator();
+  void validate() const;
+};
+
+/// A string-solver run of a canonical problem: the FrontRun plus η, η' = dη/dξ and P/P0 per sample.
+struct StringCaseRun {
+  FrontRun run;
+  std::vector<double> t, eta, eta_dot, P;  ///< t (s), η, dη/dt (1/s), P (N)
+  double t_offset = 0;  ///< time of the string's start on the reduced solution (sliding from η0 = 0)
+  nlohmann::json summary;
+};
+
+/// Builds and runs the problem. Throws InputError for a bad setup.
+StringCaseRun solve_string_case(const StringCaseSetup& setup);
+
+}  // namespace chainsim
