@@ -71,7 +71,8 @@ StringCaseRun solve_string_case(const StringCaseSetup& setup) {
       const double y0 = eta0 * ell;
       for (int i = 0; i <= links; ++i) {
         const double s = i * h;
-        x.col(i) = s <= y0 ? Vec<2>(-s * up) : Vec<2>(-y0 * up + (s - y0) * tilted);
+        // Both arms lie on one line, tilted by tilt_deg: the fold stays a fold, the ends are apart.
+        x.col(i) = s <= y0 ? Vec<2>(-s * tilted) : Vec<2>(-y0 * tilted + (s - y0) * tilted);
       }
       prescribed.push_back({0, std::make_shared<FixedPoint<2>>(Vec<2>::Zero())});
       fold = FoldSpec{f, y0};

@@ -62,7 +62,10 @@ FrontModel<dim>::FrontModel(Chain<dim> chain, std::vector<std::unique_ptr<Force<
   const HeapSpec<dim>* after = nullptr;
   for (const auto& heap : heaps) {
     require_in_range("heap.dissipation", heap.dissipation, 0.0, 1.0);
-    require_in_range("heap.s0", heap.s0, 0.0, ell, Bound::kOpen, Bound::kOpen);
+    if (heap.side == HeapSpec<dim>::Side::kAfter)
+      require_in_range("heap.s0", heap.s0, 0.0, ell, Bound::kOpen, Bound::kClosed);
+    else
+      require_in_range("heap.s0", heap.s0, 0.0, ell, Bound::kClosed, Bound::kOpen);
     auto& slot = heap.side == HeapSpec<dim>::Side::kBefore ? before : after;
     if (slot) throw InputError("at most one heap on each side of the string");
     slot = &heap;

@@ -153,7 +153,7 @@ FrontRun run_fronts(FrontModel<dim>& model, const FrontRunOptions& options) {
     }
     run.t_stop = run.samples.back().t;
     run.stats = integrator.stats();
-  } catch (const NumericalError& e) {
+  } catch (const Error& e) {  // NumericalError, or a RecoverableError outside a step (at a crossing)
     run.status = "failed";
     run.error = e.what();
     run.t_stop = run.samples.empty() ? 0 : run.samples.back().t;
