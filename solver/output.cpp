@@ -100,7 +100,7 @@ void ensure_directory(const std::filesystem::path& dir) {
 
 void ensure_writable_directory(const std::filesystem::path& dir) {
   ensure_directory(dir);
-  const std::filesystem::path probe = dir / ".chainsim_write_probe";
+  const std::filesystem::path probe = dir / "chainsim_write_probe";
   try {
     AtomicFile file(probe);
     file.stream() << "probe\n";
