@@ -66,7 +66,10 @@ int main(int argc, char** argv) {
   auto* cmd_run = app.add_subcommand("run", "Run a string scene (a TOML file) with the general string solver");
   cmd_run->add_option("scene", run.scene, "scene file")->required();
   cmd_run->add_option("--out", run.out, "output directory (default results/<scene name>)");
-  cmd_run->add_flag("--json", run.json, "print the run summary as one JSON object on stdout");
+  double run_t_end = 0;
+  auto* opt_t_end = cmd_run->add_option("--t-end", run_t_end, "end time (s), > 0: replaces the scene's [stop] t_end");
+  cmd_run->add_flag("--json", run.json,
+                    "print the run summary as one JSON object on stdout (on failure: status \"failed\" and the error)");
 
   try {
     app.parse(argc, argv);
@@ -77,7 +80,10 @@ int main(int argc, char** argv) {
   try {
     if (*cmd_reduced) return chainsim::run_reduced_command(reduced, std::cout);
     if (*cmd_canonical) return chainsim::run_canonical_command(canonical, std::cout);
-    if (*cmd_run) return chainsim::run_scene_command(run, std::cout);
+    if (*cmd_run) {
+      if (opt_t_end->count() > 0) run.t_end = run_t_end;
+      return chainsim::run_scene_command(run, std::cout);
+    }
   } catch (const chainsim::InputError& e) {
     std::cerr << "chainsim: error: " << e.what() << '\n';
     return 2;

@@ -1,49 +1,31 @@
 #pragma once
 /// @file scene.hpp
-/// A minimal string scene (TOML), read in two separate steps:
-///   parse_scene()        TOML -> SceneSpec (plain data; every key checked, unknown keys rejected with
-///                        file:line:column, the key and the list of valid keys),
+/// A string scene (TOML, SI units), read in two separate steps:
+///   parse_scene()        TOML -> SceneSpec (plain data). Every key is checked: an unknown section or
+///                        key, a missing required key, a wrong type or a value out of range throws
+///                        InputError with file:line:column, the key, the value as written and what is
+///                        allowed (the valid keys for a typo, with a "did you mean" when one is close).
+///                        The position of every key read is kept in SceneSpec::locations.
 ///   build_string_scene() SceneSpec -> StringModel + solver options (the physics; the solver itself
-///                        never reads files).
-/// The full scene format (its own issue) will grow SceneSpec and the parser; the builder stays.
+///                        never reads files). It builds only the effects the scene declares, and
+///                        refuses a physically inconsistent scene (shape and string of different
+///                        lengths, vectors of the wrong dimension, ends on a closed string, prescribed
+///                        ends pulled further apart than the string is long, a shape that cannot be
+///                        fitted to the links, …) before any run, naming the file:line:column of the
+///                        offending key.
+/// The keys, their units, defaults and ranges are documented in docs/scenes.md. In short:
 ///
-/// Example (2D, lengths in m, times in s, SI units throughout):
-///
-///     [string]
-///     length = 1.0        # optional: default = the shape's length
-///     density = 0.1       # kg/m
-///     nodes = 41
-///     closed = false      # default: true for kind = "circle", else false
-///     dimension = 2
-///
-///     [shape]
-///     kind = "polyline"   # polyline | points | arc | circle | catenary
-///     points = [[0.0, 0.0], [0.0, -1.0]]
-///     # arc/circle: center, radius, start_angle_deg, sweep_deg (arc), axis1, axis2 (plane)
-///     # catenary:   start, end  (sags along the gravity vector, default -y)
-///     length_tolerance = 1e-6   # relative mismatch allowed between the shape and string.length
-///
-///     [velocity]
-///     kind = "rest"       # rest | uniform (value = [..]) | tangential (speed) | nodes (values = [[..], ..])
-///
-///     [ends]
-///     start = "fixed"     # free | fixed | loaded | driven, or a table:
-///     end = { kind = "driven", path = "shake", amplitude = [0.05, 0.0], omega = 12.0 }
-///     #  loaded: force = [..] (N), amplitude = [..] (N), omega: F(t) = force + amplitude sin(omega t)
-///     #  driven: path = "shake": x0 + amplitude (1 - cos omega t)   "sine": x0 + amplitude sin(omega t)
-///     #          path = "linear": x0 + velocity t
-///
-///     [gravity]
-///     g = [0.0, -9.81]
-///
-///     [drag]
-///     coefficient = 0.5   # 1/s: force -coefficient m v on every node
-///
-///     [solver]
-///     method = "erk8"     rtol = 1e-8   atol = 1e-10   t_end = 5.0   output_interval = 0.05
-///     stabilization_time = 0.03   # Baumgarte time scale (s); 0 = off; default 0.1 t_char
-///     backend = "auto"    check_slack = false   slack_tolerance = 1e-8   max_step = 0   vtk = true
+///     [string]   length (m), density (kg/m), nodes | link_length (m), closed, dimension (2 | 3)
+///     [shape]    kind = polyline | points | arc | circle | catenary, and that kind's keys
+///     [velocity] kind = rest | uniform | tangential | nodes
+///     [ends]     start, end = "free" | "fixed" | { kind = "loaded", … } | { kind = "driven", … }
+///     [effects.gravity] g (m/s²)          [effects.drag] coefficient (1/s)
+///     [solver]   method, rtol, atol, max_step, initial_step, max_steps, stabilization_time, backend,
+///                check_slack, slack_tolerance
+///     [output]   interval (s), fields = [nodes, tension, energy, stats], formats = [csv, vtk]
+///     [stop]     t_end (s)
 #include <filesystem>
+#include <map>
 #include <memory>
 #include <optional>
 #include <string>
@@ -55,7 +37,7 @@
 
 namespace chainsim {
 
-/// One end of an open string.
+/// One end of an open string: [ends] start / end.
 struct EndSpec {
   std::string kind = "free";      ///< free | fixed | loaded | driven
   std::vector<double> force;      ///< loaded: constant force F0 (N)
@@ -63,16 +45,31 @@ struct EndSpec {
   double omega = 0;               ///< angular frequency (rad/s)
   std::string path = "shake";     ///< driven: shake | sine | linear
   std::vector<double> velocity;   ///< driven, linear path: velocity (m/s)
+  bool prescribed() const { return kind == "fixed" || kind == "driven"; }
+};
+
+/// Where a key was written and how.
+struct KeyLocation {
+  std::string where;  ///< "file:line:column" of its value (of the header, for a section)
+  std::string text;   ///< the value as written in the file (shortened if long)
 };
 
 struct SceneSpec {
   std::string source;  ///< file name, for messages
+  /// Every key and section read, by its dotted name ("string.length", "shape.points[1]",
+  /// "effects.gravity.g", "ends.start", "stop"): where it was written.
+  std::map<std::string, KeyLocation> locations;
+  /// "file:line:column" of `key`, or of the nearest enclosing section written in the file, else
+  /// "file:1:1" (a key that is missing altogether concerns the whole file).
+  std::string where(const std::string& key) const;
+
   // [string]
   int dimension = 2;
-  std::optional<double> length;  ///< m; default: the shape's length
-  double density = 1.0;          ///< kg/m
-  int nodes = 41;
-  std::optional<bool> closed;
+  std::optional<double> length;       ///< m; default: the shape's length
+  double density = 1.0;               ///< kg/m
+  std::optional<int> nodes;           ///< default 41 (unless link_length is given)
+  std::optional<double> link_length;  ///< m; target material length of a link (instead of nodes)
+  std::optional<bool> closed;         ///< default: true for a circle, else false
   // [shape]
   struct Shape {
     std::string kind;
@@ -90,25 +87,35 @@ struct SceneSpec {
   } velocity;
   // [ends]
   EndSpec start, end;
-  // [gravity], [drag]
-  std::vector<double> gravity;  ///< empty: no gravity
-  double drag = 0;              ///< 1/s; 0: no drag effect
+  // [effects.*]: each effect exists only if its section is written (std::nullopt: not declared).
+  struct Effects {
+    std::optional<std::vector<double>> gravity;  ///< [effects.gravity] g (m/s²)
+    std::optional<double> drag;                  ///< [effects.drag] coefficient (1/s)
+  } effects;
   // [solver]
   struct Solver {
     std::string method = "erk8";
     double rtol = 1e-8, atol = 1e-10;
-    double t_end = 1.0, output_interval = 0.05;
+    double max_step = 0, initial_step = 0;
+    long max_steps = 500000;
     std::optional<double> stabilization_time;  ///< s; default 0.1 t_char (see build_string_scene)
     std::string backend = "auto";
     bool check_slack = false;
     double slack_tolerance = 1e-8;
-    double max_step = 0;
-    bool vtk = true;
   } solver;
+  // [output]
+  struct Output {
+    double interval = 0.05;  ///< s between frames
+    OutputSelection select;  ///< fields and formats
+  } output;
+  // [stop]
+  struct Stop {
+    double t_end = 0;  ///< s (required in a scene file)
+  } stop;
 };
 
 /// Reads a scene file. Throws InputError (with file:line:column) on a syntax error, an unknown
-/// section or key, or a value of the wrong type.
+/// section or key, a missing required key, or a value of the wrong type or out of range.
 SceneSpec parse_scene(const std::filesystem::path& file);
 /// The same from text; `source` names it in messages.
 SceneSpec parse_scene_text(std::string_view text, const std::string& source);
@@ -116,15 +123,17 @@ SceneSpec parse_scene_text(std::string_view text, const std::string& source);
 /// A scene ready to run.
 template <int dim>
 struct StringScene {
-  std::unique_ptr<StringModel<dim>> model;
+  std::unique_ptr<StringModel<dim>> model;  ///< already projected onto the constraints at t = 0
   StringSolverOptions solver;
-  bool vtk = true;
+  OutputSelection output;
   double characteristic_time = 0;  ///< t_char used for the default stabilization time (s)
 };
 
-/// Builds the model of a parsed scene (dim must equal spec.dimension). Default Baumgarte time:
-/// τ_b = 0.1 t_char with t_char the shortest of sqrt(ℓ/|g|) (gravity), ℓ/max|v0| (moving start),
-/// 2π/ω (shaken or periodically loaded ends) and t_end.
+/// Builds the model of a parsed scene (dim must equal spec.dimension) with exactly the effects the
+/// scene declares, checks it physically and projects its initial state onto the constraints.
+/// Default Baumgarte time: τ_b = 0.1 t_char with t_char the shortest of sqrt(ℓ/|g|) (gravity),
+/// ℓ/max|v0| (moving start), 2π/ω (shaken or periodically loaded ends) and t_end.
+/// Throws InputError naming the file:line:column of the key at fault.
 template <int dim>
 StringScene<dim> build_string_scene(const SceneSpec& spec);
 

@@ -1,6 +1,8 @@
 #include "output.hpp"
 
+#include <cerrno>
 #include <cmath>
+#include <cstring>
 #include <system_error>
 
 #include <fmt/format.h>
@@ -13,8 +15,11 @@ namespace chainsim {
 AtomicFile::AtomicFile(std::filesystem::path target) : target_(std::move(target)) {
   temp_ = target_;
   temp_.replace_filename("." + target_.filename().string() + ".tmp");
+  errno = 0;
   out_.open(temp_, std::ios::out | std::ios::trunc);
-  if (!out_) throw InputError(fmt::format("cannot write the output file '{}'", temp_.string()));
+  if (!out_)
+    throw InputError(fmt::format("cannot write the output file '{}'{}", temp_.string(),
+                                 errno ? std::string(": ") + std::strerror(errno) : std::string()));
 }
 
 AtomicFile::~AtomicFile() {
@@ -91,6 +96,20 @@ void ensure_directory(const std::filesystem::path& dir) {
   if (ec || !std::filesystem::is_directory(dir))
     throw InputError(fmt::format("--out = '{}' cannot be used as an output directory: {}", dir.string(),
                                  ec ? ec.message() : "not a directory"));
+}
+
+void ensure_writable_directory(const std::filesystem::path& dir) {
+  ensure_directory(dir);
+  const std::filesystem::path probe = dir / "chainsim_write_probe";
+  try {
+    AtomicFile file(probe);
+    file.stream() << "probe\n";
+    file.commit();
+  } catch (const Error& e) {
+    throw InputError(fmt::format("--out = '{}' is not writable: {}", dir.string(), e.what()));
+  }
+  std::error_code ec;
+  std::filesystem::remove(probe, ec);
 }
 
 nlohmann::json to_json(const IntegratorStats& s) {

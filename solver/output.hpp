@@ -64,6 +64,11 @@ void write_json(const std::filesystem::path& path, const nlohmann::json& doc);
 /// Creates `dir` (and parents) or throws InputError naming the directory and the OS error.
 void ensure_directory(const std::filesystem::path& dir);
 
+/// ensure_directory(), then checks that a file can be created and renamed in `dir` (by writing and
+/// removing a probe through AtomicFile); throws InputError naming the directory and the OS error.
+/// Call it before a long run, so that a read-only --out fails at once rather than at the end.
+void ensure_writable_directory(const std::filesystem::path& dir);
+
 /// ARKODE's statistics as a JSON object (keys as in IntegratorStats).
 nlohmann::json to_json(const IntegratorStats& stats);
 

@@ -4,12 +4,14 @@
 /// link constraints (and slack, if asked) after every accepted step, keeps the energy ledger, and
 /// writes the outputs.
 ///
-/// Outputs (write_outputs, all through AtomicFile):
+/// Outputs (write_outputs, all through AtomicFile; which ones: OutputSelection):
 ///   nodes.csv    t, node, x, y[, z], vx, vy[, vz]       at every output time
 ///   tension.csv  t, link, s_mid, T                       s_mid: material coordinate of the link midpoint
 ///   energy.csv   t, K, V, W_applied, drift               drift = K + V − (K0 + V0) − W_applied
-///   stats.json   ARKODE statistics, tension solves, wall time, ledger, constraint violation
 ///   frames/frame_XXXX.vtp and string.pvd                 ParaView time series
+///   stats.json   ARKODE statistics, tension solves, wall time, ledger, constraint violation, the
+///                effects built, root functions and junction unknowns; written last, so its
+///                presence means the set of files is complete
 #include <filesystem>
 #include <functional>
 #include <string>
@@ -24,9 +26,20 @@ namespace chainsim {
 
 struct StringSolverOptions {
   IntegratorOptions integrator;
-  double t_end = 1.0;            ///< end time (s), > 0
-  double output_interval = 0.1;  ///< time between frames (s); frames at 0, Δ, 2Δ, …, and t_end
+  double t_end = 1.0;            ///< end time (s), > 0 ([stop] t_end)
+  double output_interval = 0.1;  ///< time between frames (s); frames at 0, Δ, 2Δ, …, and t_end ([output] interval)
   void validate() const;
+  /// Frames are kept in memory until the outputs are written: throws InputError if t_end and
+  /// output_interval ask for more than 2·10⁷ node-frames of a string with `nodes` nodes.
+  void check_frame_budget(int nodes) const;
+};
+
+/// Which outputs write_outputs() produces: fields × formats. A CSV file per field (nodes, tension,
+/// energy), the ParaView frames (geometry and velocities, plus the tension as cell data if the
+/// tension field is selected; they need the nodes field), and stats.json.
+struct OutputSelection {
+  bool nodes = true, tension = true, energy = true, stats = true;  ///< fields
+  bool csv = true, vtk = true;                                     ///< formats
 };
 
 /// One recorded output time.
@@ -52,6 +65,16 @@ struct RunSummary {
   long tension_solves = 0;
   long frames = 0;
   std::string tension_backend;
+  std::string stop_reason;         ///< "t_end" when completed
+  // What the model holds (observable proof that a scene pays only for what it declares):
+  int dimension = 0;               ///< 2 or 3: the instantiation that ran
+  int nodes = 0, links = 0;
+  std::vector<std::string> effects;     ///< names of the force effects built (Force::name())
+  std::vector<std::string> prescribed;  ///< prescribed nodes, e.g. "node 0: fixed"
+  int root_functions = 0;          ///< event functions registered with the integrator (OdeSystem::num_events)
+  int tension_unknowns = 0;        ///< size of the tension system
+  int junction_unknowns = 0;       ///< tension_unknowns − links: unknowns junctions (shocks) add
+  double stabilization_time = 0;   ///< Baumgarte time scale used (s)
   IntegratorStats stats;
   /// energy_drift / energy_scale (0 if the scale is 0).
   double relative_energy_drift() const { return energy_scale > 0 ? energy_drift / energy_scale : 0.0; }
@@ -78,11 +101,14 @@ class StringSolver {
   /// The integrator's final state.
   const Eigen::VectorXd& final_state() const { return final_state_; }
 
-  /// Writes the output files (see the file comment) into `dir` (created if needed).
-  void write_outputs(const std::filesystem::path& dir, bool vtk = true) const;
+  /// Writes the selected output files (see the file comment) into `dir` (created if needed). Outputs
+  /// of an earlier run in `dir` are removed first, so the directory never mixes two runs; stats.json
+  /// is written last.
+  void write_outputs(const std::filesystem::path& dir, const OutputSelection& select = {}) const;
 
  private:
   void record(double t, const Eigen::VectorXd& y);
+  void describe_model();
 
   StringModel<dim>& model_;
   StringSolverOptions options_;

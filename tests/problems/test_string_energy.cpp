@@ -256,6 +256,6 @@ TEST_CASE("an output request too large for memory is refused before the run", "[
   so.t_end = 1e6;
   so.output_interval = 1e-9;
   CHECK_THROWS_WITH(StringSolver<2>(*model, so),
-                    Contains("solver.output_interval = 1e-09 s with solver.t_end = 1e+06 s") &&
+                    Contains("output.interval = 1e-09 s with stop.t_end = 1e+06 s") &&
                         Contains("allowed at most 2e+07"));
 }

@@ -15,8 +15,9 @@ struct Result {
   std::string output;  // stdout and stderr
 };
 
-Result run(const std::string& args) {
-  const std::string cmd = std::string(CHAINSIM_BINARY) + " " + args + " 2>&1";
+/// Runs chainsim with `args`; stdout and stderr are captured together unless stdout_only.
+Result run(const std::string& args, bool stdout_only = false) {
+  const std::string cmd = std::string(CHAINSIM_BINARY) + " " + args + (stdout_only ? " 2>/dev/null" : " 2>&1");
   FILE* pipe = popen(cmd.c_str(), "r");
   REQUIRE(pipe);
   std::string out;
@@ -97,7 +98,7 @@ TEST_CASE("chainsim run: a numerical failure exits 3, says what and when, and wr
     REQUIRE(f);
     std::fputs("[string]\nnodes = 11\n[shape]\nkind = \"polyline\"\npoints = [[0.0, 0.0], [1.0, 0.0]]\n"
                "[ends]\nstart = \"fixed\"\nend = { kind = \"loaded\", force = [-1.0, 0.0] }\n"
-               "[solver]\nt_end = 1.0\ncheck_slack = true\n",
+               "[solver]\ncheck_slack = true\n[stop]\nt_end = 1.0\n",
                f);
     std::fclose(f);
   }
@@ -109,4 +110,13 @@ TEST_CASE("chainsim run: a numerical failure exits 3, says what and when, and wr
   const auto j = nlohmann::json::parse(stats);
   CHECK(j["status"] == "failed");
   CHECK_THAT(j["error"].get<std::string>(), Catch::Matchers::Contains("slack"));
+  // With --json the failure is one JSON object on stdout (the summary up to the failure); the
+  // message still goes to stderr.
+  const Result json = run("run " + scene + " --json --out " + dir + "/out", true);
+  CHECK(json.status == 3);
+  const auto failed = nlohmann::json::parse(json.output);
+  CHECK(failed["status"] == "failed");
+  CHECK(failed["exit_code"] == 3);
+  CHECK_THAT(failed["error"].get<std::string>(), Catch::Matchers::StartsWith("slack at t = 0 s"));
+  CHECK(failed["root_functions"] == 0);
 }
