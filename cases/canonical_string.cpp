@@ -1,6 +1,8 @@
 // The canonical problems on the string solver: see canonical_string.hpp.
 #include "cases/canonical_string.hpp"
 
+#include <algorithm>
+#include <chrono>
 #include <cmath>
 
 #include <fmt/format.h>
@@ -131,6 +133,92 @@ StringCaseRun solve_string_case(const StringCaseSetup& setup) {
   out.summary["eta_stop"] = out.eta.empty() ? 0.0 : out.eta.back();
   out.summary["tilt_deg"] = setup.tilt_deg;
   return out;
+}
+
+namespace {
+
+/// A solution known at increasing times t_k with values q_k and derivatives dq_k: cubic Hermite.
+struct Hermite {
+  std::vector<double> t, q, dq;
+  double operator()(double x) const {
+    if (x <= t.front()) return q.front();
+    if (x >= t.back()) return q.back();
+    const std::size_t k = static_cast<std::size_t>(std::upper_bound(t.begin(), t.end(), x) - t.begin()) - 1;
+    const double h = t[k + 1] - t[k], u = (x - t[k]) / h;
+    const double h00 = (1 + 2 * u) * (1 - u) * (1 - u), h10 = u * (1 - u) * (1 - u);
+    const double h01 = u * u * (3 - 2 * u), h11 = u * u * (u - 1);
+    return h00 * q[k] + h10 * h * dq[k] + h01 * q[k + 1] + h11 * h * dq[k + 1];
+  }
+};
+
+/// The time at which the (monotone) reduced η takes the value `eta`, by bisection on the Hermite
+/// interpolant, then P there.
+double time_at_eta(const Hermite& eta, double value, bool increasing) {
+  double lo = eta.t.front(), hi = eta.t.back();
+  for (int it = 0; it < 200 && hi - lo > 1e-15 * hi; ++it) {
+    const double mid = 0.5 * (lo + hi);
+    ((eta(mid) < value) == increasing ? lo : hi) = mid;
+  }
+  return 0.5 * (lo + hi);
+}
+
+}  // namespace
+
+Comparison compare_with_reduced(const StringCaseSetup& setup) {
+  Comparison c;
+  c.string = solve_string_case(setup);
+  ReducedSetup rs;
+  rs.problem = setup.problem;
+  rs.chain = setup.chain;
+  rs.eps = setup.eps;
+  rs.eta0 = setup.eta0;
+  rs.force = setup.force;
+  rs.t_max_over_t0 = setup.t_max_over_t0;
+  const double t0 = setup.chain.t0(), P0 = setup.chain.P0(), ell = setup.chain.length;
+  rs.integrator.max_step = t0 / 5000;
+  const auto start = std::chrono::steady_clock::now();
+  c.reduced = solve_reduced(rs);
+  const double wall_reduced = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  Hermite eta{c.reduced.series.column("t"), c.reduced.series.column("y"), c.reduced.series.column("ydot")};
+  for (double& y : eta.q) y /= ell;
+  for (double& yd : eta.dq) yd /= ell;
+  // P of the reduced model from the paper's closed forms in (y, ẏ), with ẏ interpolated from (ẏ, ÿ).
+  Hermite ydot{eta.t, c.reduced.series.column("ydot"), c.reduced.series.column("yddot")};
+  const double lambda = setup.chain.density, g = setup.chain.gravity, f = setup.chain.dissipation;
+  auto reduced_P_at = [&](double t) {
+    const double y = eta(t) * ell, yd = ydot(t);
+    const double sg = (yd > 0) - (yd < 0);
+    switch (setup.problem) {
+      case Problem::kFolded: return lambda * (1 + f * sg) * yd * yd + lambda * g * y;
+      default: return f * lambda * yd * yd + lambda * g * (ell - y);  // falling and sliding
+    }
+  };
+  bool monotone = true;
+  for (std::size_t k = 1; k < eta.q.size(); ++k)
+    if ((eta.q[k] - eta.q[k - 1]) * (eta.q.back() - eta.q.front()) < 0) monotone = false;
+  const bool increasing = eta.q.back() > eta.q.front();
+  const StringCaseRun& s = c.string;
+  double err_eta = 0, err_P = 0;
+  for (std::size_t k = 0; k < s.t.size(); ++k) {
+    err_eta = std::max(err_eta, std::abs(s.eta[k] - eta(s.t[k])));
+    const double t_ref = monotone ? time_at_eta(eta, s.eta[k], increasing) : s.t[k];
+    const double P_ref = reduced_P_at(t_ref);
+    err_P = std::max(err_P, std::abs(s.P[k] - P_ref) / std::max(std::abs(P_ref), P0));
+  }
+  const double ts = c.string.summary["t_stop_over_t0"].get<double>();
+  const double tr = c.reduced.summary["t_stop_over_t0"].get<double>();
+  c.summary = c.string.summary;
+  c.summary["t_stop_over_t0_reduced"] = tr;
+  c.summary["rel_err_t_stop"] = std::abs(ts - tr) / tr;
+  c.summary["max_abs_err_eta"] = err_eta;
+  c.summary["max_rel_err_P"] = err_P;
+  c.summary["P_compared_at"] = monotone ? "equal eta" : "equal t";
+  c.summary["wall_s_reduced"] = wall_reduced;
+  c.summary["f"] = setup.chain.dissipation;
+  c.summary["eps"] = setup.eps;
+  c.summary["force"] = setup.force;
+  c.summary["eta0"] = rs.initial_eta();
+  return c;
 }
 
 }  // namespace chainsim

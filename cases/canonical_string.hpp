@@ -49,4 +49,21 @@ struct StringCaseRun {
 /// Builds and runs the problem. Throws InputError for a bad setup.
 StringCaseRun solve_string_case(const StringCaseSetup& setup);
 
+/// The string solver and the reduced ODE on the same problem (`chainsim compare`). The reduced model
+/// is integrated with its default method and max_step t0/5000, and evaluated at the string's sample
+/// times by cubic Hermite interpolation (η, dη/dt). Summary keys (besides the string run's):
+///   t_stop_over_t0, t_stop_over_t0_reduced, rel_err_t_stop,
+///   max_abs_err_eta      max over the string's samples of |η_string(t) − η_reduced(t)|,
+///   max_rel_err_P        max over the samples of |P_string − P_reduced| / max(|P_reduced|, P0) at equal η
+///                        (P_reduced at the string's η, by Hermite interpolation in t of the reduced
+///                        run at the time it has that η), or at equal t where η is not monotone,
+///   energy_residual      the string run's relative energy ledger residual,
+///   nodes, wall_s (string solver), wall_s_reduced.
+struct Comparison {
+  StringCaseRun string;
+  ReducedRun reduced{CsvTable(series_columns()), {}};
+  nlohmann::json summary;
+};
+Comparison compare_with_reduced(const StringCaseSetup& setup);
+
 }  // namespace chainsim

@@ -5,6 +5,7 @@
 #include <iosfwd>
 #include <string>
 
+#include "cases/canonical_string.hpp"
 #include "cases/reduced_models.hpp"
 
 namespace chainsim {
@@ -26,5 +27,15 @@ struct CanonicalCommandOptions {
   bool json = false;
 };
 int run_canonical_command(const CanonicalCommandOptions& options, std::ostream& out);
+
+/// `chainsim compare falling|folded|sliding --nodes N ...`: the string solver (front tracking) and the
+/// reduced ODE on the same problem; writes string_series.csv, reduced_series.csv and summary.json.
+struct CompareCommandOptions {
+  std::string problem;
+  StringCaseSetup setup;  ///< problem is filled in from `problem`
+  std::string out;        ///< output directory; "" = results/compare/<problem>
+  bool json = false;
+};
+int run_compare_command(CompareCommandOptions options, std::ostream& out);
 
 }  // namespace chainsim

@@ -61,6 +61,27 @@ int main(int argc, char** argv) {
   cmd_canonical->add_option("--out", canonical.out, "output directory")->capture_default_str();
   cmd_canonical->add_flag("--json", canonical.json, "print the three summaries as a JSON array on stdout");
 
+  // --- chainsim compare ------------------------------------------------------------------------
+  chainsim::CompareCommandOptions compare;
+  auto* cmd_compare = app.add_subcommand(
+      "compare", "Solve a canonical problem with the string solver (front tracking) and with its reduced ODE, and "
+                 "compare them");
+  cmd_compare->add_option("problem", compare.problem, "falling | folded | sliding")->required();
+  auto& cs = compare.setup;
+  cmd_compare->add_option("--nodes", cs.nodes, "nodes of the string, 4 <= N <= 200001")->capture_default_str();
+  cmd_compare->add_option("--f", cs.chain.dissipation, "shock dissipation parameter f, 0 <= f <= 1")->capture_default_str();
+  cmd_compare->add_option("--eps", cs.eps, "cutoff eps, 0 < eps < 1")->capture_default_str();
+  cmd_compare->add_option("--eta0", cs.eta0, "initial eta = y(0)/l (defaults: falling 1, folded 0, sliding 0)");
+  cmd_compare->add_option("--force", cs.force, "upward force F on the free end of the folded chain (N), F >= 0")
+      ->capture_default_str();
+  cmd_compare->add_option("--length", cs.chain.length, "chain length l (m), > 0")->capture_default_str();
+  cmd_compare->add_option("--density", cs.chain.density, "linear density lambda (kg/m), > 0")->capture_default_str();
+  cmd_compare->add_option("--gravity", cs.chain.gravity, "gravitational acceleration g (m/s^2), > 0")->capture_default_str();
+  cmd_compare->add_option("--t-max", cs.t_max_over_t0, "safety stop time, in units of t0")->capture_default_str();
+  add_integrator_options(*cmd_compare, cs.integrator);
+  cmd_compare->add_option("--out", compare.out, "output directory (default results/compare/<problem>)");
+  cmd_compare->add_flag("--json", compare.json, "print the summary as one JSON object on stdout");
+
   // --- chainsim run ----------------------------------------------------------------------------
   chainsim::RunCommandOptions run;
   auto* cmd_run = app.add_subcommand("run", "Run a string scene (a TOML file) with the general string solver");
@@ -80,6 +101,7 @@ int main(int argc, char** argv) {
   try {
     if (*cmd_reduced) return chainsim::run_reduced_command(reduced, std::cout);
     if (*cmd_canonical) return chainsim::run_canonical_command(canonical, std::cout);
+    if (*cmd_compare) return chainsim::run_compare_command(compare, std::cout);
     if (*cmd_run) {
       if (opt_t_end->count() > 0) run.t_end = run_t_end;
       return chainsim::run_scene_command(run, std::cout);

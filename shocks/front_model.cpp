@@ -60,8 +60,10 @@ FrontModel<dim>::FrontModel(Chain<dim> chain, std::vector<std::unique_ptr<Force<
   // 2. Fronts in order of s: heap before, fold, heap after.
   const HeapSpec<dim>* before = nullptr;
   const HeapSpec<dim>* after = nullptr;
-  for (const auto& heap : heaps) {
+  for (auto& heap : heaps) {
     require_in_range("heap.dissipation", heap.dissipation, 0.0, 1.0);
+    if (std::abs(heap.s0 - ell) <= 1e-12 * ell) heap.s0 = ell;  // ℓ is a sum of link lengths
+    if (std::abs(heap.s0) <= 1e-12 * ell) heap.s0 = 0;
     if (heap.side == HeapSpec<dim>::Side::kAfter)
       require_in_range("heap.s0", heap.s0, 0.0, ell, Bound::kOpen, Bound::kClosed);
     else
