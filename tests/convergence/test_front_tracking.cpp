@@ -4,6 +4,10 @@
 
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
+#include <string>
+
+#include <nlohmann/json.hpp>
 
 #include "cases/canonical_string.hpp"
 
@@ -88,4 +92,24 @@ TEST_CASE("a sliding chain whose hanging part swings converges under refinement 
   CHECK(order_p > 0.9);   // measured 1.1
   CHECK(energy[2] < 1e-5);
   CHECK(d2 / t_stop[2] < 1e-4);
+}
+
+TEST_CASE("chainsim compare prints the summary keys and rejects bad input", "[convergence][shocks][cli]") {
+  const std::string out = "/tmp/chainsim_test_compare";
+  const std::string cmd = std::string(CHAINSIM_BINARY) + " compare folded --nodes 21 --f 0.5 --json --out " + out +
+                          " 2>&1";
+  FILE* pipe = popen(cmd.c_str(), "r");
+  REQUIRE(pipe != nullptr);
+  std::string text;
+  char buffer[4096];
+  while (std::fgets(buffer, sizeof buffer, pipe)) text += buffer;
+  REQUIRE(pclose(pipe) == 0);
+  const auto j = nlohmann::json::parse(text);
+  for (const char* key : {"t_stop_over_t0", "t_stop_over_t0_reduced", "rel_err_t_stop", "max_abs_err_eta",
+                          "max_rel_err_P", "energy_residual", "nodes", "wall_s"})
+    CHECK(j.contains(key));
+  CHECK(j["nodes"] == 21);
+  CHECK(j["rel_err_t_stop"].get<double>() < 1e-7);
+  const std::string bad = std::string(CHAINSIM_BINARY) + " compare folded --nodes 2 >/dev/null 2>&1";
+  CHECK(WEXITSTATUS(std::system(bad.c_str())) == 2);
 }
