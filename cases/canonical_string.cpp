@@ -19,17 +19,22 @@ IntegratorOptions StringCaseSetup::default_integrator() {
   return o;
 }
 
+ReducedSetup StringCaseSetup::reduced() const {
+  ReducedSetup r;
+  r.problem = problem;
+  r.chain = chain;
+  r.eps = eps;
+  r.eta0 = eta0;
+  r.force = force;
+  r.t_max_over_t0 = t_max_over_t0;
+  return r;
+}
+
 void StringCaseSetup::validate() const {
   chain.validate();
   if (nodes < 4 || nodes > 200001)
     throw InputError(fmt::format("--nodes = {} is out of range: allowed 4 <= nodes <= 200001", nodes));
-  ReducedSetup reduced;
-  reduced.problem = problem;
-  reduced.chain = chain;
-  reduced.eps = eps;
-  reduced.eta0 = eta0;
-  reduced.force = force;
-  reduced.validate();
+  reduced().validate();
   require_in_range("--tilt", tilt_deg, -80.0, 80.0);
   require_in_range("t_max_over_t0", t_max_over_t0, 0.0, INFINITY, Bound::kOpen);
   integrator.validate();
@@ -44,10 +49,7 @@ StringCaseRun solve_string_case(const StringCaseSetup& setup) {
   const double tilt = setup.tilt_deg * kPi / 180.0;
   const Vec<2> up(0.0, 1.0);
   const Vec<2> tilted(std::sin(tilt), std::cos(tilt));  // unit vector tilt away from up
-  ReducedSetup defaults;
-  defaults.problem = setup.problem;
-  defaults.eta0 = setup.eta0;
-  double eta0 = defaults.initial_eta();
+  const double eta0 = setup.reduced().initial_eta();
   Chain<2> chain = Chain<2>::uniform(lambda, ell, links, false);
   Points<2>& x = chain.positions();
   Points<2>& v = chain.velocities();
@@ -167,13 +169,7 @@ double time_at_eta(const Hermite& eta, double value, bool increasing) {
 Comparison compare_with_reduced(const StringCaseSetup& setup) {
   Comparison c;
   c.string = solve_string_case(setup);
-  ReducedSetup rs;
-  rs.problem = setup.problem;
-  rs.chain = setup.chain;
-  rs.eps = setup.eps;
-  rs.eta0 = setup.eta0;
-  rs.force = setup.force;
-  rs.t_max_over_t0 = setup.t_max_over_t0;
+  ReducedSetup rs = setup.reduced();
   const double t0 = setup.chain.t0(), P0 = setup.chain.P0(), ell = setup.chain.length;
   rs.integrator.max_step = t0 / 5000;
   const auto start = std::chrono::steady_clock::now();

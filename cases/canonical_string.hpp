@@ -35,6 +35,8 @@ struct StringCaseSetup {
   double t_max_over_t0 = 50.0;    ///< safety stop
   IntegratorOptions integrator = default_integrator();
   static IntegratorOptions default_integrator();
+  /// The reduced model's setup of the same problem (its own default integrator).
+  ReducedSetup reduced() const;
   void validate() const;
 };
 

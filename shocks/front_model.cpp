@@ -3,7 +3,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <limits>
 
 #include <fmt/format.h>
 
@@ -19,8 +18,6 @@ namespace {
 constexpr double kRemove = 0.5, kInsert = 1.5;
 /// The last node of an arc cannot be taken in; the run stops when its partial link is this short.
 constexpr double kLastPartial = 1e-3;
-/// Value of a disabled event function (never crosses zero).
-constexpr double kDisabled = 1.0;
 constexpr double kProjectionTolerance = 1e-13;
 constexpr int kProjectionIterations = 30;
 
@@ -107,7 +104,7 @@ FrontModel<dim>::FrontModel(Chain<dim> chain, std::vector<std::unique_ptr<Force<
     if (stop.front < 0 || stop.front >= static_cast<int>(fronts_.size()))
       throw InputError(fmt::format("stop condition on front {}: the string has {} fronts", stop.front, fronts_.size()));
   // 4. Workspace, then check that the fronts sit where the specs say.
-  for (Points<dim>* p : {&x_, &v_, &a_, &force_, &force_nc_, &front_force_, &tension_force_, &b_}) *p = Points<dim>::Zero(dim, n_);
+  for (Points<dim>* p : {&x_, &v_, &a_, &force_, &force_nc_, &front_force_, &tension_force_, &b_, &e_, &reaction_}) *p = Points<dim>::Zero(dim, n_);
   m_ = Eigen::VectorXd::Zero(n_);
   rebuild();
   x_ = chain_.positions();
@@ -152,6 +149,21 @@ void FrontModel<dim>::rebuild() {
 }
 
 template <int dim>
+typename FrontModel<dim>::HeapEnd FrontModel<dim>::heap_end(const Front& front) const {
+  HeapEnd end;
+  end.after = front.arc_plus < 0;
+  end.arc = end.after ? front.arc_minus : front.arc_plus;
+  const ArcRange& arc = arcs_[static_cast<std::size_t>(end.arc)];
+  end.node = end.after ? arc.last : arc.first;
+  end.inner = end.after ? end.node - 1 : end.node + 1;
+  end.outer = end.after ? end.node + 1 : end.node - 1;
+  end.removable = arc.last > arc.first && path_of_[end.node] < 0;
+  // A node comes out whole only if the front then stays inside the string (s0 = s_outer ± h/2).
+  end.insertable = end.after ? end.outer <= n_ - 2 : end.outer >= 1;
+  return end;
+}
+
+template <int dim>
 Vec<dim> FrontModel<dim>::gravity() const {
   for (const auto& force : forces_)
     if (const auto* g = dynamic_cast<const Gravity<dim>*>(force.get())) return g->g();
@@ -188,8 +200,9 @@ void FrontModel<dim>::front_states() {
     const Front& front = fronts_[k];
     FrontState& s = fs_[k];
     if (front.kind == FrontKind::kHeap) {
-      const bool after = front.arc_plus < 0;
-      const int node = after ? arcs_[front.arc_minus].last : arcs_[front.arc_plus].first;
+      const HeapEnd end = heap_end(front);
+      const bool after = end.after;
+      const int node = end.node;
       const Vec<dim> d = front.point - x_.col(node);
       const double l = d.norm();
       if (!(l > 1e-9 * h_)) throw RecoverableError(fmt::format("the partial link at the heap has collapsed (node {})", node));
@@ -283,6 +296,7 @@ double FrontModel<dim>::evaluate(double t) {
         if (!(l > 1e-6 * h_) || !std::isfinite(l))
           throw RecoverableError(fmt::format("link {} has collapsed to length {:g}", j, l));
         const Vec<dim> e = dx / l;
+        e_.col(j) = e;
         system_->add_diagonal(u, -(w(j) + w(j + 1)));
         if (j > arc.first) system_->set_coupling(u - 1, w(j) * e_prev.dot(e));
         const double stab = 2 * alpha_ * dx.dot(dv) + beta2 * 0.5 * (l * l - h_ * h_);
@@ -296,13 +310,13 @@ double FrontModel<dim>::evaluate(double t) {
       const ArcRange& arc = arcs_[k];
       for (int j = arc.first; j < arc.last; ++j) {
         const double Tj = T[first_unknown_[k] + (j - arc.first)];
-        const Vec<dim> e = (x_.col(j + 1) - x_.col(j)).normalized();
-        tension_force.col(j) += Tj * e;
-        tension_force.col(j + 1) -= Tj * e;
+        tension_force.col(j) += Tj * e_.col(j);
+        tension_force.col(j + 1) -= Tj * e_.col(j);
       }
     }
   }
   double power = 0;
+  reaction_.setZero();
   for (int i = 0; i < n_; ++i) {
     if (!in_arc(i)) continue;
     if (path_of_[i] < 0) {
@@ -311,9 +325,9 @@ double FrontModel<dim>::evaluate(double t) {
     } else {
       a_.col(i) = b_.col(i);
       // the support's reaction R_i = m a − F − T − front force (drag on it counted as applied work too)
-      const Vec<dim> reaction = m_[i] * a_.col(i) - force_.col(i) - force_nc_.col(i) - tension_force.col(i) -
-                                front_force_.col(i);
-      power += (reaction + force_nc_.col(i)).dot(v_.col(i));
+      reaction_.col(i) = m_[i] * a_.col(i) - force_.col(i) - force_nc_.col(i) - tension_force.col(i) -
+                         front_force_.col(i);
+      power += (reaction_.col(i) + force_nc_.col(i)).dot(v_.col(i));
     }
   }
   return power;
@@ -329,11 +343,8 @@ void FrontModel<dim>::rhs(double t, const Eigen::Ref<const Eigen::VectorXd>& y, 
   for (int i = 0; i < n_; ++i) {
     if (!in_arc(i)) continue;
     const int k = slot_[i];
-    external += force_.col(i) + force_nc_.col(i);
-    if (k < 0) {
-      external += m_[i] * a_.col(i) - force_.col(i) - force_nc_.col(i) - tension_force_.col(i) - front_force_.col(i);
-      continue;
-    }
+    external += force_.col(i) + force_nc_.col(i) + reaction_.col(i);
+    if (k < 0) continue;
     ydot.template segment<dim>(dim * k) = v_.col(i);
     ydot.template segment<dim>(voff + dim * k) = a_.col(i);
   }
@@ -360,17 +371,11 @@ void FrontModel<dim>::events(double t, const Eigen::Ref<const Eigen::VectorXd>& 
     const FrontState& s = fs_[k];
     double* gk = g.data() + 2 * k;
     if (front.kind == FrontKind::kHeap) {
-      const bool after = front.arc_plus < 0;
-      const ArcRange& arc = arcs_[after ? front.arc_minus : front.arc_plus];
-      const int node = after ? arc.last : arc.first;
-      const double l = after ? s.l_minus : s.l_plus;
-      const bool removable = arc.last > arc.first && path_of_[node] < 0;
-      gk[0] = l - (removable ? kRemove : kLastPartial) * h_;
-      // Insertion needs the next node to come out whole: s0 must stay inside the string.
-      const int next = after ? node + 1 : node - 1;
-      const bool insertable = after ? next <= n_ - 2 : next >= 1;
+      const HeapEnd end = heap_end(front);
+      const double l = end.after ? s.l_minus : s.l_plus;
+      gk[0] = l - (end.removable ? kRemove : kLastPartial) * h_;
       // When no node can come out any more, the event is the heap running empty.
-      gk[1] = insertable ? l - kInsert * h_ : -(after ? ell - s.s0 : s.s0);
+      gk[1] = end.insertable ? l - kInsert * h_ : -(end.after ? ell - s.s0 : s.s0);
     } else {
       gk[0] = s.l_plus;   // the fold reaches arc B's first node
       gk[1] = s.l_minus;  // the fold reaches arc A's last node
@@ -450,6 +455,7 @@ void FrontModel<dim>::project(double t) {
         const Vec<dim> dx = x_.col(j + 1) - x_.col(j);
         const double l = dx.norm();
         const Vec<dim> e = dx / l;
+        e_.col(j) = e;
         system_->add_diagonal(u, -(w(j) + w(j + 1)));
         if (j > arc.first) system_->set_coupling(u - 1, w(j) * e_prev.dot(e));
         system_->rhs(u) = velocity ? e.dot(v_.col(j + 1) - v_.col(j)) : l - h_;
@@ -464,9 +470,8 @@ void FrontModel<dim>::project(double t) {
       const ArcRange& arc = arcs_[k];
       for (int j = arc.first; j < arc.last; ++j) {
         const double n = nu[first_unknown_[k] + (j - arc.first)];
-        const Vec<dim> e = (x_.col(j + 1) - x_.col(j)).normalized();
-        target.col(j) -= w(j) * n * e;
-        target.col(j + 1) += w(j + 1) * n * e;
+        target.col(j) -= w(j) * n * e_.col(j);
+        target.col(j + 1) += w(j + 1) * n * e_.col(j);
       }
     }
   };
@@ -522,15 +527,12 @@ typename FrontModel<dim>::EventAction FrontModel<dim>::handle_events(double t, E
     Front& front = fronts_[f];
     const FrontState s = fs_[f];
     if (front.kind == FrontKind::kHeap) {
-      const bool after = front.arc_plus < 0;
-      ArcRange& arc = arcs_[after ? front.arc_minus : front.arc_plus];
-      const int node = after ? arc.last : arc.first;
-      const int inner = after ? node - 1 : node + 1;
-      const int outer = after ? node + 1 : node - 1;
-      const bool removable = arc.last > arc.first && path_of_[node] < 0;
-      const bool insertable = after ? outer <= n_ - 2 : outer >= 1;
+      const HeapEnd end = heap_end(front);
+      const bool after = end.after;
+      ArcRange& arc = arcs_[static_cast<std::size_t>(end.arc)];
+      const int node = end.node, inner = end.inner, outer = end.outer;
       if (e0 != 0) {
-        if (!removable)
+        if (!end.removable)
           return {EventAction::Kind::kStop,
                   fmt::format("the string has run into the heap: its last node is {:.3g} h from the heap point",
                               kLastPartial)};
@@ -544,7 +546,7 @@ typename FrontModel<dim>::EventAction FrontModel<dim>::handle_events(double t, E
         front_states();
         ledger.template tail<dim>() -= (M - m_[inner]) * v_.col(inner);
       } else {
-        if (!insertable) return {EventAction::Kind::kStop, "the heap has run empty"};
+        if (!end.insertable) return {EventAction::Kind::kStop, "the heap has run empty"};
         // A new node comes out of the partial link at distance h from the end node, with its velocity.
         x_.col(outer) = x_.col(node) + h_ * s.direction;
         v_.col(outer) = v_.col(node);
@@ -648,11 +650,7 @@ typename FrontModel<dim>::Snapshot FrontModel<dim>::snapshot(double t, const Eig
     s.kinetic += 0.5 * m_[i] * v_.col(i).squaredNorm();
     s.momentum += m_[i] * v_.col(i);
     s.moving_mass += m_[i];
-    if (path_of_[i] >= 0) {
-      const Vec<dim> reaction = m_[i] * a_.col(i) - force_.col(i) - force_nc_.col(i) - tension_force_.col(i) -
-                                front_force_.col(i);
-      s.support += reaction;
-    }
+    s.support += reaction_.col(i);
   }
   for (const ArcRange& arc : arcs_)
     for (int j = arc.first; j < arc.last; ++j) {
@@ -665,8 +663,9 @@ typename FrontModel<dim>::Snapshot FrontModel<dim>::snapshot(double t, const Eig
     const Front& front = fronts_[k];
     const FrontState& f = fs_[k];
     if (front.kind == FrontKind::kHeap) {
-      const bool after = front.arc_plus < 0;
-      const int node = after ? arcs_[front.arc_minus].last : arcs_[front.arc_plus].first;
+      const HeapEnd end = heap_end(front);
+      const bool after = end.after;
+      const int node = end.node;
       const double l = after ? f.l_minus : f.l_plus;
       const double heap = lambda_ * (after ? ell - f.s0 : f.s0);
       first_moment += lambda_ * l * g.dot(0.5 * (x_.col(node) + front.point)) + heap * g.dot(front.point);

@@ -183,7 +183,14 @@ class FrontModel final : public OdeSystem {
   void project(double t);     // constraint projection of x_, v_ (moving nodes)
   Eigen::VectorXd pack(const Eigen::VectorXd& ledger) const;
   bool in_arc(int node) const { return arc_of_[static_cast<std::size_t>(node)] >= 0; }
-  void front_masses_and_forces();
+  /// The arc end at a heap front: its end node, the node inside the arc next to it, the node that
+  /// comes out of the heap next, and whether the end node can be taken in / a node given out.
+  struct HeapEnd {
+    bool after = true;  ///< the heap holds s > s0
+    int arc = 0, node = 0, inner = 0, outer = 0;
+    bool removable = false, insertable = false;
+  };
+  HeapEnd heap_end(const Front& front) const;
 
   Chain<dim> chain_;
   std::vector<std::unique_ptr<Force<dim>>> forces_;
@@ -202,6 +209,8 @@ class FrontModel final : public OdeSystem {
   double w_remesh_ = 0;
   // workspace (all nodes)
   Points<dim> x_, v_, a_, force_, force_nc_, front_force_, tension_force_, b_;
+  Points<dim> e_;         // unit vector of link (j, j+1) in column j, for the links inside arcs
+  Points<dim> reaction_;  // support reaction on prescribed nodes (zero elsewhere), from evaluate()
   Eigen::VectorXd m_;
   std::vector<FrontState> fs_;
 };
