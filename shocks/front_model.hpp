@@ -71,6 +71,10 @@ struct HeapSpec {
   Vec<dim> point = Vec<dim>::Zero();  ///< x0 (m)
   double dissipation = 0;             ///< f of the internal shock at x0, in [0, 1]
   double s0 = 0;                      ///< initial material coordinate of the front (m), in (0, ℓ)
+  /// Unset: the front is pinned at `point` (a hole or an edge the string runs through). Set: the
+  /// heap lies on the smooth plane through `point` with this normal (pointing to the string's side),
+  /// and the contact slides along the plane where the string meets it (a table under a falling chain).
+  std::optional<Vec<dim>> plane_normal;
 };
 
 /// A fold (internal shock) between the arc before and the arc after s0.
