@@ -36,6 +36,13 @@ void StringCaseSetup::validate() const {
     throw InputError(fmt::format("--nodes = {} is out of range: allowed 4 <= nodes <= 200001", nodes));
   reduced().validate();
   require_in_range("--tilt", tilt_deg, -80.0, 80.0);
+  require_in_range("--bend", bend_deg, -80.0, 80.0);
+  if (bend_deg != 0 && problem != Problem::kFalling)
+    throw InputError("--bend: only the falling chain has a curved variant");
+  if (std::abs(tilt_deg + bend_deg) > 80.0)
+    throw InputError(fmt::format("--tilt + --bend = {:g} degrees: the top of the falling chain must stay within 80 "
+                                 "degrees of the vertical (its height must grow along the string)",
+                                 tilt_deg + bend_deg));
   require_in_range("t_max_over_t0", t_max_over_t0, 0.0, INFINITY, Bound::kOpen);
   integrator.validate();
 }
@@ -63,10 +70,21 @@ StringCaseRun solve_string_case(const StringCaseSetup& setup) {
   const double t0 = setup.chain.t0();
   switch (setup.problem) {
     case Problem::kFalling: {
-      // Free end (s = 0) on top; the material s <= y falls, the rest lies in the heap at x0 = 0.
+      // Free end (s = 0) on top; the material s <= y falls, the rest lies in the heap on the table.
+      // σ = y0 − s is the distance from the contact along the string; the tangent turns from `tilt`
+      // at the table to `tilt + bend` at the top (a straight line when bend = 0).
       const double y0 = eta0 * ell;
-      for (int i = 0; i <= links; ++i) x.col(i) = std::max(y0 - i * h, 0.0) * tilted;
-      heaps.push_back({HeapSpec<2>::Side::kAfter, Vec<2>::Zero(), f, y0});
+      const double bend = setup.bend_deg * kPi / 180.0;
+      for (int i = 0; i <= links; ++i) {
+        const double sigma = std::max(y0 - i * h, 0.0);
+        if (bend == 0) {
+          x.col(i) = sigma * tilted;
+        } else {
+          const double R = y0 / bend, phi = tilt + sigma / R;
+          x.col(i) = Vec<2>(R * (std::cos(tilt) - std::cos(phi)), R * (std::sin(phi) - std::sin(tilt)));
+        }
+      }
+      heaps.push_back({HeapSpec<2>::Side::kAfter, Vec<2>::Zero(), f, y0, up});
       options.stop_at.push_back({0, setup.eps * ell});
       break;
     }
@@ -105,7 +123,7 @@ StringCaseRun solve_string_case(const StringCaseSetup& setup) {
         x.col(i) = -std::max(s - s0, 0.0) * tilted;
         if (s > s0) v.col(i) = -speed * tilted;
       }
-      heaps.push_back({HeapSpec<2>::Side::kBefore, Vec<2>::Zero(), f, s0});
+      heaps.push_back({HeapSpec<2>::Side::kBefore, Vec<2>::Zero(), f, s0, std::nullopt});
       break;
     }
   }
@@ -134,6 +152,7 @@ StringCaseRun solve_string_case(const StringCaseSetup& setup) {
   out.summary["t_stop_over_t0"] = (out.run.t_stop + out.t_offset) / t0;
   out.summary["eta_stop"] = out.eta.empty() ? 0.0 : out.eta.back();
   out.summary["tilt_deg"] = setup.tilt_deg;
+  if (setup.problem == Problem::kFalling) out.summary["bend_deg"] = setup.bend_deg;
   return out;
 }
 

@@ -3,9 +3,11 @@
 /// The paper's three chain problems solved with the string solver (shocks/front_model.hpp), in the
 /// paper's geometry (2D, x horizontal, y up, g = −g e_y) or in a general variant:
 ///
-///   falling  the part above the table (material s ∈ [0, y], free end at s = 0 on top) ends at the
-///            heap point x0 = 0 on the table; the heap holds s > y. Variant: released tilted by
-///            `tilt_deg` from the vertical (it pivots about x0 while it runs into the heap).
+///   falling  the part above the table (material s ∈ [0, y], free end at s = 0 on top) ends on the
+///            table y = 0 at x0 = 0 at t = 0; the heap holds s > y and lies on the table, and the
+///            contact slides along the table where the string meets it. Variants: released tilted
+///            by `tilt_deg` from the vertical (a straight line), and curved by `bend_deg` (a circular
+///            arc whose tangent turns from tilt_deg at the table to tilt_deg + bend_deg at the top).
 ///   folded   node 0 fixed at the origin; the resting arm hangs to the fold at depth y; the moving
 ///            arm goes up from the fold to the free end (loaded by F e_y). Variant: the moving arm
 ///            released tilted by `tilt_deg` (ends apart: it swings while it falls).
@@ -32,6 +34,7 @@ struct StringCaseSetup {
   std::optional<double> eta0;     ///< as ReducedSetup (defaults: falling 1, folded 0, sliding 0)
   double force = 0;               ///< folded: upward end force F (N)
   double tilt_deg = 0;            ///< general variant (see the file comment); 0 = the paper's geometry
+  double bend_deg = 0;            ///< falling only: curved release (see the file comment)
   double t_max_over_t0 = 50.0;    ///< safety stop
   IntegratorOptions integrator = default_integrator();
   static IntegratorOptions default_integrator();

@@ -18,6 +18,9 @@ namespace {
 constexpr double kRemove = 0.5, kInsert = 1.5;
 /// The last node of an arc cannot be taken in; the run stops when its partial link is this short.
 constexpr double kLastPartial = 1e-3;
+/// A string meeting a plane at less than this cosine between its tangent and the plane's normal
+/// runs along the plane: the contact point is then ill-defined and the run stops.
+constexpr double kGrazing = 1e-3;
 constexpr double kProjectionTolerance = 1e-13;
 constexpr int kProjectionIterations = 30;
 
@@ -91,9 +94,22 @@ FrontModel<dim>::FrontModel(Chain<dim> chain, std::vector<std::unique_ptr<Force<
     arcs_.push_back({first, last});
   }
   const int last_arc = static_cast<int>(arcs_.size()) - 1;
-  if (before) fronts_.push_back({FrontKind::kHeap, before->dissipation, before->point, -1, 0});
-  if (fold) fronts_.push_back({FrontKind::kFold, fold->dissipation, Vec<dim>::Zero(), 0, 1});
-  if (after) fronts_.push_back({FrontKind::kHeap, after->dissipation, after->point, last_arc, -1});
+  auto heap_front = [&](const HeapSpec<dim>& spec, int arc_minus, int arc_plus) {
+    Front front{FrontKind::kHeap, spec.dissipation, spec.point, false, Vec<dim>::Zero(), Vec<dim>::Zero(), arc_minus, arc_plus};
+    if (spec.plane_normal) {
+      const double norm = spec.plane_normal->norm();
+      if (!(norm > 0) || !std::isfinite(norm)) throw InputError("the normal of a heap's plane must be a nonzero vector");
+      front.on_plane = true;
+      front.normal = *spec.plane_normal / norm;
+      const ArcRange& arc = arcs_[static_cast<std::size_t>(arc_minus >= 0 ? arc_minus : arc_plus)];
+      if (arc.num_links() < 1)
+        throw InputError("a heap on a plane needs at least one full link next to it (its direction is the string's)");
+    }
+    return front;
+  };
+  if (before) fronts_.push_back(heap_front(*before, -1, 0));
+  if (fold) fronts_.push_back({FrontKind::kFold, fold->dissipation, Vec<dim>::Zero(), false, Vec<dim>::Zero(), Vec<dim>::Zero(), 0, 1});
+  if (after) fronts_.push_back(heap_front(*after, last_arc, -1));
   for (std::size_t k = 0; k < prescribed_.size(); ++k) {
     const int node = prescribed_[k].node;
     if (node < first || node > last)
@@ -115,13 +131,17 @@ FrontModel<dim>::FrontModel(Chain<dim> chain, std::vector<std::unique_ptr<Force<
   if (before) expected.push_back(before->s0);
   if (fold) expected.push_back(fold->s0);
   if (after) expected.push_back(after->s0);
+  // A front is where the links put it: a curved shape puts it off s0 by O(κ h²), which is accepted
+  // up to a tenth of a link (the masses follow the geometry).
   for (std::size_t k = 0; k < fronts_.size(); ++k)
-    if (std::abs(fs_[k].s0 - expected[k]) > 1e-6 * ell)
+    if (std::abs(fs_[k].s0 - expected[k]) > std::max(1e-6 * ell, 0.1 * h_))
       throw InputError(fmt::format(
           "the {} front is meant to be at s0 = {:.9g} m but the initial shape puts it at s0 = {:.9g} m: "
           "place the {} at the string's material point s0",
           fronts_[k].kind == FrontKind::kHeap ? "heap" : "fold", expected[k], fs_[k].s0,
           fronts_[k].kind == FrontKind::kHeap ? "heap point" : "fold"));
+  for (std::size_t k = 0; k < fronts_.size(); ++k)
+    if (fronts_[k].kind == FrontKind::kHeap) heap_moment0_ += heap_mass(k) * fronts_[k].point;
 }
 
 template <int dim>
@@ -203,13 +223,40 @@ void FrontModel<dim>::front_states() {
       const HeapEnd end = heap_end(front);
       const bool after = end.after;
       const int node = end.node;
-      const Vec<dim> d = front.point - x_.col(node);
-      const double l = d.norm();
-      if (!(l > 1e-9 * h_)) throw RecoverableError(fmt::format("the partial link at the heap has collapsed (node {})", node));
-      s.direction = d / l;
-      s.position = front.point;
-      s.inflow = -v_.col(node).dot(s.direction);
-      const double w = s.inflow;
+      // The partial link: its length l, direction e (from the arc into the heap), the contact point
+      // and w = dl/dt, the rate at which the arc gains material (w < 0: it runs into the heap).
+      double l = 0, w = 0;
+      // On a plane the partial link continues the arc's last full link; once the arc has none left,
+      // it keeps that link's last direction (handle_events stores it).
+      const bool has_link = arcs_[static_cast<std::size_t>(end.arc)].num_links() > 0;
+      if (!front.on_plane) {  // pinned at the point: e and l from the end node to it
+        const Vec<dim> d = front.point - x_.col(node);
+        l = d.norm();
+        if (!(l > 1e-9 * h_)) throw RecoverableError(fmt::format("the partial link at the heap has collapsed (node {})", node));
+        s.direction = d / l;
+        s.position = front.point;
+        w = -v_.col(node).dot(s.direction);
+      } else {  // on a plane: the arc's last link continued to where it meets the plane
+        const Vec<dim> link = has_link ? Vec<dim>(x_.col(node) - x_.col(end.inner)) : front.last_direction;
+        const Vec<dim> dv = has_link ? Vec<dim>(v_.col(node) - v_.col(end.inner)) : Vec<dim>::Zero();
+        const Vec<dim>& n = front.normal;
+        const Vec<dim> e = unit<dim>(link, "the link next to the heap");
+        const double ne = n.dot(e);
+        if (!(ne < -kGrazing))
+          throw RecoverableError(fmt::format("the string meets the heap's plane at a grazing angle (n·t = {:.3g} at node {})", ne, node));
+        l = n.dot(front.point - x_.col(node)) / ne;
+        if (!(l > 1e-9 * h_)) throw RecoverableError(fmt::format("node {} has gone through the heap's plane", node));
+        const Vec<dim> e_dot = (dv - e * e.dot(dv)) / link.norm();
+        s.direction = e;
+        s.position = x_.col(node) + l * e;
+        w = -(n.dot(v_.col(node)) + l * n.dot(e_dot)) / ne;
+        for (int i = arcs_[static_cast<std::size_t>(end.arc)].first; i <= arcs_[static_cast<std::size_t>(end.arc)].last; ++i)
+          if (n.dot(x_.col(i) - front.point) < 0)
+            throw RecoverableError(fmt::format("node {} has gone through the heap's plane away from the contact", i));
+      }
+      const Vec<dim> e = s.direction;
+      const Vec<dim> v_end = v_.col(node);
+      s.inflow = w;
       const double tau = lambda_ * w * w * (1 + front.dissipation * jump::sign(w));
       const double sk = chain_.node_coordinate(node);
       s.s0 = after ? sk + l : sk - l;
@@ -218,11 +265,15 @@ void FrontModel<dim>::front_states() {
       s.l_plus = after ? 0 : l;
       s.tension_minus = after ? tau : 0;
       s.tension_plus = after ? 0 : tau;
+      // The end node carries the partial link, so its mass changes at λ w: d(½ m v²)/dt gains
+      // ½ λ w |v|², and the front force τ e works at τ e·v. The shock dissipates f λ |w|³; the rest
+      // is exchanged with the heap (−½ λ w³ for a string moving along itself, as the paper's W*).
       s.power_shock = -front.dissipation * lambda_ * std::abs(w) * w * w;
-      s.power_heap = -0.5 * lambda_ * w * w * w;
-      s.reaction = (tau - lambda_ * w * w) * s.direction;
+      s.power_heap = tau * e.dot(v_end) + 0.5 * lambda_ * w * v_end.squaredNorm() - s.power_shock;
+      // Momentum: the heap is at rest, so the supports give d(m v)/dt − (other forces) = τ e + λ w v.
+      s.reaction = tau * e + lambda_ * w * v_end;
       m_[node] += lambda_ * l;
-      front_force_.col(node) += tau * s.direction;
+      front_force_.col(node) += tau * e;
     } else {
       const ArcRange& A = arcs_[front.arc_minus];
       const ArcRange& B = arcs_[front.arc_plus];
@@ -349,16 +400,20 @@ void FrontModel<dim>::rhs(double t, const Eigen::Ref<const Eigen::VectorXd>& y, 
     ydot.template segment<dim>(voff + dim * k) = a_.col(i);
   }
   double w_shocks = 0, w_heaps = 0;
-  for (const FrontState& s : fs_) {
+  Vec<dim> heap_moment_rate = Vec<dim>::Zero();
+  for (std::size_t k = 0; k < fs_.size(); ++k) {
+    const FrontState& s = fs_[k];
     w_shocks += s.power_shock;
     w_heaps += s.power_heap;
     external += s.reaction;
+    if (fronts_[k].kind == FrontKind::kHeap) heap_moment_rate -= lambda_ * s.inflow * s.position;
   }
   const int base = 2 * dim * num_moving_;
   ydot[base] = power;
   ydot[base + 1] = w_shocks;
   ydot[base + 2] = w_heaps;
   ydot.template segment<dim>(base + kLedger) = external;
+  ydot.template segment<dim>(base + kLedger + dim) = heap_moment_rate;
 }
 
 template <int dim>
@@ -410,7 +465,8 @@ Eigen::VectorXd FrontModel<dim>::state_scale() const {
   scale.head(voff).setConstant(ell);
   scale.segment(voff, voff).setConstant(speed);
   scale.segment(2 * voff, kLedger).setConstant(mass * speed * speed);
-  scale.tail(dim).setConstant(mass * speed);
+  scale.segment(2 * voff + kLedger, dim).setConstant(mass * speed);
+  scale.tail(dim).setConstant(mass * ell);
   return scale;
 }
 
@@ -424,13 +480,13 @@ Eigen::VectorXd FrontModel<dim>::pack(const Eigen::VectorXd& ledger) const {
     y.template segment<dim>(dim * k) = x_.col(i);
     y.template segment<dim>(voff + dim * k) = v_.col(i);
   }
-  y.tail(kLedger + dim) = ledger;
+  y.tail(kLedger + 2 * dim) = ledger;
   return y;
 }
 
 template <int dim>
 Eigen::VectorXd FrontModel<dim>::state_from_chain() const {
-  Eigen::VectorXd ledger = Eigen::VectorXd::Zero(kLedger + dim);
+  Eigen::VectorXd ledger = Eigen::VectorXd::Zero(kLedger + 2 * dim);
   return pack(ledger);
 }
 
@@ -519,8 +575,10 @@ typename FrontModel<dim>::EventAction FrontModel<dim>::handle_events(double t, E
       if (in_arc(i)) K += 0.5 * m_[i] * v_.col(i).squaredNorm();
     return K;
   };
-  const double K_before = kinetic();
-  Eigen::VectorXd ledger = y.tail(kLedger + dim);
+  Eigen::VectorXd ledger = y.tail(kLedger + 2 * dim);
+  auto impulse = [&]() { return ledger.template segment<dim>(kLedger); };
+  auto heap_moment = [&]() { return ledger.template segment<dim>(kLedger + dim); };
+  const double E_before = kinetic() + potential(ledger);
   for (int f = 0; f < nf; ++f) {
     const int e0 = found[static_cast<std::size_t>(2 * f)], e1 = found[static_cast<std::size_t>(2 * f + 1)];
     if (e0 == 0 && e1 == 0) continue;
@@ -540,11 +598,13 @@ typename FrontModel<dim>::EventAction FrontModel<dim>::handle_events(double t, E
         // partial link does not hold is left in the heap with its momentum.
         const double M = m_[node] + m_[inner];
         const Vec<dim> p = m_[node] * v_.col(node) + m_[inner] * v_.col(inner);
+        if (front.on_plane && arc.num_links() == 1) front.last_direction = s.direction;
         (after ? arc.last : arc.first) = inner;
         rebuild();
         v_.col(inner) = p / M;
         front_states();
-        ledger.template tail<dim>() -= (M - m_[inner]) * v_.col(inner);
+        impulse() -= (M - m_[inner]) * v_.col(inner);
+        heap_moment() += (M - m_[inner]) * fs_[f].position;
       } else {
         if (!end.insertable) return {EventAction::Kind::kStop, "the heap has run empty"};
         // A new node comes out of the partial link at distance h from the end node, with its velocity.
@@ -626,10 +686,40 @@ typename FrontModel<dim>::EventAction FrontModel<dim>::handle_events(double t, E
   Vec<dim> p_after = Vec<dim>::Zero();
   for (int i = 0; i < n_; ++i)
     if (in_arc(i)) p_after += m_[i] * v_.col(i);
-  ledger.template tail<dim>() += p_after - p_before;  // the projection's impulse (through fixed nodes)
-  w_remesh_ += kinetic() - K_before;
+  impulse() += p_after - p_before;  // the projection's impulse (through fixed nodes)
+  w_remesh_ += kinetic() + potential(ledger) - E_before;
   y = pack(ledger);
   return {EventAction::Kind::kTransfer, {}};
+}
+
+template <int dim>
+double FrontModel<dim>::heap_mass(std::size_t k) const {
+  const bool after = fronts_[k].arc_plus < 0;
+  return lambda_ * (after ? chain_.length() - fs_[k].s0 : fs_[k].s0);
+}
+
+template <int dim>
+double FrontModel<dim>::potential(const Eigen::Ref<const Eigen::VectorXd>& ledger) const {
+  // V = −g·∫ λ x ds with full and partial links at their midpoints and the heaps at their first
+  // moment. (The dynamics lumps a partial link's mass on its end node; V does not.)
+  const Vec<dim> g = gravity();
+  double first_moment = g.dot(heap_moment0_ + ledger.template segment<dim>(kLedger + dim));
+  for (const ArcRange& arc : arcs_)
+    for (int j = arc.first; j < arc.last; ++j) first_moment += lambda_ * h_ * g.dot(0.5 * (x_.col(j) + x_.col(j + 1)));
+  for (std::size_t k = 0; k < fronts_.size(); ++k) {
+    const Front& front = fronts_[k];
+    const FrontState& f = fs_[k];
+    if (front.kind == FrontKind::kHeap) {
+      const HeapEnd end = heap_end(front);
+      const double l = end.after ? f.l_minus : f.l_plus;
+      first_moment += lambda_ * l * g.dot(0.5 * (x_.col(end.node) + f.position));
+    } else {
+      const int a = arcs_[front.arc_minus].last, b = arcs_[front.arc_plus].first;
+      first_moment += lambda_ * f.l_minus * g.dot(0.5 * (x_.col(a) + f.position)) +
+                      lambda_ * f.l_plus * g.dot(0.5 * (x_.col(b) + f.position));
+    }
+  }
+  return -first_moment;
 }
 
 template <int dim>
@@ -642,9 +732,6 @@ typename FrontModel<dim>::Snapshot FrontModel<dim>::snapshot(double t, const Eig
   s.x = x_;
   s.v = v_;
   s.fronts = fs_;
-  const Vec<dim> g = gravity();
-  // V = −g·∫ λ x ds: full links at their midpoints, partial links at theirs, heaps at their points.
-  double first_moment = 0;  // g·∫ λ x ds
   for (int i = 0; i < n_; ++i) {
     if (!in_arc(i)) continue;
     s.kinetic += 0.5 * m_[i] * v_.col(i).squaredNorm();
@@ -654,36 +741,23 @@ typename FrontModel<dim>::Snapshot FrontModel<dim>::snapshot(double t, const Eig
   }
   for (const ArcRange& arc : arcs_)
     for (int j = arc.first; j < arc.last; ++j) {
-      first_moment += lambda_ * h_ * g.dot(0.5 * (x_.col(j) + x_.col(j + 1)));
       const double l = (x_.col(j + 1) - x_.col(j)).norm();
       s.max_violation = std::max(s.max_violation, std::abs(l - h_) / h_);
     }
-  const double ell = chain_.length();
+  const Vec<dim> g = gravity();
   for (std::size_t k = 0; k < fronts_.size(); ++k) {
-    const Front& front = fronts_[k];
-    const FrontState& f = fs_[k];
-    if (front.kind == FrontKind::kHeap) {
-      const HeapEnd end = heap_end(front);
-      const bool after = end.after;
-      const int node = end.node;
-      const double l = after ? f.l_minus : f.l_plus;
-      const double heap = lambda_ * (after ? ell - f.s0 : f.s0);
-      first_moment += lambda_ * l * g.dot(0.5 * (x_.col(node) + front.point)) + heap * g.dot(front.point);
-      s.heap_mass += heap;
-      s.support += f.reaction - heap * g;
-    } else {
-      const int a = arcs_[front.arc_minus].last, b = arcs_[front.arc_plus].first;
-      first_moment += lambda_ * f.l_minus * g.dot(0.5 * (x_.col(a) + f.position)) +
-                      lambda_ * f.l_plus * g.dot(0.5 * (x_.col(b) + f.position));
-    }
+    if (fronts_[k].kind != FrontKind::kHeap) continue;
+    const double heap = heap_mass(k);
+    s.heap_mass += heap;
+    s.support += fs_[k].reaction - heap * g;
   }
-  // Nodes carry the partial links' mass in the dynamics; for V the partial links are at their midpoints.
-  s.potential = -first_moment;
   const int base = 2 * dim * num_moving_;
+  s.potential = potential(y.tail(kLedger + 2 * dim));
   s.w_applied = y[base];
   s.w_shocks = y[base + 1];
   s.w_heaps = y[base + 2];
   s.impulse = y.template segment<dim>(base + kLedger);
+  s.heap_moment = heap_moment0_ + y.template segment<dim>(base + kLedger + dim);
   s.w_remesh = w_remesh_;
   return s;
 }

@@ -40,12 +40,15 @@
 /// removes is booked as W_remesh (zero for straight motions). Then positions and velocities are
 /// projected onto the link constraints and the integration continues with the new state size.
 ///
-/// ODE state: [ x of moving free nodes | v of them | W_applied | W_shocks | W_heaps | impulse (dim) ]
+/// ODE state: [ x of moving free nodes | v of them | W_applied | W_shocks | W_heaps | impulse (dim) |
+///              heap moment (dim) ]
 ///   W_applied  work of drag, end loads and drivers (as StringModel)
 ///   W_shocks   Σ over internal shocks of W_s = −D (dissipation, ≤ 0)
 ///   W_heaps    Σ over heaps of W* (external shocks)
 ///   impulse    ∫ (all external forces on the string and heaps) dt: gravity, drag, loads, the
 ///              reactions of fixed/driven nodes and of the planes under the heaps
+///   heap moment  change of Σ over heaps of ∫ x dm (kg m): material laid on a plane stays where the
+///              contact was when it arrived, so the heaps' potential energy needs their first moment
 /// Ledgers: K + V − (K0 + V0) − W_applied − W_shocks − W_heaps − W_remesh → 0 and
 ///          p − p0 − impulse → 0 (p = Σ m_i v_i; heaps are at rest), to the discretization error.
 #include <memory>
@@ -101,7 +104,11 @@ class FrontModel final : public OdeSystem {
   struct Front {
     FrontKind kind = FrontKind::kHeap;
     double dissipation = 0;
-    Vec<dim> point = Vec<dim>::Zero();  ///< heap point x0
+    Vec<dim> point = Vec<dim>::Zero();  ///< heap point x0 (on a plane: a point of the plane)
+    bool on_plane = false;               ///< the contact slides along the plane (point, normal)
+    Vec<dim> normal = Vec<dim>::Zero();  ///< unit normal of the plane, towards the string's side
+    Vec<dim> last_direction = Vec<dim>::Zero();  ///< on a plane, once the arc has no full link left:
+                                                 ///< the direction its partial link keeps
     int arc_minus = -1, arc_plus = -1;  ///< arcs on either side (−1: the heap's side)
   };
   struct ArcRange {
@@ -130,7 +137,7 @@ class FrontModel final : public OdeSystem {
              std::optional<FoldSpec> fold, const FrontModelOptions& options);
 
   // --- OdeSystem ----------------------------------------------------------------------------
-  int size() const override { return 2 * dim * num_moving_ + kLedger + dim; }
+  int size() const override { return 2 * dim * num_moving_ + kLedger + 2 * dim; }
   void rhs(double t, const Eigen::Ref<const Eigen::VectorXd>& y, Eigen::Ref<Eigen::VectorXd> ydot) override;
   int num_events() const override { return 2 * static_cast<int>(fronts_.size()) + static_cast<int>(options_.stop_at.size()); }
   void events(double t, const Eigen::Ref<const Eigen::VectorXd>& y, Eigen::Ref<Eigen::VectorXd> g) override;
@@ -161,6 +168,8 @@ class FrontModel final : public OdeSystem {
     double kinetic = 0, potential = 0;  ///< K, V (V: gravity, moving string + heaps, links at their midpoints)
     double w_applied = 0, w_shocks = 0, w_heaps = 0, w_remesh = 0;
     Vec<dim> momentum = Vec<dim>::Zero(), impulse = Vec<dim>::Zero();
+    Vec<dim> heap_moment = Vec<dim>::Zero();  ///< Σ over heaps of ∫ x dm (kg m): heap mass × centre
+
     Vec<dim> support = Vec<dim>::Zero();  ///< force of all supports (planes under heaps incl. their weight, fixed/driven nodes) on the system (N)
     double moving_mass = 0, heap_mass = 0;
     double max_violation = 0;         ///< max | |Δx_j| − h | / h over full links
@@ -183,7 +192,9 @@ class FrontModel final : public OdeSystem {
   void rebuild();  // slots, tension system, after a topology change
   void unpack(double t, const Eigen::Ref<const Eigen::VectorXd>& y);
   void front_states();  // fills fs_ and masses m_ from x_, v_
-  double evaluate(double t);  // accelerations a_, returns dW_applied/dt; needs unpack + front_states
+  double evaluate(double t);
+  double potential(const Eigen::Ref<const Eigen::VectorXd>& ledger) const;  // V; needs front_states
+  double heap_mass(std::size_t front) const;                                 // needs front_states  // accelerations a_, returns dW_applied/dt; needs unpack + front_states
   void project(double t);     // constraint projection of x_, v_ (moving nodes)
   Eigen::VectorXd pack(const Eigen::VectorXd& ledger) const;
   bool in_arc(int node) const { return arc_of_[static_cast<std::size_t>(node)] >= 0; }
@@ -211,6 +222,7 @@ class FrontModel final : public OdeSystem {
   double alpha_ = 0, beta_ = 0;
   long transfers_ = 0, solves_ = 0;
   double w_remesh_ = 0;
+  Vec<dim> heap_moment0_ = Vec<dim>::Zero();  // Σ heap mass × point at t = 0
   // workspace (all nodes)
   Points<dim> x_, v_, a_, force_, force_nc_, front_force_, tension_force_, b_;
   Points<dim> e_;         // unit vector of link (j, j+1) in column j, for the links inside arcs

@@ -40,14 +40,15 @@ CsvTable samples_table(const FrontRun& run) {
   std::vector<std::string> cols = {"t"};
   const std::size_t nf = run.samples.empty() ? 0 : run.samples.front().s0.size();
   const std::size_t dim = run.samples.empty() ? 0 : run.samples.front().support.size();
+  const char* axes[] = {"x", "y", "z"};
   for (std::size_t k = 0; k < nf; ++k) {
     cols.push_back("s0_" + std::to_string(k));
     cols.push_back("s0dot_" + std::to_string(k));
+    for (std::size_t d = 0; d < dim; ++d) cols.push_back("front_" + std::to_string(k) + "_" + axes[d]);
   }
   for (const char* c : {"K", "V", "W_applied", "W_shocks", "W_heaps", "W_remesh", "energy_residual",
                         "momentum_residual"})
     cols.emplace_back(c);
-  const char* axes[] = {"x", "y", "z"};
   for (std::size_t d = 0; d < dim; ++d) cols.push_back(std::string("support_") + axes[d]);
   for (const char* c : {"moving_mass", "heap_mass", "max_violation", "moving_nodes"}) cols.emplace_back(c);
   CsvTable table(cols);
@@ -56,6 +57,7 @@ CsvTable samples_table(const FrontRun& run) {
     for (std::size_t k = 0; k < nf; ++k) {
       row.push_back(s.s0[k]);
       row.push_back(s.s0_dot[k]);
+      for (std::size_t d = 0; d < dim; ++d) row.push_back(s.position[k * dim + d]);
     }
     for (double v : {s.kinetic, s.potential, s.w_applied, s.w_shocks, s.w_heaps, s.w_remesh, s.energy_residual,
                      s.momentum_residual})
@@ -84,6 +86,7 @@ FrontRun run_fronts(FrontModel<dim>& model, const FrontRunOptions& options) {
     for (const auto& f : snap.fronts) {
       s.s0.push_back(f.s0);
       s.s0_dot.push_back(f.s0_dot);
+      for (int d = 0; d < dim; ++d) s.position.push_back(f.position[d]);
     }
     s.kinetic = snap.kinetic;
     s.potential = snap.potential;

@@ -26,6 +26,7 @@ struct FrontRunOptions {
 struct FrontSample {
   double t = 0;
   std::vector<double> s0, s0_dot;  ///< per front (m, m/s)
+  std::vector<double> position;    ///< per front, its point x0 (dim components, m)
   double kinetic = 0, potential = 0, w_applied = 0, w_shocks = 0, w_heaps = 0, w_remesh = 0;
   double energy_residual = 0;      ///< K + V − K0 − V0 − W_applied − W_shocks − W_heaps − W_remesh (J)
   double momentum_residual = 0;    ///< |p − p0 − impulse| (N s)
@@ -55,7 +56,7 @@ struct FrontRun {
 /// Summary keys: status, stop_reason, t_stop, wall_s, steps, rhs_evals, transfers, energy_residual
 /// (relative), momentum_residual (relative), max_constraint_violation, …
 nlohmann::json to_json(const FrontRun& run);
-/// The samples as a table (columns t, s0_k, s0dot_k, K, V, W_applied, W_shocks, W_heaps, W_remesh,
+/// The samples as a table (columns t, s0_k, s0dot_k, front_k_x.., K, V, W_applied, W_shocks, W_heaps, W_remesh,
 /// energy_residual, momentum_residual, support_x.., moving_mass, heap_mass, max_violation).
 CsvTable samples_table(const FrontRun& run);
 

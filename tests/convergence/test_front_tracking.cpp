@@ -62,7 +62,7 @@ TEST_CASE("a sliding chain whose hanging part swings converges under refinement 
           "[convergence][shocks]") {
   // General geometry: the hanging part starts tilted by 20 degrees and swings about the hole while
   // the heap feeds it. No reduced model applies: the stop time converges to itself. The ledgers close
-  // to the discretization error and converge too.
+  // to the discretization error and converge too (the momentum ledger to round-off).
   std::vector<double> t_stop, energy, momentum;
   const std::vector<int> meshes = {41, 81, 161};
   for (int nodes : meshes) {
@@ -87,10 +87,12 @@ TEST_CASE("a sliding chain whose hanging part swings converges under refinement 
               t_stop[1], t_stop[2], order_t);
   std::printf("  energy ledger %.3e %.3e %.3e (order %.2f), momentum ledger %.3e %.3e %.3e (order %.2f)\n",
               energy[0], energy[1], energy[2], order_e, momentum[0], momentum[1], momentum[2], order_p);
-  CHECK(order_t > 0.9);   // measured 1.4
+  CHECK(order_t > 0.9);   // measured 1.35
   CHECK(order_e > 1.7);   // measured 2.0
-  CHECK(order_p > 0.9);   // measured 1.1
-  CHECK(energy[2] < 1e-5);
+  CHECK(energy[2] < 2e-6);  // measured 1.3e-6
+  // The discrete momentum balance is exact: the heap's reaction τ e + λ w v includes the momentum of
+  // the material that joins the end node sideways, so only round-off remains.
+  for (double p : momentum) CHECK(p < 1e-11);
   CHECK(d2 / t_stop[2] < 1e-4);
 }
 
