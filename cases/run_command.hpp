@@ -1,11 +1,18 @@
 #pragma once
 /// @file run_command.hpp
-/// `chainsim run SCENE`: run a general string scene with the string solver (docs/scenes.md).
+/// `chainsim run SCENE`: run a scene (docs/scenes.md) on the model it asks for: the string solver,
+/// with front tracking if the scene declares a heap or a fold, or the reduced ODE (model = "reduced").
 #include <iosfwd>
 #include <optional>
 #include <string>
 
 namespace chainsim {
+
+struct SceneSpec;
+
+/// Builds the model the scene runs on (string, string with fronts, or reduced) and checks it, without
+/// running anything. Throws InputError located at the key at fault (the checks of `chainsim run`).
+void check_scene(const SceneSpec& spec);
 
 struct RunCommandOptions {
   std::string scene;  ///< path of the scene file

@@ -6,6 +6,8 @@
 // key that caused it.
 #include "cases/scene.hpp"
 
+#include "cases/scene_build.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <fstream>
@@ -19,6 +21,10 @@
 #include "solver/errors.hpp"
 
 namespace chainsim {
+
+using scene_build::as_vec;
+using scene_build::at_key;
+using scene_build::fail_at;
 
 namespace {
 
@@ -92,6 +98,12 @@ class SourceText {
   std::string name_;
   std::vector<std::string> lines_;
 };
+
+/// Plain keys (not sections) allowed at the top level of a scene.
+const std::vector<std::string> kTopLevelKeys = {"model"};
+bool is_top_level_key(const std::string& key) {
+  return std::find(kTopLevelKeys.begin(), kTopLevelKeys.end(), key) != kTopLevelKeys.end();
+}
 
 /// Optimal-string-alignment distance (a swap of two neighbours counts one edit).
 std::size_t edit_distance(const std::string& a, const std::string& b) {
@@ -167,16 +179,21 @@ class Section {
     const std::string guess = closest(k, allowed);
     const bool is_table = table.get(k)->is_table();
     if (noun == "section") {
-      if (hint.empty() && !guess.empty()) hint = fmt::format(" (did you mean [{}]?)", guess);
-      throw InputError(fmt::format("{}: unknown {} {}; valid sections: {}{}", loc, is_table ? "section" : "top-level key",
-                                   is_table ? "[" + k + "]" : "'" + k + "'", join(allowed), hint));
+      // The top level holds sections and a few plain keys (kTopLevelKeys), listed apart.
+      std::vector<std::string> sections, keys;
+      for (const auto& a : allowed) (is_top_level_key(a) ? keys : sections).push_back(a);
+      if (hint.empty() && !guess.empty())
+        hint = is_top_level_key(guess) ? fmt::format(" (did you mean '{}'?)", guess) : fmt::format(" (did you mean [{}]?)", guess);
+      throw InputError(fmt::format("{}: unknown {} {}; valid sections: {}{}{}", loc, is_table ? "section" : "top-level key",
+                                   is_table ? "[" + k + "]" : "'" + k + "'", join(sections),
+                                   keys.empty() ? "" : "; valid top-level keys: " + join(keys), hint));
     }
     if (noun == "effect") {
       if (hint.empty() && !guess.empty()) hint = fmt::format(" (did you mean [{}.{}]?)", name_, guess);
       throw InputError(fmt::format("{}: unknown effect [{}.{}]; valid effects: {}{}", loc, name_, k, join(allowed), hint));
     }
     if (hint.empty() && !guess.empty()) hint = fmt::format(" (did you mean '{}'?)", guess);
-    throw InputError(fmt::format("{}: unknown key '{}' in [{}]; valid keys: {}{}", loc, k, name_, join(allowed), hint));
+    throw InputError(fmt::format("{}: unknown key '{}' in {}; valid keys: {}{}", loc, k, shown_name(), join(allowed), hint));
   }
 
   bool has(const std::string& key) const { return table_.contains(key); }
@@ -202,8 +219,11 @@ class Section {
   }
   /// A required key is absent: "<location of the section>: [name] needs <key> (<what>)".
   [[noreturn]] void missing(const std::string& key, const std::string& what) const {
-    throw InputError(fmt::format("{}: [{}] needs {} ({})", ctx_.text.where(table_.source()), name_, key, what));
+    throw InputError(fmt::format("{}: {} needs {} ({})", ctx_.text.where(table_.source()), shown_name(), key, what));
   }
+  /// The section as messages show it: "[effects.gravity]", or "effects.heap[0]" for an element of
+  /// an array of tables.
+  std::string shown_name() const { return name_.back() == ']' ? name_ : "[" + name_ + "]"; }
   /// The key does not apply to `context` (e.g. kind = "circle").
   void forbid(const std::string& key, bool applies, const std::string& context) const {
     if (has(key) && !applies) fail(key, fmt::format("{} does not apply to {}", full(key), context));
@@ -359,6 +379,19 @@ const toml::table& subtable(const Section& parent, const std::string& name) {
   return *n->as_table();
 }
 
+/// The elements of the array of tables `name` of `parent` ([[name]]; none if it is absent).
+std::vector<const toml::table*> table_array(const Section& parent, const std::string& name, const std::string& what) {
+  std::vector<const toml::table*> out;
+  const toml::node* n = parent.node(name);
+  if (!n) return out;
+  const toml::array* arr = n->as_array();
+  if (!arr || !arr->is_array_of_tables())
+    parent.fail(name, fmt::format("{} must be an array of tables: write [[{}]] once per {}", parent.full(name),
+                                  parent.full(name), what));
+  for (const auto& item : *arr) out.push_back(item.as_table());
+  return out;
+}
+
 // ================================================================================================
 // 3. One parse function per section.
 // ================================================================================================
@@ -498,9 +531,33 @@ void parse_ends(const Section& top, Context& ctx) {
   ctx.spec.end = parse_end(s, "end", ctx);
 }
 
+/// [[effects.heap]]: one table per heap, at most one per side.
+void parse_heaps(const Section& effects, Context& ctx) {
+  auto& heaps = ctx.spec.effects.heaps;
+  const auto tables = table_array(effects, "heap", "heap");
+  for (std::size_t k = 0; k < tables.size(); ++k) {
+    Section h(*tables[k], fmt::format("effects.heap[{}]", k), ctx, {"side", "s0", "f", "point", "on_plane"});
+    if (!h.has("side")) h.missing("side", "\"start\" (the heap holds s < s0 and feeds the string) or \"end\" (it holds s > s0)");
+    if (!h.has("s0")) h.missing("s0", "m, the material coordinate of the front at t = 0");
+    if (!h.has("point")) h.missing("point", "m, the hole or edge the front sits at, or the contact point on the plane at t = 0");
+    HeapEntry heap;
+    heap.side = h.choice("side", {"start", "end"}, "");
+    for (std::size_t j = 0; j < heaps.size(); ++j)
+      if (heaps[j].side == heap.side)
+        h.fail("side", fmt::format("effects.heap[{}].side = \"{}\": effects.heap[{}] already holds that side of the "
+                                   "string; allowed at most one heap per side",
+                                   k, heap.side, j));
+    heap.s0 = *h.number("s0");
+    heap.dissipation = h.number_in("f", 0.0, 0.0, 1.0);
+    heap.point = h.vector("point");
+    heap.on_plane = h.boolean("on_plane").value_or(false);
+    heaps.push_back(heap);
+  }
+}
+
 void parse_effects(const Section& top, Context& ctx) {
   auto& fx = ctx.spec.effects;
-  Section s(subtable(top, "effects"), "effects", ctx, {"gravity", "drag"}, {}, "effect");
+  Section s(subtable(top, "effects"), "effects", ctx, {"gravity", "drag", "heap", "fold", "plane"}, {}, "effect");
   if (s.has("gravity")) {
     Section g(subtable(s, "gravity"), "effects.gravity", ctx, {"g"});
     if (!g.has("g")) g.missing("g", "m/s^2, a vector [gx, gy] or [gx, gy, gz]");
@@ -511,6 +568,32 @@ void parse_effects(const Section& top, Context& ctx) {
     if (!d.has("coefficient")) d.missing("coefficient", "1/s, >= 0: the force -coefficient m v on every node");
     fx.drag = d.number_in("coefficient", 0.0, 0.0, INFINITY);
   }
+  parse_heaps(s, ctx);
+  if (s.has("fold")) {
+    Section f(subtable(s, "fold"), "effects.fold", ctx, {"s0", "f"});
+    if (!f.has("s0")) f.missing("s0", "m, the material coordinate of the fold at t = 0");
+    fx.fold = FoldEntry{*f.number("s0"), f.number_in("f", 0.0, 0.0, 1.0)};
+  }
+  if (s.has("plane")) {
+    Section p(subtable(s, "plane"), "effects.plane", ctx, {"point", "normal"});
+    if (!p.has("point")) p.missing("point", "m, a point of the plane");
+    if (!p.has("normal")) p.missing("normal", "a vector normal to the plane, pointing to the string's side");
+    fx.plane = PlaneEntry{p.vector("point"), p.vector("normal")};
+  }
+  // The plane is the table of a heap: it exists for on_plane heaps only (the string itself does not
+  // collide with it), and an on_plane heap needs it.
+  bool on_plane = false;
+  for (std::size_t k = 0; k < fx.heaps.size(); ++k) {
+    on_plane = on_plane || fx.heaps[k].on_plane;
+    if (fx.heaps[k].on_plane && !fx.plane)
+      throw InputError(fmt::format("{}: effects.heap[{}].on_plane = true needs [effects.plane] (point, normal): the "
+                                   "table the heap lies on",
+                                   ctx.spec.where(fmt::format("effects.heap[{}].on_plane", k)), k));
+  }
+  if (fx.plane && !on_plane)
+    throw InputError(fmt::format("{}: [effects.plane] is the table under a heap, but no [[effects.heap]] has on_plane = "
+                                 "true (the string itself does not collide with the plane)",
+                                 ctx.spec.where("effects.plane")));
 }
 
 void parse_solver(const Section& top, Context& ctx) {
@@ -583,17 +666,32 @@ void parse_stop(const Section& top, Context& ctx) {
   if (!top.has("stop"))
     throw InputError(fmt::format("{}:1:1: the scene needs a [stop] section with t_end (the end time, s, > 0)",
                                  ctx.text.name()));
-  Section s(subtable(top, "stop"), "stop", ctx, {"t_end"});
+  Section s(subtable(top, "stop"), "stop", ctx, {"t_end", "front"});
   if (!s.has("t_end")) s.missing("t_end", "the end time, s, > 0");
   ctx.spec.stop.t_end = *s.positive("t_end");
+  const auto tables = table_array(s, "front", "stop event");
+  for (std::size_t k = 0; k < tables.size(); ++k) {
+    Section f(*tables[k], fmt::format("stop.front[{}]", k), ctx, {"front", "s0"});
+    if (!f.has("front")) f.missing("front", "which front: fold, heap_start or heap_end");
+    if (!f.has("s0")) f.missing("s0", "m, stop when that front reaches this material coordinate");
+    ctx.spec.stop.fronts.push_back({f.choice("front", {"fold", "heap_start", "heap_end"}, ""), *f.number("s0")});
+  }
+}
+
+void parse_model(const Section& top, Context& ctx) {
+  ctx.spec.model = top.choice("model", {"string", "reduced"}, "string");
 }
 
 SceneSpec parse_table(const toml::table& root, const SourceText& text) {
   SceneSpec spec;
   spec.source = text.name();
   Context ctx{text, spec};
-  const Section top(root, "", ctx, {"string", "shape", "velocity", "ends", "effects", "solver", "output", "stop"},
-                    {{"gravity", "[effects.gravity]"}, {"drag", "[effects.drag]"}}, "section");
+  const Section top(root, "", ctx,
+                    {"string", "shape", "velocity", "ends", "effects", "solver", "output", "stop", "model"},
+                    {{"gravity", "[effects.gravity]"}, {"drag", "[effects.drag]"}, {"heap", "[[effects.heap]]"},
+                     {"fold", "[effects.fold]"}, {"plane", "[effects.plane]"}},
+                    "section");
+  parse_model(top, ctx);
   parse_string(top, ctx);
   parse_shape(top, ctx);
   parse_velocity(top, ctx);
@@ -608,34 +706,6 @@ SceneSpec parse_table(const toml::table& root, const SourceText& text) {
 // ================================================================================================
 // 4. Building: SceneSpec -> model. Every InputError names the location of the key at fault.
 // ================================================================================================
-/// Runs f(); an InputError it throws without a location gets the location of `key` in front.
-template <class F>
-auto at_key(const SceneSpec& spec, const std::string& key, F&& f) -> decltype(f()) {
-  try {
-    return f();
-  } catch (const InputError& e) {
-    const std::string message = e.what();
-    if (message.rfind(spec.source + ":", 0) == 0) throw;
-    throw InputError(fmt::format("{}: {}", spec.where(key), message));
-  }
-}
-
-[[noreturn]] void fail_at(const SceneSpec& spec, const std::string& key, const std::string& message) {
-  throw InputError(fmt::format("{}: {}", spec.where(key), message));
-}
-
-template <int dim>
-Vec<dim> as_vec(const SceneSpec& spec, const std::vector<double>& v, const std::string& key) {
-  if (static_cast<int>(v.size()) != dim) {
-    const auto it = spec.locations.find(key);
-    fail_at(spec, key, fmt::format("{} = {} has {} components but string.dimension = {}", key,
-                                   it != spec.locations.end() ? it->second.text : "", v.size(), spec.dimension));
-  }
-  Vec<dim> out;
-  for (int d = 0; d < dim; ++d) out[d] = v[static_cast<std::size_t>(d)];
-  return out;
-}
-
 template <int dim>
 Points<dim> as_points(const SceneSpec& spec, const std::vector<std::vector<double>>& rows, const std::string& key) {
   Points<dim> out(dim, static_cast<Eigen::Index>(rows.size()));
@@ -744,9 +814,11 @@ SceneSpec parse_scene(const std::filesystem::path& file) {
   return parse_scene_text(buffer.str(), file.string());
 }
 
+namespace scene_build {
+
 template <int dim>
-StringScene<dim> build_string_scene(const SceneSpec& spec) {
-  CHAINSIM_VERIFY(spec.dimension == dim, "build_string_scene<dim> called for another dimension");
+SceneParts<dim> build_scene_parts(const SceneSpec& spec) {
+  CHAINSIM_VERIFY(spec.dimension == dim, "build_scene_parts<dim> called for another dimension");
   const auto& sh = spec.shape;
 
   // 1. Gravity (its direction also orients a catenary).
@@ -756,7 +828,7 @@ StringScene<dim> build_string_scene(const SceneSpec& spec) {
 
   // 2. The shape, and the string on it.
   const bool closed = spec.closed.value_or(sh.kind == "circle");
-  const std::unique_ptr<Curve<dim>> curve = build_curve<dim>(spec, closed, down);
+  std::unique_ptr<Curve<dim>> curve = build_curve<dim>(spec, closed, down);
   if (curve->closed() != closed)
     fail_at(spec, spec.closed ? "string.closed" : "shape.kind",
             fmt::format("string.closed = {} but the shape ({}) is {}", closed, curve->description(),
@@ -816,39 +888,87 @@ StringScene<dim> build_string_scene(const SceneSpec& spec) {
   check_prescribed_ends<dim>(spec, prescribed, length);
 
   // 4. Options. Default Baumgarte time: a tenth of the shortest physical time scale.
-  StringScene<dim> scene;
   const auto& so = spec.solver;
   double t_char = spec.stop.t_end;
   if (g.norm() > 0) t_char = std::min(t_char, std::sqrt(length / g.norm()));
   const double v_max = chain.velocities().colwise().norm().maxCoeff();
   if (v_max > 0) t_char = std::min(t_char, length / v_max);
   t_char = std::min(t_char, forcing_period);
-  scene.characteristic_time = t_char;
-  StringModelOptions mo;
-  mo.stabilization_time = so.stabilization_time.value_or(0.1 * t_char);
-  mo.backend = so.backend;
-  mo.check_slack = so.check_slack;
-  mo.slack_tolerance = so.slack_tolerance;
-  auto& io = scene.solver.integrator;
+  IntegratorOptions io;
   io.method = so.method;
   io.rtol = so.rtol;
   io.atol = so.atol;
   io.max_step = so.max_step;
   io.initial_step = so.initial_step;
   io.max_steps = so.max_steps;
+  at_key(spec, "solver", [&] { io.validate(); });
+  return SceneParts<dim>{std::move(curve), std::move(chain),      length, g, std::move(forces), std::move(prescribed),
+                         t_char,           io, so.stabilization_time.value_or(0.1 * t_char)};
+}
+
+template SceneParts<2> build_scene_parts<2>(const SceneSpec&);
+template SceneParts<3> build_scene_parts<3>(const SceneSpec&);
+
+std::vector<std::string> front_names(const SceneSpec& spec) {
+  auto has_heap = [&](const char* side) {
+    return std::any_of(spec.effects.heaps.begin(), spec.effects.heaps.end(),
+                       [&](const HeapEntry& heap) { return heap.side == side; });
+  };
+  std::vector<std::string> names;
+  if (has_heap("start")) names.push_back("heap_start");
+  if (spec.effects.fold) names.push_back("fold");
+  if (has_heap("end")) names.push_back("heap_end");
+  return names;
+}
+
+std::vector<int> front_stop_indices(const SceneSpec& spec) {
+  const std::vector<std::string> names = front_names(spec);
+  std::vector<int> out;
+  for (std::size_t k = 0; k < spec.stop.fronts.size(); ++k) {
+    const std::string& front = spec.stop.fronts[k].front;
+    const auto it = std::find(names.begin(), names.end(), front);
+    if (it == names.end()) {
+      const std::string what = front == "fold" ? "fold ([effects.fold])"
+                                               : fmt::format("heap on side \"{}\"", front.substr(5));
+      fail_at(spec, fmt::format("stop.front[{}].front", k),
+              fmt::format("stop.front[{}].front = \"{}\" but the scene has no {}; {}", k, front, what,
+                          names.empty() ? "it has no fronts" : "its fronts: " + join(names)));
+    }
+    out.push_back(static_cast<int>(it - names.begin()));
+  }
+  return out;
+}
+
+}  // namespace scene_build
+
+template <int dim>
+StringScene<dim> build_string_scene(const SceneSpec& spec) {
+  CHAINSIM_VERIFY(!spec.has_fronts(), "a scene with fronts runs on FrontModel (build_front_scene)");
+  scene_build::front_stop_indices(spec);  // refuses a stop event on a front the scene lacks
+  scene_build::SceneParts<dim> parts = scene_build::build_scene_parts<dim>(spec);
+  const auto& so = spec.solver;
+  StringScene<dim> scene;
+  scene.characteristic_time = parts.characteristic_time;
+  StringModelOptions mo;
+  mo.stabilization_time = parts.stabilization_time;
+  mo.backend = so.backend;
+  mo.check_slack = so.check_slack;
+  mo.slack_tolerance = so.slack_tolerance;
+  scene.solver.integrator = parts.integrator;
   scene.solver.t_end = spec.stop.t_end;
   scene.solver.output_interval = spec.output.interval;
   at_key(spec, "solver", [&] { scene.solver.validate(); });
-  at_key(spec, "output.interval", [&] { scene.solver.check_frame_budget(chain.num_nodes()); });
+  at_key(spec, "output.interval", [&] { scene.solver.check_frame_budget(parts.chain.num_nodes()); });
   scene.output = spec.output.select;
 
-  // 5. The model, its initial state projected onto the constraints now, so that a shape that cannot
-  //    be fitted (e.g. fixed ends further apart than the string is long) is refused before the run.
+  // The model, its initial state projected onto the constraints now, so that a shape that cannot be
+  // fitted (e.g. fixed ends further apart than the string is long) is refused before the run.
   std::string fit_key = "shape";
   if (spec.start.prescribed()) fit_key = "ends.start";
   if (spec.end.prescribed()) fit_key = "ends.end";
   scene.model = at_key(spec, fit_key, [&] {
-    auto model = std::make_unique<StringModel<dim>>(std::move(chain), std::move(forces), std::move(prescribed), mo);
+    auto model = std::make_unique<StringModel<dim>>(std::move(parts.chain), std::move(parts.forces),
+                                                    std::move(parts.prescribed), mo);
     model->make_consistent(0.0);
     return model;
   });

@@ -20,10 +20,17 @@
 ///     [velocity] kind = rest | uniform | tangential | nodes
 ///     [ends]     start, end = "free" | "fixed" | { kind = "loaded", … } | { kind = "driven", … }
 ///     [effects.gravity] g (m/s²)          [effects.drag] coefficient (1/s)
+///     [[effects.heap]] side = start | end, s0 (m), f, point (m), on_plane
+///     [effects.fold]   s0 (m), f          [effects.plane] point (m), normal (the table of a heap)
 ///     [solver]   method, rtol, atol, max_step, initial_step, max_steps, stabilization_time, backend,
 ///                check_slack, slack_tolerance
 ///     [output]   interval (s), fields = [nodes, tension, energy, stats], formats = [csv, vtk]
-///     [stop]     t_end (s)
+///     [stop]     t_end (s), [[stop.front]] front = fold | heap_start | heap_end, s0 (m)
+///     model      = "string" (default) | "reduced" (top-level key)
+///
+/// A scene with a heap or a fold runs on FrontModel (cases/front_scene.hpp); one without runs on
+/// StringModel; model = "reduced" runs the reduced ODE of the canonical problem the scene is
+/// (cases/reduced_scene.hpp).
 #include <filesystem>
 #include <map>
 #include <memory>
@@ -48,6 +55,35 @@ struct EndSpec {
   bool prescribed() const { return kind == "fixed" || kind == "driven"; }
 };
 
+/// A heap: [[effects.heap]].
+struct HeapEntry {
+  std::string side;            ///< "start": the heap holds s < s0 (feeds the string); "end": s > s0
+  double s0 = 0;               ///< material coordinate of the front at t = 0 (m)
+  double dissipation = 0;      ///< f, in [0, 1]
+  std::vector<double> point;   ///< hole / edge / contact point at t = 0 (m)
+  bool on_plane = false;       ///< the heap lies on [effects.plane] and its contact slides along it
+  /// "heap_start" or "heap_end": the name of its front in [[stop.front]] and in the outputs.
+  std::string front_name() const { return "heap_" + side; }
+};
+
+/// A fold (internal shock): [effects.fold].
+struct FoldEntry {
+  double s0 = 0;           ///< material coordinate of the fold at t = 0 (m)
+  double dissipation = 0;  ///< f, in [0, 1]
+};
+
+/// A smooth rigid plane (the table under a heap): [effects.plane].
+struct PlaneEntry {
+  std::vector<double> point;   ///< a point of the plane (m)
+  std::vector<double> normal;  ///< its normal, towards the string's side (any length > 0)
+};
+
+/// A stop event: [[stop.front]].
+struct FrontStop {
+  std::string front;  ///< "fold" | "heap_start" | "heap_end"
+  double s0 = 0;      ///< stop when that front reaches this material coordinate (m)
+};
+
 /// Where a key was written and how.
 struct KeyLocation {
   std::string where;  ///< "file:line:column" of its value (of the header, for a section)
@@ -62,6 +98,9 @@ struct SceneSpec {
   /// "file:line:column" of `key`, or of the nearest enclosing section written in the file, else
   /// "file:1:1" (a key that is missing altogether concerns the whole file).
   std::string where(const std::string& key) const;
+
+  /// model = "string" (the string solver, with front tracking if the scene has fronts) or "reduced".
+  std::string model = "string";
 
   // [string]
   int dimension = 2;
@@ -91,7 +130,12 @@ struct SceneSpec {
   struct Effects {
     std::optional<std::vector<double>> gravity;  ///< [effects.gravity] g (m/s²)
     std::optional<double> drag;                  ///< [effects.drag] coefficient (1/s)
+    std::vector<HeapEntry> heaps;                ///< [[effects.heap]], at most one per side
+    std::optional<FoldEntry> fold;               ///< [effects.fold]
+    std::optional<PlaneEntry> plane;             ///< [effects.plane]
   } effects;
+  /// The scene has a heap or a fold: it runs on FrontModel.
+  bool has_fronts() const { return !effects.heaps.empty() || effects.fold.has_value(); }
   // [solver]
   struct Solver {
     std::string method = "erk8";
@@ -111,6 +155,7 @@ struct SceneSpec {
   // [stop]
   struct Stop {
     double t_end = 0;  ///< s (required in a scene file)
+    std::vector<FrontStop> fronts;  ///< [[stop.front]]
   } stop;
 };
 

@@ -1,0 +1,345 @@
+// Scenes with shocks: SceneSpec -> FrontModel, the run's summary and its outputs (front_scene.hpp).
+//
+// Steps of build_front_scene: 1. the string, as for any scene (scene_build.hpp); 2. what a string
+// with fronts cannot have (a closed string, ends inside heaps, keys for scenes without fronts);
+// 3. each heap against the string, the shape and its plane; 4. the fold; 5. the stop events;
+// 6. the model (its own layout checks re-located at the fronts' keys) and the run options.
+#include "cases/front_scene.hpp"
+
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+#include <optional>
+
+#include <fmt/format.h>
+
+#include "cases/scene_build.hpp"
+#include "solver/errors.hpp"
+#include "solver/output.hpp"
+#include "solver/string_solver.hpp"
+#include "solver/vtk_output.hpp"
+
+namespace chainsim {
+
+using scene_build::as_vec;
+using scene_build::at_key;
+using scene_build::fail_at;
+using scene_build::text_of;
+
+namespace {
+
+/// A heap point, a fold or a stop event closer than this (relative to ℓ) to where it should be is
+/// there (FrontModel checks the fronts' initial positions to 1e-6 ℓ as well).
+constexpr double kPlaceTolerance = 1e-6;
+/// A fold's arms must be antiparallel to this angle (rad).
+constexpr double kFoldAngleTolerance = 1e-6;
+/// Step (relative to ℓ) on each side of a fold for the shape's tangents there.
+constexpr double kTangentStep = 1e-4;
+
+template <int dim>
+std::string show(const Vec<dim>& v) {
+  std::string out = "[";
+  for (int d = 0; d < dim; ++d) out += fmt::format("{}{:.6g}", d ? ", " : "", v[d]);
+  return out + "]";
+}
+
+template <int dim>
+nlohmann::json to_array(const Vec<dim>& v) {
+  nlohmann::json a = nlohmann::json::array();
+  for (int d = 0; d < dim; ++d) a.push_back(v[d]);
+  return a;
+}
+
+/// "front 2 reached s0 = …" (FrontModel's wording) -> "the heap_end front reached s0 = …".
+std::string name_fronts(const std::string& reason, const std::vector<std::string>& names) {
+  const std::string prefix = "front ";
+  if (reason.rfind(prefix, 0) != 0) return reason;
+  std::size_t end = prefix.size();
+  while (end < reason.size() && std::isdigit(static_cast<unsigned char>(reason[end]))) ++end;
+  if (end == prefix.size()) return reason;
+  const std::size_t k = std::stoul(reason.substr(prefix.size(), end - prefix.size()));
+  if (k >= names.size()) return reason;
+  return fmt::format("the {} front{}", names[k], reason.substr(end));
+}
+
+}  // namespace
+
+template <int dim>
+FrontScene<dim> build_front_scene(const SceneSpec& spec) {
+  CHAINSIM_VERIFY(spec.has_fronts(), "a scene without fronts runs on StringModel (build_string_scene)");
+  const auto& fx = spec.effects;
+  const std::string first_front = fx.heaps.empty() ? "effects.fold" : "effects.heap[0]";
+
+  // 1. The string, its forces and ends.
+  scene_build::SceneParts<dim> parts = scene_build::build_scene_parts<dim>(spec);
+  const double ell = parts.length;
+  const Chain<dim>& chain = parts.chain;
+
+  // 2. What a string with fronts cannot have.
+  if (chain.closed())
+    fail_at(spec, first_front,
+            fmt::format("{} on a closed string: fronts are tracked on open strings only (string.closed = true)",
+                        fx.heaps.empty() ? "[effects.fold]" : "[[effects.heap]]"));
+  for (std::size_t k = 0; k < fx.heaps.size(); ++k) {
+    const HeapEntry& heap = fx.heaps[k];
+    const EndSpec& end = heap.side == "start" ? spec.start : spec.end;
+    if (end.kind != "free")
+      fail_at(spec, "ends." + heap.side,
+              fmt::format("ends.{} = \"{}\" is inside the heap of effects.heap[{}] (side = \"{}\", s0 = {:g} m): an "
+                          "end held by a heap cannot be fixed, loaded or driven",
+                          heap.side, end.kind, k, heap.side, heap.s0));
+  }
+  if (spec.solver.backend != "auto")
+    fail_at(spec, "solver.backend",
+            fmt::format("solver.backend = \"{}\" applies to scenes without fronts: a string with fronts solves one "
+                        "tridiagonal tension system per arc (allowed: auto)",
+                        spec.solver.backend));
+  if (spec.solver.check_slack)
+    fail_at(spec, "solver.check_slack",
+            "solver.check_slack = true applies to scenes without fronts: the front model has no slack check");
+  if (spec.output.select.tension && spec.locations.count("output.fields"))
+    fail_at(spec, "output.fields",
+            "output.fields lists \"tension\", which a run with fronts does not record; allowed with fronts: nodes, "
+            "energy, stats");
+
+  // 3. Heaps: s0 inside the string, the shape through the heap point at s0, the point on its plane.
+  double s_lo = 0, s_hi = ell;  // the moving part at t = 0
+  std::vector<HeapSpec<dim>> heaps;
+  std::optional<Vec<dim>> plane_point, plane_normal;
+  if (fx.plane) {
+    plane_point = as_vec<dim>(spec, fx.plane->point, "effects.plane.point");
+    const Vec<dim> n = as_vec<dim>(spec, fx.plane->normal, "effects.plane.normal");
+    if (!(n.norm() > 0))
+      fail_at(spec, "effects.plane.normal",
+              fmt::format("effects.plane.normal = {} is zero: a plane needs a normal", text_of(spec, "effects.plane.normal")));
+    plane_normal = n.normalized();
+  }
+  for (std::size_t k = 0; k < fx.heaps.size(); ++k) {
+    const HeapEntry& heap = fx.heaps[k];
+    const std::string key = fmt::format("effects.heap[{}]", k);
+    const bool start = heap.side == "start";
+    const bool inside = start ? (heap.s0 >= 0 && heap.s0 < ell) : (heap.s0 > 0 && heap.s0 <= ell * (1 + 1e-12));
+    if (!inside)
+      fail_at(spec, key + ".s0",
+              fmt::format("{}.s0 = {} is outside the string: allowed {} for side = \"{}\" (the string is {:g} m long)",
+                          key, text_of(spec, key + ".s0"),
+                          start ? fmt::format("0 <= s0 < {:g}", ell) : fmt::format("0 < s0 <= {:g}", ell), heap.side,
+                          ell));
+    const Vec<dim> point = as_vec<dim>(spec, heap.point, key + ".point");
+    const Vec<dim> on_shape = parts.curve->point(heap.s0);
+    const double miss = (point - on_shape).norm();
+    if (miss > kPlaceTolerance * ell)
+      fail_at(spec, key + ".point",
+              fmt::format("{}.point = {} is {:.6g} m from the string's material point s0 = {:g} m, which the shape puts "
+                          "at {}: the shape must pass through the heap point at s0",
+                          key, text_of(spec, key + ".point"), miss, heap.s0, show<dim>(on_shape)));
+    if (heap.on_plane) {
+      const double distance = (point - *plane_point).dot(*plane_normal);
+      if (std::abs(distance) > kPlaceTolerance * ell)
+        fail_at(spec, key + ".point",
+                fmt::format("{}.point = {} is not on its plane: it is {:.6g} m from effects.plane (through {} with "
+                            "normal {})",
+                            key, text_of(spec, key + ".point"), std::abs(distance), show<dim>(*plane_point),
+                            show<dim>(*plane_normal)));
+    }
+    (start ? s_lo : s_hi) = heap.s0;
+    HeapSpec<dim> hs;
+    hs.side = start ? HeapSpec<dim>::Side::kBefore : HeapSpec<dim>::Side::kAfter;
+    hs.point = point;
+    hs.dissipation = heap.dissipation;
+    hs.s0 = heap.s0;
+    if (heap.on_plane) hs.plane_normal = *plane_normal;
+    heaps.push_back(hs);
+  }
+  if (plane_normal) {
+    // The moving string starts on the side the normal points to (it may touch the plane).
+    for (int i = 0; i < chain.num_nodes(); ++i) {
+      const double s = chain.node_coordinate(i);
+      if (s < s_lo || s > s_hi) continue;
+      const double side = (chain.positions().col(i) - *plane_point).dot(*plane_normal);
+      if (side < -kPlaceTolerance * ell)
+        fail_at(spec, "effects.plane.normal",
+                fmt::format("effects.plane.normal = {}: node {} (s = {:g} m) of the moving string lies {:.6g} m on the "
+                            "other side of the plane; the normal points to the string's side, and the string may not "
+                            "start below its table",
+                            text_of(spec, "effects.plane.normal"), i, s, -side));
+    }
+  }
+
+  // 4. The fold: inside the moving part, where the shape folds back on itself.
+  std::optional<FoldSpec> fold;
+  if (fx.fold) {
+    const double s0 = fx.fold->s0;
+    const std::string key = "effects.fold.s0";
+    const bool start_heap = std::any_of(fx.heaps.begin(), fx.heaps.end(), [](const HeapEntry& e) { return e.side == "start"; });
+    const bool end_heap = std::any_of(fx.heaps.begin(), fx.heaps.end(), [](const HeapEntry& e) { return e.side == "end"; });
+    if (!((start_heap ? s0 > s_lo : s0 >= 0) && s0 < s_hi))
+      fail_at(spec, key,
+              fmt::format("effects.fold.s0 = {} is {}: allowed {:g} {} s0 < {:g}", text_of(spec, key),
+                          start_heap || end_heap ? "not between the heaps" : "outside the string", s_lo,
+                          start_heap ? "<" : "<=", s_hi));
+    const double d = kTangentStep * ell;
+    if (s0 - d > 0 && s0 + d < ell) {
+      const Vec<dim> before = parts.curve->point(s0) - parts.curve->point(s0 - d);
+      const Vec<dim> after = parts.curve->point(s0 + d) - parts.curve->point(s0);
+      const double c = std::clamp(before.dot(after) / (before.norm() * after.norm()), -1.0, 1.0);
+      const double turn = std::acos(c);
+      if (kPi - turn > kFoldAngleTolerance)
+        fail_at(spec, key,
+                fmt::format("effects.fold.s0 = {}: the shape does not fold back there (it turns by {:.3g} deg at s = "
+                            "{:g} m; a fold turns by 180 deg, its two arms side by side)",
+                            text_of(spec, key), turn * 180 / kPi, s0));
+    }
+    fold = FoldSpec{fx.fold->dissipation, s0};
+  }
+
+  // 5. Stop events: a front reaching a material coordinate inside the string.
+  const std::vector<std::string> names = scene_build::front_names(spec);
+  const std::vector<int> stop_fronts = scene_build::front_stop_indices(spec);
+  FrontModelOptions options;
+  options.stabilization_time = parts.stabilization_time;
+  for (std::size_t k = 0; k < stop_fronts.size(); ++k) {
+    const double s = spec.stop.fronts[k].s0;
+    const std::string key = fmt::format("stop.front[{}].s0", k);
+    if (!(s >= 0 && s <= ell))
+      fail_at(spec, key, fmt::format("{} = {} is outside the string: allowed 0 <= s0 <= {:g} m", key, text_of(spec, key), ell));
+    const std::string& name = names[static_cast<std::size_t>(stop_fronts[k])];
+    const double s_start = name == "fold" ? fx.fold->s0 : name == "heap_start" ? s_lo : s_hi;
+    if (std::abs(s - s_start) <= kPlaceTolerance * ell)
+      fail_at(spec, key,
+              fmt::format("{} = {} is where the {} front starts: a stop event needs a front that gets there", key,
+                          text_of(spec, key), name));
+    options.stop_at.push_back({stop_fronts[k], s});
+  }
+
+  // 6. The model (FrontModel's own layout checks, located at the fronts) and the run options.
+  FrontScene<dim> scene;
+  scene.front_names = names;
+  scene.characteristic_time = parts.characteristic_time;
+  nlohmann::json& d = scene.description;
+  d["model"] = "string";
+  d["dimension"] = dim;
+  d["nodes"] = chain.num_nodes();
+  d["links"] = chain.num_links();
+  d["effects"] = nlohmann::json::array();
+  for (const auto& force : parts.forces) d["effects"].push_back(force->name());
+  d["prescribed"] = nlohmann::json::array();
+  for (const auto& p : parts.prescribed) d["prescribed"].push_back(fmt::format("node {}: {}", p.node, p.path->description()));
+  const std::string fit_key = fold && heaps.empty() ? "effects.fold.s0" : first_front;
+  scene.model = at_key(spec, fit_key, [&] {
+    try {
+      return std::make_unique<FrontModel<dim>>(std::move(parts.chain), std::move(parts.forces),
+                                               std::move(parts.prescribed), heaps, fold, options);
+    } catch (const RecoverableError& e) {  // a degenerate front geometry found while placing the fronts
+      throw InputError(e.what());
+    }
+  });
+  d["fronts"] = nlohmann::json::array();
+  for (std::size_t k = 0; k < names.size(); ++k) {
+    const auto& front = scene.model->fronts()[k];
+    nlohmann::json f = {{"name", names[k]}, {"kind", front.kind == FrontModel<dim>::FrontKind::kFold ? "fold" : "heap"},
+                        {"f", front.dissipation}};
+    if (names[k] == "fold") {
+      f["s0"] = fold->s0;
+    } else {
+      const bool start = names[k] == "heap_start";
+      const auto& heap = *std::find_if(fx.heaps.begin(), fx.heaps.end(),
+                                       [&](const HeapEntry& e) { return e.side == (start ? "start" : "end"); });
+      f["side"] = heap.side;
+      f["s0"] = heap.s0;
+      f["point"] = to_array<dim>(front.point);
+      f["on_plane"] = heap.on_plane;
+      if (heap.on_plane) f["plane_normal"] = to_array<dim>(*plane_normal);
+    }
+    d["fronts"].push_back(f);
+  }
+  d["root_functions"] = scene.model->num_events();
+  d["stop_events"] = nlohmann::json::array();
+  for (const auto& stop : options.stop_at)
+    d["stop_events"].push_back({{"front", names[static_cast<std::size_t>(stop.front)]}, {"s0", stop.s}});
+  d["stabilization_time"] = options.stabilization_time;
+
+  scene.output = spec.output.select;
+  scene.output.tension = false;  // not recorded with fronts (refused above when asked for explicitly)
+  scene.run.integrator = parts.integrator;
+  scene.run.t_end = spec.stop.t_end;
+  scene.run.record_nodes = scene.output.nodes;
+  scene.run.frame_interval = scene.output.nodes ? spec.output.interval : 0.0;
+  at_key(spec, "solver", [&] { scene.run.validate(); });
+  StringSolverOptions budget;
+  budget.t_end = spec.stop.t_end;
+  budget.output_interval = spec.output.interval;
+  at_key(spec, "output.interval", [&] { budget.check_frame_budget(scene.model->chain().num_nodes()); });
+  return scene;
+}
+
+template <int dim>
+nlohmann::json front_summary(const FrontScene<dim>& scene, const FrontRun& run) {
+  nlohmann::json j = to_json(run);
+  j.update(scene.description);
+  j["t_end"] = scene.run.t_end;
+  j["stop_reason"] = name_fronts(run.stop_reason, scene.front_names);
+  nlohmann::json final_s0 = nlohmann::json::object();
+  if (!run.samples.empty())
+    for (std::size_t k = 0; k < scene.front_names.size(); ++k) final_s0[scene.front_names[k]] = run.samples.back().s0[k];
+  j["fronts_final_s0"] = final_s0;
+  return j;
+}
+
+template <int dim>
+void write_front_outputs(const std::filesystem::path& dir, const FrontScene<dim>& scene, const FrontRun& run,
+                         const nlohmann::json& summary) {
+  const OutputSelection& select = scene.output;
+  ensure_directory(dir);
+  const Chain<dim>& chain = scene.model->chain();
+  // 1. CSV: the moving nodes at each frame, and the samples.
+  if (select.csv && select.nodes) {
+    const char* axes[] = {"x", "y", "z"};
+    std::vector<std::string> columns = {"t", "node", "s"};
+    for (int d = 0; d < dim; ++d) columns.emplace_back(axes[d]);
+    CsvTable nodes(columns);
+    for (std::size_t k = 0; k < run.frames.size(); ++k)
+      for (int i : run.frame_moving[k]) {
+        std::vector<double> row = {run.frame_times[k], static_cast<double>(i), chain.node_coordinate(i)};
+        for (int d = 0; d < dim; ++d) row.push_back(run.frames[k](d, i));
+        nodes.add_row(row);
+      }
+    nodes.write(dir / "nodes.csv");
+  }
+  if (select.csv && select.energy) samples_table(run).write(dir / "series.csv");
+  // 2. ParaView frames: the moving part as line cells, then their index.
+  if (select.vtk && select.nodes) {
+    ensure_directory(dir / "frames");
+    std::vector<std::pair<double, std::string>> index;
+    for (std::size_t k = 0; k < run.frames.size(); ++k) {
+      const std::vector<int>& moving = run.frame_moving[k];
+      VtkPolyline line;
+      line.points = Eigen::Matrix3Xd::Zero(3, static_cast<Eigen::Index>(moving.size()));
+      Eigen::MatrixXd s(1, static_cast<Eigen::Index>(moving.size()));
+      for (std::size_t q = 0; q < moving.size(); ++q) {
+        const auto col = static_cast<Eigen::Index>(q);
+        line.points.col(col).head(dim) = run.frames[k].col(moving[q]);
+        s(0, col) = chain.node_coordinate(moving[q]);
+        if (q > 0 && moving[q] == moving[q - 1] + 1) line.segments.emplace_back(static_cast<int>(q) - 1, static_cast<int>(q));
+      }
+      line.point_data = {{"s", s}};
+      const std::string name = fmt::format("frame_{:04d}.vtp", k);
+      write_vtp(dir / "frames" / name, line);
+      index.emplace_back(run.frame_times[k], "frames/" + name);
+    }
+    write_pvd(dir / "string.pvd", index);
+  }
+  // 3. The summary, last: its presence means the set is complete.
+  if (select.stats) write_json(dir / "stats.json", summary);
+}
+
+template FrontScene<2> build_front_scene<2>(const SceneSpec&);
+template FrontScene<3> build_front_scene<3>(const SceneSpec&);
+template nlohmann::json front_summary<2>(const FrontScene<2>&, const FrontRun&);
+template nlohmann::json front_summary<3>(const FrontScene<3>&, const FrontRun&);
+template void write_front_outputs<2>(const std::filesystem::path&, const FrontScene<2>&, const FrontRun&,
+                                     const nlohmann::json&);
+template void write_front_outputs<3>(const std::filesystem::path&, const FrontScene<3>&, const FrontRun&,
+                                     const nlohmann::json&);
+
+}  // namespace chainsim
