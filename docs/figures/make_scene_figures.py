@@ -50,11 +50,16 @@ def shapes(ax, data, times, closed=False, mark=None, title="", equal=True):
         ax.plot(xs, ys, "-", lw=1.2, color=color, label=f"t = {t:.3g} s")
         if mark is not None:
             ax.plot(pts[mark][1], pts[mark][2], "o", ms=4, color=color)
+    space_axes(ax, title, 10, equal)
+
+
+def space_axes(ax, title, title_size, equal=True):
+    """An x-y panel of the string's shapes."""
     if equal:
         ax.set_aspect("equal")
     ax.set_xlabel("x (m)")
     ax.set_ylabel("y (m)")
-    ax.set_title(title, fontsize=10)
+    ax.set_title(title, fontsize=title_size)
     ax.legend(fontsize=6, loc="best")
     ax.grid(alpha=0.3)
 
@@ -206,12 +211,7 @@ def front_shapes(ax, root, times, title, aside=0.0, stagger=0.0):
             ax.plot([px + 0.03, px + 0.3 + shift], [py, py], "k-", lw=2.5, alpha=0.6)
             ax.plot([px + k * stagger for k in range(len(times))], [py] * len(times), "v", color="tab:brown", ms=6,
                     label="hole (pinned front)")
-    ax.set_aspect("equal")
-    ax.set_xlabel("x (m)")
-    ax.set_ylabel("y (m)")
-    ax.set_title(title, fontsize=9)
-    ax.legend(fontsize=6, loc="best")
-    ax.grid(alpha=0.3)
+    space_axes(ax, title, 9)
 
 
 def front_ledger(ax, root):
