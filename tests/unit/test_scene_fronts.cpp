@@ -134,6 +134,7 @@ TEST_CASE("fronts are built only when declared: root functions and fronts in the
   const nlohmann::json none = run_json(dir, "plain", test::kSceneBase);
   CHECK(none["model"] == "string");
   CHECK(none["fronts"] == nlohmann::json::array());
+  CHECK(none["num_fronts"] == 0);
   CHECK(none["root_functions"] == 0);
   CHECK(none["junction_unknowns"] == 0);
 
@@ -146,6 +147,7 @@ TEST_CASE("fronts are built only when declared: root functions and fronts in the
   };
   const nlohmann::json falling = built(test::kFallingBase);  // one heap, one stop event
   CHECK(falling["root_functions"] == 3);
+  CHECK(falling["num_fronts"] == 1);
   REQUIRE(falling["fronts"].size() == 1);
   CHECK(falling["fronts"][0]["name"] == "heap_end");
   CHECK(falling["fronts"][0]["on_plane"] == true);
@@ -188,6 +190,7 @@ front = "heap_start"
 s0 = 0.5
 )");
   CHECK(two["root_functions"] == 5);
+  CHECK(two["num_fronts"] == 2);
   REQUIRE(two["fronts"].size() == 2);
   CHECK(two["fronts"][0]["name"] == "heap_start");
   CHECK(two["fronts"][1]["name"] == "heap_end");
