@@ -362,3 +362,25 @@ TEST_CASE("chainsim run on a front scene writes its outputs, stats.json last, an
   CHECK_FALSE(std::filesystem::exists(out / "series.csv"));
   CHECK(std::filesystem::exists(out / "tension.csv"));
 }
+
+TEST_CASE("a front run that fails writes its outputs up to the failure, then reports it (exit code 3)",
+          "[unit][scene]") {
+  // Three steps allowed per output interval: ARKODE gives up early in the fall.
+  const auto dir = temp_dir("scene_fronts_fail");
+  const auto scene = dir / "fail.toml";
+  std::ofstream(scene) << test::kFallingBase << "[solver]\nmax_steps = 3\n";
+  RunCommandOptions options;
+  options.scene = scene.string();
+  options.out = (dir / "out").string();
+  options.json = true;
+  std::ostringstream out;
+  CHECK_THROWS_AS(run_scene_command(options, out), NumericalError);
+  const nlohmann::json j = nlohmann::json::parse(out.str());
+  CHECK(j["status"] == "failed");
+  CHECK(j["exit_code"] == 3);
+  CHECK_THAT(j["error"].get<std::string>(), Contains("ARK_TOO_MUCH_WORK"));
+  CHECK(j["t_stop"].get<double>() < 0.38);  // before the cutoff
+  const nlohmann::json stats = nlohmann::json::parse(read(dir / "out" / "stats.json"));
+  CHECK(stats["status"] == "failed");
+  CHECK(std::filesystem::exists(dir / "out" / "series.csv"));
+}
