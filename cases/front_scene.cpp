@@ -253,6 +253,7 @@ FrontScene<dim> build_front_scene(const SceneSpec& spec) {
     }
     d["fronts"].push_back(f);
   }
+  d["num_fronts"] = names.size();
   d["root_functions"] = scene.model->num_events();
   d["stop_events"] = nlohmann::json::array();
   for (const auto& stop : options.stop_at)

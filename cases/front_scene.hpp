@@ -40,8 +40,8 @@ struct FrontScene {
   OutputSelection output;
   std::vector<std::string> front_names;  ///< "heap_start", "fold", "heap_end": those built, in order of s
   /// What was built, read back from the model: dimension, nodes, links, effects, prescribed, fronts
-  /// (name, kind, side, f, s0, point, on_plane, plane_normal), root_functions (2 per front + stop
-  /// events), stop_events, stabilization_time.
+  /// (name, kind, side, f, s0, point, on_plane, plane_normal), num_fronts, root_functions (2 per
+  /// front + stop events), stop_events, stabilization_time.
   nlohmann::json description;
   double characteristic_time = 0;  ///< t_char (s), as for a string scene
 };

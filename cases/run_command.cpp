@@ -82,6 +82,7 @@ int run_string_scene(const SceneSpec& spec, const std::filesystem::path& dir, bo
     nlohmann::json j = to_json(solver.summary());
     j["model"] = "string";
     j["fronts"] = nlohmann::json::array();  // none built: no front unknowns, no root functions
+    j["num_fronts"] = 0;
     return j;
   };
   // 4.-5. Integrate and write.

@@ -4,10 +4,14 @@
 Usage: /usr/bin/python3 docs/figures/make_scene_figures.py RESULTS_DIR
 where RESULTS_DIR/<scene>/ holds the outputs of
     build/chainsim run cases/scenes/<scene>.toml --out RESULTS_DIR/<scene>
-for shaken_chain, travelling_loop, whip_crack and pendulum_release. Writes docs/figures/scene_<scene>.png:
-the string at several times, the quantity that scene is about, and its energy ledger.
+for shaken_chain, travelling_loop, whip_crack and pendulum_release (string scenes) and falling_chain,
+folded_chain, sliding_chain, swinging_sliding_chain and tilted_falling_chain (scenes with fronts), and
+RESULTS_DIR/<scene>_reduced/ the same canonical scenes run with model = "reduced".
+docs/figures/run_scene_figures.sh RESULTS_DIR does all of it. Writes docs/figures/scene_<scene>.png: the
+string at several times, the quantity that scene is about, and its energy ledger.
 """
 import csv
+import json
 import math
 import os
 import sys
@@ -46,11 +50,16 @@ def shapes(ax, data, times, closed=False, mark=None, title="", equal=True):
         ax.plot(xs, ys, "-", lw=1.2, color=color, label=f"t = {t:.3g} s")
         if mark is not None:
             ax.plot(pts[mark][1], pts[mark][2], "o", ms=4, color=color)
+    space_axes(ax, title, 10, equal)
+
+
+def space_axes(ax, title, title_size, equal=True):
+    """An x-y panel of the string's shapes."""
     if equal:
         ax.set_aspect("equal")
     ax.set_xlabel("x (m)")
     ax.set_ylabel("y (m)")
-    ax.set_title(title, fontsize=10)
+    ax.set_title(title, fontsize=title_size)
     ax.legend(fontsize=6, loc="best")
     ax.grid(alpha=0.3)
 
@@ -131,13 +140,161 @@ def pendulum_release(root, ax):
                 "free fall from the same height, sqrt(2 g |y_tip|)", "the tip falls faster than a free particle")
 
 
+# --- scenes with fronts: nodes.csv holds the moving nodes (t, node, s, x, y), series.csv the samples
+# (t, s0_k, s0dot_k, front_k_x, front_k_y, K, V, W_*, ...), stats.json the fronts that were built.
+
+def front_frames(root):
+    """{t: [(node, s, x, y), ...]} of the moving nodes, sorted by time and node."""
+    by_t = defaultdict(list)
+    for r in read_rows(os.path.join(root, "nodes.csv")):
+        by_t[float(r["t"])].append((int(r["node"]), float(r["s"]), float(r["x"]), float(r["y"])))
+    return {t: sorted(v) for t, v in sorted(by_t.items())}
+
+
+def series(root):
+    rows = read_rows(os.path.join(root, "series.csv"))
+    return {k: [float(r[k]) for r in rows] for k in rows[0]}
+
+
+def nearest(ts, t):
+    return min(range(len(ts)), key=lambda i: abs(ts[i] - t))
+
+
+def front_shapes(ax, root, times, title, aside=0.0, stagger=0.0):
+    """The moving string at several times, with its partial link to each heap's front (from the samples)
+    and the heaps: a table for a heap on a plane, a hole for a pinned one. `aside`: the part beyond a
+    fold is drawn shifted by this much in x (the two arms of a fold lie on one line). `stagger`: each
+    later snapshot is drawn this much further right (motions along one vertical line)."""
+    data, ser = front_frames(root), series(root)
+    times = sorted({min(data, key=lambda s: abs(s - want)) for want in times} | {list(data)[-1]})
+    with open(os.path.join(root, "stats.json")) as fh:
+        fronts = json.load(fh)["fronts"]
+    cmap = plt.get_cmap("viridis")
+    keys = list(data)
+    for k, want in enumerate(times):
+        t = min(keys, key=lambda s: abs(s - want))
+        pts = data[t]
+        i = nearest(ser["t"], t)
+        color = cmap(k / max(1, len(times) - 1))
+        xs, ys = [], []
+        for q, f in enumerate(fronts):
+            if f["kind"] == "fold":
+                s_fold = ser[f"s0_{q}"][i]
+                xs = [p[2] + (aside if p[1] > s_fold else 0.0) for p in pts]
+                ys = [p[3] for p in pts]
+        if not xs:
+            xs, ys = [p[2] for p in pts], [p[3] for p in pts]
+        for q, f in enumerate(fronts):  # partial links to the heaps' fronts
+            if f["kind"] == "heap":
+                fx, fy = ser[f"front_{q}_x"][i], ser[f"front_{q}_y"][i]
+                if f["side"] == "end":
+                    xs, ys = xs + [fx], ys + [fy]
+                else:
+                    xs, ys = [fx] + xs, [fy] + ys
+        xs = [x + k * stagger for x in xs]
+        ax.plot(xs, ys, "-", lw=1.2, color=color, label=f"t = {t:.3g} s")
+        if stagger:
+            ax.plot(xs[0], ys[0], "o", ms=3, color=color)
+    shift = (len(times) - 1) * stagger
+    for q, f in enumerate(fronts):
+        if f["kind"] != "heap":
+            continue
+        px, py = f["point"][0], f["point"][1]
+        if f["on_plane"]:
+            xs = ser[f"front_{q}_x"]
+            lo, hi = min(xs + [px]) - 0.25, max(xs + [px]) + 0.25 + shift
+            ax.plot([lo, hi], [py, py], "k-", lw=2.5, alpha=0.6)
+            ax.plot([min(xs), max(xs)], [py, py], "-", color="tab:brown", lw=5, alpha=0.7,
+                    label="heap laid on the table")
+        else:
+            ax.plot([px - 0.6, px - 0.03], [py, py], "k-", lw=2.5, alpha=0.6)
+            ax.plot([px + 0.03, px + 0.3 + shift], [py, py], "k-", lw=2.5, alpha=0.6)
+            ax.plot([px + k * stagger for k in range(len(times))], [py] * len(times), "v", color="tab:brown", ms=6,
+                    label="hole (pinned front)")
+    space_axes(ax, title, 9)
+
+
+def front_ledger(ax, root):
+    ser = series(root)
+    e0 = ser["K"][0] + ser["V"][0]
+    ax.plot(ser["t"], [k + v - e0 for k, v in zip(ser["K"], ser["V"])], label="K + V - (K0 + V0)")
+    ax.plot(ser["t"], ser["W_shocks"], "--", label="W_shocks (dissipated at the shock)")
+    if max(abs(w) for w in ser["W_heaps"]) > 0:
+        ax.plot(ser["t"], ser["W_heaps"], ":", label="W_heaps (external shock at the heap)")
+    if max(abs(w) for w in ser["W_remesh"]) > 1e-9:
+        ax.plot(ser["t"], ser["W_remesh"], "-.", label="W_remesh")
+    ax.plot(ser["t"], [a + b + c + d for a, b, c, d in zip(ser["W_applied"], ser["W_shocks"], ser["W_heaps"], ser["W_remesh"])],
+            "k--", lw=0.8, label="sum of the works")
+    resid = max(abs(r) for r in ser["energy_residual"])
+    decorate(ax, "t (s)", "J", f"energy ledger (max |residual| = {resid:.1e} J)")
+
+
+def reduced_overlay(ax, root, to_s0, label="reduced ODE"):
+    path = root + "_reduced"
+    if not os.path.exists(os.path.join(path, "series.csv")):
+        return
+    rows = read_rows(os.path.join(path, "series.csv"))
+    ax.plot([float(r["t"]) for r in rows], [to_s0(float(r["y"])) for r in rows], "k:", lw=2, label=label)
+
+
+def front_position(ax, root, name, to_s0, title):
+    ser = series(root)
+    ax.plot(ser["t"], ser["s0_0"], lw=2, alpha=0.7, label=f"{name} front s0 (string solver)")
+    reduced_overlay(ax, root, to_s0)
+    decorate(ax, "t (s)", "s0 (m)", title)
+
+
+def falling_chain(root, ax):
+    front_shapes(ax[0], root, [0, 0.15, 0.25, 0.32, 0.36], "falling chain onto a table, f = 0.5 (time runs right)",
+                 stagger=0.15)
+    front_position(ax[1], root, "heap_end", lambda y: y,
+                   "material above the table = s0: the reduced ODE is exact")
+
+
+def folded_chain(root, ax):
+    front_shapes(ax[0], root, [0, 0.2, 0.35, 0.45, 0.52], "folded chain, f = 0.5 (falling arm 3 cm aside; time runs right)",
+                 aside=0.03, stagger=0.15)
+    front_position(ax[1], root, "fold", lambda y: y, "resting arm = s0 of the fold")
+
+
+def sliding_chain(root, ax):
+    front_shapes(ax[0], root, [0, 0.25, 0.4, 0.5], "sliding chain through a hole, f = 0.5 (time runs right)",
+                 stagger=0.15)
+    front_position(ax[1], root, "heap_start", lambda y: 1.0 - y, "heap = s0: the hanging part is 1 - s0")
+
+
+def swinging_sliding_chain(root, ax):
+    front_shapes(ax[0], root, [0, 0.15, 0.3, 0.4, 0.47, 0.52], "sliding chain released 30 deg off the vertical")
+    data, ser = front_frames(root), series(root)
+    ts = list(data)
+    angle = [math.degrees(math.atan2(data[t][-1][2], -data[t][-1][3])) for t in ts]
+    ax[1].plot(ser["t"], [1.0 - s for s in ser["s0_0"]], label="hanging length 1 - s0 (m)")
+    ax[1].plot(ts, [a / 100 for a in angle], label="free end's angle from the vertical / 100 (deg)")
+    decorate(ax[1], "t (s)", "", "it swings while it slides out of the heap")
+
+
+def tilted_falling_chain(root, ax):
+    front_shapes(ax[0], root, [0, 0.15, 0.25, 0.31, 0.345, 0.36], "chain falling tilted 25 deg onto a table, f = 0.5")
+    ser = series(root)
+    ax[1].plot(ser["t"], ser["s0_0"], label="material above the table s0 (m)")
+    ax[1].plot(ser["t"], ser["front_0_x"], label="contact position x (m)")
+    decorate(ax[1], "t (s)", "m", "the contact slides along the table as the chain comes down")
+
+
 def main():
     root = sys.argv[1]
-    for scene, draw in [("shaken_chain", shaken_chain), ("travelling_loop", travelling_loop),
-                        ("whip_crack", whip_crack), ("pendulum_release", pendulum_release)]:
+    for scene, draw, fronts in [("shaken_chain", shaken_chain, False), ("travelling_loop", travelling_loop, False),
+                                ("whip_crack", whip_crack, False), ("pendulum_release", pendulum_release, False),
+                                ("falling_chain", falling_chain, True), ("folded_chain", folded_chain, True),
+                                ("sliding_chain", sliding_chain, True),
+                                ("swinging_sliding_chain", swinging_sliding_chain, True),
+                                ("tilted_falling_chain", tilted_falling_chain, True)]:
+        if not os.path.exists(os.path.join(root, scene)):
+            print("skipped", scene, "(no results)")
+            continue
         fig, ax = plt.subplots(1, 3, figsize=(15, 4.2), gridspec_kw={"width_ratios": [1.1, 1.2, 1.2]})
         draw(os.path.join(root, scene), ax)
-        ledger(ax[2], os.path.join(root, scene))
+        (front_ledger if fronts else ledger)(ax[2], os.path.join(root, scene))
         fig.suptitle(f"cases/scenes/{scene}.toml", fontsize=11)
         fig.tight_layout()
         out = os.path.join(HERE, f"scene_{scene}.png")

@@ -6,6 +6,7 @@
 
 #include <catch2/catch.hpp>
 
+#include "cases/run_command.hpp"
 #include "cases/scene.hpp"
 #include "solver/errors.hpp"
 #include "solver/tension_system.hpp"
@@ -28,14 +29,11 @@ std::string edit(const std::string& text, const std::string& from, const std::st
   return out;
 }
 
-/// The message of the InputError that parsing and building `text` raises, or "" if none.
+/// The message of the InputError that parsing `text` and building the model it asks for (string,
+/// string with fronts, or reduced) raises, or "" if none.
 std::string error_of(const std::string& text) {
   try {
-    const SceneSpec spec = parse_scene_text(text, "s.toml");
-    if (spec.dimension == 3)
-      build_string_scene<3>(spec);
-    else
-      build_string_scene<2>(spec);
+    check_scene(parse_scene_text(text, "s.toml"));
   } catch (const InputError& e) {
     return e.what();
   }
@@ -50,7 +48,14 @@ struct BadScene {
 
 }  // namespace
 
-TEST_CASE("the base of the bad scenes is good", "[unit][scene]") { CHECK(error_of(kBase).empty()); }
+TEST_CASE("the bases of the bad scenes are good", "[unit][scene]") {
+  CHECK(error_of(kBase).empty());
+  // The three canonical problems, on the string solver and as reduced models.
+  for (const std::string* base : {&test::kFallingBase, &test::kFoldedBase, &test::kSlidingBase}) {
+    CHECK(error_of(*base).empty());
+    CHECK(error_of(edit(*base, "model = \"string\"", "model = \"reduced\"")).empty());
+  }
+}
 
 TEST_CASE("bad scenes are refused with the location, the key, the value and what is allowed", "[unit][scene]") {
   // The tension backends of this build (KLU is optional), as the message lists them.
@@ -229,6 +234,98 @@ TEST_CASE("bad scenes are refused with the location, the key, the value and what
        "s.toml:20:10: velocity.values has 2 entries but the string has 11 nodes"},
   };
   CHECK(sizeof(cases) / sizeof(cases[0]) >= 30);
+  for (const BadScene& c : cases) {
+    CAPTURE(c.what, c.text);
+    CHECK(error_of(c.text) == c.message);
+  }
+}
+
+TEST_CASE("bad scenes with fronts, and scenes the reduced model does not fit, are refused with their reasons",
+          "[unit][scene]") {
+  // The messages point into test_scene_support.hpp's falling (F), folded (D) and sliding (S) chains.
+  const std::string& F = test::kFallingBase;
+  const std::string& D = test::kFoldedBase;
+  const std::string& S = test::kSlidingBase;
+  auto reduced = [](const std::string& text) { return edit(text, "model = \"string\"", "model = \"reduced\""); };
+  const BadScene cases[] = {
+      {"typo in a heap's key", edit(F, "side = \"end\"", "sid = \"end\""),
+       "s.toml:15:1: unknown key 'sid' in effects.heap[0]; valid keys: side, s0, f, point, on_plane (did you mean 'side'?)"},
+      {"a heap's f above one", edit(F, "f = 0.5", "f = 1.5"),
+       "s.toml:17:5: effects.heap[0].f = 1.5 is out of range: allowed 0 <= f <= 1"},
+      {"a heap on neither side", edit(F, "side = \"end\"", "side = \"top\""),
+       "s.toml:15:8: effects.heap[0].side = \"top\" is not allowed; valid values: start, end"},
+      {"a heap written as one table", edit(F, "[[effects.heap]]", "[effects.heap]"),
+       "s.toml:14:1: effects.heap must be an array of tables: write [[effects.heap]] once per heap"},
+      {"two heaps on one side", edit(F, "[effects.plane]", "[[effects.heap]]\nside = \"end\"\ns0 = 0.5\npoint = [0.0, 0.5]\n\n[effects.plane]"),
+       "s.toml:22:8: effects.heap[1].side = \"end\": effects.heap[0] already holds that side of the string; allowed at most one heap per side"},
+      {"a heap without s0", edit(F, "s0 = 1.0\n", ""),
+       "s.toml:14:1: effects.heap[0] needs s0 (m, the material coordinate of the front at t = 0)"},
+      {"a heap on a plane without a plane", edit(F, "[effects.plane]\npoint = [0.0, 0.0]\nnormal = [0.0, 1.0]\n", ""),
+       "s.toml:19:12: effects.heap[0].on_plane = true needs [effects.plane] (point, normal): the table the heap lies on"},
+      {"a plane under no heap", edit(F, "on_plane = true", "on_plane = false"),
+       "s.toml:21:1: [effects.plane] is the table under a heap, but no [[effects.heap]] has on_plane = true (the string itself does not collide with the plane)"},
+      {"a heap not on its plane", edit(F, "[effects.plane]\npoint = [0.0, 0.0]", "[effects.plane]\npoint = [0.0, 0.1]"),
+       "s.toml:18:9: effects.heap[0].point = [0.0, 0.0] is not on its plane: it is 0.1 m from effects.plane (through [0, 0.1] with normal [0, 1])"},
+      {"a plane facing away from the string", edit(F, "normal = [0.0, 1.0]", "normal = [0.0, -1.0]"),
+       "s.toml:23:10: effects.plane.normal = [0.0, -1.0]: node 0 (s = 0 m) of the moving string lies 1 m on the other side of the plane; the normal points to the string's side, and the string may not start below its table"},
+      {"a heap's s0 outside the string", edit(F, "s0 = 1.0", "s0 = 1.5"),
+       "s.toml:16:6: effects.heap[0].s0 = 1.5 is outside the string: allowed 0 < s0 <= 1 for side = \"end\" (the string is 1 m long)"},
+      {"a shape that misses the heap point", edit(F, "point = [0.0, 0.0]\non_plane", "point = [0.1, 0.0]\non_plane"),
+       "s.toml:18:9: effects.heap[0].point = [0.1, 0.0] is 0.1 m from the string's material point s0 = 1 m, which the shape puts at [0, 0]: the shape must pass through the heap point at s0"},
+      {"a closed string with a heap", edit(edit(F, "kind = \"polyline\"\npoints = [[0.0, 1.0], [0.0, 0.0]]", "kind = \"circle\"\ncenter = [0.0, 0.5]\nradius = 0.15915494309189535"), "length = 1.0\n", ""),
+       "s.toml:14:1: [[effects.heap]] on a closed string: fronts are tracked on open strings only (string.closed = true)"},
+      {"a fixed end inside a heap", edit(F, "[effects.gravity]", "[ends]\nend = \"fixed\"\n\n[effects.gravity]"),
+       "s.toml:12:7: ends.end = \"fixed\" is inside the heap of effects.heap[0] (side = \"end\", s0 = 1 m): an end held by a heap cannot be fixed, loaded or driven"},
+      {"a fold outside the heaps", edit(S, "[stop]", "[effects.fold]\ns0 = 0.5\n\n[stop]"),
+       "s.toml:21:6: effects.fold.s0 = 0.5 is not between the heaps: allowed 0.8 < s0 < 1"},
+      {"a fold where the shape does not fold", edit(D, "points = [[0.0, 0.0], [0.0, -0.2], [0.0, 0.6]]", "points = [[0.0, 0.0], [0.0, -1.0]]"),
+       "s.toml:18:6: effects.fold.s0 = 0.2: the shape does not fold back there (it turns by 0 deg at s = 0.2 m; a fold turns by 180 deg, its two arms side by side)"},
+      {"a stop on a front the scene lacks", edit(F, "front = \"heap_end\"", "front = \"fold\""),
+       "s.toml:28:9: stop.front[0].front = \"fold\" but the scene has no fold ([effects.fold]); its fronts: heap_end"},
+      {"a misspelt front in a stop", edit(F, "front = \"heap_end\"", "front = \"heap_ned\""),
+       "s.toml:28:9: stop.front[0].front = \"heap_ned\" is not allowed; valid values: fold, heap_start, heap_end (did you mean \"heap_end\"?)"},
+      {"a stop where the front starts", edit(F, "s0 = 0.01", "s0 = 1.0"),
+       "s.toml:29:6: stop.front[0].s0 = 1.0 is where the heap_end front starts: a stop event needs a front that gets there"},
+      {"two heaps closer than two links (the front model's own check, located at the first heap)",
+       edit(S, "[stop]", "[[effects.heap]]\nside = \"end\"\ns0 = 0.85\npoint = [0.0, -0.05]\n\n[stop]"),
+       "s.toml:14:1: the heaps are less than two links apart: use more nodes"},
+      {"a chain lying along its table (a degenerate contact, located at the heap)",
+       edit(F, "points = [[0.0, 1.0], [0.0, 0.0]]", "points = [[1.0, 0.0], [0.0, 0.0]]"),
+       "s.toml:14:1: the string meets the heap's plane at a grazing angle (n·t = 0 at node 19)"},
+      {"a misspelt model", edit(F, "model = \"string\"", "model = \"reduce\""),
+       "s.toml:1:9: model = \"reduce\" is not allowed; valid values: string, reduced (did you mean \"reduced\"?)"},
+      {"the tension field with fronts", F + "[output]\nfields = [\"nodes\", \"tension\"]\n",
+       "s.toml:31:10: output.fields lists \"tension\", which a run with fronts does not record; allowed with fronts: nodes, energy, stats"},
+      {"the slack check with fronts", F + "[solver]\ncheck_slack = true\n",
+       "s.toml:31:15: solver.check_slack = true applies to scenes without fronts: the front model has no slack check"},
+      {"reduced: no front", "model = \"reduced\"\n" + kBase,
+       "s.toml:1:9: model = \"reduced\" needs a fold or a heap: the reduced models are the falling chain (a heap at the end, on a table), the folded chain (a fold) and the sliding chain (a heap at the start, at a hole)"},
+      {"reduced: no gravity", reduced(edit(D, "[effects.gravity]\ng = [0.0, -9.81]\n", "")),
+       "s.toml:1:9: model = \"reduced\" needs gravity ([effects.gravity]): each reduced model is driven by it"},
+      {"reduced: a tilted falling chain", reduced(edit(F, "points = [[0.0, 1.0], [0.0, 0.0]]", "points = [[0.34202014332567, 0.93969262078591], [0.0, 0.0]]")),
+       "s.toml:1:9: model = \"reduced\" needs a straight string along gravity: the falling part is tilted 20.0° from it"},
+      {"reduced: a bent resting arm", reduced(edit(edit(D, "[[0.0, 0.0], [0.0, -0.2], [0.0, 0.6]]", "[[0.0, 0.0], [0.06, -0.08], [0.0, -0.16], [0.0, -0.2], [0.0, 0.56]]"), "s0 = 0.2", "s0 = 0.24")),
+       "s.toml:1:9: model = \"reduced\" needs a straight string along gravity: the resting arm is not straight (node 2 is 0.0632 m off the line along gravity)"},
+      {"reduced: a moving start", reduced(S + "[velocity]\nkind = \"uniform\"\nvalue = [0.5, 0.0]\n"),
+       "s.toml:1:9: model = \"reduced\" needs the string at rest: node 16 (s = 0.8 m) moves at 0.5 m/s"},
+      {"reduced: drag", reduced(S + "[effects.drag]\ncoefficient = 0.1\n"),
+       "s.toml:1:9: model = \"reduced\" has no drag: remove [effects.drag]"},
+      {"reduced: a falling chain into a hole", reduced(edit(edit(F, "on_plane = true\n", ""), "[effects.plane]\npoint = [0.0, 0.0]\nnormal = [0.0, 1.0]\n", "")),
+       "s.toml:1:9: model = \"reduced\" needs the falling chain's heap on a table: on_plane = true, with [effects.plane] perpendicular to gravity"},
+      {"reduced: a sloping table", reduced(edit(F, "normal = [0.0, 1.0]", "normal = [0.1, 1.0]")),
+       "s.toml:1:9: model = \"reduced\" needs the table perpendicular to gravity: effects.plane.normal is tilted 5.7° from -g"},
+      {"reduced: a falling chain without cutoff", reduced(edit(F, "[[stop.front]]\nfront = \"heap_end\"\ns0 = 0.01\n", "")),
+       "s.toml:1:9: model = \"reduced\" needs a cutoff for the falling chain: one [[stop.front]] with front = \"heap_end\" and 0 < s0 < 1 (s0 = eps l; the reduced model is singular at the end of the motion)"},
+      {"reduced: a folded chain with a free start", reduced(edit(D, "start = \"fixed\"", "start = \"free\"")),
+       "s.toml:1:9: model = \"reduced\" needs the folded chain's start fixed: ends.start = \"free\" (the resting arm hangs from it)"},
+      {"reduced: a sideways end load", reduced(edit(D, "start = \"fixed\"", "start = \"fixed\"\nend = { kind = \"loaded\", force = [1.0, 1.0] }")),
+       "s.toml:1:9: model = \"reduced\" needs the load on the free end along -g (upward, F >= 0): ends.end.force is tilted 45.0° from it"},
+      {"reduced: a sliding chain with a stop", reduced(S + "[[stop.front]]\nfront = \"heap_start\"\ns0 = 0.9\n"),
+       "s.toml:1:9: model = \"reduced\" stops the sliding chain when the heap runs empty (eta = 1): remove [[stop.front]]"},
+      {"reduced: two fronts", reduced(edit(S, "[stop]", "[[effects.heap]]\nside = \"end\"\ns0 = 1.0\npoint = [0.0, -0.2]\n\n[stop]")),
+       "s.toml:1:9: model = \"reduced\" needs exactly one front (a heap or a fold): the scene has 2 (heap_start, heap_end)"},
+  };
+  CHECK(sizeof(cases) / sizeof(cases[0]) >= 12);
   for (const BadScene& c : cases) {
     CAPTURE(c.what, c.text);
     CHECK(error_of(c.text) == c.message);

@@ -1,9 +1,42 @@
 #pragma once
-// A small good scene shared by the scene tests: a hanging chain, fixed at its top, under gravity.
-// Line numbers matter: test_scene_errors.cpp checks messages that point into this text.
+// Small good scenes shared by the scene tests: a hanging chain, fixed at its top, under gravity, and
+// the three canonical problems with fronts (falling, folded, sliding chain, 21 nodes, f = 0.5).
+// Line numbers matter: test_scene_errors.cpp checks messages that point into these texts.
+#include <filesystem>
+#include <fstream>
+#include <sstream>
 #include <string>
 
+#include "cases/front_scene.hpp"
+#include "cases/scene.hpp"
+
 namespace chainsim::test {
+
+/// An empty directory for one test's files (under the system's temporary directory).
+inline std::filesystem::path temp_dir(const std::string& name) {
+  auto dir = std::filesystem::temp_directory_path() / ("chainsim_test_" + name);
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir);
+  return dir;
+}
+
+/// The whole text of a file.
+inline std::string read(const std::filesystem::path& file) {
+  std::ifstream in(file);
+  std::stringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+
+/// Builds a scene with fronts in its own dimension and runs it (no outputs written).
+inline FrontRun run_front_spec(const SceneSpec& spec) {
+  if (spec.dimension == 3) {
+    FrontScene<3> scene = build_front_scene<3>(spec);
+    return run_fronts(*scene.model, scene.run);
+  }
+  FrontScene<2> scene = build_front_scene<2>(spec);
+  return run_fronts(*scene.model, scene.run);
+}
 
 inline const std::string kSceneBase = R"([string]
 length = 1.0
@@ -22,6 +55,90 @@ g = [0.0, -9.81]
 
 [stop]
 t_end = 0.2
+)";
+
+// The falling chain: a heap at the end on a table, a cutoff at s0 = 0.01 m.
+inline const std::string kFallingBase = R"(model = "string"
+
+[string]
+length = 1.0
+nodes = 21
+
+[shape]
+kind = "polyline"
+points = [[0.0, 1.0], [0.0, 0.0]]
+
+[effects.gravity]
+g = [0.0, -9.81]
+
+[[effects.heap]]
+side = "end"
+s0 = 1.0
+f = 0.5
+point = [0.0, 0.0]
+on_plane = true
+
+[effects.plane]
+point = [0.0, 0.0]
+normal = [0.0, 1.0]
+
+[stop]
+t_end = 1.0
+[[stop.front]]
+front = "heap_end"
+s0 = 0.01
+)";
+
+// The folded chain: start fixed, a resting arm of 0.2 m, the fold, the free arm back up; cutoff 0.99 m.
+inline const std::string kFoldedBase = R"(model = "string"
+
+[string]
+length = 1.0
+nodes = 21
+
+[shape]
+kind = "polyline"
+points = [[0.0, 0.0], [0.0, -0.2], [0.0, 0.6]]
+
+[ends]
+start = "fixed"
+
+[effects.gravity]
+g = [0.0, -9.81]
+
+[effects.fold]
+s0 = 0.2
+f = 0.5
+
+[stop]
+t_end = 1.0
+[[stop.front]]
+front = "fold"
+s0 = 0.99
+)";
+
+// The sliding chain: a heap at the start feeding a hole at the origin, 0.2 m hanging.
+inline const std::string kSlidingBase = R"(model = "string"
+
+[string]
+length = 1.0
+nodes = 21
+
+[shape]
+kind = "polyline"
+points = [[-0.8, 0.0], [0.0, 0.0], [0.0, -0.2]]
+
+[effects.gravity]
+g = [0.0, -9.81]
+
+[[effects.heap]]
+side = "start"
+s0 = 0.8
+f = 0.5
+point = [0.0, 0.0]
+
+[stop]
+t_end = 1.0
 )";
 
 }  // namespace chainsim::test
