@@ -126,13 +126,26 @@ FrontModel<dim>::FrontModel(Chain<dim> chain, std::vector<std::unique_ptr<Force<
   x_ = chain_.positions();
   v_ = chain_.velocities();
   for (const auto& p : prescribed_) x_.col(p.node) = p.path->position(0.0);
-  front_states();
+  for (const Front& front : fronts_) {
+    if (!front.on_plane) continue;
+    const int inner = heap_end(front).inner;
+    const double height = front.normal.dot(x_.col(inner) - front.point);
+    if (height < 0)  // on the plane itself: the grazing check below says more
+      throw InputError(fmt::format("the normal of the heap's plane must point to the string's side: node {} is "
+                                   "{:.6g} m from the plane along it",
+                                   inner, height));
+  }
+  try {
+    front_states();
+  } catch (const RecoverableError& e) {
+    throw InputError(fmt::format("the initial shape does not fit the fronts: {}", e.what()));
+  }
   std::vector<double> expected;
   if (before) expected.push_back(before->s0);
   if (fold) expected.push_back(fold->s0);
   if (after) expected.push_back(after->s0);
-  // A front is where the links put it: a curved shape puts it off s0 by O(κ h²), which is accepted
-  // up to a tenth of a link (the masses follow the geometry).
+  // A front is where the links put it: a partial link is straight, so on a curved shape the front
+  // lies off s0 by O(κ h²). That is accepted up to a tenth of a link; the masses follow the geometry.
   for (std::size_t k = 0; k < fronts_.size(); ++k)
     if (std::abs(fs_[k].s0 - expected[k]) > std::max(1e-6 * ell, 0.1 * h_))
       throw InputError(fmt::format(
@@ -141,7 +154,7 @@ FrontModel<dim>::FrontModel(Chain<dim> chain, std::vector<std::unique_ptr<Force<
           fronts_[k].kind == FrontKind::kHeap ? "heap" : "fold", expected[k], fs_[k].s0,
           fronts_[k].kind == FrontKind::kHeap ? "heap point" : "fold"));
   for (std::size_t k = 0; k < fronts_.size(); ++k)
-    if (fronts_[k].kind == FrontKind::kHeap) heap_moment0_ += heap_mass(k) * fronts_[k].point;
+    if (fronts_[k].kind == FrontKind::kHeap) heap_moment0_ += heap_mass(k) * fs_[k].position;
 }
 
 template <int dim>
@@ -250,9 +263,11 @@ void FrontModel<dim>::front_states() {
         s.direction = e;
         s.position = x_.col(node) + l * e;
         w = -(n.dot(v_.col(node)) + l * n.dot(e_dot)) / ne;
-        for (int i = arcs_[static_cast<std::size_t>(end.arc)].first; i <= arcs_[static_cast<std::size_t>(end.arc)].last; ++i)
-          if (n.dot(x_.col(i) - front.point) < 0)
-            throw RecoverableError(fmt::format("node {} has gone through the heap's plane away from the contact", i));
+        if (has_link) fronts_[k].last_direction = e;  // kept for when a crossing empties the arc
+        for (const ArcRange& arc : arcs_)
+          for (int i = arc.first; i <= arc.last; ++i)
+            if (n.dot(x_.col(i) - front.point) < 0)
+              throw RecoverableError(fmt::format("node {} has gone through the heap's plane away from the contact", i));
       }
       const Vec<dim> e = s.direction;
       const Vec<dim> v_end = v_.col(node);
@@ -598,7 +613,6 @@ typename FrontModel<dim>::EventAction FrontModel<dim>::handle_events(double t, E
         // partial link does not hold is left in the heap with its momentum.
         const double M = m_[node] + m_[inner];
         const Vec<dim> p = m_[node] * v_.col(node) + m_[inner] * v_.col(inner);
-        if (front.on_plane && arc.num_links() == 1) front.last_direction = s.direction;
         (after ? arc.last : arc.first) = inner;
         rebuild();
         v_.col(inner) = p / M;

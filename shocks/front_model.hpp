@@ -6,15 +6,22 @@
 /// coordinate s_i = i h. The material line is cut at *fronts* into *arcs* (runs of moving nodes) and
 /// *heaps* (quiescent, shapeless reservoirs). Two kinds of front:
 ///
-///   heap   a quiescent heap at a fixed point x0 (a table with the pile of fallen links, or a pile
-///          feeding the string through a hole or over an edge). The arc ends at x0: the material
-///          between its end node k and x0 is a straight *partial link* of length l = |x0 − x_k|
-///          sliding through x0 (l is the material length, so s0 = s_k ± l). Jump conditions
-///          (the internal shock of dissipation f at x0 plus the external shock at the heap, model.md):
-///              end tension  τ = λ w² (1 + f sgn w),  w = −v_k·e  (speed of material entering the arc;
-///                           e = (x0 − x_k)/l points from the arc into the heap)
-///              W_s = −f λ |w|³ (internal shock),  W* = −½ λ w³ (external shock)
-///              reaction on the string  R = (τ − λ w²) e   (plus the heap's own weight, held by the plane)
+///   heap   a quiescent heap, either fed through a fixed point x0 (a pile under a hole, an edge:
+///          *pinned*) or lying on a plane (the table under a falling chain). The arc ends in a
+///          straight *partial link* of material length l from its end node k to the contact
+///          (s0 = s_k ± l), in direction e (from the arc into the heap):
+///              pinned     the contact is x0, l = |x0 − x_k|, e = (x0 − x_k)/l
+///              on a plane the arc's last full link continued to the plane (point p, normal n):
+///                         l = n·(p − x_k)/(n·e); the contact x_k + l e slides along the plane
+///          w = dl/dt is the rate at which the arc gains material (w < 0: it runs into the heap).
+///          Jump conditions (the internal shock of dissipation f at the contact plus the external
+///          shock at the heap, docs/shocks.md):
+///              end tension  τ = λ w² (1 + f sgn w)
+///              W_s = −f λ |w|³ (internal shock)
+///              reaction on the string  R = τ e + λ w v_k,  heap power W* = τ e·v_k + ½ λ w |v_k|² − W_s
+///          (R and W* are what the discrete string exchanges with the heap; for a string moving along
+///          itself they are the paper's (τ − λ w²) e and −½ λ w³). The heap is held at rest by its
+///          support: on a tilted string R has a component along the plane (friction, no slip).
 ///          Falling chain: w = −ẏ < 0, τ = (1 − f) λ ẏ²; sliding chain: w = ẏ > 0, τ = (1 + f) λ ẏ².
 ///
 ///   fold   an internal shock at a fold (the bight of a folded chain) between arc A (s < s0) and
@@ -192,9 +199,9 @@ class FrontModel final : public OdeSystem {
   void rebuild();  // slots, tension system, after a topology change
   void unpack(double t, const Eigen::Ref<const Eigen::VectorXd>& y);
   void front_states();  // fills fs_ and masses m_ from x_, v_
-  double evaluate(double t);
+  double evaluate(double t);  // accelerations a_, returns dW_applied/dt; needs unpack + front_states
   double potential(const Eigen::Ref<const Eigen::VectorXd>& ledger) const;  // V; needs front_states
-  double heap_mass(std::size_t front) const;                                 // needs front_states  // accelerations a_, returns dW_applied/dt; needs unpack + front_states
+  double heap_mass(std::size_t front) const;                                 // needs front_states
   void project(double t);     // constraint projection of x_, v_ (moving nodes)
   Eigen::VectorXd pack(const Eigen::VectorXd& ledger) const;
   bool in_arc(int node) const { return arc_of_[static_cast<std::size_t>(node)] >= 0; }

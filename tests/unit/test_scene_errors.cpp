@@ -291,7 +291,7 @@ TEST_CASE("bad scenes with fronts, and scenes the reduced model does not fit, ar
        "s.toml:14:1: the heaps are less than two links apart: use more nodes"},
       {"a chain lying along its table (a degenerate contact, located at the heap)",
        edit(F, "points = [[0.0, 1.0], [0.0, 0.0]]", "points = [[1.0, 0.0], [0.0, 0.0]]"),
-       "s.toml:14:1: the string meets the heap's plane at a grazing angle (n·t = 0 at node 19)"},
+       "s.toml:14:1: the initial shape does not fit the fronts: the string meets the heap's plane at a grazing angle (n·t = 0 at node 19)"},
       {"a misspelt model", edit(F, "model = \"string\"", "model = \"reduce\""),
        "s.toml:1:9: model = \"reduce\" is not allowed; valid values: string, reduced (did you mean \"reduced\"?)"},
       {"the tension field with fronts", F + "[output]\nfields = [\"nodes\", \"tension\"]\n",
