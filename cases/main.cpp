@@ -84,7 +84,8 @@ int main(int argc, char** argv) {
 
   // --- chainsim run ----------------------------------------------------------------------------
   chainsim::RunCommandOptions run;
-  auto* cmd_run = app.add_subcommand("run", "Run a string scene (a TOML file) with the general string solver");
+  auto* cmd_run = app.add_subcommand("run", "Run a string scene (a TOML file): the string solver, with front tracking when the scene has heaps or a "
+                      "fold, or the reduced ODE (model = \"reduced\")");
   cmd_run->add_option("scene", run.scene, "scene file")->required();
   cmd_run->add_option("--out", run.out, "output directory (default results/<scene name>)");
   double run_t_end = 0;

@@ -5,7 +5,8 @@ Usage: /usr/bin/python3 docs/figures/make_scene_figures.py RESULTS_DIR
 where RESULTS_DIR/<scene>/ holds the outputs of
     build/chainsim run cases/scenes/<scene>.toml --out RESULTS_DIR/<scene>
 for shaken_chain, travelling_loop, whip_crack and pendulum_release (string scenes) and falling_chain,
-folded_chain, sliding_chain, swinging_sliding_chain and tilted_falling_chain (scenes with fronts), and
+folded_chain, sliding_chain, swinging_sliding_chain, tilted_falling_chain and curved_falling_chain (scenes
+with fronts), and
 RESULTS_DIR/<scene>_reduced/ the same canonical scenes run with model = "reduced".
 docs/figures/run_scene_figures.sh RESULTS_DIR does all of it. Writes docs/figures/scene_<scene>.png: the
 string at several times, the quantity that scene is about, and its energy ledger.
@@ -273,12 +274,22 @@ def swinging_sliding_chain(root, ax):
     decorate(ax[1], "t (s)", "", "it swings while it slides out of the heap")
 
 
-def tilted_falling_chain(root, ax):
-    front_shapes(ax[0], root, [0, 0.15, 0.25, 0.31, 0.345, 0.36], "chain falling tilted 25 deg onto a table, f = 0.5")
+def chain_onto_table(root, ax, title, subtitle):
+    front_shapes(ax[0], root, [0, 0.15, 0.25, 0.31, 0.345, 0.36], title)
     ser = series(root)
     ax[1].plot(ser["t"], ser["s0_0"], label="material above the table s0 (m)")
     ax[1].plot(ser["t"], ser["front_0_x"], label="contact position x (m)")
-    decorate(ax[1], "t (s)", "m", "the contact slides along the table as the chain comes down")
+    decorate(ax[1], "t (s)", "m", subtitle)
+
+
+def tilted_falling_chain(root, ax):
+    chain_onto_table(root, ax, "chain falling tilted 25 deg onto a table, f = 0.5",
+                     "the contact slides along the table as the chain comes down")
+
+
+def curved_falling_chain(root, ax):
+    chain_onto_table(root, ax, "chain falling curved onto a table, f = 0.5",
+                     "the contact slides along the table as the arc comes down")
 
 
 def main():
@@ -288,7 +299,8 @@ def main():
                                 ("falling_chain", falling_chain, True), ("folded_chain", folded_chain, True),
                                 ("sliding_chain", sliding_chain, True),
                                 ("swinging_sliding_chain", swinging_sliding_chain, True),
-                                ("tilted_falling_chain", tilted_falling_chain, True)]:
+                                ("tilted_falling_chain", tilted_falling_chain, True),
+                                ("curved_falling_chain", curved_falling_chain, True)]:
         if not os.path.exists(os.path.join(root, scene)):
             print("skipped", scene, "(no results)")
             continue
