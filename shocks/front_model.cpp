@@ -95,7 +95,11 @@ FrontModel<dim>::FrontModel(Chain<dim> chain, std::vector<std::unique_ptr<Force<
   }
   const int last_arc = static_cast<int>(arcs_.size()) - 1;
   auto heap_front = [&](const HeapSpec<dim>& spec, int arc_minus, int arc_plus) {
-    Front front{FrontKind::kHeap, spec.dissipation, spec.point, false, Vec<dim>::Zero(), Vec<dim>::Zero(), arc_minus, arc_plus};
+    Front front;
+    front.dissipation = spec.dissipation;
+    front.point = spec.point;
+    front.arc_minus = arc_minus;
+    front.arc_plus = arc_plus;
     if (spec.plane_normal) {
       const double norm = spec.plane_normal->norm();
       if (!(norm > 0) || !std::isfinite(norm)) throw InputError("the normal of a heap's plane must be a nonzero vector");
@@ -108,7 +112,14 @@ FrontModel<dim>::FrontModel(Chain<dim> chain, std::vector<std::unique_ptr<Force<
     return front;
   };
   if (before) fronts_.push_back(heap_front(*before, -1, 0));
-  if (fold) fronts_.push_back({FrontKind::kFold, fold->dissipation, Vec<dim>::Zero(), false, Vec<dim>::Zero(), Vec<dim>::Zero(), 0, 1});
+  if (fold) {
+    Front front;
+    front.kind = FrontKind::kFold;
+    front.dissipation = fold->dissipation;
+    front.arc_minus = 0;
+    front.arc_plus = 1;
+    fronts_.push_back(front);
+  }
   if (after) fronts_.push_back(heap_front(*after, last_arc, -1));
   for (std::size_t k = 0; k < prescribed_.size(); ++k) {
     const int node = prescribed_[k].node;
@@ -239,8 +250,8 @@ void FrontModel<dim>::front_states() {
       // The partial link: its length l, direction e (from the arc into the heap), the contact point
       // and w = dl/dt, the rate at which the arc gains material (w < 0: it runs into the heap).
       double l = 0, w = 0;
-      // On a plane the partial link continues the arc's last full link; once the arc has none left,
-      // it keeps that link's last direction (handle_events stores it).
+      // On a plane the partial link continues the arc's last full link; once a crossing has left the
+      // arc without one, it keeps that link's last direction (stored below at every evaluation).
       const bool has_link = arcs_[static_cast<std::size_t>(end.arc)].num_links() > 0;
       if (!front.on_plane) {  // pinned at the point: e and l from the end node to it
         const Vec<dim> d = front.point - x_.col(node);
