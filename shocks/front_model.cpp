@@ -188,31 +188,7 @@ void FrontModel<dim>::rebuild() {
     links.push_back(arcs_[k].num_links());
     closed.push_back(false);
   }
-  // A fold holds its folded link on the fold line (shocks/fold_contact.hpp): a junction coupling
-  // the two arcs, so the tension system is solved by KLU instead of arc by arc.
-  contact_.reset();
-  std::vector<Junction*> junctions;
-  for (const Front& front : fronts_) {
-    if (front.kind != FrontKind::kFold) continue;
-    const ArcRange& A = arcs_[static_cast<std::size_t>(front.arc_minus)];
-    const ArcRange& B = arcs_[static_cast<std::size_t>(front.arc_plus)];
-    if (A.num_links() == 0 && B.num_links() == 0) break;  // front_states() reports it
-    const bool on_A = A.num_links() > 0;
-    const int p = on_A ? A.last - 1 : B.first + 1, r = on_A ? A.last : B.first, o = on_A ? B.first : A.last;
-    std::vector<typename FoldContact<dim>::Link> touching;
-    for (const int i : {p, r, o})
-      for (const int j : {i - 1, i}) {
-        if (j < 0 || j + 1 >= n_ || !in_arc(j) || arc_of_[j] != arc_of_[j + 1]) continue;
-        const int arc = arc_of_[j];
-        const int u = first_unknown_[static_cast<std::size_t>(arc)] + (j - arcs_[static_cast<std::size_t>(arc)].first);
-        if (std::none_of(touching.begin(), touching.end(), [&](const auto& l) { return l.start == j; }))
-          touching.push_back({u, j});
-      }
-    contact_ = std::make_unique<FoldContact<dim>>(p, r, o, std::move(touching), h_);
-    junctions.push_back(contact_.get());
-  }
-  system_ = links.empty() ? nullptr
-                          : std::make_unique<TensionSystem>(links, closed, junctions, junctions.empty() ? "tridiagonal" : "auto");
+  system_ = links.empty() ? nullptr : std::make_unique<TensionSystem>(links, closed, std::vector<Junction*>{}, "tridiagonal");
   fs_.assign(fronts_.size(), FrontState{});
 }
 
@@ -328,19 +304,17 @@ void FrontModel<dim>::front_states() {
       const ArcRange& A = arcs_[front.arc_minus];
       const ArcRange& B = arcs_[front.arc_plus];
       const int a = A.last, b = B.first;
-      // The fold line: arc A's last link, or arc B's first link backwards (as the fold contact).
-      Vec<dim> link, link_rate;
-      if (A.num_links() > 0) {
-        link = x_.col(a) - x_.col(a - 1);
-        link_rate = v_.col(a) - v_.col(a - 1);
-      } else if (B.num_links() > 0) {
-        link = x_.col(b) - x_.col(b + 1);
-        link_rate = v_.col(b) - v_.col(b + 1);
-      } else {
+      Vec<dim> e;
+      if (A.num_links() > 0 && B.num_links() > 0)
+        e = unit<dim>(unit<dim>(x_.col(a) - x_.col(a - 1), "arc A's end link") -
+                          unit<dim>(x_.col(b + 1) - x_.col(b), "arc B's first link"),
+                      "the fold direction");
+      else if (A.num_links() > 0)
+        e = unit<dim>(x_.col(a) - x_.col(a - 1), "arc A's end link");
+      else if (B.num_links() > 0)
+        e = -unit<dim>(x_.col(b + 1) - x_.col(b), "arc B's first link");
+      else
         throw InputError("a fold needs at least one full link next to it");
-      }
-      const Vec<dim> e = unit<dim>(link, "the fold's reference link");
-      const Vec<dim> e_dot = (link_rate - e * e.dot(link_rate)) / link.norm();
       const double c = (x_.col(b) - x_.col(a)).dot(e);
       const double lA = 0.5 * (h_ + c), lB = 0.5 * (h_ - c);
       const double sd = 0.5 * (v_.col(b) - v_.col(a)).dot(e);
@@ -359,13 +333,8 @@ void FrontModel<dim>::front_states() {
       s.inflow = 0;
       m_[a] += lambda_ * lA;
       m_[b] += lambda_ * lB;
-      // Material crossing the fold changes node (λ ṡ0 from b to a) while the fold line turns: with
-      // v_b − v_a = 2 ṡ0 e + c ė, the forces τ∓ e alone leave λ ṡ0 c ė of momentum and
-      // λ ṡ0 c (ė·v_a + ½ c |ė|²) of energy unaccounted; ½ λ ṡ0 c ė on each node closes both
-      // exactly (zero when the fold line does not turn, as in the paper's geometry).
-      const Vec<dim> turn = 0.5 * lambda_ * sd * c * e_dot;
-      front_force_.col(a) += s.tension_minus * e + turn;
-      front_force_.col(b) += s.tension_plus * e + turn;
+      front_force_.col(a) += s.tension_minus * e;
+      front_force_.col(b) += s.tension_plus * e;
     }
   }
   for (int i = 0; i < n_; ++i)
@@ -412,16 +381,8 @@ double FrontModel<dim>::evaluate(double t) {
         e_prev = e;
       }
     }
-    if (contact_) {  // the fold line: g̈ = −2α ġ − β² g, like the links
-      contact_->set_geometry(x_);
-      contact_->write_matrix(*system_, e_, w);
-      const typename FoldContact<dim>::Rows rows = -contact_->curvature_term(v_) - contact_->apply(b_) - 2 * alpha_ * contact_->rate(v_) -
-                        beta2 * contact_->value();
-      for (int k = 0; k < FoldContact<dim>::kRows; ++k) system_->rhs(contact_->unknown(k)) = rows[k];
-    }
     const Eigen::VectorXd& T = system_->solve(t);
     ++solves_;
-    if (contact_) contact_->add_force(T, tension_force);
     for (std::size_t k = 0; k < arcs_.size(); ++k) {
       const ArcRange& arc = arcs_[k];
       for (int j = arc.first; j < arc.last; ++j) {
@@ -584,15 +545,6 @@ void FrontModel<dim>::project(double t) {
         e_prev = e;
       }
     }
-    if (contact_) {
-      contact_->set_geometry(x_);
-      contact_->write_matrix(*system_, e_, w);
-      const typename FoldContact<dim>::Rows rows = velocity ? contact_->rate(v_) : contact_->value();
-      for (int k = 0; k < FoldContact<dim>::kRows; ++k) {
-        system_->rhs(contact_->unknown(k)) = rows[k];
-        worst = std::max(worst, std::abs(rows[k]) / (velocity ? 1.0 : h_));
-      }
-    }
     return worst;
   };
   auto correct = [&](Points<dim>& target, const Eigen::VectorXd& nu) {
@@ -604,7 +556,6 @@ void FrontModel<dim>::project(double t) {
         target.col(j + 1) += w(j + 1) * n * e_.col(j);
       }
     }
-    if (contact_) contact_->add_correction(nu, w, target);
   };
   for (int it = 0;; ++it) {
     const double worst = assemble(false);

@@ -66,7 +66,6 @@
 #include <Eigen/Core>
 
 #include "mesh/chain.hpp"
-#include "shocks/fold_contact.hpp"
 #include "solver/forces.hpp"
 #include "solver/integrator.hpp"
 #include "solver/tension_system.hpp"
@@ -225,7 +224,6 @@ class FrontModel final : public OdeSystem {
   std::vector<ArcRange> arcs_;
   std::vector<int> arc_of_, slot_, path_of_;
   int num_moving_ = 0;
-  std::unique_ptr<FoldContact<dim>> contact_;  // the tight fold's line constraint (with a fold)
   std::unique_ptr<TensionSystem> system_;
   std::vector<int> first_unknown_;  // per arc
   double alpha_ = 0, beta_ = 0;
