@@ -424,11 +424,12 @@ void parse_shape(const Section& top, Context& ctx) {
     throw InputError(fmt::format("{}:1:1: the scene needs a [shape] section with kind = one of {}", ctx.text.name(),
                                  join(kinds)));
   Section s(subtable(top, "shape"), "shape", ctx,
-            {"kind", "points", "center", "radius", "start_angle_deg", "sweep_deg", "axis1", "axis2", "start", "end",
-             "length_tolerance"});
+            {"kind", "points", "corner_radius", "center", "radius", "start_angle_deg", "sweep_deg", "axis1", "axis2",
+             "start", "end", "length_tolerance"});
   if (!s.has("kind")) s.missing("kind", "one of " + join(kinds));
   sh.kind = s.choice("kind", kinds, "");
   sh.points = s.matrix("points");
+  sh.corner_radius = s.positive("corner_radius");
   sh.center = s.vector("center");
   sh.radius = s.positive("radius").value_or(0.0);
   sh.start_angle_deg = s.number("start_angle_deg").value_or(0.0);
@@ -458,6 +459,7 @@ void parse_shape(const Section& top, Context& ctx) {
     s.fail("points", fmt::format("shape.points = {} has {} point: a shape needs at least 2", s.text("points"),
                                  sh.points.size()));
   s.forbid("points", line, context);
+  s.forbid("corner_radius", line, context);
   for (const char* key : {"center", "radius", "start_angle_deg", "axis1", "axis2"}) s.forbid(key, round, context);
   s.forbid("sweep_deg", arc, context);
   s.forbid("start", catenary, context);
@@ -727,7 +729,13 @@ std::unique_ptr<Curve<dim>> build_curve(const SceneSpec& spec, bool closed, cons
   const auto& sh = spec.shape;
   if (sh.kind == "polyline" || sh.kind == "points") {
     const Points<dim> points = as_points<dim>(spec, sh.points, "shape.points");
-    return at_key(spec, "shape.points", [&] { return polyline_curve<dim>(points, closed); });
+    auto polyline = at_key(spec, "shape.points", [&] { return polyline_curve<dim>(points, closed); });
+    if (!sh.corner_radius) return polyline;
+    if (closed)
+      fail_at(spec, "shape.corner_radius",
+              "shape.corner_radius does not apply to a closed string (string.closed = true): only the interior "
+              "points of an open polyline are rounded");
+    return at_key(spec, "shape.corner_radius", [&] { return rounded_polyline_curve<dim>(points, *sh.corner_radius); });
   }
   if (sh.kind == "arc" || sh.kind == "circle") {
     const Vec<dim> center = as_vec<dim>(spec, sh.center, "shape.center");

@@ -115,6 +115,7 @@ struct SceneSpec {
     std::vector<std::vector<double>> points;
     std::vector<double> center, start, end, axis1, axis2;
     double radius = 0, start_angle_deg = 0, sweep_deg = 0;
+    std::optional<double> corner_radius;  ///< m; polyline, points: fillet radius at every interior point
     double length_tolerance = 1e-6;
   } shape;
   // [velocity]

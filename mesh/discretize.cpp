@@ -84,6 +84,135 @@ class Polyline final : public Curve<dim> {
   bool closed_;
 };
 
+/// A point as messages show it: "[0.04, -0.3]".
+template <int dim>
+std::string show_point(const Vec<dim>& x) {
+  std::string out = "[";
+  for (int d = 0; d < dim; ++d) out += fmt::format("{}{:g}", d > 0 ? ", " : "", x[d]);
+  return out + "]";
+}
+
+/// An open polyline whose interior vertices are rounded by fillets (rounded_polyline_curve).
+///
+/// At vertex k with unit directions a (incoming) and b (outgoing), cos θ = a·b and the unit normal
+/// towards the fillet's centre is n = (b − (a·b) a) / sin θ. The fillet starts at the tangent point
+/// T = x_k − t a, t = r tan(θ/2), and, σ ∈ [0, r θ] along it,
+///   p(σ) = T + r sin(σ/r) a + r (1 − cos(σ/r)) n,
+/// which is well conditioned even for small θ (no centre is formed) and ends at x_k + t b with the
+/// direction b. The curve is a list of pieces, straight or circular, each starting at arc length
+/// start_.
+template <int dim>
+class RoundedPolyline final : public Curve<dim> {
+ public:
+  RoundedPolyline(const Points<dim>& vertices, double radius) : vertex_count_(vertices.cols()), radius_(radius) {
+    // The vertices are checked as for a plain polyline (and with the same messages).
+    Polyline<dim> plain(vertices, false);
+    check_positive("shape.corner_radius", radius);
+    const int n = static_cast<int>(vertices.cols());
+    const auto vertex = [&](int k) -> Vec<dim> { return vertices.col(k); };
+    std::vector<Vec<dim>> direction(static_cast<std::size_t>(n - 1));  // of segment k: x_k -> x_{k+1}
+    std::vector<double> segment(static_cast<std::size_t>(n - 1));
+    for (int k = 0; k + 1 < n; ++k) {
+      const Vec<dim> d = vertex(k + 1) - vertex(k);
+      segment[static_cast<std::size_t>(k)] = d.norm();
+      direction[static_cast<std::size_t>(k)] = d / d.norm();
+    }
+    // 1. The turn θ_k at every interior vertex, its normal, and its tangent factor tan(θ_k/2).
+    std::vector<double> turn(static_cast<std::size_t>(n), 0.0), factor(static_cast<std::size_t>(n), 0.0);
+    std::vector<Vec<dim>> normal(static_cast<std::size_t>(n), Vec<dim>::Zero());
+    for (int k = 1; k + 1 < n; ++k) {
+      const auto K = static_cast<std::size_t>(k);
+      const Vec<dim>& a = direction[K - 1];
+      const Vec<dim>& b = direction[K];
+      const double cos_turn = a.dot(b);
+      const Vec<dim> w = b - cos_turn * a;
+      const double sin_turn = w.norm();
+      const double theta = std::atan2(sin_turn, cos_turn);
+      if (kPi - theta < kTurnBack)
+        throw InputError(fmt::format(
+            "shape.corner_radius = {:g} m cannot round point {} = {}: the polyline turns back on itself there (it "
+            "turns by {:.9g} deg, to within {:g} rad of 180 deg), and no arc is tangent to both of its segments",
+            radius, k, show_point<dim>(vertex(k)), theta * 180 / kPi, kTurnBack));
+      if (theta < kStraight) continue;  // straight through: no arc
+      turn[K] = theta;
+      factor[K] = std::tan(0.5 * theta);
+      normal[K] = w / sin_turn;
+    }
+    // 2. Every segment must hold the tangent lengths of the fillets at its two ends. The segment
+    //    with the smallest radius that fits decides: if it fails, it is named with that radius.
+    int tightest = -1;
+    double largest_fit = INFINITY;
+    for (int k = 0; k + 1 < n; ++k) {
+      const auto K = static_cast<std::size_t>(k);
+      const double need = factor[K] + factor[K + 1];
+      if (need > 0 && segment[K] / need < largest_fit) {
+        largest_fit = segment[K] / need;
+        tightest = k;
+      }
+    }
+    if (tightest >= 0) {
+      const auto K = static_cast<std::size_t>(tightest);
+      const double t0 = radius * factor[K], t1 = radius * factor[K + 1];
+      if (t0 + t1 > segment[K] * (1 + kFitTolerance))
+        throw InputError(fmt::format(
+            "shape.corner_radius = {:g} m is too large for the segment from point {} = {} to point {} = {}: it is "
+            "{:.9g} m long but the fillets at its ends need {:.9g} m of it (tangent lengths {:.9g} m + {:.9g} m); the "
+            "largest corner_radius that fits every segment is {:.9g} m",
+            radius, tightest, show_point<dim>(vertex(tightest)), tightest + 1, show_point<dim>(vertex(tightest + 1)),
+            segment[K], t0 + t1, t0, t1, largest_fit));
+    }
+    // 3. The pieces: segment k without its tangent lengths, then the fillet at vertex k + 1.
+    double s = 0;
+    for (int k = 0; k + 1 < n; ++k) {
+      const auto K = static_cast<std::size_t>(k);
+      const double t0 = radius * factor[K], t1 = radius * factor[K + 1];
+      const double straight = segment[K] - t0 - t1;
+      if (straight > 0) {
+        pieces_.push_back({s, straight, 0.0, vertex(k) + t0 * direction[K], direction[K], Vec<dim>::Zero()});
+        s += straight;
+      }
+      if (turn[K + 1] > 0) {
+        const double arc = radius * turn[K + 1];
+        pieces_.push_back({s, arc, radius, vertex(k + 1) - t1 * direction[K], direction[K], normal[K + 1]});
+        s += arc;
+      }
+    }
+    length_ = s;
+  }
+  double length() const override { return length_; }
+  Vec<dim> point(double s) const override {
+    s = std::clamp(s, 0.0, length_);
+    auto it = std::upper_bound(pieces_.begin(), pieces_.end(), s, [](double v, const Piece& p) { return v < p.start; });
+    const Piece& p = it == pieces_.begin() ? pieces_.front() : *std::prev(it);  // the last piece starting <= s
+    const double sigma = std::min(s - p.start, p.length);
+    if (p.radius == 0) return p.origin + sigma * p.direction;
+    const double phi = sigma / p.radius;
+    return p.origin + p.radius * std::sin(phi) * p.direction + p.radius * (1 - std::cos(phi)) * p.normal;
+  }
+  std::string description() const override {
+    return fmt::format("polyline through {} points with corners rounded to radius {:g} m", vertex_count_, radius_);
+  }
+
+ private:
+  /// Within this angle (rad) of π a vertex turns back on itself: it has no fillet.
+  static constexpr double kTurnBack = 1e-9;
+  /// Below this turn (rad) a vertex is straight through: its fillet would differ from the corner by
+  /// r θ²/8 < 1e-24 r.
+  static constexpr double kStraight = 1e-12;
+  /// Relative excess of the tangent lengths over a segment still accepted (an exact fit, in floating point).
+  static constexpr double kFitTolerance = 1e-12;
+
+  /// A straight piece (radius 0): origin + σ direction; a fillet: origin + r sin(σ/r) direction +
+  /// r (1 − cos(σ/r)) normal; σ ∈ [0, length].
+  struct Piece {
+    double start, length, radius;
+    Vec<dim> origin, direction, normal;
+  };
+  std::vector<Piece> pieces_;
+  Eigen::Index vertex_count_;
+  double radius_, length_ = 0;
+};
+
 template <int dim>
 class CircleArc final : public Curve<dim> {
  public:
@@ -197,6 +326,11 @@ std::unique_ptr<Curve<dim>> polyline_curve(const Points<dim>& vertices, bool clo
 }
 
 template <int dim>
+std::unique_ptr<Curve<dim>> rounded_polyline_curve(const Points<dim>& vertices, double corner_radius) {
+  return std::make_unique<RoundedPolyline<dim>>(vertices, corner_radius);
+}
+
+template <int dim>
 std::unique_ptr<Curve<dim>> circle_arc_curve(const Vec<dim>& center, double radius, double start_angle,
                                              double sweep, const Vec<dim>& axis1, const Vec<dim>& axis2) {
   return std::make_unique<CircleArc<dim>>(center, radius, start_angle, sweep, axis1, axis2, false);
@@ -283,6 +417,7 @@ void set_node_velocities(Chain<dim>& chain, const Points<dim>& velocities) {
 
 #define CHAINSIM_INSTANTIATE(D)                                                                         \
   template std::unique_ptr<Curve<D>> polyline_curve<D>(const Points<D>&, bool);                        \
+  template std::unique_ptr<Curve<D>> rounded_polyline_curve<D>(const Points<D>&, double);              \
   template std::unique_ptr<Curve<D>> circle_arc_curve<D>(const Vec<D>&, double, double, double,       \
                                                          const Vec<D>&, const Vec<D>&);                \
   template std::unique_ptr<Curve<D>> circle_curve<D>(const Vec<D>&, double, const Vec<D>&, const Vec<D>&); \

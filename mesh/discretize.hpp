@@ -38,6 +38,19 @@ class Curve {
 template <int dim>
 std::unique_ptr<Curve<dim>> polyline_curve(const Points<dim>& vertices, bool closed = false);
 
+/// The open polyline through `vertices` (as polyline_curve) with every interior vertex rounded by a
+/// fillet: the circular arc of radius `corner_radius` (m, > 0) tangent to both adjacent segments.
+/// At a vertex where the direction turns by θ (the angle between the incoming and the outgoing
+/// segment), the arc starts and ends r·tan(θ/2) from the vertex and is r·θ long, so the curve is
+/// Σ segments − Σ (2 r tan(θ/2) − r θ) long and has a continuous tangent. A straight-through
+/// vertex (θ ≈ 0) keeps no arc. Fillets may use a whole segment (the two tangent lengths on it
+/// summing to its length, to a relative 1e-12): then two arcs meet there.
+/// Throws InputError (naming the vertex or segment, zero-based as in the list of vertices) if the
+/// polyline turns back on itself at a vertex (θ within 1e-9 of π), or if a segment is too short for
+/// the fillets at its two ends (with the largest corner_radius that fits every segment).
+template <int dim>
+std::unique_ptr<Curve<dim>> rounded_polyline_curve(const Points<dim>& vertices, double corner_radius);
+
 /// The circular arc of the given radius (m) around `center`, in the plane spanned by the unit
 /// vectors axis1, axis2 (orthonormalised), from angle `start_angle` through the signed angle
 /// `sweep` (radians, counter-clockwise from axis1 towards axis2). Its length is radius · |sweep|.

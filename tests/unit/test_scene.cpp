@@ -16,6 +16,7 @@ using namespace chainsim;
 using test::read;
 using test::temp_dir;
 using Catch::Matchers::Contains;
+using Catch::Matchers::WithinAbs;
 using Catch::Matchers::WithinRel;
 
 namespace {
@@ -78,6 +79,44 @@ t_end = 1.0
   const StringScene<2> scene = build_string_scene<2>(parse_scene_text(text, "s.toml"));
   CHECK(scene.model->chain().num_links() == 40);
   CHECK_THAT(scene.model->chain().link_length(0), WithinRel(0.05, 1e-12));
+}
+
+TEST_CASE("shape.corner_radius rounds the polyline's corners and the string takes the rounded length",
+          "[unit][scene]") {
+  // The U of docs/scenes.md: two fillets of 0.02 m meeting in the middle of the 0.04 m bottom, a
+  // semicircle around (0.02, -0.28). No string.length: the string takes the shape's length.
+  const SceneSpec spec = parse_scene_text(R"(
+[string]
+link_length = 0.005
+[shape]
+kind = "points"
+points = [[0.0, 0.0], [0.0, -0.3], [0.04, -0.3], [0.04, 0.377]]
+corner_radius = 0.02
+[ends]
+start = "fixed"
+[effects.gravity]
+g = [0.0, -9.81]
+[stop]
+t_end = 0.05
+)",
+                                          "u.toml");
+  REQUIRE(spec.shape.corner_radius);
+  CHECK(*spec.shape.corner_radius == 0.02);
+  const StringScene<2> scene = build_string_scene<2>(spec);
+  const Chain<2>& chain = scene.model->chain();
+  const double length = 0.3 + 0.04 + 0.677 - 2 * (2 * 0.02 - 0.02 * kPi / 2);
+  CHECK_THAT(chain.length(), WithinRel(length, 1e-12));
+  CHECK(chain.num_links() == 200);
+  // The nodes on the bottom (s in [0.28, 0.28 + 0.02 pi]) lie on the semicircle, up to the projection
+  // onto the links, which pushes them out by h^2 / (24 r) = 5.2e-5 m so that chords are h long
+  // (measured at most 5.5e-5 m).
+  const Vec<2> center(0.02, -0.28);
+  for (int i = 0; i < chain.num_nodes(); ++i) {
+    const double s = length * i / chain.num_links();
+    if (s < 0.28 || s > 0.28 + 0.02 * kPi) continue;
+    CAPTURE(i, s);
+    CHECK_THAT((chain.positions().col(i) - center).norm(), WithinAbs(0.02, 1e-4));
+  }
 }
 
 TEST_CASE("driven, loaded and closed scenes build, and a closed string has no ends", "[unit][scene]") {
