@@ -165,6 +165,9 @@ FrontModel<dim>::FrontModel(Chain<dim> chain, std::vector<std::unique_ptr<Force<
           fronts_[k].kind == FrontKind::kHeap ? "heap" : "fold", expected[k], fs_[k].s0,
           fronts_[k].kind == FrontKind::kHeap ? "heap point" : "fold"));
   for (std::size_t k = 0; k < fronts_.size(); ++k)
+    if (fronts_[k].kind == FrontKind::kFold && fs_[k].opening > kMaxFoldOpeningDeg * kPi / 180)
+      throw InputError(fold_opened_message(k));
+  for (std::size_t k = 0; k < fronts_.size(); ++k)
     if (fronts_[k].kind == FrontKind::kHeap) heap_moment0_ += heap_mass(k) * fs_[k].position;
 }
 
@@ -205,6 +208,15 @@ typename FrontModel<dim>::HeapEnd FrontModel<dim>::heap_end(const Front& front) 
   // A node comes out whole only if the front then stays inside the string (s0 = s_outer ± h/2).
   end.insertable = end.after ? end.outer <= n_ - 2 : end.outer >= 1;
   return end;
+}
+
+template <int dim>
+std::string FrontModel<dim>::fold_opened_message(std::size_t front) const {
+  return fmt::format(
+      "the fold at s0 = {:.6g} m has opened: its arms leave it {:.3g} degrees from antiparallel (a tight bight allows "
+      "at most {:g}; a dissipative fold needs both arms along one line, and a bight that opens, as in a folded chain "
+      "whose ends are apart, is resolved by the string solver without [effects.fold]: docs/shocks.md)",
+      fs_[front].s0, fs_[front].opening * 180 / kPi, kMaxFoldOpeningDeg);
 }
 
 template <int dim>
@@ -304,17 +316,23 @@ void FrontModel<dim>::front_states() {
       const ArcRange& A = arcs_[front.arc_minus];
       const ArcRange& B = arcs_[front.arc_plus];
       const int a = A.last, b = B.first;
-      Vec<dim> e;
-      if (A.num_links() > 0 && B.num_links() > 0)
-        e = unit<dim>(unit<dim>(x_.col(a) - x_.col(a - 1), "arc A's end link") -
-                          unit<dim>(x_.col(b + 1) - x_.col(b), "arc B's first link"),
-                      "the fold direction");
-      else if (A.num_links() > 0)
-        e = unit<dim>(x_.col(a) - x_.col(a - 1), "arc A's end link");
-      else if (B.num_links() > 0)
-        e = -unit<dim>(x_.col(b + 1) - x_.col(b), "arc B's first link");
-      else
-        throw InputError("a fold needs at least one full link next to it");
+      // The fold direction e: the bisector of arc A's end link t_A and arc B's first link reversed
+      // (−t_B), or the one of them that exists; with its rate ė, for the mass flux below.
+      auto tangent = [&](int i, int j, const char* what, Vec<dim>& rate) -> Vec<dim> {  // of link i → j
+        const Vec<dim> link = x_.col(j) - x_.col(i), link_rate = v_.col(j) - v_.col(i);
+        const Vec<dim> t = unit<dim>(link, what);
+        rate = (link_rate - t * t.dot(link_rate)) / link.norm();
+        return t;
+      };
+      Vec<dim> tA_rate = Vec<dim>::Zero(), tB_rate = Vec<dim>::Zero();
+      const bool has_A = A.num_links() > 0, has_B = B.num_links() > 0;
+      if (!has_A && !has_B) throw InputError("a fold needs at least one full link next to it");
+      const Vec<dim> tA = has_A ? tangent(a - 1, a, "arc A's end link", tA_rate) : Vec<dim>::Zero();
+      const Vec<dim> tB = has_B ? tangent(b, b + 1, "arc B's first link", tB_rate) : Vec<dim>::Zero();
+      const Vec<dim> d = tA - tB, d_rate = tA_rate - tB_rate;
+      const Vec<dim> e = unit<dim>(d, "the fold direction");
+      const Vec<dim> e_rate = (d_rate - e * e.dot(d_rate)) / d.norm();
+      s.opening = has_A && has_B ? std::acos(std::clamp(-tA.dot(tB), -1.0, 1.0)) : 0.0;
       const double c = (x_.col(b) - x_.col(a)).dot(e);
       const double lA = 0.5 * (h_ + c), lB = 0.5 * (h_ - c);
       const double sd = 0.5 * (v_.col(b) - v_.col(a)).dot(e);
@@ -333,8 +351,15 @@ void FrontModel<dim>::front_states() {
       s.inflow = 0;
       m_[a] += lambda_ * lA;
       m_[b] += lambda_ * lB;
-      front_force_.col(a) += s.tension_minus * e;
-      front_force_.col(b) += s.tension_plus * e;
+      // Material crosses from b to a at the rate l̇_A = ½ (u·e + (x_b − x_a)·ė), u = v_b − v_a, carrying
+      // the momentum flux λ l̇_A u. For arms on one line (u = 2 ṡ0 e, ė = 0) that is 2 λ ṡ0² e = τ⁻ + τ⁺,
+      // the paper's fold. Otherwise the remainder δ, shared equally by the two nodes, keeps momentum
+      // exact, and the energy then balances with W_s = −2 f λ |ṡ0|³ exactly (docs/shocks.md).
+      const Vec<dim> u = v_.col(b) - v_.col(a);
+      const double lA_rate = 0.5 * (u.dot(e) + (x_.col(b) - x_.col(a)).dot(e_rate));
+      const Vec<dim> delta = lambda_ * lA_rate * u - 2 * lambda_ * sd * sd * e;
+      front_force_.col(a) += s.tension_minus * e + 0.5 * delta;
+      front_force_.col(b) += s.tension_plus * e + 0.5 * delta;
     }
   }
   for (int i = 0; i < n_; ++i)
@@ -466,6 +491,10 @@ void FrontModel<dim>::events(double t, const Eigen::Ref<const Eigen::VectorXd>& 
     const auto& stop = options_.stop_at[k];
     g[2 * static_cast<int>(fronts_.size()) + static_cast<int>(k)] = fs_[stop.front].s0 - stop.s;
   }
+  // Each fold: positive while its arms are within kMaxFoldOpeningDeg of antiparallel.
+  int q = 2 * static_cast<int>(fronts_.size()) + static_cast<int>(options_.stop_at.size());
+  for (std::size_t k = 0; k < fronts_.size(); ++k)
+    if (fronts_[k].kind == FrontKind::kFold) g[q++] = std::cos(fs_[k].opening) - std::cos(kMaxFoldOpeningDeg * kPi / 180);
 }
 
 template <int dim>
@@ -476,6 +505,7 @@ std::vector<int> FrontModel<dim>::event_directions() const {
     dirs.push_back(front.kind == FrontKind::kHeap ? +1 : -1);
   }
   for (std::size_t k = 0; k < options_.stop_at.size(); ++k) dirs.push_back(0);
+  for (int k = 0; k < num_folds(); ++k) dirs.push_back(-1);
   return dirs;
 }
 
@@ -594,6 +624,10 @@ typename FrontModel<dim>::EventAction FrontModel<dim>::handle_events(double t, E
     if (found[static_cast<std::size_t>(2 * nf) + k] != 0)
       return {EventAction::Kind::kStop,
               fmt::format("front {} reached s0 = {:.9g} m", options_.stop_at[k].front, options_.stop_at[k].s)};
+  for (std::size_t k = 0, q = static_cast<std::size_t>(2 * nf) + options_.stop_at.size(); k < fronts_.size(); ++k) {
+    if (fronts_[k].kind != FrontKind::kFold) continue;
+    if (found[q++] != 0) return {EventAction::Kind::kStop, fold_opened_message(k)};
+  }
   // Kinetic energy and momentum before, to book what the crossing changes.
   auto kinetic = [&]() {
     double K = 0;

@@ -134,6 +134,7 @@ class FrontModel final : public OdeSystem {
     double power_shock = 0;  ///< W_s = −D (W)
     double power_heap = 0;   ///< W* (W), heaps only
     Vec<dim> reaction = Vec<dim>::Zero();  ///< heap: (τ − λ w²) e, the plane's reaction on the string (N)
+    double opening = 0;  ///< fold: angle between arc A's end link and arc B's first link reversed (rad); 0 = antiparallel
   };
 
   /// `chain`: uniform open chain with the initial positions and velocities (nodes inside heaps are
@@ -146,7 +147,10 @@ class FrontModel final : public OdeSystem {
   // --- OdeSystem ----------------------------------------------------------------------------
   int size() const override { return 2 * dim * num_moving_ + kLedger + 2 * dim; }
   void rhs(double t, const Eigen::Ref<const Eigen::VectorXd>& y, Eigen::Ref<Eigen::VectorXd> ydot) override;
-  int num_events() const override { return 2 * static_cast<int>(fronts_.size()) + static_cast<int>(options_.stop_at.size()); }
+  /// Two per front (crossings), one per stop condition, one per fold (it opens past kMaxFoldOpeningDeg).
+  int num_events() const override {
+    return 2 * static_cast<int>(fronts_.size()) + static_cast<int>(options_.stop_at.size()) + num_folds();
+  }
   void events(double t, const Eigen::Ref<const Eigen::VectorXd>& y, Eigen::Ref<Eigen::VectorXd> g) override;
   std::vector<int> event_directions() const override;
   Eigen::VectorXd state_scale() const override;
@@ -194,6 +198,15 @@ class FrontModel final : public OdeSystem {
   long tension_solves() const { return solves_; }
   Vec<dim> gravity() const;
   static constexpr int kLedger = 3;  ///< W_applied, W_shocks, W_heaps
+  /// A fold is a tight bight: its arms leave it along one line. The jump conditions allow a
+  /// dissipative kink nowhere else (docs/shocks.md), so a run stops when the arms open wider than
+  /// this angle from antiparallel (and a fold that starts wider is refused).
+  static constexpr double kMaxFoldOpeningDeg = 20;
+  int num_folds() const {
+    int n = 0;
+    for (const Front& front : fronts_) n += front.kind == FrontKind::kFold ? 1 : 0;
+    return n;
+  }
 
  private:
   void rebuild();  // slots, tension system, after a topology change
@@ -213,6 +226,7 @@ class FrontModel final : public OdeSystem {
     bool removable = false, insertable = false;
   };
   HeapEnd heap_end(const Front& front) const;
+  std::string fold_opened_message(std::size_t front) const;  // needs front_states
 
   Chain<dim> chain_;
   std::vector<std::unique_ptr<Force<dim>>> forces_;

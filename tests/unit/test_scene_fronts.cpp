@@ -138,7 +138,8 @@ TEST_CASE("fronts are built only when declared: root functions and fronts in the
   CHECK(none["root_functions"] == 0);
   CHECK(none["junction_unknowns"] == 0);
 
-  // Two root functions per front (take a node in, give one out) plus one per stop event.
+  // Two root functions per front (take a node in, give one out), one per stop event, and one per fold
+  // (it stops the run when the fold opens).
   auto built = [](const std::string& text) {
     const SceneSpec spec = parse_scene_text(text, "s.toml");
     const FrontScene<2> scene = build_front_scene<2>(spec);
@@ -157,8 +158,8 @@ TEST_CASE("fronts are built only when declared: root functions and fronts in the
   CHECK(sliding["root_functions"] == 2);
   CHECK(sliding["fronts"][0]["name"] == "heap_start");
   CHECK(sliding["fronts"][0]["on_plane"] == false);
-  const nlohmann::json folded = built(test::kFoldedBase);  // a fold and its cutoff
-  CHECK(folded["root_functions"] == 3);
+  const nlohmann::json folded = built(test::kFoldedBase);  // a fold, its cutoff, and its opening
+  CHECK(folded["root_functions"] == 4);
   CHECK(folded["fronts"][0]["kind"] == "fold");
   CHECK(folded["prescribed"] == nlohmann::json::array({"node 0: fixed"}));
   // A chain fed from a shelf through a hole, falling onto a table: two heaps, and a stop event.
