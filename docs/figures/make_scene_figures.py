@@ -4,7 +4,7 @@
 Usage: /usr/bin/python3 docs/figures/make_scene_figures.py RESULTS_DIR
 where RESULTS_DIR/<scene>/ holds the outputs of
     build/chainsim run cases/scenes/<scene>.toml --out RESULTS_DIR/<scene>
-for shaken_chain, travelling_loop, whip_crack and pendulum_release (string scenes) and falling_chain,
+for shaken_chain, travelling_loop, whip_crack, pendulum_release and folded_chain_ends_apart (string scenes) and falling_chain,
 folded_chain, sliding_chain, swinging_sliding_chain, tilted_falling_chain and curved_falling_chain (scenes
 with fronts), and
 RESULTS_DIR/<scene>_reduced/ the same canonical scenes run with model = "reduced".
@@ -292,6 +292,42 @@ def curved_falling_chain(root, ax):
                      "the contact slides along the table as the arc comes down")
 
 
+def tight_fold_end_height(f, length, y0, times, g=9.81):
+    """The free end's height l - 2 y(t) in the paper's folded chain (tight fold, F = 0), integrated here
+    by RK4 from y'' = g/2 + (1 - f) y'^2 / (2 (l - y)) (an independent check of the scene, for the plot)."""
+    def acc(y, v):
+        return 0.5 * g + (1 - f) * v * v / (2 * (length - y))
+    out, y, v, t, dt = [], y0, 0.0, 0.0, 1e-5
+    for want in times:
+        while t < want - 1e-12:
+            step = min(dt, want - t)
+            k1 = (v, acc(y, v))
+            k2 = (v + 0.5 * step * k1[1], acc(y + 0.5 * step * k1[0], v + 0.5 * step * k1[1]))
+            k3 = (v + 0.5 * step * k2[1], acc(y + 0.5 * step * k2[0], v + 0.5 * step * k2[1]))
+            k4 = (v + step * k3[1], acc(y + step * k3[0], v + step * k3[1]))
+            y += step * (k1[0] + 2 * k2[0] + 2 * k3[0] + k4[0]) / 6
+            v += step * (k1[1] + 2 * k2[1] + 2 * k3[1] + k4[1]) / 6
+            t += step
+        out.append(length - 2 * y)
+    return out
+
+
+def folded_chain_ends_apart(root, ax):
+    data = frames(root)
+    shapes(ax[0], data, [0, 0.15, 0.25, 0.32, 0.37, 0.4, 0.42], mark=-1,
+           title="folded chain, ends 4 cm apart (x stretched)", equal=False)
+    ts = list(data)
+    end = [data[t][-1][2] for t in ts]
+    first = data[ts[0]]
+    length = sum(math.hypot(b[1] - a[1], b[2] - a[2]) for a, b in zip(first, first[1:]))  # links are exact
+    top = end[0]
+    y0 = (length - top) / 2  # the tight fold whose free end starts as high
+    ax[1].plot(ts, end, "o", ms=3, label="string solver, resolved bight")
+    for f, style in [(0.0, "-"), (0.5, "--"), (1.0, ":")]:
+        ax[1].plot(ts, tight_fold_end_height(f, length, y0, ts), style, lw=1.2, label=f"tight fold, f = {f:g}")
+    decorate(ax[1], "t (s)", "free end height (m)", "it follows the energy-conserving fold (f = 0)")
+
+
 def main():
     root = sys.argv[1]
     for scene, draw, fronts in [("shaken_chain", shaken_chain, False), ("travelling_loop", travelling_loop, False),
@@ -300,7 +336,8 @@ def main():
                                 ("sliding_chain", sliding_chain, True),
                                 ("swinging_sliding_chain", swinging_sliding_chain, True),
                                 ("tilted_falling_chain", tilted_falling_chain, True),
-                                ("curved_falling_chain", curved_falling_chain, True)]:
+                                ("curved_falling_chain", curved_falling_chain, True),
+                                ("folded_chain_ends_apart", folded_chain_ends_apart, False)]:
         if not os.path.exists(os.path.join(root, scene)):
             print("skipped", scene, "(no results)")
             continue
