@@ -13,6 +13,8 @@
 #include <catch2/catch.hpp>
 
 #include <cmath>
+#include <map>
+#include <utility>
 #include <string>
 #include <vector>
 
@@ -34,7 +36,11 @@ struct Run {
   double relative_drift = 0;
 };
 
+/// Runs the U (each (d, nodes) once per test binary: both test cases use d = 0.04 m with 321 nodes).
 Run run_u(double d, int nodes) {
+  static std::map<std::pair<double, int>, Run> done;
+  const auto key = std::make_pair(d, nodes);
+  if (const auto it = done.find(key); it != done.end()) return it->second;
   const std::string text = fmt::format(R"([string]
 density = 1.0
 nodes = {}
@@ -66,7 +72,7 @@ t_end = 0.4
     run.end_height.push_back(frame.x(1, frame.x.cols() - 1));
   }
   run.relative_drift = summary.relative_energy_drift();
-  return run;
+  return done[key] = run;
 }
 
 /// The free end's height in the paper's folded chain of the same length and the same initial height

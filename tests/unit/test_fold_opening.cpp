@@ -13,6 +13,7 @@
 #include "shocks/front_model.hpp"
 #include "shocks/front_solver.hpp"
 #include "solver/errors.hpp"
+#include "test_scene_support.hpp"
 
 using namespace chainsim;
 
@@ -57,36 +58,10 @@ TEST_CASE("a fold's opening is the angle of its arms from antiparallel, and a fo
 
 TEST_CASE("a fold whose arms swing apart stops the run when they are 20 degrees from antiparallel",
           "[unit][shocks][scene]") {
-  // The folded chain (resting arm 0.2 m, antiparallel free arm) thrown sideways at 1 m/s: the resting
+  // The folded chain of the scene tests (resting arm 0.2 m, antiparallel free arm) thrown sideways at 1 m/s: the resting
   // arm swings about the fixed start while the free arm flies on, so the arms turn apart at the
   // fold. The opening event (a root) ends the run before the cutoff, with the ledgers closed.
-  const std::string text = R"(
-[string]
-length = 1.0
-nodes = 41
-[shape]
-kind = "polyline"
-points = [[0.0, 0.0], [0.0, -0.2], [0.0, 0.6]]
-[velocity]
-kind = "uniform"
-value = [1.0, 0.0]
-[ends]
-start = "fixed"
-[effects.gravity]
-g = [0.0, -9.81]
-[effects.fold]
-s0 = 0.2
-f = 0.5
-[solver]
-method = "erk5"
-rtol = 1e-9
-atol = 1e-11
-[stop]
-t_end = 2.0
-[[stop.front]]
-front = "fold"
-s0 = 0.99
-)";
+  const std::string text = test::kFoldedBase + "[velocity]\nkind = \"uniform\"\nvalue = [1.0, 0.0]\n";
   const SceneSpec spec = parse_scene_text(text, "thrown_fold.toml");
   FrontScene<2> scene = build_front_scene<2>(spec);
   CHECK(scene.model->num_events() == 4);  // 2 crossings + the cutoff + the opening
