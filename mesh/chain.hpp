@@ -24,7 +24,7 @@
 #include <Eigen/Core>
 #include <fmt/format.h>
 
-#include "solver/errors.hpp"  // header-only use: InputError
+#include "mesh/errors.hpp"  // header-only use: InputError
 
 namespace chainsim {
 

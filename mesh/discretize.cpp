@@ -8,7 +8,7 @@
 #include <boost/math/tools/toms748_solve.hpp>
 #include <fmt/format.h>
 
-#include "solver/errors.hpp"
+#include "mesh/errors.hpp"
 
 namespace chainsim {
 

@@ -3,7 +3,7 @@
 
 Usage: /usr/bin/python3 scripts/plot_canonical.py DIR
 Writes DIR/figures/*.png. Solid lines: the reduced ODE integrated by ARKODE; markers / dashed
-lines: the exact quadratures (cases/exact_solutions). Needs Debian's python3-matplotlib.
+lines: the exact quadratures (cases/reduced/exact_solutions). Needs Debian's python3-matplotlib.
 """
 import csv
 import math

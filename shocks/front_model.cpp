@@ -7,7 +7,7 @@
 #include <fmt/format.h>
 
 #include "shocks/jump_conditions.hpp"
-#include "solver/errors.hpp"
+#include "mesh/errors.hpp"
 
 namespace chainsim {
 

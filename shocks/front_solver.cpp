@@ -6,7 +6,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "solver/errors.hpp"
+#include "mesh/errors.hpp"
 
 namespace chainsim {
 

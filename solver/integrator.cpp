@@ -14,7 +14,7 @@
 #include <sunlinsol/sunlinsol_dense.h>
 #include <sunmatrix/sunmatrix_dense.h>
 
-#include "errors.hpp"
+#include "mesh/errors.hpp"
 
 namespace chainsim {
 

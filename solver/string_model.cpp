@@ -7,7 +7,7 @@
 
 #include <fmt/format.h>
 
-#include "errors.hpp"
+#include "mesh/errors.hpp"
 
 namespace chainsim {
 

@@ -8,7 +8,7 @@
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
-#include "errors.hpp"
+#include "mesh/errors.hpp"
 #include "output.hpp"
 #include "vtk_output.hpp"
 

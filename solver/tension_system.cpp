@@ -13,7 +13,7 @@
 #include <klu.h>
 #endif
 
-#include "errors.hpp"
+#include "mesh/errors.hpp"
 #include "junction.hpp"
 
 namespace chainsim {

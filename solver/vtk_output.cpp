@@ -3,7 +3,7 @@
 
 #include <fmt/format.h>
 
-#include "errors.hpp"
+#include "mesh/errors.hpp"
 #include "output.hpp"
 
 namespace chainsim {

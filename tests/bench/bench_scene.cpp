@@ -23,7 +23,7 @@
 
 #include <fmt/format.h>
 
-#include "cases/scene.hpp"
+#include "cases/scene/scene.hpp"
 #include "mesh/discretize.hpp"
 #include "solver/forces.hpp"
 #include "solver/string_solver.hpp"

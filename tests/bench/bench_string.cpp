@@ -18,7 +18,7 @@
 #include <string>
 #include <vector>
 
-#include "solver/errors.hpp"
+#include "mesh/errors.hpp"
 #include "solver/integrator.hpp"
 #include "solver/junction.hpp"
 #include "solver/string_model.hpp"

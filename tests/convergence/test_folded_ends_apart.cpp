@@ -20,8 +20,8 @@
 
 #include <fmt/format.h>
 
-#include "cases/exact_solutions.hpp"
-#include "cases/scene.hpp"
+#include "cases/reduced/exact_solutions.hpp"
+#include "cases/scene/scene.hpp"
 #include "solver/string_solver.hpp"
 
 using namespace chainsim;

@@ -9,7 +9,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "cases/canonical_string.hpp"
+#include "cases/canonical/canonical_string.hpp"
 
 using namespace chainsim;
 

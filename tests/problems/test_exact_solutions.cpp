@@ -1,4 +1,4 @@
-// Independent checks of the exact references in cases/exact_solutions.hpp (DESIGN.md §2).
+// Independent checks of the exact references in cases/reduced/exact_solutions.hpp (DESIGN.md §2).
 //
 // The implementation evaluates ξ(η) by tanh-sinh quadrature after sin/cosh substitutions. Here every
 // quadrature is instead written as an incomplete Beta function and evaluated with Boost's
@@ -24,8 +24,8 @@
 
 #include <boost/math/special_functions/beta.hpp>
 
-#include "cases/exact_solutions.hpp"
-#include "solver/errors.hpp"
+#include "cases/reduced/exact_solutions.hpp"
+#include "mesh/errors.hpp"
 
 namespace {
 

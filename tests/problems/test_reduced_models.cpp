@@ -1,5 +1,5 @@
-// The reduced ODEs of the three canonical problems (cases/reduced_models) against independent
-// references: the exact quadratures ξ(η) and P/P0(η) (cases/exact_solutions, checked on their own
+// The reduced ODEs of the three canonical problems (cases/reduced/reduced_models) against independent
+// references: the exact quadratures ξ(η) and P/P0(η) (cases/reduced/exact_solutions, checked on their own
 // against incomplete Beta functions), the sliding chain's special solution, first integrals of the
 // folded chain with an end force, energy conservation, and invariance under a change of units.
 #include <cmath>
@@ -7,9 +7,9 @@
 
 #include <catch2/catch.hpp>
 
-#include "cases/exact_solutions.hpp"
-#include "cases/reduced_models.hpp"
-#include "solver/errors.hpp"
+#include "cases/reduced/exact_solutions.hpp"
+#include "cases/reduced/reduced_models.hpp"
+#include "mesh/errors.hpp"
 
 using namespace chainsim;
 using Catch::Matchers::WithinAbs;

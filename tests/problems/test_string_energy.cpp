@@ -8,7 +8,7 @@
 
 #include <catch2/catch.hpp>
 
-#include "solver/errors.hpp"
+#include "mesh/errors.hpp"
 #include "solver/string_solver.hpp"
 #include "string_test_support.hpp"
 

@@ -10,7 +10,7 @@
 
 #include "mesh/chain.hpp"
 #include "mesh/discretize.hpp"
-#include "solver/errors.hpp"
+#include "mesh/errors.hpp"
 
 using namespace chainsim;
 using Catch::Matchers::Contains;

@@ -7,12 +7,12 @@
 #include <cmath>
 #include <string>
 
-#include "cases/front_scene.hpp"
-#include "cases/scene.hpp"
+#include "cases/scene/front_scene.hpp"
+#include "cases/scene/scene.hpp"
 #include "mesh/discretize.hpp"
 #include "shocks/front_model.hpp"
 #include "shocks/front_solver.hpp"
-#include "solver/errors.hpp"
+#include "mesh/errors.hpp"
 #include "test_scene_support.hpp"
 
 using namespace chainsim;

@@ -1,4 +1,4 @@
-// cases/scene.hpp: the TOML scene (parser and builder), the effects it builds, and `chainsim run`.
+// cases/scene/scene.hpp: the TOML scene (parser and builder), the effects it builds, and `chainsim run`.
 // The table of bad scenes and their messages is in test_scene_errors.cpp.
 #include <filesystem>
 #include <fstream>
@@ -7,9 +7,9 @@
 #include <catch2/catch.hpp>
 #include <nlohmann/json.hpp>
 
-#include "cases/run_command.hpp"
-#include "cases/scene.hpp"
-#include "solver/errors.hpp"
+#include "cases/cli/run_command.hpp"
+#include "cases/scene/scene.hpp"
+#include "mesh/errors.hpp"
 #include "test_scene_support.hpp"
 
 using namespace chainsim;

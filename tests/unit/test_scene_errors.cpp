@@ -1,4 +1,4 @@
-// cases/scene.cpp: a table of bad scenes, each refused with its exact message: the file:line:column
+// cases/scene/scene.cpp: a table of bad scenes, each refused with its exact message: the file:line:column
 // of the key at fault (the value, or the key itself when it is unknown, or the section header when
 // a key is missing), the key, the value as written, and what is allowed. Errors found while
 // building the model (dimensions, lengths, ends, frames) are located the same way.
@@ -6,9 +6,9 @@
 
 #include <catch2/catch.hpp>
 
-#include "cases/run_command.hpp"
-#include "cases/scene.hpp"
-#include "solver/errors.hpp"
+#include "cases/cli/run_command.hpp"
+#include "cases/scene/scene.hpp"
+#include "mesh/errors.hpp"
 #include "solver/tension_system.hpp"
 #include "test_scene_support.hpp"
 

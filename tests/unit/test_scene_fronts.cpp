@@ -1,6 +1,6 @@
-// Scenes with shocks (cases/front_scene.hpp) and the model choice (cases/reduced_scene.hpp), checked
+// Scenes with shocks (cases/scene/front_scene.hpp) and the model choice (cases/scene/reduced_scene.hpp), checked
 // against references that do not use the scene code: the exact quadratures of DESIGN.md §2
-// (cases/exact_solutions.hpp), `chainsim compare` on the same problem set up in C++, and the
+// (cases/reduced/exact_solutions.hpp), `chainsim compare` on the same problem set up in C++, and the
 // closed-form free fall of a tilted chain with f = 1. The table of bad scenes is in
 // test_scene_errors.cpp.
 #include <cmath>
@@ -11,11 +11,11 @@
 #include <catch2/catch.hpp>
 #include <nlohmann/json.hpp>
 
-#include "cases/canonical_string.hpp"
-#include "cases/exact_solutions.hpp"
-#include "cases/reduced_scene.hpp"
-#include "cases/run_command.hpp"
-#include "solver/errors.hpp"
+#include "cases/canonical/canonical_string.hpp"
+#include "cases/reduced/exact_solutions.hpp"
+#include "cases/scene/reduced_scene.hpp"
+#include "cases/cli/run_command.hpp"
+#include "mesh/errors.hpp"
 #include "test_scene_support.hpp"
 
 using namespace chainsim;

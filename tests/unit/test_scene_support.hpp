@@ -7,8 +7,8 @@
 #include <sstream>
 #include <string>
 
-#include "cases/front_scene.hpp"
-#include "cases/scene.hpp"
+#include "cases/scene/front_scene.hpp"
+#include "cases/scene/scene.hpp"
 
 namespace chainsim::test {
 

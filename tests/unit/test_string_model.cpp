@@ -5,7 +5,7 @@
 #include <catch2/catch.hpp>
 
 #include "mesh/discretize.hpp"
-#include "solver/errors.hpp"
+#include "mesh/errors.hpp"
 #include "solver/string_model.hpp"
 
 using namespace chainsim;

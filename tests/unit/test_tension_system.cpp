@@ -8,7 +8,7 @@
 #include <Eigen/Dense>
 #include <catch2/catch.hpp>
 
-#include "solver/errors.hpp"
+#include "mesh/errors.hpp"
 #include "solver/junction.hpp"
 #include "solver/string_model.hpp"
 #include "solver/tension_system.hpp"

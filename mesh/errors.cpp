@@ -1,4 +1,4 @@
-#include "errors.hpp"
+#include "mesh/errors.hpp"
 
 #include <cmath>
 

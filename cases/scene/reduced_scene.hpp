@@ -1,6 +1,6 @@
 #pragma once
 /// @file reduced_scene.hpp
-/// model = "reduced": a scene may be solved by the reduced ODE (cases/reduced_models.hpp) only when
+/// model = "reduced": a scene may be solved by the reduced ODE (cases/reduced/reduced_models.hpp) only when
 /// it IS one of the paper's three canonical problems, where the reduced model is exact. Which one is
 /// read from the scene; anything else is refused with the reason, located at the `model` key.
 ///
@@ -23,8 +23,8 @@
 /// In all three: ℓ = the string's length, λ = string.density, g = |effects.gravity.g|, f = the
 /// front's f, and the safety stop t_max = stop.t_end. The scene's [solver] is not used: the reduced
 /// ODE keeps its own tolerances (ReducedSetup::default_integrator()).
-#include "cases/reduced_models.hpp"
-#include "cases/scene.hpp"
+#include "cases/reduced/reduced_models.hpp"
+#include "cases/scene/scene.hpp"
 
 namespace chainsim {
 

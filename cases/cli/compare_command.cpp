@@ -5,8 +5,8 @@
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
-#include "cases/commands.hpp"
-#include "solver/errors.hpp"
+#include "cases/cli/commands.hpp"
+#include "mesh/errors.hpp"
 #include "solver/output.hpp"
 
 namespace chainsim {

@@ -26,7 +26,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "cases/scene.hpp"
+#include "cases/scene/scene.hpp"
 #include "shocks/front_model.hpp"
 #include "shocks/front_solver.hpp"
 

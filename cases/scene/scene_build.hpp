@@ -10,9 +10,9 @@
 
 #include <fmt/format.h>
 
-#include "cases/scene.hpp"
+#include "cases/scene/scene.hpp"
 #include "mesh/discretize.hpp"
-#include "solver/errors.hpp"
+#include "mesh/errors.hpp"
 #include "solver/forces.hpp"
 #include "solver/integrator.hpp"
 

@@ -1,5 +1,5 @@
 // The canonical problems on the string solver: see canonical_string.hpp.
-#include "cases/canonical_string.hpp"
+#include "cases/canonical/canonical_string.hpp"
 
 #include <algorithm>
 #include <chrono>
@@ -7,7 +7,7 @@
 
 #include <fmt/format.h>
 
-#include "solver/errors.hpp"
+#include "mesh/errors.hpp"
 
 namespace chainsim {
 

@@ -4,7 +4,7 @@
 // with fronts cannot have (a closed string, ends inside heaps, keys for scenes without fronts);
 // 3. each heap against the string, the shape and its plane; 4. the fold; 5. the stop events;
 // 6. the model (its own layout checks re-located at the fronts' keys) and the run options.
-#include "cases/front_scene.hpp"
+#include "cases/scene/front_scene.hpp"
 
 #include <algorithm>
 #include <cctype>
@@ -13,8 +13,8 @@
 
 #include <fmt/format.h>
 
-#include "cases/scene_build.hpp"
-#include "solver/errors.hpp"
+#include "cases/scene/scene_build.hpp"
+#include "mesh/errors.hpp"
 #include "solver/output.hpp"
 #include "solver/string_solver.hpp"
 #include "solver/vtk_output.hpp"

@@ -1,12 +1,12 @@
 #pragma once
 /// @file commands.hpp
-/// The chainsim subcommands as plain functions (cases/main.cpp only parses the command line).
+/// The chainsim subcommands as plain functions (cases/cli/main.cpp only parses the command line).
 /// Each returns the process exit code and throws InputError / NumericalError on failure.
 #include <iosfwd>
 #include <string>
 
-#include "cases/canonical_string.hpp"
-#include "cases/reduced_models.hpp"
+#include "cases/canonical/canonical_string.hpp"
+#include "cases/reduced/reduced_models.hpp"
 
 namespace chainsim {
 

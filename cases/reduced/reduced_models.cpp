@@ -6,8 +6,8 @@
 
 #include <fmt/format.h>
 
-#include "cases/exact_solutions.hpp"
-#include "solver/errors.hpp"
+#include "cases/reduced/exact_solutions.hpp"
+#include "mesh/errors.hpp"
 
 namespace chainsim {
 

@@ -4,9 +4,9 @@
 // Steps: 1. the scene text (positions and values as written), 2. a checked view of one TOML table,
 // 3. one parse function per section, 4. the builder, which re-locates every error it raises at the
 // key that caused it.
-#include "cases/scene.hpp"
+#include "cases/scene/scene.hpp"
 
-#include "cases/scene_build.hpp"
+#include "cases/scene/scene_build.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -18,7 +18,7 @@
 #include <toml++/toml.h>
 
 #include "mesh/discretize.hpp"
-#include "solver/errors.hpp"
+#include "mesh/errors.hpp"
 
 namespace chainsim {
 

@@ -6,9 +6,9 @@
 #include <fmt/format.h>
 #include <fmt/ostream.h>
 
-#include "cases/commands.hpp"
-#include "cases/exact_solutions.hpp"
-#include "solver/errors.hpp"
+#include "cases/cli/commands.hpp"
+#include "cases/reduced/exact_solutions.hpp"
+#include "mesh/errors.hpp"
 
 namespace chainsim {
 

@@ -7,9 +7,9 @@
 #include <CLI/CLI.hpp>
 #include <fmt/format.h>
 
-#include "cases/commands.hpp"
-#include "cases/run_command.hpp"
-#include "solver/errors.hpp"
+#include "cases/cli/commands.hpp"
+#include "cases/cli/run_command.hpp"
+#include "mesh/errors.hpp"
 
 namespace {
 

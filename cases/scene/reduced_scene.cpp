@@ -3,16 +3,16 @@
 // Steps: 1. the scene must be a valid scene with fronts; 2. the effects (gravity, one front, no
 // drag); 3. the problem from its front, with that problem's ends, table and cutoff; 4. the shape
 // against the problem's straight arms along gravity, and rest; 5. the reduced setup.
-#include "cases/reduced_scene.hpp"
+#include "cases/scene/reduced_scene.hpp"
 
 #include <algorithm>
 #include <cmath>
 
 #include <fmt/format.h>
 
-#include "cases/front_scene.hpp"
-#include "cases/scene_build.hpp"
-#include "solver/errors.hpp"
+#include "cases/scene/front_scene.hpp"
+#include "cases/scene/scene_build.hpp"
+#include "mesh/errors.hpp"
 
 namespace chainsim {
 

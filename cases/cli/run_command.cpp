@@ -1,7 +1,7 @@
 // `chainsim run SCENE [--out DIR] [--t-end T] [--json]`: runs a scene on the model it asks for:
 //   - no heap and no fold: the string solver (StringModel; no fronts, no root functions);
-//   - a heap or a fold:    the string solver with front tracking (FrontModel, cases/front_scene.hpp);
-//   - model = "reduced":   the reduced ODE of the canonical problem the scene is (cases/reduced_scene.hpp).
+//   - a heap or a fold:    the string solver with front tracking (FrontModel, cases/scene/front_scene.hpp);
+//   - model = "reduced":   the reduced ODE of the canonical problem the scene is (cases/scene/reduced_scene.hpp).
 //
 // Sample runs:
 //   $ chainsim run cases/scenes/hanging_chain.toml --out results/hanging
@@ -20,7 +20,7 @@
 // directory is writable, 4. integrate, 5. write the outputs (also after a numerical failure, up to
 // the failure, before the error is reported; stats.json last), 6. print the summary. With --json
 // every outcome, failures included, prints one JSON object on stdout.
-#include "cases/run_command.hpp"
+#include "cases/cli/run_command.hpp"
 
 #include <cmath>
 #include <filesystem>
@@ -29,10 +29,10 @@
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
-#include "cases/front_scene.hpp"
-#include "cases/reduced_scene.hpp"
-#include "cases/scene.hpp"
-#include "solver/errors.hpp"
+#include "cases/scene/front_scene.hpp"
+#include "cases/scene/reduced_scene.hpp"
+#include "cases/scene/scene.hpp"
+#include "mesh/errors.hpp"
 #include "solver/output.hpp"
 
 namespace chainsim {

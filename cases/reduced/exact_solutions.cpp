@@ -43,7 +43,7 @@
 // folded chain straightening), a bounded algebraic endpoint singularity that the tanh-sinh rule
 // integrates at its usual double-exponential rate. Near that end the integrand is evaluated from
 // the distance to the endpoint (the two-argument functor form), so cos φ carries no cancellation.
-#include "cases/exact_solutions.hpp"
+#include "cases/reduced/exact_solutions.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -54,7 +54,7 @@
 #include <boost/math/quadrature/tanh_sinh.hpp>
 #include <boost/math/tools/toms748_solve.hpp>
 
-#include "solver/errors.hpp"
+#include "mesh/errors.hpp"
 
 namespace chainsim::exact {
 

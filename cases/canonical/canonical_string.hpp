@@ -21,7 +21,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "cases/reduced_models.hpp"
+#include "cases/reduced/reduced_models.hpp"
 #include "shocks/front_solver.hpp"
 
 namespace chainsim {

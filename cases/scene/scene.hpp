@@ -28,9 +28,9 @@
 ///     [stop]     t_end (s), [[stop.front]] front = fold | heap_start | heap_end, s0 (m)
 ///     model      = "string" (default) | "reduced" (top-level key)
 ///
-/// A scene with a heap or a fold runs on FrontModel (cases/front_scene.hpp); one without runs on
+/// A scene with a heap or a fold runs on FrontModel (cases/scene/front_scene.hpp); one without runs on
 /// StringModel; model = "reduced" runs the reduced ODE of the canonical problem the scene is
-/// (cases/reduced_scene.hpp).
+/// (cases/scene/reduced_scene.hpp).
 #include <filesystem>
 #include <map>
 #include <memory>
