@@ -1,4 +1,4 @@
-// The discrete string as an ODE system: see string_model.hpp.
+// The one discrete string as an ODE system: see string_model.hpp.
 #include "string_model.hpp"
 
 #include <algorithm>
@@ -15,10 +15,11 @@ namespace {
 /// A link shorter than this fraction of its material length is a trial state the model cannot use
 /// (the unit vector e_j is undefined): ARKODE retries with a smaller step.
 constexpr double kCollapsedLink = 1e-6;
-/// The initial projection stops when every link length is right to this relative accuracy, or when
-/// Newton's method stalls (round-off of coordinates large against h) below kProjectionStall.
+/// The projection is converged when every link length is right to the larger of this relative
+/// accuracy and the round-off of its coordinates, kRoundoffUlps · ε · max|x| / h_min: a link's length
+/// cannot be represented more accurately than its end points' coordinates.
 constexpr double kProjectionTolerance = 1e-14;
-constexpr double kProjectionStall = 1e-10;
+constexpr double kRoundoffUlps = 64;
 constexpr int kProjectionIterations = 60;
 }  // namespace
 
@@ -30,14 +31,27 @@ void StringModelOptions::validate() const {
 
 template <int dim>
 StringModel<dim>::StringModel(Chain<dim> chain, std::vector<std::unique_ptr<Force<dim>>> forces,
-                              std::vector<PrescribedNode<dim>> prescribed, const StringModelOptions& options)
-    : chain_(std::move(chain)), forces_(std::move(forces)), prescribed_(std::move(prescribed)), options_(options) {
+                              std::vector<PrescribedNode<dim>> prescribed, const StringModelOptions& options,
+                              std::unique_ptr<StringModule<dim>> module)
+    : chain_(std::move(chain)),
+      forces_(std::move(forces)),
+      prescribed_(std::move(prescribed)),
+      options_(options),
+      module_(std::move(module)) {
   options_.validate();
-  // The rows below number link j as unknown j and close the loop through chain_.closed(): one arc.
-  // The shock module assembles per arc (ArcBlock) when it splits chains at fronts.
-  CHAINSIM_VERIFY(chain_.arcs().size() == 1, "StringModel assembles a single arc");
   const int n = chain_.num_nodes(), L = chain_.num_links();
-  // 1. Which nodes are prescribed.
+  // 1. The arcs: the whole string, or the module's layout.
+  if (module_) {
+    if (chain_.closed()) throw InputError("fronts are tracked on open strings only");
+    arcs_ = module_->initial_arcs(chain_);
+    num_ledgers_ = module_->num_ledgers();
+  } else {
+    arcs_ = {ArcRange{0, n - 1, chain_.closed()}};
+  }
+  arc_of_.assign(static_cast<std::size_t>(n), -1);
+  for (std::size_t k = 0; k < arcs_.size(); ++k)
+    for (int i = arcs_[k].first; i <= arcs_[k].last; ++i) arc_of_[static_cast<std::size_t>(i)] = static_cast<int>(k);
+  // 2. Which nodes are prescribed; what may be prescribed or loaded.
   path_of_.assign(static_cast<std::size_t>(n), -1);
   for (std::size_t k = 0; k < prescribed_.size(); ++k) {
     const int node = prescribed_[k].node;
@@ -45,6 +59,7 @@ StringModel<dim>::StringModel(Chain<dim> chain, std::vector<std::unique_ptr<Forc
       throw InputError(fmt::format("prescribed node {} does not exist: the string has nodes 0..{}", node, n - 1));
     if (path_of_[node] >= 0) throw InputError(fmt::format("node {} has two prescribed motions", node));
     CHAINSIM_VERIFY(prescribed_[k].path != nullptr, "a prescribed node needs a path");
+    if (!in_arc(node)) throw InputError(fmt::format("prescribed node {} lies inside a heap", node));
     path_of_[node] = static_cast<int>(k);
   }
   for (const auto& force : forces_) {
@@ -55,35 +70,67 @@ StringModel<dim>::StringModel(Chain<dim> chain, std::vector<std::unique_ptr<Forc
       if (path_of_[load->node()] >= 0)
         throw InputError(fmt::format("node {} is both loaded and prescribed: a driven or fixed end takes no load",
                                      load->node()));
+      if (!in_arc(load->node())) throw InputError(fmt::format("the end load acts on node {}, inside a heap", load->node()));
     }
   }
   for (int j = 0; j < L; ++j)
-    if (path_of_[chain_.link_start(j)] >= 0 && path_of_[chain_.link_end(j)] >= 0)
+    if (in_arc(chain_.link_start(j)) && in_arc(chain_.link_end(j)) && path_of_[chain_.link_start(j)] >= 0 &&
+        path_of_[chain_.link_end(j)] >= 0)
       throw InputError(fmt::format("link {} joins two prescribed nodes ({} and {}): its tension is undetermined; "
                                    "use more nodes",
                                    j, chain_.link_start(j), chain_.link_end(j)));
-  // 2. The free nodes, in node order, make the ODE state.
-  slot_.assign(static_cast<std::size_t>(n), -1);
-  w_ = Eigen::VectorXd::Zero(n);
-  for (int i = 0; i < n; ++i) {
-    if (path_of_[i] >= 0) continue;
-    slot_[i] = num_free_++;
-    w_[i] = 1.0 / chain_.mass(i);
-  }
+  if (options_.stabilization_time > 0) alpha_ = beta_ = 1.0 / options_.stabilization_time;
+  // 3. Workspace, the state, then slots, masses and the tension system.
+  for (Points<dim>* p : {&a_, &force_, &force_nc_, &module_force_, &tension_force_, &b_, &reaction_})
+    *p = Points<dim>::Zero(dim, n);
+  for (Points<dim>* p : {&dx_, &dv_, &e_}) *p = Points<dim>::Zero(dim, L);
+  l_ = Eigen::VectorXd::Zero(L);
+  x_ = chain_.positions();
+  v_ = chain_.velocities();
+  for (const auto& p : prescribed_) x_.col(p.node) = p.path->position(0.0);
+  rebuild();
   if (num_free_ == 0) throw InputError("every node of the string is prescribed: nothing to solve");
-  // 3. The tension system: one arc per chain arc, pattern assembled once.
+  if (module_) module_->initialize(*this);
+}
+
+template <int dim>
+void StringModel<dim>::rebuild() {
+  const int n = chain_.num_nodes(), L = chain_.num_links();
+  arc_of_.assign(static_cast<std::size_t>(n), -1);
+  for (std::size_t k = 0; k < arcs_.size(); ++k)
+    for (int i = arcs_[k].first; i <= arcs_[k].last; ++i) arc_of_[static_cast<std::size_t>(i)] = static_cast<int>(k);
+  slot_.assign(static_cast<std::size_t>(n), -1);
+  num_free_ = 0;
+  for (int i = 0; i < n; ++i)
+    if (in_arc(i) && path_of_[i] < 0) slot_[i] = num_free_++;
+  // Each arc with a link owns a block of unknowns; its links' masses are lumped on their nodes.
+  base_mass_ = Eigen::VectorXd::Zero(n);
+  link_unknown_.assign(static_cast<std::size_t>(L), -1);
+  first_unknown_.assign(arcs_.size(), -1);
   std::vector<int> arc_links;
   std::vector<bool> arc_closed;
-  for (const Arc& arc : chain_.arcs()) {
+  int unknown = 0;
+  const double lambda = chain_.density();
+  for (std::size_t k = 0; k < arcs_.size(); ++k) {
+    const ArcRange& arc = arcs_[k];
+    if (arc.num_links() == 0) continue;
+    first_unknown_[k] = unknown;
+    for (int q = 0; q < arc.num_links(); ++q) {
+      const int j = arc.first + q;
+      link_unknown_[static_cast<std::size_t>(j)] = unknown + q;
+      base_mass_[chain_.link_start(j)] += 0.5 * lambda * chain_.link_length(j);
+      base_mass_[chain_.link_end(j)] += 0.5 * lambda * chain_.link_length(j);
+    }
+    unknown += arc.num_links();
     arc_links.push_back(arc.num_links());
     arc_closed.push_back(arc.closed);
   }
-  system_ = std::make_unique<TensionSystem>(arc_links, arc_closed, std::vector<Junction*>{}, options_.backend);
-  if (options_.stabilization_time > 0) alpha_ = beta_ = 1.0 / options_.stabilization_time;
-  // 4. Workspace.
-  for (Points<dim>* p : {&x_, &v_, &a_, &force_, &force_nc_, &tension_force_, &b_}) *p = Points<dim>::Zero(dim, n);
-  for (Points<dim>* p : {&dx_, &dv_, &e_}) *p = Points<dim>::Zero(dim, L);
-  l_ = Eigen::VectorXd::Zero(L);
+  if (system_) solves_ += system_->num_solves();
+  system_ = arc_links.empty() ? nullptr : std::make_unique<TensionSystem>(arc_links, arc_closed, options_.backend);
+  m_ = base_mass_;
+  w_ = Eigen::VectorXd::Zero(n);
+  for (int i = 0; i < n; ++i)
+    if (slot_[i] >= 0) w_[i] = 1.0 / m_[i];
 }
 
 template <int dim>
@@ -94,13 +141,32 @@ Vec<dim> StringModel<dim>::gravity() const {
 }
 
 template <int dim>
+void StringModel<dim>::unpack_state(double t, const Eigen::Ref<const Eigen::VectorXd>& y) {
+  const int n = chain_.num_nodes();
+  const int voff = dim * num_free_;
+  for (int i = 0; i < n; ++i) {
+    if (arc_of_[i] < 0) continue;
+    const int k = slot_[i];
+    if (k >= 0) {
+      x_.col(i) = y.template segment<dim>(dim * k);
+      v_.col(i) = y.template segment<dim>(voff + dim * k);
+    } else {
+      const EndPath<dim>& path = *prescribed_[static_cast<std::size_t>(path_of_[i])].path;
+      x_.col(i) = path.position(t);
+      v_.col(i) = path.velocity(t);
+    }
+  }
+}
+
+template <int dim>
 void StringModel<dim>::unpack(double t, const Eigen::Ref<const Eigen::VectorXd>& y, Points<dim>& x,
                               Points<dim>& v) const {
   const int n = chain_.num_nodes();
-  x.resize(dim, n);
-  v.resize(dim, n);
+  x = x_;
+  v = v_;
   const int voff = dim * num_free_;
   for (int i = 0; i < n; ++i) {
+    if (arc_of_[i] < 0) continue;
     const int k = slot_[i];
     if (k >= 0) {
       x.col(i) = y.template segment<dim>(dim * k);
@@ -114,86 +180,125 @@ void StringModel<dim>::unpack(double t, const Eigen::Ref<const Eigen::VectorXd>&
 }
 
 template <int dim>
-void StringModel<dim>::links(const Points<dim>& x, const Points<dim>& v) {
-  const int L = chain_.num_links();
-  for (int j = 0; j < L; ++j) {
+template <class Visit>
+void StringModel<dim>::for_each_link(Visit&& visit) const {
+  // visit(j, u, next): link j, its tension unknown u, and the next link of its arc (−1 at an open end).
+  for (const ArcRange& arc : arcs_) {
+    const int nl = arc.num_links();
+    for (int q = 0; q < nl; ++q) {
+      const int j = arc.first + q;
+      const int next = q + 1 < nl ? j + 1 : (arc.closed ? arc.first : -1);
+      visit(j, link_unknown_[static_cast<std::size_t>(j)], next);
+    }
+  }
+}
+
+template <int dim>
+void StringModel<dim>::links() {
+  for_each_link([&](int j, int, int) {
     const int a = chain_.link_start(j), b = chain_.link_end(j);
-    dx_.col(j) = x.col(b) - x.col(a);
-    dv_.col(j) = v.col(b) - v.col(a);
+    dx_.col(j) = x_.col(b) - x_.col(a);
+    dv_.col(j) = v_.col(b) - v_.col(a);
     const double l = dx_.col(j).norm();
     if (!(l > kCollapsedLink * chain_.link_length(j)) || !std::isfinite(l))
       throw RecoverableError(fmt::format("link {} has collapsed to length {:g}", j, l));
     l_[j] = l;
     e_.col(j) = dx_.col(j) / l;
-  }
+  });
 }
 
 template <int dim>
 void StringModel<dim>::assemble_matrix() {
   // Row j: T_{j−1} w_a (e_{j−1}·e_j) − T_j (w_a + w_b) + T_{j+1} w_b (e_j·e_{j+1}); the coupling of
-  // link j with the next link j+1 goes through their shared node b = link_end(j).
-  const int L = chain_.num_links();
-  const bool closed = chain_.closed();
-  for (int j = 0; j < L; ++j) {
+  // link j with the next link of its arc goes through their shared node b = link_end(j).
+  for_each_link([&](int j, int u, int next) {
     const int a = chain_.link_start(j), b = chain_.link_end(j);
-    system_->add_diagonal(j, -(w_[a] + w_[b]));
-    if (j + 1 < L || closed) {
-      const int next = j + 1 < L ? j + 1 : 0;
-      system_->set_coupling(j, w_[b] * e_.col(j).dot(e_.col(next)));
-    }
-  }
+    system_->add_diagonal(u, -(w_[a] + w_[b]));
+    if (next >= 0) system_->set_coupling(u, w_[b] * e_.col(j).dot(e_.col(next)));
+  });
+}
+
+template <int dim>
+void StringModel<dim>::refresh() {
+  if (!module_) return;
+  m_ = base_mass_;
+  module_force_.setZero();
+  module_->add_mass_and_forces(*this, m_, module_force_);
+  for (int i = 0; i < chain_.num_nodes(); ++i)
+    if (slot_[i] >= 0) w_[i] = 1.0 / m_[i];
 }
 
 template <int dim>
 double StringModel<dim>::evaluate(double t, const Points<dim>& x, const Points<dim>& v) {
-  const int n = chain_.num_nodes(), L = chain_.num_links();
-  // 1. Applied forces; b_i = F_i / m_i for free nodes, the prescribed acceleration otherwise.
-  const NodeState<dim> state{t, x, v, chain_.masses()};
+  x_ = x;
+  v_ = v;
+  return evaluate_current(t);
+}
+
+template <int dim>
+double StringModel<dim>::evaluate_current(double t) {
+  const int n = chain_.num_nodes();
+  // 1. The module's masses and forces; applied forces; b_i = F_i / m_i for free nodes, the
+  //    prescribed acceleration otherwise.
+  refresh();
+  const NodeState<dim> state{t, x_, v_, m_};
   force_.setZero();
   force_nc_.setZero();
   for (const auto& force : forces_) force->add_force(state, force->conservative() ? force_ : force_nc_);
   for (int i = 0; i < n; ++i) {
-    if (path_of_[i] < 0)
-      b_.col(i) = w_[i] * (force_.col(i) + force_nc_.col(i));
-    else
+    if (arc_of_[i] < 0) continue;
+    if (path_of_[i] < 0) {
+      if (module_)
+        b_.col(i) = w_[i] * (force_.col(i) + force_nc_.col(i) + module_force_.col(i));
+      else
+        b_.col(i) = w_[i] * (force_.col(i) + force_nc_.col(i));
+    } else {
       b_.col(i) = prescribed_[static_cast<std::size_t>(path_of_[i])].path->acceleration(t);
+    }
   }
   // 2. Link geometry and the tension system.
-  links(x, v);
-  system_->zero();
-  assemble_matrix();
-  const double beta2 = beta_ * beta_;
-  for (int j = 0; j < L; ++j) {
-    const int a = chain_.link_start(j), b = chain_.link_end(j);
-    const double h = chain_.link_length(j), l = l_[j];
-    const double stab = 2 * alpha_ * dx_.col(j).dot(dv_.col(j)) + beta2 * 0.5 * (l * l - h * h);
-    system_->rhs(j) = -dv_.col(j).squaredNorm() / l - e_.col(j).dot(b_.col(b) - b_.col(a)) - stab / l;
-  }
-  system_->add_junction_rows(t);
-  const Eigen::VectorXd& T = system_->solve(t);
-  // 3. Accelerations and the power of everything not booked in V.
   tension_force_.setZero();
-  for (int j = 0; j < L; ++j) {
-    tension_force_.col(chain_.link_start(j)) += T[j] * e_.col(j);
-    tension_force_.col(chain_.link_end(j)) -= T[j] * e_.col(j);
+  if (system_) {
+    links();
+    system_->zero();
+    assemble_matrix();
+    const double beta2 = beta_ * beta_;
+    for_each_link([&](int j, int u, int) {
+      const int a = chain_.link_start(j), b = chain_.link_end(j);
+      const double h = chain_.link_length(j), l = l_[j];
+      const double stab = 2 * alpha_ * dx_.col(j).dot(dv_.col(j)) + beta2 * 0.5 * (l * l - h * h);
+      system_->rhs(u) = -dv_.col(j).squaredNorm() / l - e_.col(j).dot(b_.col(b) - b_.col(a)) - stab / l;
+    });
+    const Eigen::VectorXd& T = system_->solve(t);
+    for_each_link([&](int j, int u, int) {
+      tension_force_.col(chain_.link_start(j)) += T[u] * e_.col(j);
+      tension_force_.col(chain_.link_end(j)) -= T[u] * e_.col(j);
+    });
   }
+  // 3. Accelerations, the supports' reactions and the power of everything not booked in V.
   double power = 0;
+  if (module_) external_.setZero();
   for (int i = 0; i < n; ++i) {
+    if (arc_of_[i] < 0) continue;
     if (path_of_[i] < 0) {
       a_.col(i) = b_.col(i) + w_[i] * tension_force_.col(i);
-      power += force_nc_.col(i).dot(v.col(i));
+      power += force_nc_.col(i).dot(v_.col(i));
     } else {
       a_.col(i) = b_.col(i);
-      power += (chain_.mass(i) * a_.col(i) - force_.col(i) - tension_force_.col(i)).dot(v.col(i));
+      // the support's reaction R_i = m a − F − T − (module force); drag on it is applied work too
+      reaction_.col(i) = m_[i] * a_.col(i) - force_.col(i) - force_nc_.col(i) - tension_force_.col(i) -
+                         module_force_.col(i);
+      power += (reaction_.col(i) + force_nc_.col(i)).dot(v_.col(i));
     }
+    if (module_) external_ += force_.col(i) + force_nc_.col(i) + reaction_.col(i);
   }
   return power;
 }
 
 template <int dim>
 void StringModel<dim>::rhs(double t, const Eigen::Ref<const Eigen::VectorXd>& y, Eigen::Ref<Eigen::VectorXd> ydot) {
-  unpack(t, y, x_, v_);
-  const double power = evaluate(t, x_, v_);
+  unpack_state(t, y);
+  const double power = evaluate_current(t);
   const int n = chain_.num_nodes(), voff = dim * num_free_;
   for (int i = 0; i < n; ++i) {
     const int k = slot_[i];
@@ -201,69 +306,125 @@ void StringModel<dim>::rhs(double t, const Eigen::Ref<const Eigen::VectorXd>& y,
     ydot.template segment<dim>(dim * k) = v_.col(i);
     ydot.template segment<dim>(voff + dim * k) = a_.col(i);
   }
-  ydot[size() - 1] = power;
+  ydot[work_index()] = power;
+  if (module_) module_->ledger_rates(*this, ydot.segment(work_index() + 1, num_ledgers_));
+}
+
+template <int dim>
+void StringModel<dim>::events(double t, const Eigen::Ref<const Eigen::VectorXd>& y, Eigen::Ref<Eigen::VectorXd> g) {
+  if (!module_) return;
+  unpack_state(t, y);
+  refresh();
+  module_->events(*this, g);
+}
+
+template <int dim>
+Eigen::VectorXd StringModel<dim>::state_scale() const {
+  if (!module_) return {};
+  const double ell = chain_.length();
+  double v2 = gravity().norm() * ell;
+  for (int i = 0; i < chain_.num_nodes(); ++i) v2 = std::max(v2, chain_.velocities().col(i).squaredNorm());
+  const double speed = v2 > 0 ? std::sqrt(v2) : ell;
+  const double mass = chain_.density() * ell;
+  Eigen::VectorXd scale(size());
+  const int voff = dim * num_free_;
+  scale.head(voff).setConstant(ell);
+  scale.segment(voff, voff).setConstant(speed);
+  scale[work_index()] = mass * speed * speed;
+  scale.tail(num_ledgers_) = module_->ledger_scale(mass, speed, ell);
+  return scale;
+}
+
+template <int dim>
+void StringModel<dim>::project(double t) {
+  if (!system_) return;
+  for (const auto& p : prescribed_) {
+    x_.col(p.node) = p.path->position(t);
+    v_.col(p.node) = p.path->velocity(t);
+  }
+  // Newton's method for g_j(x) = |Δx_j| − h_j = 0 along δx = W Gᵀ ν: the matrix is the tension
+  // matrix A = −G W Gᵀ, so A ν = g gives the smallest mass-weighted correction.
+  auto correct = [&](Points<dim>& target, const Eigen::VectorXd& nu) {
+    for_each_link([&](int j, int u, int) {
+      const int a = chain_.link_start(j), b = chain_.link_end(j);
+      target.col(a) -= w_[a] * nu[u] * e_.col(j);
+      target.col(b) += w_[b] * nu[u] * e_.col(j);
+    });
+  };
+  double h_min = INFINITY, x_max = 0;
+  for_each_link([&](int j, int, int) { h_min = std::min(h_min, chain_.link_length(j)); });
+  for (int i = 0; i < chain_.num_nodes(); ++i)
+    if (in_arc(i)) x_max = std::max(x_max, x_.col(i).cwiseAbs().maxCoeff());
+  const double roundoff = kRoundoffUlps * std::numeric_limits<double>::epsilon() * x_max / h_min;
+  const double tolerance = std::max(kProjectionTolerance, roundoff);
+  double violation = 0, previous = INFINITY;
+  for (int iteration = 0;; ++iteration) {
+    links();
+    violation = 0;
+    for_each_link([&](int j, int, int) {
+      violation = std::max(violation, std::abs(l_[j] - chain_.link_length(j)) / chain_.link_length(j));
+    });
+    // Converged; or stalled at a few times the round-off level (Newton no longer halves it).
+    if (violation <= tolerance || (violation < 1e3 * tolerance && violation > 0.5 * previous)) break;
+    if (iteration == kProjectionIterations || !std::isfinite(violation))
+      throw NumericalError(fmt::format("at t = {:.9g} s the links cannot be projected onto their lengths: after {} "
+                                       "projection steps a link is still off by {:.3g} of its length (round-off "
+                                       "level of the coordinates {:.3g})",
+                                       t, iteration, violation, roundoff),
+                           t);
+    previous = violation;
+    system_->zero();
+    assemble_matrix();
+    for_each_link([&](int j, int u, int) { system_->rhs(u) = l_[j] - chain_.link_length(j); });
+    correct(x_, system_->solve(t));
+  }
+  // Velocities: one linear projection onto e_j·Δv_j = 0.
+  links();
+  system_->zero();
+  assemble_matrix();
+  for_each_link([&](int j, int u, int) { system_->rhs(u) = e_.col(j).dot(dv_.col(j)); });
+  correct(v_, system_->solve(t));
 }
 
 template <int dim>
 double StringModel<dim>::make_consistent(double t0) {
-  const int n = chain_.num_nodes(), L = chain_.num_links();
-  Points<dim>& x = chain_.positions();
-  Points<dim>& v = chain_.velocities();
+  x_ = chain_.positions();
+  v_ = chain_.velocities();
   for (const auto& p : prescribed_) {
-    x.col(p.node) = p.path->position(t0);
-    v.col(p.node) = p.path->velocity(t0);
+    x_.col(p.node) = p.path->position(t0);
+    v_.col(p.node) = p.path->velocity(t0);
   }
-  const Points<dim> x_start = x;
-  // Newton's method for g_j(x) = |Δx_j| − h_j = 0 along δx = W Gᵀ ν: the matrix is the tension
-  // matrix A = −G W Gᵀ, so A ν = g gives the minimal mass-weighted correction.
-  auto apply_correction = [&](Points<dim>& target, const Eigen::VectorXd& nu) {
-    for (int j = 0; j < L; ++j) {
-      const int a = chain_.link_start(j), b = chain_.link_end(j);
-      target.col(a) -= w_[a] * nu[j] * e_.col(j);
-      target.col(b) += w_[b] * nu[j] * e_.col(j);
-    }
-  };
-  // Coordinates far from the origin, or links far shorter than the coordinates, limit how well a
-  // link length can be represented at all: stall detection starts at that round-off level.
-  double h_min = INFINITY;
-  for (int j = 0; j < L; ++j) h_min = std::min(h_min, chain_.link_length(j));
-  const double roundoff = 64 * std::numeric_limits<double>::epsilon() * x.cwiseAbs().maxCoeff() / h_min;
-  const double stall = std::max(kProjectionStall, roundoff);
-  double violation = 0;
+  const Points<dim> x_start = x_;
   try {
-    int iteration = 0;
-    double previous = INFINITY;
-    for (;; ++iteration) {
-      links(x, v);
-      violation = 0;
-      for (int j = 0; j < L; ++j)
-        violation = std::max(violation, std::abs(l_[j] - chain_.link_length(j)) / chain_.link_length(j));
-      if (violation <= kProjectionTolerance || (violation < stall && violation > 0.5 * previous)) break;
-      previous = violation;
-      if (iteration == kProjectionIterations || !std::isfinite(violation))
-        throw InputError(fmt::format(
-            "the initial shape cannot be fitted to the link lengths: after {} projection steps a link is still "
-            "off by {:.3g} of its length (are the fixed or driven ends further apart than the string is long?)",
-            iteration, violation));
-      system_->zero();
-      assemble_matrix();
-      for (int j = 0; j < L; ++j) system_->rhs(j) = l_[j] - chain_.link_length(j);
-      apply_correction(x, system_->solve(t0));
-    }
-    // Velocities: one linear projection onto e_j·Δv_j = 0.
-    links(x, v);
-    system_->zero();
-    assemble_matrix();
-    for (int j = 0; j < L; ++j) system_->rhs(j) = e_.col(j).dot(dv_.col(j));
-    apply_correction(v, system_->solve(t0));
+    refresh();
+    project(t0);
   } catch (const RecoverableError& e) {
     throw InputError(fmt::format("the initial shape is degenerate: {}", e.what()));
   } catch (const NumericalError& e) {
-    throw InputError(fmt::format("the initial shape cannot be fitted to the link lengths: {}", e.what()));
+    throw InputError(fmt::format("the initial shape cannot be fitted to the link lengths: {} (are the fixed or "
+                                 "driven ends further apart than the string is long?)",
+                                 e.what()));
   }
+  chain_.positions() = x_;
+  chain_.velocities() = v_;
   double moved = 0;
-  for (int i = 0; i < n; ++i) moved = std::max(moved, (x.col(i) - x_start.col(i)).norm());
+  for (int i = 0; i < chain_.num_nodes(); ++i)
+    if (in_arc(i)) moved = std::max(moved, (x_.col(i) - x_start.col(i)).norm());
   return moved;
+}
+
+template <int dim>
+Eigen::VectorXd StringModel<dim>::pack(const Eigen::Ref<const Eigen::VectorXd>& ledgers) const {
+  Eigen::VectorXd y = Eigen::VectorXd::Zero(size());
+  const int voff = dim * num_free_;
+  for (int i = 0; i < chain_.num_nodes(); ++i) {
+    const int k = slot_[i];
+    if (k < 0) continue;
+    y.template segment<dim>(dim * k) = x_.col(i);
+    y.template segment<dim>(voff + dim * k) = v_.col(i);
+  }
+  y.tail(1 + num_ledgers_) = ledgers;
+  return y;
 }
 
 template <int dim>
@@ -280,61 +441,126 @@ Eigen::VectorXd StringModel<dim>::state_from_chain() const {
 }
 
 template <int dim>
+double StringModel<dim>::kinetic_energy() const {
+  double K = 0;
+  for (int i = 0; i < chain_.num_nodes(); ++i)
+    if (in_arc(i)) K += 0.5 * m_[i] * v_.col(i).squaredNorm();
+  return K;
+}
+
+template <int dim>
+Vec<dim> StringModel<dim>::momentum() const {
+  Vec<dim> p = Vec<dim>::Zero();
+  for (int i = 0; i < chain_.num_nodes(); ++i)
+    if (in_arc(i)) p += m_[i] * v_.col(i);
+  return p;
+}
+
+template <int dim>
+Vec<dim> StringModel<dim>::support_reaction() const {
+  Vec<dim> r = Vec<dim>::Zero();
+  for (const auto& p : prescribed_) r += reaction_.col(p.node);
+  return r;
+}
+
+template <int dim>
+double StringModel<dim>::potential_energy(const Eigen::Ref<const Eigen::VectorXd>& ledger) const {
+  const NodeState<dim> state{0.0, x_, v_, m_};
+  double V = 0;
+  for (const auto& force : forces_)
+    if (force->conservative()) V += force->potential(state);
+  if (module_) V += module_->potential_correction(*this, ledger);
+  return V;
+}
+
+template <int dim>
 typename StringModel<dim>::Snapshot StringModel<dim>::snapshot(double t, const Eigen::Ref<const Eigen::VectorXd>& y) {
   Snapshot s;
   s.t = t;
-  unpack(t, y, s.x, s.v);
-  s.power = evaluate(t, s.x, s.v);
+  unpack_state(t, y);
+  s.power = evaluate_current(t);
+  s.x = x_;
+  s.v = v_;
   s.a = a_;
-  s.tension = system_->solution();
-  const NodeState<dim> state{t, s.x, s.v, chain_.masses()};
-  for (int i = 0; i < chain_.num_nodes(); ++i) s.kinetic += 0.5 * chain_.mass(i) * s.v.col(i).squaredNorm();
-  for (const auto& force : forces_)
-    if (force->conservative()) s.potential += force->potential(state);
-  s.work = y[size() - 1];
-  for (int j = 0; j < chain_.num_links(); ++j) {
+  s.tension = Eigen::VectorXd::Constant(chain_.num_links(), std::numeric_limits<double>::quiet_NaN());
+  if (system_) {
+    const Eigen::VectorXd& T = system_->solution();
+    for_each_link([&](int j, int u, int) { s.tension[j] = T[u]; });
+  }
+  const auto ledger = y.tail(num_ledgers_);
+  s.kinetic = kinetic_energy();
+  s.potential = potential_energy(ledger);
+  s.momentum = momentum();
+  for (int i = 0; i < chain_.num_nodes(); ++i)
+    if (in_arc(i)) s.moving_mass += m_[i];
+  s.work = y[work_index()];
+  for_each_link([&](int j, int, int) {
     s.max_violation = std::max(s.max_violation, std::abs(l_[j] - chain_.link_length(j)) / chain_.link_length(j));
     s.max_rate_violation = std::max(s.max_rate_violation, std::abs(e_.col(j).dot(dv_.col(j))));
+  });
+  s.support = support_reaction();
+  if (module_) {
+    ModuleLedger<dim>& extra = s;
+    const Vec<dim> prescribed_support = s.support;
+    module_->fill(*this, ledger, extra);
+    s.support += prescribed_support;
   }
   return s;
 }
 
 template <int dim>
 double StringModel<dim>::max_constraint_violation(double t, const Eigen::Ref<const Eigen::VectorXd>& y) const {
+  const int voff = dim * num_free_;
+  (void)voff;
   auto position = [&](int i) -> Vec<dim> {
     const int k = slot_[i];
     if (k >= 0) return y.template segment<dim>(dim * k);
     return prescribed_[static_cast<std::size_t>(path_of_[i])].path->position(t);
   };
   double worst = 0;
-  for (int j = 0; j < chain_.num_links(); ++j) {
+  for_each_link([&](int j, int, int) {
     const double h = chain_.link_length(j);
     const double l = (position(chain_.link_end(j)) - position(chain_.link_start(j))).norm();
     worst = std::max(worst, std::abs(l - h) / h);
-  }
+  });
   return worst;
 }
 
 template <int dim>
 void StringModel<dim>::check_slack(double t, const Eigen::Ref<const Eigen::VectorXd>& y) {
-  unpack(t, y, x_, v_);
-  evaluate(t, x_, v_);
+  if (!system_) return;
+  unpack_state(t, y);
+  evaluate_current(t);
   const Eigen::VectorXd& T = system_->solution();
   // Compare with a physical tension scale too, so that a string whose exact tension is zero (free
   // fall, uniform motion) is not reported slack for round-off: λ (|g| ℓ + max |v|²).
   double v2_max = 0;
-  for (int i = 0; i < v_.cols(); ++i) v2_max = std::max(v2_max, v_.col(i).squaredNorm());
+  for (int i = 0; i < v_.cols(); ++i)
+    if (in_arc(i)) v2_max = std::max(v2_max, v_.col(i).squaredNorm());
   const double physical = chain_.density() * (gravity().norm() * chain_.length() + v2_max);
   const double scale = std::max(T.cwiseAbs().maxCoeff(), physical);
-  int worst = 0;
-  for (int j = 1; j < T.size(); ++j)
-    if (T[j] < T[worst]) worst = j;
-  if (T[worst] < -options_.slack_tolerance * scale)
+  int worst = -1;
+  for_each_link([&](int j, int u, int) {
+    if (worst < 0 || T[u] < T[link_unknown_[static_cast<std::size_t>(worst)]]) worst = j;
+  });
+  const double T_worst = T[link_unknown_[static_cast<std::size_t>(worst)]];
+  if (T_worst < -options_.slack_tolerance * scale)
     throw NumericalError(fmt::format("slack at t = {:.9g} s: link {} (s = {:.6g} m from node 0) has tension "
                                      "T = {:.6g} N < 0 (largest |T| = {:.6g} N); an inextensible string cannot "
                                      "push, so the model does not apply",
-                                     t, worst, chain_.link_midpoint(worst), T[worst], scale),
+                                     t, worst, chain_.link_midpoint(worst), T_worst, scale),
                          t);
+}
+
+template <int dim>
+EventAction StringModel<dim>::handle_events(double t, Eigen::VectorXd& y, const std::vector<int>& found) {
+  CHAINSIM_VERIFY(module_ != nullptr, "events come from a module");
+  unpack_state(t, y);
+  refresh();
+  Eigen::VectorXd ledgers = y.tail(1 + num_ledgers_);
+  const EventAction action = module_->handle_events(*this, t, ledgers.tail(num_ledgers_), found);
+  if (action.kind == EventAction::Kind::kTransfer) y = pack(ledgers);
+  return action;
 }
 
 template class StringModel<2>;

@@ -1,6 +1,9 @@
 #pragma once
 /// @file string_model.hpp
-/// The discrete inextensible string as an ODE system (DESIGN.md §1, §3).
+/// The one discrete inextensible string of chainsim, as an ODE system (docs/string_solver.md).
+/// Every model runs on it: a plain string, and a string whose motion carries shocks, whose front
+/// tracking is a module (string_module.hpp, shocks/front_tracker.hpp) that cuts the material into
+/// arcs and adds the jump conditions of its fronts.
 ///
 /// Momentum per free node i (the tension T_j acts along the link unit vector e_j, from node j towards
 /// node j+1):
@@ -12,7 +15,13 @@
 /// motion (fixed or driven ends) are not in the ODE state; their position, velocity and acceleration
 /// come from their EndPath.
 ///
-/// ODE state y = [ x of the free nodes (dim each, node order) | v of the free nodes | W_applied ].
+/// Arcs. The moving nodes form arcs (ArcRange: runs of nodes with no front inside; one arc, open or
+/// closed, without a module). Each arc owns a block of the tension system; nodes in no arc (inside
+/// a heap) have no equation of motion. Masses are lumped per arc, m_i = Σ ½ λ h_j over the arc's
+/// links at node i, plus what the module adds (a partial link's material).
+///
+/// ODE state y = [ x of the free nodes (dim each, node order) | v of the free nodes | W_applied |
+///                 the module's ledgers ].
 /// The last component integrates the power of the non-conservative effects and of the drivers,
 ///     dW/dt = Σ_free F_nc,i · v_i + Σ_prescribed (m_i a_i − m_i g − (tension force)_i) · v_i,
 /// as an extra ODE component (so it is error-controlled like the rest), and the ledger
@@ -26,6 +35,7 @@
 /// term adds eigenvalues −1/τ_b, harmless to an explicit method when τ_b ≫ h) and short compared
 /// with the run; it does not change the exact solution, for which C = C' = 0. τ_b = 0 turns it off.
 #include <memory>
+#include <string>
 #include <vector>
 
 #include <Eigen/Core>
@@ -33,6 +43,7 @@
 #include "mesh/chain.hpp"
 #include "forces.hpp"
 #include "integrator.hpp"
+#include "string_module.hpp"
 #include "tension_system.hpp"
 
 namespace chainsim {
@@ -53,46 +64,61 @@ template <int dim>
 class StringModel final : public OdeSystem {
  public:
   /// The model of `chain` (its current positions and velocities are the initial state) under the
-  /// given forces, with the listed nodes prescribed. Throws InputError on bad input.
+  /// given forces, with the listed nodes prescribed, and an optional module (front tracking).
+  /// Throws InputError on bad input.
   StringModel(Chain<dim> chain, std::vector<std::unique_ptr<Force<dim>>> forces,
-              std::vector<PrescribedNode<dim>> prescribed, const StringModelOptions& options);
+              std::vector<PrescribedNode<dim>> prescribed, const StringModelOptions& options,
+              std::unique_ptr<StringModule<dim>> module = nullptr);
 
   // --- OdeSystem ----------------------------------------------------------------------------
-  int size() const override { return 2 * dim * num_free_ + 1; }
+  int size() const override { return 2 * dim * num_free_ + 1 + num_ledgers_; }
   void rhs(double t, const Eigen::Ref<const Eigen::VectorXd>& y, Eigen::Ref<Eigen::VectorXd> ydot) override;
+  int num_events() const override { return module_ ? module_->num_events() : 0; }
+  void events(double t, const Eigen::Ref<const Eigen::VectorXd>& y, Eigen::Ref<Eigen::VectorXd> g) override;
+  std::vector<int> event_directions() const override {
+    return module_ ? module_->event_directions() : std::vector<int>{};
+  }
+  /// With a module: positions scale with ℓ, velocities with a reference speed, ledgers with the
+  /// matching energies; without one, plain absolute tolerances (empty).
+  Eigen::VectorXd state_scale() const override;
 
   // --- set-up -------------------------------------------------------------------------------
   /// Puts the prescribed nodes on their paths at t0, then projects the positions and velocities of
-  /// the chain onto the link constraints (|Δx_j| = h_j and Δx_j·Δv_j = 0) by the smallest
-  /// mass-weighted correction, keeping prescribed nodes. Returns the largest position correction (m).
-  /// Throws InputError if the projection does not converge (e.g. fixed ends further apart than the
-  /// string is long).
+  /// the moving nodes onto the link constraints (project()). The chain's positions and velocities
+  /// become the projected ones. Returns the largest position correction (m). Throws InputError if
+  /// the projection fails (e.g. fixed ends further apart than the string is long).
   double make_consistent(double t0);
-  /// The ODE state of the chain's current positions and velocities, with W_applied = 0.
+  /// The ODE state of the chain's current positions and velocities, with every ledger zero.
   Eigen::VectorXd state_from_chain() const;
 
   // --- evaluation ---------------------------------------------------------------------------
-  /// All node positions and velocities at (t, y) (prescribed nodes from their paths).
+  /// All node positions and velocities at (t, y) (prescribed nodes from their paths; nodes in no
+  /// arc keep their last known values).
   void unpack(double t, const Eigen::Ref<const Eigen::VectorXd>& y, Points<dim>& x, Points<dim>& v) const;
 
   /// Everything at one state (one tension solve).
-  struct Snapshot {
+  struct Snapshot : ModuleLedger<dim> {
     double t = 0;
     Points<dim> x, v, a;            ///< positions, velocities, accelerations of all nodes
-    Eigen::VectorXd tension;        ///< T_j (N)
+    Eigen::VectorXd tension;        ///< T_j (N) of every link; NaN for a link in no arc
     double kinetic = 0;             ///< K (J)
     double potential = 0;           ///< V (J)
     double work = 0;                ///< W_applied (J)
     double power = 0;               ///< dW_applied/dt (W)
-    double max_violation = 0;       ///< max_j | |Δx_j| − h_j | / h_j
+    double max_violation = 0;       ///< max_j | |Δx_j| − h_j | / h_j over the links of the arcs
     double max_rate_violation = 0;  ///< max_j |e_j·Δv_j| (m/s)
+    Vec<dim> momentum = Vec<dim>::Zero();  ///< Σ m_i v_i (N s)
+    double moving_mass = 0;                ///< Σ m_i over the moving nodes (kg)
   };
   Snapshot snapshot(double t, const Eigen::Ref<const Eigen::VectorXd>& y);
 
-  /// max_j | |Δx_j| − h_j | / h_j at (t, y), without a tension solve.
+  /// max_j | |Δx_j| − h_j | / h_j at (t, y) over the links of the arcs, without a tension solve.
   double max_constraint_violation(double t, const Eigen::Ref<const Eigen::VectorXd>& y) const;
-  /// Throws NumericalError naming the link, its tension and t if some T_j < −slack_tolerance·max|T|.
+  /// Throws NumericalError naming the link, its tension and t if some T_j < −slack_tolerance·scale.
   void check_slack(double t, const Eigen::Ref<const Eigen::VectorXd>& y);
+  /// Acts on the root functions found at (t, y) (the module's events): `y` is replaced by the new,
+  /// possibly longer or shorter, state after a transfer.
+  EventAction handle_events(double t, Eigen::VectorXd& y, const std::vector<int>& found);
 
   // --- access -------------------------------------------------------------------------------
   const Chain<dim>& chain() const { return chain_; }
@@ -100,15 +126,19 @@ class StringModel final : public OdeSystem {
   const std::vector<std::unique_ptr<Force<dim>>>& forces() const { return forces_; }
   const std::vector<PrescribedNode<dim>>& prescribed() const { return prescribed_; }
   const StringModelOptions& options() const { return options_; }
-  bool is_prescribed(int node) const { return slot_[node] < 0; }
+  const StringModule<dim>* module() const { return module_.get(); }
+  bool is_prescribed(int node) const { return path_of_[static_cast<std::size_t>(node)] >= 0; }
   int num_free_nodes() const { return num_free_; }
-  int work_index() const { return size() - 1; }
+  /// Nodes with an equation of motion (free and in an arc).
+  int num_moving_nodes() const { return num_free_; }
+  int work_index() const { return 2 * dim * num_free_; }
   /// Baumgarte coefficients α, β (1/s).
   double alpha() const { return alpha_; }
   double beta() const { return beta_; }
   TensionSystem& tension_system() { return *system_; }
-  long tension_solves() const { return system_->num_solves(); }
-  /// Tensions and accelerations of the last evaluation (rhs or snapshot).
+  bool has_tension_system() const { return system_ != nullptr; }
+  long tension_solves() const { return solves_ + (system_ ? system_->num_solves() : 0); }
+  /// Tensions (per tension unknown) and accelerations of the last evaluation (rhs or snapshot).
   const Eigen::VectorXd& tensions() const { return system_->solution(); }
   const Points<dim>& accelerations() const { return a_; }
   /// The constant vector g of the gravity effect (zero without gravity).
@@ -118,22 +148,72 @@ class StringModel final : public OdeSystem {
   /// Public for tests: the core of rhs().
   double evaluate(double t, const Points<dim>& x, const Points<dim>& v);
 
+  // --- what a module works with (shocks/front_tracker.hpp) --------------------------------------
+  const std::vector<ArcRange>& arcs() const { return arcs_; }
+  /// The arcs, to change at a front crossing; call rebuild() after.
+  std::vector<ArcRange>& arcs() { return arcs_; }
+  /// After the arcs change: free-node slots, lumped masses and the tension system anew.
+  void rebuild();
+  /// Index of the arc holding `node`, or −1 (inside a heap).
+  int arc_of(int node) const { return arc_of_[static_cast<std::size_t>(node)]; }
+  bool in_arc(int node) const { return arc_of(node) >= 0; }
+  /// The current positions and velocities of all nodes (the state being evaluated).
+  const Points<dim>& x() const { return x_; }
+  const Points<dim>& v() const { return v_; }
+  Points<dim>& x() { return x_; }
+  Points<dim>& v() { return v_; }
+  /// Current masses (lumped plus the module's), after refresh() or an evaluation.
+  const Eigen::VectorXd& masses() const { return m_; }
+  /// Recomputes the masses (and the module's fronts) at the current x(), v(); no tension solve.
+  void refresh();
+  /// Sum over the moving nodes of the applied forces and the prescribed nodes' support reactions,
+  /// after an evaluation (N).
+  const Vec<dim>& external_force() const { return external_; }
+  /// Sum of the prescribed nodes' support reactions on the string, after an evaluation (N).
+  Vec<dim> support_reaction() const;
+  /// K = ½ Σ m_i |v_i|² and p = Σ m_i v_i over the moving nodes at the current state.
+  double kinetic_energy() const;
+  Vec<dim> momentum() const;
+  /// V at the current state (needs refresh() or an evaluation): the forces' potentials with the
+  /// lumped masses, plus the module's correction.
+  double potential_energy(const Eigen::Ref<const Eigen::VectorXd>& ledger) const;
+  /// Projects x(), v() of the moving nodes onto the link constraints (prescribed nodes on their paths
+  /// at t): the smallest mass-weighted correction onto |Δx_j| = h_j (Newton's method, until every link
+  /// is right to the round-off of its coordinates), then onto e_j·Δv_j = 0. Throws NumericalError
+  /// naming t and the residual if it does not converge.
+  void project(double t);
+
  private:
-  void links(const Points<dim>& x, const Points<dim>& v);
+  void links();
   void assemble_matrix();
+  Eigen::VectorXd pack(const Eigen::Ref<const Eigen::VectorXd>& ledgers) const;
+  void unpack_state(double t, const Eigen::Ref<const Eigen::VectorXd>& y);
+  double evaluate_current(double t);
+  template <class Visit>
+  void for_each_link(Visit&& visit) const;
 
   Chain<dim> chain_;
   std::vector<std::unique_ptr<Force<dim>>> forces_;
   std::vector<PrescribedNode<dim>> prescribed_;
   StringModelOptions options_;
+  std::unique_ptr<StringModule<dim>> module_;
+  int num_ledgers_ = 0;
+  std::vector<ArcRange> arcs_;
+  std::vector<int> first_unknown_;  // per arc: its first tension unknown (−1: no link)
   std::unique_ptr<TensionSystem> system_;
-  std::vector<int> slot_;        // node -> index among free nodes, or -1 if prescribed
+  long solves_ = 0;              // tension solves of systems replaced by rebuild()
+  std::vector<int> arc_of_;      // node -> arc, or -1
+  std::vector<int> slot_;        // node -> index among free nodes, or -1 (prescribed or in no arc)
   std::vector<int> path_of_;     // node -> index into prescribed_, or -1
-  Eigen::VectorXd w_;            // 1/m_i for free nodes, 0 for prescribed ones
+  std::vector<int> link_unknown_;  // link -> tension unknown, or -1 (in no arc)
+  Eigen::VectorXd base_mass_;    // lumped masses of the arcs' links
+  Eigen::VectorXd m_;            // current masses (base + module)
+  Eigen::VectorXd w_;            // 1/m_i for free nodes, 0 otherwise
   int num_free_ = 0;
   double alpha_ = 0, beta_ = 0;
+  Vec<dim> external_ = Vec<dim>::Zero();
   // workspace
-  Points<dim> x_, v_, a_, force_, force_nc_, tension_force_, b_;
+  Points<dim> x_, v_, a_, force_, force_nc_, module_force_, tension_force_, b_, reaction_;
   Points<dim> dx_, dv_, e_;
   Eigen::VectorXd l_;
 };

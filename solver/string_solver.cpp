@@ -1,4 +1,4 @@
-// Drives a StringModel with the Integrator and writes its outputs: see string_solver.hpp.
+// Drives the one discrete string with the Integrator and writes its outputs: see string_solver.hpp.
 #include "string_solver.hpp"
 
 #include <algorithm>
@@ -9,7 +9,6 @@
 #include <nlohmann/json.hpp>
 
 #include "mesh/errors.hpp"
-#include "output.hpp"
 #include "vtk_output.hpp"
 
 namespace chainsim {
@@ -31,9 +30,17 @@ void StringSolverOptions::check_frame_budget(int nodes) const {
                                  output_interval, t_end, frames, nodes, node_frames, kMaxNodeFrames));
 }
 
+const std::vector<std::string>& run_output_files() {
+  static const std::vector<std::string> files = {"stats.json", "nodes.csv",  "tension.csv",
+                                                 "energy.csv", "series.csv", "string.pvd"};
+  return files;
+}
+
 nlohmann::json to_json(const RunSummary& s) {
   nlohmann::json j = {{"status", s.status},
+                      {"stop_reason", s.stop_reason},
                       {"t_end", s.t_end},
+                      {"t_stop", s.t_stop},
                       {"steps", s.stats.steps},
                       {"rhs_evals", s.stats.rhs_evals},
                       {"wall_s", s.wall_s},
@@ -41,11 +48,15 @@ nlohmann::json to_json(const RunSummary& s) {
                       {"final_energy_drift", s.final_energy_drift},
                       {"energy_scale", s.energy_scale},
                       {"relative_energy_drift", s.relative_energy_drift()},
+                      {"energy_residual", s.relative_energy_residual()},
+                      {"energy_residual_abs", s.energy_drift},
+                      {"momentum_residual", s.relative_momentum_residual()},
                       {"max_constraint_violation", s.max_constraint_violation},
+                      {"transfers", s.transfers},
                       {"tension_solves", s.tension_solves},
                       {"tension_backend", s.tension_backend},
                       {"frames", s.frames},
-                      {"stop_reason", s.stop_reason},
+                      {"samples", s.samples.size()},
                       {"dimension", s.dimension},
                       {"nodes", s.nodes},
                       {"links", s.links},
@@ -58,6 +69,40 @@ nlohmann::json to_json(const RunSummary& s) {
                       {"stats", to_json(s.stats)}};
   if (!s.error.empty()) j["error"] = s.error;
   return j;
+}
+
+CsvTable samples_table(const RunSummary& run) {
+  std::vector<std::string> cols = {"t"};
+  const std::size_t nf = run.samples.empty() ? 0 : run.samples.front().s0.size();
+  const std::size_t dim = run.samples.empty() ? 0 : run.samples.front().support.size();
+  const char* axes[] = {"x", "y", "z"};
+  for (std::size_t k = 0; k < nf; ++k) {
+    cols.push_back("s0_" + std::to_string(k));
+    cols.push_back("s0dot_" + std::to_string(k));
+    for (std::size_t d = 0; d < dim; ++d) cols.push_back("front_" + std::to_string(k) + "_" + axes[d]);
+  }
+  for (const char* c : {"K", "V", "W_applied", "W_shocks", "W_heaps", "W_remesh", "energy_residual",
+                        "momentum_residual"})
+    cols.emplace_back(c);
+  for (std::size_t d = 0; d < dim; ++d) cols.push_back(std::string("support_") + axes[d]);
+  for (const char* c : {"moving_mass", "heap_mass", "max_violation", "moving_nodes"}) cols.emplace_back(c);
+  CsvTable table(cols);
+  for (const StepSample& s : run.samples) {
+    std::vector<double> row = {s.t};
+    for (std::size_t k = 0; k < nf; ++k) {
+      row.push_back(s.s0[k]);
+      row.push_back(s.s0_dot[k]);
+      for (std::size_t d = 0; d < dim; ++d) row.push_back(s.position[k * dim + d]);
+    }
+    for (double v : {s.kinetic, s.potential, s.w_applied, s.w_shocks, s.w_heaps, s.w_remesh, s.energy_residual,
+                     s.momentum_residual})
+      row.push_back(v);
+    for (double v : s.support) row.push_back(v);
+    for (double v : {s.moving_mass, s.heap_mass, s.max_violation, static_cast<double>(s.moving_nodes)})
+      row.push_back(v);
+    table.add_row(row);
+  }
+  return table;
 }
 
 template <int dim>
@@ -81,56 +126,108 @@ void StringSolver<dim>::describe_model() {
   for (const auto& p : model_.prescribed())
     summary_.prescribed.push_back(fmt::format("node {}: {}", p.node, p.path->description()));
   summary_.root_functions = model_.num_events();
-  summary_.tension_unknowns = model_.tension_system().size();
-  summary_.junction_unknowns = summary_.tension_unknowns - chain.num_links();
+  int links_in_arcs = 0;
+  for (const ArcRange& arc : model_.arcs()) links_in_arcs += arc.num_links();
+  summary_.tension_unknowns = model_.has_tension_system() ? model_.tension_system().size() : 0;
+  summary_.junction_unknowns = summary_.tension_unknowns - links_in_arcs;
   summary_.stabilization_time = model_.options().stabilization_time;
-  summary_.tension_backend = model_.tension_system().backend_name();
+  summary_.tension_backend = model_.has_tension_system() ? model_.tension_system().backend_name() : "none";
+  summary_.t_end = options_.t_end;
 }
 
 template <int dim>
-void StringSolver<dim>::record(double t, const Eigen::VectorXd& y) {
+void StringSolver<dim>::book(double t, const typename StringModel<dim>::Snapshot& snap) {
+  if (!have_start_) {
+    e0_ = snap.kinetic + snap.potential;
+    v0_ = snap.potential;
+    p0_ = snap.momentum;
+    have_start_ = true;
+  }
+  const double drift = snap.kinetic + snap.potential - e0_ - snap.work - snap.w_shocks - snap.w_heaps - snap.w_remesh;
+  if (!snap.x.allFinite() || !snap.v.allFinite() || !std::isfinite(drift))
+    throw NumericalError(fmt::format("the solution is no longer finite at t = {:.9g} s", t), t);
+  summary_.energy_drift = std::max(summary_.energy_drift, std::abs(drift));
+  summary_.final_energy_drift = drift;
+  summary_.energy_scale =
+      std::max(summary_.energy_scale, snap.kinetic + std::abs(snap.potential - v0_) + std::abs(snap.work) +
+                                          std::abs(snap.w_shocks) + std::abs(snap.w_heaps));
+  summary_.max_constraint_violation = std::max(summary_.max_constraint_violation, snap.max_violation);
+  if (snap.has_momentum_ledger) {
+    summary_.max_momentum_residual =
+        std::max(summary_.max_momentum_residual, (snap.momentum - p0_ - snap.impulse).norm());
+    summary_.momentum_scale = std::max(summary_.momentum_scale, snap.momentum.norm() + snap.impulse.norm());
+  }
+}
+
+template <int dim>
+void StringSolver<dim>::record_frame(double t, const Eigen::VectorXd& y) {
   auto snap = model_.snapshot(t, y);
+  book(t, snap);
   Frame<dim> f;
   f.t = t;
-  f.x = std::move(snap.x);
-  f.v = std::move(snap.v);
-  f.tension = std::move(snap.tension);
   f.kinetic = snap.kinetic;
   f.potential = snap.potential;
   f.work = snap.work;
+  f.w_shocks = snap.w_shocks;
+  f.w_heaps = snap.w_heaps;
+  f.w_remesh = snap.w_remesh;
+  f.drift = summary_.final_energy_drift;
   f.max_violation = snap.max_violation;
-  if (frames_.empty()) {
-    e0_ = snap.kinetic + snap.potential;
-    v0_ = snap.potential;
-  }
-  f.drift = f.kinetic + f.potential - e0_ - f.work;
-  if (!f.x.allFinite() || !f.v.allFinite() || !f.tension.allFinite() || !std::isfinite(f.drift))
-    throw NumericalError(fmt::format("the solution is no longer finite at t = {:.9g} s", t), t);
-  summary_.energy_drift = std::max(summary_.energy_drift, std::abs(f.drift));
-  summary_.final_energy_drift = f.drift;
-  summary_.energy_scale =
-      std::max(summary_.energy_scale, f.kinetic + std::abs(f.potential - v0_) + std::abs(f.work));
-  summary_.max_constraint_violation = std::max(summary_.max_constraint_violation, f.max_violation);
+  for (int i = 0; i < model_.chain().num_nodes(); ++i)
+    if (model_.in_arc(i)) f.moving.push_back(i);
+  f.x = std::move(snap.x);
+  f.v = std::move(snap.v);
+  f.tension = std::move(snap.tension);
   frames_.push_back(std::move(f));
   summary_.frames = static_cast<long>(frames_.size());
+}
+
+template <int dim>
+void StringSolver<dim>::record_sample(double t, const Eigen::VectorXd& y) {
+  const auto snap = model_.snapshot(t, y);
+  book(t, snap);
+  StepSample s;
+  s.t = t;
+  for (const auto& f : snap.fronts) {
+    s.s0.push_back(f.s0);
+    s.s0_dot.push_back(f.s0_dot);
+    for (int d = 0; d < dim; ++d) s.position.push_back(f.position[d]);
+  }
+  s.kinetic = snap.kinetic;
+  s.potential = snap.potential;
+  s.w_applied = snap.work;
+  s.w_shocks = snap.w_shocks;
+  s.w_heaps = snap.w_heaps;
+  s.w_remesh = snap.w_remesh;
+  s.energy_residual = summary_.final_energy_drift;
+  s.momentum_residual = snap.has_momentum_ledger ? (snap.momentum - p0_ - snap.impulse).norm() : 0.0;
+  for (int d = 0; d < dim; ++d) s.support.push_back(snap.support[d]);
+  s.moving_mass = snap.moving_mass;
+  s.heap_mass = snap.heap_mass;
+  s.max_violation = snap.max_violation;
+  s.moving_nodes = model_.num_moving_nodes();
+  summary_.samples.push_back(std::move(s));
 }
 
 template <int dim>
 const RunSummary& StringSolver<dim>::run() {
   frames_.clear();
   summary_ = RunSummary{};
+  have_start_ = false;
   describe_model();
   const auto start = std::chrono::steady_clock::now();
   const long solves_before = model_.tension_solves();
+  const long transfers_before = model_.module() ? model_.module()->transfers() : 0;
   const double t0 = 0.0;
   std::unique_ptr<Integrator> integrator;
   auto finish = [&](const std::string& status) {
     summary_.status = status;
     summary_.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     summary_.tension_solves = model_.tension_solves() - solves_before;
+    summary_.transfers = (model_.module() ? model_.module()->transfers() : 0) - transfers_before;
     if (integrator) {
       summary_.stats = integrator->stats();
-      summary_.t_end = integrator->time();
+      summary_.t_stop = integrator->time();
       final_state_ = integrator->state();
     }
   };
@@ -139,22 +236,43 @@ const RunSummary& StringSolver<dim>::run() {
     model_.make_consistent(t0);
     const Eigen::VectorXd y0 = model_.state_from_chain();
     integrator = std::make_unique<Integrator>(model_, t0, y0, options_.integrator);
-    record(t0, y0);
+    record_frame(t0, y0);
+    if (options_.record_steps) record_sample(t0, y0);
     if (model_.options().check_slack) model_.check_slack(t0, y0);
-    // 2. Step by step to each output time: constraints (and slack) are checked at accepted steps.
+    // 2. Step by step to each output time: constraints (and slack) are checked at accepted steps,
+    //    root functions acted on where they vanish.
     const auto n_out = static_cast<long>(std::ceil(options_.t_end / options_.output_interval - 1e-9));
-    for (long k = 1; k <= n_out; ++k) {
+    for (long k = 1; k <= n_out;) {
       const double t_out = std::min(options_.t_end, k * options_.output_interval);
-      while (integrator->time() < t_out) {
-        integrator->advance(t_out, /*one_step=*/true);
-        const double t = integrator->time();
-        const Eigen::VectorXd& y = integrator->state();
-        summary_.max_constraint_violation =
-            std::max(summary_.max_constraint_violation, model_.max_constraint_violation(t, y));
-        if (model_.options().check_slack) model_.check_slack(t, y);
-        if (on_step) on_step(t, y);
+      const Integrator::Outcome outcome = integrator->advance(t_out, /*one_step=*/true);
+      const double t = integrator->time();
+      if (outcome == Integrator::Outcome::kEvent) {
+        Eigen::VectorXd state = integrator->state();
+        const EventAction action = model_.handle_events(t, state, integrator->events_found());
+        if (action.kind == EventAction::Kind::kStop) {
+          if (options_.record_steps) record_sample(t, state);
+          record_frame(t, state);
+          finish("stopped");
+          summary_.stop_reason = action.reason;
+          return summary_;
+        }
+        if (state.size() == integrator->state().size())
+          integrator->restart(t, state);
+        else
+          integrator->resize(t, state);
+        if (options_.record_steps) record_sample(t, state);
+        continue;
       }
-      record(t_out, integrator->state());
+      const Eigen::VectorXd& y = integrator->state();
+      summary_.max_constraint_violation =
+          std::max(summary_.max_constraint_violation, model_.max_constraint_violation(t, y));
+      if (model_.options().check_slack) model_.check_slack(t, y);
+      if (on_step) on_step(t, y);
+      if (options_.record_steps) record_sample(t, y);
+      if (outcome == Integrator::Outcome::kReachedTarget) {
+        record_frame(t_out, y);
+        ++k;
+      }
     }
   } catch (const RecoverableError& e) {
     // Only a trial stage may be retried: at an accepted state the model cannot go on.
@@ -173,60 +291,82 @@ const RunSummary& StringSolver<dim>::run() {
 }
 
 template <int dim>
-void StringSolver<dim>::write_outputs(const std::filesystem::path& dir, const OutputSelection& select) const {
+void StringSolver<dim>::write_outputs(const std::filesystem::path& dir, const OutputSelection& select,
+                                      const nlohmann::json* summary) const {
   CHAINSIM_VERIFY(!select.vtk || select.nodes, "the ParaView frames need the nodes field");
   ensure_directory(dir);
   // 1. Remove every output of an earlier run first: the directory then holds this run's files or
   //    none, never a mix; stats.json, written last, marks a complete set.
   std::error_code ec;
-  for (const char* name : {"stats.json", "nodes.csv", "tension.csv", "energy.csv", "string.pvd"})
-    std::filesystem::remove(dir / name, ec);
+  for (const std::string& name : run_output_files()) std::filesystem::remove(dir / name, ec);
   std::filesystem::remove_all(dir / "frames", ec);
   const auto& chain = model_.chain();
-  const int n = chain.num_nodes(), L = chain.num_links();
+  const int L = chain.num_links();
+  const bool fronts = model_.module() != nullptr;
   // 2. CSV tables.
   if (select.csv) {
     const char* axes[] = {"x", "y", "z"};
     std::vector<std::string> columns = {"t", "node"};
+    if (fronts) columns.emplace_back("s");
     for (int d = 0; d < dim; ++d) columns.emplace_back(axes[d]);
     for (int d = 0; d < dim; ++d) columns.push_back(std::string("v") + axes[d]);
     CsvTable nodes(columns);
     CsvTable tension({"t", "link", "s_mid", "T"});
-    CsvTable energy({"t", "K", "V", "W_applied", "drift"});
-    std::vector<double> s_mid(static_cast<std::size_t>(L));
-    for (int j = 0; j < L; ++j) s_mid[static_cast<std::size_t>(j)] = chain.link_midpoint(j);
+    std::vector<std::string> energy_columns = {"t", "K", "V", "W_applied", "drift"};
+    if (fronts) energy_columns.insert(energy_columns.end(), {"W_shocks", "W_heaps", "W_remesh"});
+    CsvTable energy(energy_columns);
     std::vector<double> row;
     for (const auto& f : frames_) {
-      for (int i = 0; select.nodes && i < n; ++i) {
+      for (int i : f.moving) {
+        if (!select.nodes) break;
         row = {f.t, static_cast<double>(i)};
+        if (fronts) row.push_back(chain.node_coordinate(i));
         for (int d = 0; d < dim; ++d) row.push_back(f.x(d, i));
         for (int d = 0; d < dim; ++d) row.push_back(f.v(d, i));
         nodes.add_row(row);
       }
       for (int j = 0; select.tension && j < L; ++j)
-        tension.add_row({f.t, static_cast<double>(j), s_mid[static_cast<std::size_t>(j)], f.tension[j]});
-      energy.add_row({f.t, f.kinetic, f.potential, f.work, f.drift});
+        if (!std::isnan(f.tension[j])) tension.add_row({f.t, static_cast<double>(j), chain.link_midpoint(j), f.tension[j]});
+      row = {f.t, f.kinetic, f.potential, f.work, f.drift};
+      if (fronts) row.insert(row.end(), {f.w_shocks, f.w_heaps, f.w_remesh});
+      energy.add_row(row);
     }
     if (select.nodes) nodes.write(dir / "nodes.csv");
     if (select.tension) tension.write(dir / "tension.csv");
     if (select.energy) energy.write(dir / "energy.csv");
+    if (select.energy && !summary_.samples.empty()) samples_table(summary_).write(dir / "series.csv");
   }
-  // 3. ParaView frames, then their index.
+  // 3. ParaView frames (the moving nodes, a line cell per link of an arc), then their index.
   if (select.vtk) {
     ensure_directory(dir / "frames");
     std::vector<std::pair<double, std::string>> index;
-    VtkPolyline line;
-    for (int j = 0; j < L; ++j) line.segments.emplace_back(chain.link_start(j), chain.link_end(j));
-    Eigen::MatrixXd mass = chain.masses().transpose();
     for (std::size_t k = 0; k < frames_.size(); ++k) {
       const auto& f = frames_[k];
-      line.points = Eigen::Matrix3Xd::Zero(3, n);
-      line.points.topRows(dim) = f.x;
-      Eigen::MatrixXd velocity = Eigen::MatrixXd::Zero(3, n);
-      velocity.topRows(dim) = f.v;
-      line.point_data = {{"velocity", velocity}, {"mass", mass}};
-      line.cell_data.clear();
-      if (select.tension) line.cell_data.emplace_back("tension", f.tension.transpose());
+      const auto count = static_cast<Eigen::Index>(f.moving.size());
+      std::vector<int> point_of(static_cast<std::size_t>(chain.num_nodes()), -1);
+      VtkPolyline line;
+      line.points = Eigen::Matrix3Xd::Zero(3, count);
+      Eigen::MatrixXd velocity = Eigen::MatrixXd::Zero(3, count), mass(1, count), s(1, count);
+      for (Eigen::Index q = 0; q < count; ++q) {
+        const int i = f.moving[static_cast<std::size_t>(q)];
+        point_of[static_cast<std::size_t>(i)] = static_cast<int>(q);
+        line.points.col(q).head(dim) = f.x.col(i);
+        velocity.col(q).head(dim) = f.v.col(i);
+        mass(0, q) = chain.mass(i);
+        s(0, q) = chain.node_coordinate(i);
+      }
+      std::vector<double> cell_tension;
+      for (int j = 0; j < L; ++j) {
+        if (std::isnan(f.tension[j])) continue;
+        line.segments.emplace_back(point_of[static_cast<std::size_t>(chain.link_start(j))],
+                                   point_of[static_cast<std::size_t>(chain.link_end(j))]);
+        cell_tension.push_back(f.tension[j]);
+      }
+      line.point_data = {{"velocity", velocity}, {"mass", mass}, {"s", s}};
+      if (select.tension)
+        line.cell_data.emplace_back(
+            "tension", Eigen::Map<const Eigen::MatrixXd>(cell_tension.data(), 1,
+                                                          static_cast<Eigen::Index>(cell_tension.size())));
       const std::string name = fmt::format("frame_{:04d}.vtp", k);
       write_vtp(dir / "frames" / name, line);
       index.emplace_back(f.t, "frames/" + name);
@@ -234,7 +374,7 @@ void StringSolver<dim>::write_outputs(const std::filesystem::path& dir, const Ou
     write_pvd(dir / "string.pvd", index);
   }
   // 4. stats.json, last.
-  if (select.stats) write_json(dir / "stats.json", to_json(summary_));
+  if (select.stats) write_json(dir / "stats.json", summary ? *summary : to_json(summary_));
 }
 
 template class StringSolver<2>;

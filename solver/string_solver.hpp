@@ -1,17 +1,20 @@
 #pragma once
 /// @file string_solver.hpp
-/// Runs a StringModel with the ARKODE Integrator: records frames at the output times, checks the
-/// link constraints (and slack, if asked) after every accepted step, keeps the energy ledger, and
-/// writes the outputs.
+/// Runs the one discrete string (StringModel, with or without fronts) with the ARKODE Integrator:
+/// records frames at the exact output times, checks the link constraints (and slack, if asked)
+/// after every accepted step, acts on the model's root functions (front crossings, stop events),
+/// keeps the energy ledger (and, with fronts, the momentum ledger), and writes the outputs.
 ///
 /// Outputs (write_outputs, all through AtomicFile; which ones: OutputSelection):
-///   nodes.csv    t, node, x, y[, z], vx, vy[, vz]       at every output time
-///   tension.csv  t, link, s_mid, T                       s_mid: material coordinate of the link midpoint
-///   energy.csv   t, K, V, W_applied, drift               drift = K + V − (K0 + V0) − W_applied
+///   nodes.csv    t, node[, s], x, y[, z], vx, vy[, vz]   the moving nodes at every frame (s: with fronts)
+///   tension.csv  t, link, s_mid, T                       the links of the arcs; s_mid: material
+///                                                        coordinate of the link midpoint
+///   energy.csv   t, K, V, W_applied, drift[, W_shocks, W_heaps, W_remesh]    at every frame
+///                drift = K + V − (K0 + V0) − W_applied − W_shocks − W_heaps − W_remesh
+///   series.csv   one row per accepted step (StringSolverOptions::record_steps, on for runs with
+///                fronts): samples_table()
 ///   frames/frame_XXXX.vtp and string.pvd                 ParaView time series
-///   stats.json   ARKODE statistics, tension solves, wall time, ledger, constraint violation, the
-///                effects built, root functions and junction unknowns; written last, so its
-///                presence means the set of files is complete
+///   stats.json   the summary (to_json); written last, so its presence means the set is complete
 #include <filesystem>
 #include <functional>
 #include <string>
@@ -20,6 +23,7 @@
 #include <nlohmann/json_fwd.hpp>
 
 #include "integrator.hpp"
+#include "output.hpp"
 #include "string_model.hpp"
 
 namespace chainsim {
@@ -27,7 +31,8 @@ namespace chainsim {
 struct StringSolverOptions {
   IntegratorOptions integrator;
   double t_end = 1.0;            ///< end time (s), > 0 ([stop] t_end)
-  double output_interval = 0.1;  ///< time between frames (s); frames at 0, Δ, 2Δ, …, and t_end ([output] interval)
+  double output_interval = 0.1;  ///< time between frames (s); frames at 0, Δ, 2Δ, …, t_end, and at a stop
+  bool record_steps = false;     ///< a StepSample after every accepted step (series.csv)
   void validate() const;
   /// Frames are kept in memory until the outputs are written: throws InputError if t_end and
   /// output_interval ask for more than 2·10⁷ node-frames of a string with `nodes` nodes.
@@ -35,8 +40,9 @@ struct StringSolverOptions {
 };
 
 /// Which outputs write_outputs() produces: fields × formats. A CSV file per field (nodes, tension,
-/// energy), the ParaView frames (geometry and velocities, plus the tension as cell data if the
-/// tension field is selected; they need the nodes field), and stats.json.
+/// energy: energy.csv and, when steps are recorded, series.csv), the ParaView frames (geometry and
+/// velocities, plus the tension as cell data if the tension field is selected; they need the nodes
+/// field), and stats.json.
 struct OutputSelection {
   bool nodes = true, tension = true, energy = true, stats = true;  ///< fields
   bool csv = true, vtk = true;                                     ///< formats
@@ -47,41 +53,72 @@ template <int dim>
 struct Frame {
   double t = 0;
   Points<dim> x, v;
-  Eigen::VectorXd tension;
+  Eigen::VectorXd tension;   ///< per link; NaN for a link in no arc
+  std::vector<int> moving;   ///< the nodes in an arc (all of them without fronts)
   double kinetic = 0, potential = 0, work = 0, drift = 0;
+  double w_shocks = 0, w_heaps = 0, w_remesh = 0;
   double max_violation = 0;
+};
+
+/// One accepted step (or crossing, or the stop) of a run that records its steps.
+struct StepSample {
+  double t = 0;
+  std::vector<double> s0, s0_dot;  ///< per front (m, m/s)
+  std::vector<double> position;    ///< per front, its point x0 (dim components, m)
+  double kinetic = 0, potential = 0, w_applied = 0, w_shocks = 0, w_heaps = 0, w_remesh = 0;
+  double energy_residual = 0;      ///< K + V − K0 − V0 − W_applied − W_shocks − W_heaps − W_remesh (J)
+  double momentum_residual = 0;    ///< |p − p0 − impulse| (N s); 0 without a momentum ledger
+  std::vector<double> support;     ///< force of all supports on the system (N), dim components
+  double moving_mass = 0, heap_mass = 0, max_violation = 0;
+  int moving_nodes = 0;
 };
 
 /// What a run did.
 struct RunSummary {
-  std::string status = "not run";  ///< "completed" or "failed"
+  std::string status = "not run";  ///< "completed" (t_end), "stopped" (a stop event) or "failed"
   std::string error;               ///< the failure's message
-  double t_end = 0;                ///< time reached (s)
+  std::string stop_reason;         ///< "t_end" when completed
+  double t_end = 0;                ///< the end time asked for (s)
+  double t_stop = 0;               ///< the time reached (s)
   double wall_s = 0;               ///< wall-clock time of the integration (s)
-  double energy_drift = 0;         ///< max over frames of |K + V − (K0 + V0) − W_applied| (J)
-  double final_energy_drift = 0;   ///< the signed drift at the last frame (J)
-  double energy_scale = 0;         ///< max over frames of K + |V − V0| + |W_applied| (J)
+  double energy_drift = 0;         ///< max over frames and samples of |drift| (J), see the file comment
+  double final_energy_drift = 0;   ///< the signed drift at the last record (J)
+  double energy_scale = 0;         ///< max of K + |V − V0| + |W_applied| + |W_shocks| + |W_heaps| (J)
+  double max_momentum_residual = 0, momentum_scale = 0;  ///< with a momentum ledger (fronts)
   double max_constraint_violation = 0;  ///< max over accepted steps of | |Δx_j| − h_j | / h_j
   long tension_solves = 0;
+  long transfers = 0;              ///< nodes moved across fronts
   long frames = 0;
   std::string tension_backend;
-  std::string stop_reason;         ///< "t_end" when completed
   // What the model holds (observable proof that a scene pays only for what it declares):
   int dimension = 0;               ///< 2 or 3: the instantiation that ran
   int nodes = 0, links = 0;
   std::vector<std::string> effects;     ///< names of the force effects built (Force::name())
   std::vector<std::string> prescribed;  ///< prescribed nodes, e.g. "node 0: fixed"
   int root_functions = 0;          ///< event functions registered with the integrator (OdeSystem::num_events)
-  int tension_unknowns = 0;        ///< size of the tension system
-  int junction_unknowns = 0;       ///< tension_unknowns − links: unknowns junctions (shocks) add
+  int tension_unknowns = 0;        ///< size of the tension system at the start
+  int junction_unknowns = 0;       ///< unknowns beyond one per link: none (fronts enter as known loads)
   double stabilization_time = 0;   ///< Baumgarte time scale used (s)
   IntegratorStats stats;
+  std::vector<StepSample> samples;     ///< after every accepted step (StringSolverOptions::record_steps)
   /// energy_drift / energy_scale (0 if the scale is 0).
   double relative_energy_drift() const { return energy_scale > 0 ? energy_drift / energy_scale : 0.0; }
+  double relative_energy_residual() const { return relative_energy_drift(); }
+  double relative_momentum_residual() const {
+    return momentum_scale > 0 ? max_momentum_residual / momentum_scale : 0.0;
+  }
 };
 
-/// The summary as JSON: t_end, steps, rhs_evals, wall_s, energy_drift, max_constraint_violation, …
+/// The summary as JSON: status, stop_reason, t_end, t_stop, steps, rhs_evals, wall_s, energy_drift
+/// (J) and relative_energy_drift, energy_residual (relative, the same number) and momentum_residual
+/// (relative), max_constraint_violation, transfers, tension_solves, frames, samples, the model's
+/// description (dimension, nodes, links, effects, prescribed, root functions, tension unknowns,
+/// stabilization time, backend) and ARKODE's statistics.
 nlohmann::json to_json(const RunSummary& summary);
+/// The samples as a table (columns t, s0_k, s0dot_k, front_k_x.., K, V, W_applied, W_shocks, W_heaps,
+/// W_remesh, energy_residual, momentum_residual, support_x.., moving_mass, heap_mass, max_violation,
+/// moving_nodes).
+CsvTable samples_table(const RunSummary& run);
 
 template <int dim>
 class StringSolver {
@@ -92,8 +129,9 @@ class StringSolver {
   std::function<void(double, const Eigen::VectorXd&)> on_step;
 
   /// Projects the initial state onto the constraints (StringModel::make_consistent) and integrates
-  /// from t = 0 to t_end. Throws NumericalError on failure (slack, singular system, ARKODE failure);
-  /// frames() and summary() then hold what was done up to the failure.
+  /// from t = 0 to t_end or to a stop event. Throws NumericalError on failure (slack, singular
+  /// system, ARKODE failure, a front crossing that cannot be completed); frames() and summary() then
+  /// hold what was done up to the failure.
   const RunSummary& run();
 
   const std::vector<Frame<dim>>& frames() const { return frames_; }
@@ -103,11 +141,14 @@ class StringSolver {
 
   /// Writes the selected output files (see the file comment) into `dir` (created if needed). Outputs
   /// of an earlier run in `dir` are removed first, so the directory never mixes two runs; stats.json
-  /// is written last.
-  void write_outputs(const std::filesystem::path& dir, const OutputSelection& select = {}) const;
+  /// (`summary`, or to_json(summary()) when null) is written last.
+  void write_outputs(const std::filesystem::path& dir, const OutputSelection& select = {},
+                     const nlohmann::json* summary = nullptr) const;
 
  private:
-  void record(double t, const Eigen::VectorXd& y);
+  void record_frame(double t, const Eigen::VectorXd& y);
+  void record_sample(double t, const Eigen::VectorXd& y);
+  void book(double t, const typename StringModel<dim>::Snapshot& snap);
   void describe_model();
 
   StringModel<dim>& model_;
@@ -115,7 +156,12 @@ class StringSolver {
   std::vector<Frame<dim>> frames_;
   RunSummary summary_;
   Eigen::VectorXd final_state_;
+  bool have_start_ = false;
   double e0_ = 0, v0_ = 0;
+  Vec<dim> p0_ = Vec<dim>::Zero();
 };
+
+/// Every file write_outputs() may write (to clear a directory before a run of any model).
+const std::vector<std::string>& run_output_files();
 
 }  // namespace chainsim

@@ -14,7 +14,6 @@
 #endif
 
 #include "mesh/errors.hpp"
-#include "junction.hpp"
 
 namespace chainsim {
 
@@ -59,7 +58,7 @@ class TridiagonalBackend final : public TensionBackend {
     }
     if (covered != n || pattern.nnz() != expected)
       throw InputError(
-          "the tridiagonal tension backend solves arcs only; this system has junction rows coupling arcs: "
+          "the tridiagonal tension backend solves arcs only; this system has entries coupling arcs: "
           "use backend = \"klu\" or \"eigen\"");
     const int max_links = arcs.empty() ? 0 : std::max_element(arcs.begin(), arcs.end(), [](auto& a, auto& b) {
                                                return a.num_links < b.num_links;
@@ -284,25 +283,17 @@ std::unique_ptr<TensionBackend> make_tension_backend(const std::string& name) {
   throw InputError(fmt::format("backend = \"{}\" is not a tension solver: allowed auto, {}", name, list));
 }
 
-int TensionPatternBuilder::link_unknown(int arc, int link) const {
-  CHAINSIM_VERIFY(arc >= 0 && arc < static_cast<int>(arcs_.size()), "arc index out of range");
-  const ArcBlock& a = arcs_[static_cast<std::size_t>(arc)];
-  CHAINSIM_VERIFY(link >= 0 && link < a.num_links, "link index out of range");
-  return a.first_unknown + link;
-}
-
 TensionSystem::TensionSystem(const std::vector<int>& arc_links, const std::vector<bool>& arc_closed,
-                             std::vector<Junction*> junctions, const std::string& backend)
-    : junctions_(std::move(junctions)) {
+                             const std::string& backend) {
   CHAINSIM_VERIFY(arc_links.size() == arc_closed.size() && !arc_links.empty(), "one closed flag per arc");
-  // 1. Unknowns: arcs first (contiguous link blocks), then the junctions' own unknowns.
+  // 1. Unknowns: one contiguous block of link tensions per arc.
   int n = 0;
   for (std::size_t k = 0; k < arc_links.size(); ++k) {
     CHAINSIM_VERIFY(arc_links[k] >= 1 && (!arc_closed[k] || arc_links[k] >= 3), "arc too short");
     arcs_.push_back(ArcBlock{n, arc_links[k], arc_closed[k]});
     n += arc_links[k];
   }
-  // 2. Pattern: tridiagonal (cyclic) blocks plus junction entries.
+  // 2. Pattern: tridiagonal (cyclic) blocks.
   std::vector<std::pair<int, int>> entries;
   for (const ArcBlock& arc : arcs_) {
     const int f = arc.first_unknown, m = arc.num_links;
@@ -318,21 +309,6 @@ TensionSystem::TensionSystem(const std::vector<int>& arc_links, const std::vecto
       entries.emplace_back(f + m - 1, f);
     }
   }
-  for (Junction* junction : junctions_) {
-    CHAINSIM_VERIFY(junction != nullptr, "null junction");
-    TensionPatternBuilder builder(arcs_, n);
-    junction->declare_entries(builder);
-    junction_offset_.push_back(n);
-    n += junction->num_unknowns();
-    for (auto [r, c] : builder.extra_) {
-      CHAINSIM_VERIFY(r >= 0 && c >= 0, "junction entry out of range");
-      entries.emplace_back(r, c);
-    }
-    // Every junction unknown needs its diagonal slot (possibly zero) so the pattern is square-complete.
-    for (int k = 0; k < junction->num_unknowns(); ++k)
-      entries.emplace_back(junction_offset_.back() + k, junction_offset_.back() + k);
-  }
-  for (auto [r, c] : entries) CHAINSIM_VERIFY(r < n && c < n, "junction entry beyond the unknowns");
   std::sort(entries.begin(), entries.end(), [](auto& a, auto& b) {
     return a.second != b.second ? a.second < b.second : a.first < b.first;
   });
@@ -362,16 +338,9 @@ TensionSystem::TensionSystem(const std::vector<int>& arc_links, const std::vecto
       prev_slot_of_next_[f + i] = pattern_.find(next, f + i);
     }
   }
-  for (Junction* junction : junctions_) junction->bind(*this);
 
   // 4. Backend: symbolic analysis once.
-  backend_name_ = backend;
-  if (backend == "auto") {
-    backend_name_ = junctions_.empty() ? "tridiagonal" : "klu";
-#ifndef CHAINSIM_WITH_KLU
-    if (backend_name_ == "klu") backend_name_ = "eigen";
-#endif
-  }
+  backend_name_ = backend == "auto" ? "tridiagonal" : backend;
   backend_ = make_tension_backend(backend_name_);
   backend_->analyze(pattern_, arcs_);
 }
@@ -387,10 +356,6 @@ int TensionSystem::slot(int row, int col) const {
   const int s = pattern_.find(row, col);
   CHAINSIM_VERIFY(s >= 0, fmt::format("entry ({}, {}) was not declared in the tension pattern", row, col));
   return s;
-}
-
-void TensionSystem::add_junction_rows(double t) {
-  for (Junction* junction : junctions_) junction->add_rows(t, *this);
 }
 
 const Eigen::VectorXd& TensionSystem::solve(double t) {
@@ -411,7 +376,6 @@ const Eigen::VectorXd& TensionSystem::solve(double t) {
                                      describe(bad)),
                          t);
   }
-  for (Junction* junction : junctions_) junction->read_solution(*this);
   return solution_;
 }
 
@@ -420,11 +384,6 @@ std::string TensionSystem::describe(int unknown) const {
     const ArcBlock& a = arcs_[k];
     if (unknown >= a.first_unknown && unknown < a.first_unknown + a.num_links)
       return fmt::format("link {} of arc {}", unknown - a.first_unknown, k);
-  }
-  for (std::size_t k = 0; k < junctions_.size(); ++k) {
-    const int off = junction_offset_[k];
-    if (unknown >= off && unknown < off + junctions_[k]->num_unknowns())
-      return fmt::format("unknown {} of junction '{}'", unknown - off, junctions_[k]->name());
   }
   return fmt::format("unknown {}", unknown);
 }

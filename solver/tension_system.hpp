@@ -1,10 +1,10 @@
 #pragma once
 /// @file tension_system.hpp
-/// The discrete tension equation: one sparse linear system per right-hand side (DESIGN.md §1, §3).
+/// The discrete tension equation: one sparse linear system per right-hand side (docs/string_solver.md).
 ///
-/// Unknowns. Every arc owns a contiguous block of link tensions T_j (N), in link order; junctions
-/// (solver/junction.hpp: internal shocks, table contact, reservoirs, later) append their own unknowns
-/// after all arc blocks and may add entries that couple several arcs.
+/// Unknowns. Every arc of the string (string_model.hpp) owns a contiguous block of link tensions
+/// T_j (N), in link order. Arcs are not coupled through the matrix: at a front, the jump conditions
+/// give the end tensions explicitly (shocks/front_tracker.hpp), and they enter as known loads.
 ///
 /// Rows. Differentiating the link constraint |x_{j+1} − x_j|² = h_j² twice in time and substituting
 /// the momentum balance m_i a_i = F_i + T_i e_i − T_{i−1} e_{i−1} gives, per link j (nodes a = j,
@@ -20,13 +20,13 @@
 /// the links can move, so no pivoting is needed on an arc.
 ///
 /// Assembly. The pattern (compressed sparse columns) is built once in the constructor; each call
-/// writes values into it (zero(), add_diagonal(), set_coupling(), junction entries) and solve()
+/// writes values into it (zero(), add_diagonal(), set_coupling()) and solve()
 /// refactors numerically through a TensionBackend:
-///   - "tridiagonal": Thomas' algorithm per arc, Sherman–Morrison for a closed (cyclic) arc; arcs only,
+///   - "tridiagonal": Thomas' algorithm per arc, Sherman–Morrison for a closed (cyclic) arc,
 ///   - "klu":         SuiteSparse KLU, klu_analyze once, klu_factor then klu_refactor each call,
 ///   - "eigen":       Eigen's SparseLU, analyzePattern once, factorize each call (the fallback when
 ///                    chainsim is built with CHAINSIM_WITH_KLU=OFF),
-///   - "auto":        tridiagonal when no junction couples arcs, else klu (eigen without KLU).
+///   - "auto":        tridiagonal (the fastest for arcs: measured in docs/string_solver.md).
 #include <memory>
 #include <string>
 #include <vector>
@@ -34,8 +34,6 @@
 #include <Eigen/Core>
 
 namespace chainsim {
-
-class Junction;
 
 /// One arc's block of link unknowns.
 struct ArcBlock {
@@ -79,33 +77,13 @@ std::vector<std::string> tension_backend_names();
 /// A backend by name; throws InputError (listing the valid names) for an unknown one.
 std::unique_ptr<TensionBackend> make_tension_backend(const std::string& name);
 
-/// Collects the pattern: arcs' tridiagonal blocks plus what junctions declare.
-class TensionPatternBuilder {
- public:
-  TensionPatternBuilder(const std::vector<ArcBlock>& arcs, int first_junction_unknown)
-      : arcs_(arcs), next_unknown_(first_junction_unknown) {}
-  /// Unknown index of link `link` (0-based within the arc) of arc `arc`.
-  int link_unknown(int arc, int link) const;
-  /// First unknown owned by the junction being declared (valid inside Junction::declare_entries).
-  int first_own_unknown() const { return next_unknown_; }
-  /// Declares that entry (row, col) will receive values.
-  void add_entry(int row, int col) { extra_.emplace_back(row, col); }
-
- private:
-  friend class TensionSystem;
-  const std::vector<ArcBlock>& arcs_;
-  int next_unknown_;
-  std::vector<std::pair<int, int>> extra_;
-};
-
 /// The sparse tension system of one string model.
 class TensionSystem {
  public:
-  /// `arc_links[k]`, `arc_closed[k]` describe arc k (its links get consecutive unknowns); junctions
-  /// (may be empty; not owned, must outlive the system) add unknowns and entries. `backend`: see the
-  /// file comment. Throws InputError for an unknown backend or a tridiagonal backend with junctions.
+  /// `arc_links[k]`, `arc_closed[k]` describe arc k (its links get consecutive unknowns).
+  /// `backend`: see the file comment. Throws InputError for an unknown backend.
   TensionSystem(const std::vector<int>& arc_links, const std::vector<bool>& arc_closed,
-                std::vector<Junction*> junctions = {}, const std::string& backend = "auto");
+                const std::string& backend = "auto");
   ~TensionSystem();
   TensionSystem(const TensionSystem&) = delete;
   TensionSystem& operator=(const TensionSystem&) = delete;
@@ -128,15 +106,12 @@ class TensionSystem {
   }
   /// Right side b(u).
   double& rhs(int u) { return rhs_[u]; }
-  /// Position of entry (row, col) in the value array (junctions look their slots up once).
+  /// Position of entry (row, col) in the value array.
   int slot(int row, int col) const;
   /// Value at a slot found by slot().
   double& value(int slot) { return values_[static_cast<std::size_t>(slot)]; }
   const std::vector<double>& values() const { return values_; }
   const Eigen::VectorXd& rhs_vector() const { return rhs_; }
-
-  /// Lets every junction add its rows (call after the arcs' rows are assembled).
-  void add_junction_rows(double t);
 
   /// Factors and solves A T = b. Throws NumericalError naming the link (or junction unknown), the
   /// pivot and the time t when the matrix is singular, or when the solution is not finite.
@@ -146,13 +121,11 @@ class TensionSystem {
   /// Number of factor-and-solve calls so far.
   long num_solves() const { return solves_; }
 
-  /// "link 12 of arc 0" or "unknown 1 of junction 'shock'".
+  /// "link 12 of arc 0".
   std::string describe(int unknown) const;
 
  private:
   std::vector<ArcBlock> arcs_;
-  std::vector<Junction*> junctions_;
-  std::vector<int> junction_offset_;
   SparsePattern pattern_;
   std::vector<double> values_;
   std::vector<int> diag_slot_, next_slot_, prev_slot_of_next_;

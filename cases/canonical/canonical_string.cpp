@@ -65,7 +65,7 @@ StringCaseRun solve_string_case(const StringCaseSetup& setup) {
   std::vector<PrescribedNode<2>> prescribed;
   std::vector<HeapSpec<2>> heaps;
   std::optional<FoldSpec> fold;
-  FrontModelOptions options;
+  FrontOptions options;
   StringCaseRun out;
   const double t0 = setup.chain.t0();
   switch (setup.problem) {
@@ -127,14 +127,23 @@ StringCaseRun solve_string_case(const StringCaseSetup& setup) {
       break;
     }
   }
-  options.stabilization_time = 0.02 * t0;
-  FrontModel<2> model(std::move(chain), std::move(forces), std::move(prescribed), std::move(heaps), fold, options);
-  FrontRunOptions run_options;
+  StringModelOptions string_options;
+  string_options.stabilization_time = 0.02 * t0;
+  StringModel<2> model = make_front_model<2>(std::move(chain), std::move(forces), std::move(prescribed),
+                                             std::move(heaps), fold, options, string_options);
+  StringSolverOptions run_options;
   run_options.integrator = setup.integrator;
   run_options.t_end = setup.t_max_over_t0 * t0;
-  out.run = run_fronts(model, run_options);
+  run_options.output_interval = run_options.t_end;  // the samples after every step are what is compared
+  run_options.record_steps = true;
+  StringSolver<2> solver(model, run_options);
+  try {
+    solver.run();
+  } catch (const NumericalError&) {  // the run's status says "failed" and why
+  }
+  out.run = solver.summary();
   // η, dη/dt and P per sample.
-  for (const FrontSample& s : out.run.samples) {
+  for (const StepSample& s : out.run.samples) {
     const double s0 = s.s0[0], sd = s.s0_dot[0];
     double eta = s0 / ell, eta_dot = sd / ell;
     if (setup.problem == Problem::kSliding) {

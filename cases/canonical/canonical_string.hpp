@@ -1,6 +1,7 @@
 #pragma once
 /// @file canonical_string.hpp
-/// The paper's three chain problems solved with the string solver (shocks/front_model.hpp), in the
+/// The paper's three chain problems solved with the string solver and its front tracking
+/// (shocks/front_tracker.hpp), in the
 /// paper's geometry (2D, x horizontal, y up, g = −g e_y) or in a general variant:
 ///
 ///   falling  the part above the table (material s ∈ [0, y], free end at s = 0 on top) ends on the
@@ -22,7 +23,8 @@
 #include <nlohmann/json.hpp>
 
 #include "cases/reduced/reduced_models.hpp"
-#include "shocks/front_solver.hpp"
+#include "shocks/front_tracker.hpp"
+#include "solver/string_solver.hpp"
 
 namespace chainsim {
 
@@ -43,9 +45,9 @@ struct StringCaseSetup {
   void validate() const;
 };
 
-/// A string-solver run of a canonical problem: the FrontRun plus η, η' = dη/dξ and P/P0 per sample.
+/// A string-solver run of a canonical problem: the run plus η, η' = dη/dξ and P/P0 per sample.
 struct StringCaseRun {
-  FrontRun run;
+  RunSummary run;
   std::vector<double> t, eta, eta_dot, P;  ///< t (s), η, dη/dt (1/s), P (N)
   double t_offset = 0;  ///< time of the string's start on the reduced solution (sliding from η0 = 0)
   nlohmann::json summary;

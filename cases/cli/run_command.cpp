@@ -1,6 +1,6 @@
 // `chainsim run SCENE [--out DIR] [--t-end T] [--json]`: runs a scene on the model it asks for:
 //   - no heap and no fold: the string solver (StringModel; no fronts, no root functions);
-//   - a heap or a fold:    the string solver with front tracking (FrontModel, cases/scene/front_scene.hpp);
+//   - a heap or a fold:    the same string solver with front tracking (cases/scene/front_scene.hpp);
 //   - model = "reduced":   the reduced ODE of the canonical problem the scene is (cases/scene/reduced_scene.hpp).
 //
 // Sample runs:
@@ -24,6 +24,7 @@
 
 #include <cmath>
 #include <filesystem>
+#include <optional>
 #include <ostream>
 
 #include <fmt/format.h>
@@ -45,14 +46,14 @@ std::string join_words(const std::vector<std::string>& words) {
   return out;
 }
 
-std::string output_files(const OutputSelection& o, bool fronts = false) {
+std::string output_files(const OutputSelection& o, bool fronts) {
   std::string files;
   auto add = [&](bool on, const char* name) {
     if (on) files += std::string(files.empty() ? "" : " ") + name;
   };
   add(o.csv && o.nodes, "nodes.csv");
-  add(o.csv && o.tension && !fronts, "tension.csv");
-  add(o.csv && o.energy, fronts ? "series.csv" : "energy.csv");
+  add(o.csv && o.tension, "tension.csv");
+  add(o.csv && o.energy, fronts ? "energy.csv series.csv" : "energy.csv");
   add(o.vtk && o.nodes, "string.pvd frames/");
   add(o.stats, "stats.json");
   return files.empty() ? "(none)" : files;
@@ -61,8 +62,7 @@ std::string output_files(const OutputSelection& o, bool fronts = false) {
 /// Removes every file a run of any model writes, so that a directory never mixes two runs.
 void clear_outputs(const std::filesystem::path& dir) {
   std::error_code ec;
-  for (const char* name : {"stats.json", "nodes.csv", "tension.csv", "energy.csv", "series.csv", "string.pvd"})
-    std::filesystem::remove(dir / name, ec);
+  for (const std::string& name : run_output_files()) std::filesystem::remove(dir / name, ec);
   std::filesystem::remove_all(dir / "frames", ec);
 }
 
@@ -72,105 +72,100 @@ void print_json(std::ostream& out, nlohmann::json j, const SceneSpec& spec, cons
   out << j.dump() << '\n';
 }
 
+/// A string scene, with or without fronts, built and ready to run.
 template <int dim>
-int run_string_scene(const SceneSpec& spec, const std::filesystem::path& dir, bool json, std::ostream& out) {
-  // 2.-3. Model, checked; the output directory, before integrating.
-  StringScene<dim> scene = build_string_scene<dim>(spec);
-  ensure_writable_directory(dir);
-  StringSolver<dim> solver(*scene.model, scene.solver);
-  auto summary_json = [&] {
-    nlohmann::json j = to_json(solver.summary());
-    j["model"] = "string";
-    j["fronts"] = nlohmann::json::array();  // none built: no front unknowns, no root functions
-    j["num_fronts"] = 0;
-    return j;
-  };
-  // 4.-5. Integrate and write.
-  try {
-    solver.run();
-  } catch (const NumericalError& e) {
-    clear_outputs(dir);
-    solver.write_outputs(dir, scene.output);
-    if (json) {
-      nlohmann::json j = summary_json();
-      j["exit_code"] = 3;
-      print_json(out, j, spec, dir);
-    }
-    throw;
+struct Built {
+  std::unique_ptr<StringModel<dim>> model;
+  StringSolverOptions solver;
+  OutputSelection output;
+  nlohmann::json description;  ///< with fronts: front_scene's description (fronts, stop events)
+  std::optional<FrontScene<dim>> fronts;
+};
+
+template <int dim>
+Built<dim> build(const SceneSpec& spec) {
+  Built<dim> b;
+  if (spec.has_fronts()) {
+    FrontScene<dim> scene = build_front_scene<dim>(spec);
+    b.model = std::move(scene.model);
+    b.solver = scene.solver;
+    b.output = scene.output;
+    b.description = scene.description;
+    b.fronts = std::move(scene);
+  } else {
+    StringScene<dim> scene = build_string_scene<dim>(spec);
+    b.model = std::move(scene.model);
+    b.solver = scene.solver;
+    b.output = scene.output;
   }
-  clear_outputs(dir);
-  solver.write_outputs(dir, scene.output);
-  // 6. Summary.
-  const RunSummary& s = solver.summary();
-  if (json) {
-    print_json(out, summary_json(), spec, dir);
-    return 0;
-  }
-  out << fmt::format("scene      {} ({}D, {} nodes, {})\n", spec.source, s.dimension, s.nodes,
-                     scene.model->chain().closed() ? "closed" : "open");
-  out << fmt::format("effects    {}; {}{} root functions, {} junction unknowns\n",
-                     s.effects.empty() ? "none" : join_words(s.effects),
-                     s.prescribed.empty() ? "" : "prescribed " + join_words(s.prescribed) + "; ", s.root_functions,
-                     s.junction_unknowns);
-  out << fmt::format("method     {} (order {}), rtol {:g}, atol {:g}, tension backend {}\n", s.stats.method,
-                     s.stats.order, scene.solver.integrator.rtol, scene.solver.integrator.atol, s.tension_backend);
-  out << fmt::format("run        t_end = {:g} s in {:.3f} s wall: {} steps, {} rhs evaluations, {} tension solves\n",
-                     s.t_end, s.wall_s, s.stats.steps, s.stats.rhs_evals, s.tension_solves);
-  out << fmt::format("ledger     energy drift {:.3e} J (max over frames; energy scale {:.3e} J)\n", s.energy_drift,
-                     s.energy_scale);
-  out << fmt::format("links      max | |dx| - h | / h = {:.3e} (stabilization time {:g} s)\n",
-                     s.max_constraint_violation, s.stabilization_time);
-  out << fmt::format("outputs    {}: {}\n", dir.string(), output_files(scene.output));
-  return 0;
+  return b;
 }
 
 template <int dim>
-int run_front_scene(const SceneSpec& spec, const std::filesystem::path& dir, bool json, std::ostream& out) {
+int run_string_scene(const SceneSpec& spec, const std::filesystem::path& dir, bool json, std::ostream& out) {
   // 2.-3. Model, checked; the output directory, before integrating.
-  FrontScene<dim> scene = build_front_scene<dim>(spec);
+  Built<dim> scene = build<dim>(spec);
   ensure_writable_directory(dir);
-  // 4.-5. Integrate (a numerical failure ends the run with status "failed"), write, summary last.
-  const FrontRun run = run_fronts(*scene.model, scene.run);
-  const nlohmann::json summary = front_summary(scene, run);
-  clear_outputs(dir);
-  write_front_outputs(dir, scene, run, summary);
-  const bool failed = run.status == "failed";
-  // 6. Summary.
-  if (json) {
-    nlohmann::json j = summary;
-    if (failed) j["exit_code"] = 3;
-    print_json(out, j, spec, dir);
-  } else {
-    const nlohmann::json& d = scene.description;
-    std::vector<std::string> fronts;
-    for (const nlohmann::json& f : d["fronts"]) {
-      std::string where;
-      if (f.contains("on_plane")) where = f["on_plane"].get<bool>() ? ", on a plane" : ", pinned";
-      fronts.push_back(fmt::format("{} (f = {:g}, s0 = {:g} m{})", f["name"].get<std::string>(), f["f"].get<double>(),
-                                   f["s0"].get<double>(), where));
-    }
-    const int stops = static_cast<int>(d["stop_events"].size());
-    std::vector<std::string> effects = d["effects"].get<std::vector<std::string>>();
-    const auto prescribed = d["prescribed"].get<std::vector<std::string>>();
-    out << fmt::format("scene      {} ({}D, {} nodes, open)\n", spec.source, dim, d["nodes"].get<int>());
-    out << fmt::format("fronts     {}; {} root functions (2 per front + {} stop event{})\n", join_words(fronts),
-                       d["root_functions"].get<int>(), stops, stops == 1 ? "" : "s");
-    out << fmt::format("effects    {}{}\n", effects.empty() ? "none" : join_words(effects),
-                       prescribed.empty() ? "" : "; prescribed " + join_words(prescribed));
-    out << fmt::format("method     {} (order {}), rtol {:g}, atol {:g}\n", run.stats.method, run.stats.order,
-                       scene.run.integrator.rtol, scene.run.integrator.atol);
-    out << fmt::format("run        {} at t = {:.6g} s (t_end = {:g} s) in {:.3f} s wall: {} steps, {} rhs "
-                       "evaluations, {} crossings\n",
-                       run.status, run.t_stop, scene.run.t_end, run.wall_s, run.stats.steps, run.stats.rhs_evals,
-                       run.transfers);
-    out << fmt::format("stop       {}\n", failed ? run.error : summary["stop_reason"].get<std::string>());
-    out << fmt::format("ledger     energy residual {:.3e}, momentum residual {:.3e} (relative)\n",
-                       run.relative_energy_residual(), run.relative_momentum_residual());
-    out << fmt::format("links      max | |dx| - h | / h = {:.3e} (stabilization time {:g} s)\n", run.max_violation,
-                       d["stabilization_time"].get<double>());
-    out << fmt::format("outputs    {}: {}\n", dir.string(), output_files(scene.output, true));
+  StringSolver<dim> solver(*scene.model, scene.solver);
+  const bool fronts = scene.fronts.has_value();
+  auto summary_json = [&] {
+    if (fronts) return front_summary(*scene.fronts, solver.summary());
+    nlohmann::json j = to_json(solver.summary());
+    j["model"] = "string";
+    j["fronts"] = nlohmann::json::array();  // none built: no fronts, no root functions
+    j["num_fronts"] = 0;
+    return j;
+  };
+  // 4.-5. Integrate (a numerical failure still writes what was done), write, summary last.
+  std::optional<NumericalError> failure;
+  try {
+    solver.run();
+  } catch (const NumericalError& e) {
+    failure = e;
   }
-  if (failed) throw NumericalError(fmt::format("the string solver with fronts failed: {}", run.error), run.t_stop);
+  nlohmann::json summary = summary_json();
+  clear_outputs(dir);
+  solver.write_outputs(dir, scene.output, &summary);
+  if (failure && json) summary["exit_code"] = 3;
+  // 6. Summary.
+  const RunSummary& s = solver.summary();
+  if (json) {
+    print_json(out, summary, spec, dir);
+  } else if (!failure) {  // a failure is reported by its message (outputs written up to it)
+    out << fmt::format("scene      {} ({}D, {} nodes, {})\n", spec.source, s.dimension, s.nodes,
+                       scene.model->chain().closed() ? "closed" : "open");
+    if (fronts) {
+      std::vector<std::string> names;
+      for (const nlohmann::json& f : scene.description["fronts"]) {
+        std::string where;
+        if (f.contains("on_plane")) where = f["on_plane"].get<bool>() ? ", on a plane" : ", pinned";
+        names.push_back(fmt::format("{} (f = {:g}, s0 = {:g} m{})", f["name"].get<std::string>(),
+                                    f["f"].get<double>(), f["s0"].get<double>(), where));
+      }
+      const int stops = static_cast<int>(scene.description["stop_events"].size());
+      out << fmt::format("fronts     {}; {} root functions (2 per front + {} stop event{})\n", join_words(names),
+                         s.root_functions, stops, stops == 1 ? "" : "s");
+    }
+    out << fmt::format("effects    {}; {}{} root functions, {} junction unknowns\n",
+                       s.effects.empty() ? "none" : join_words(s.effects),
+                       s.prescribed.empty() ? "" : "prescribed " + join_words(s.prescribed) + "; ", s.root_functions,
+                       s.junction_unknowns);
+    out << fmt::format("method     {} (order {}), rtol {:g}, atol {:g}, tension backend {}\n", s.stats.method,
+                       s.stats.order, scene.solver.integrator.rtol, scene.solver.integrator.atol, s.tension_backend);
+    out << fmt::format("run        {} at t = {:.6g} s (t_end = {:g} s) in {:.3f} s wall: {} steps, {} rhs "
+                       "evaluations, {} tension solves{}\n",
+                       s.status, s.t_stop, s.t_end, s.wall_s, s.stats.steps, s.stats.rhs_evals, s.tension_solves,
+                       fronts ? fmt::format(", {} crossings", s.transfers) : "");
+    if (s.status != "completed") out << fmt::format("stop       {}\n", summary["stop_reason"].get<std::string>());
+    out << fmt::format("ledger     energy drift {:.3e} J (max over frames{}; energy scale {:.3e} J){}\n",
+                       s.energy_drift, fronts ? " and steps" : "", s.energy_scale,
+                       fronts ? fmt::format(", momentum residual {:.3e} (relative)", s.relative_momentum_residual())
+                              : "");
+    out << fmt::format("links      max | |dx| - h | / h = {:.3e} (stabilization time {:g} s)\n",
+                       s.max_constraint_violation, s.stabilization_time);
+    out << fmt::format("outputs    {}: {}\n", dir.string(), output_files(scene.output, fronts));
+  }
+  if (failure) throw *failure;
   return 0;
 }
 
@@ -213,7 +208,6 @@ int run_reduced_scene(const SceneSpec& spec, const std::filesystem::path& dir, b
 template <int dim>
 int run_scene(const SceneSpec& spec, const std::filesystem::path& dir, bool json, std::ostream& out) {
   if (spec.model == "reduced") return run_reduced_scene(spec, dir, json, out);
-  if (spec.has_fronts()) return run_front_scene<dim>(spec, dir, json, out);
   return run_string_scene<dim>(spec, dir, json, out);
 }
 
@@ -221,10 +215,8 @@ template <int dim>
 void check_in(const SceneSpec& spec) {
   if (spec.model == "reduced")
     match_canonical_problem(spec);
-  else if (spec.has_fronts())
-    build_front_scene<dim>(spec);
   else
-    build_string_scene<dim>(spec);
+    build<dim>(spec);
 }
 
 }  // namespace

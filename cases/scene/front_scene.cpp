@@ -1,4 +1,4 @@
-// Scenes with shocks: SceneSpec -> FrontModel, the run's summary and its outputs (front_scene.hpp).
+// Scenes with shocks: SceneSpec -> the string with front tracking, the run's summary and its outputs (front_scene.hpp).
 //
 // Steps of build_front_scene: 1. the string, as for any scene (scene_build.hpp); 2. what a string
 // with fronts cannot have (a closed string, ends inside heaps, keys for scenes without fronts);
@@ -17,7 +17,6 @@
 #include "mesh/errors.hpp"
 #include "solver/output.hpp"
 #include "solver/string_solver.hpp"
-#include "solver/vtk_output.hpp"
 
 namespace chainsim {
 
@@ -29,7 +28,7 @@ using scene_build::text_of;
 namespace {
 
 /// A heap point, a fold or a stop event closer than this (relative to ℓ) to where it should be is
-/// there (FrontModel checks the fronts' initial positions to 1e-6 ℓ as well).
+/// there (the front tracker checks the fronts' initial positions to 1e-6 ℓ as well).
 constexpr double kPlaceTolerance = 1e-6;
 /// A fold's arms must be antiparallel to this angle (rad).
 constexpr double kFoldAngleTolerance = 1e-6;
@@ -50,7 +49,7 @@ nlohmann::json to_array(const Vec<dim>& v) {
   return a;
 }
 
-/// "front 2 reached s0 = …" (FrontModel's wording) -> "the heap_end front reached s0 = …".
+/// "front 2 reached s0 = …" (the front tracker's wording) -> "the heap_end front reached s0 = …".
 std::string name_fronts(const std::string& reason, const std::vector<std::string>& names) {
   const std::string prefix = "front ";
   if (reason.rfind(prefix, 0) != 0) return reason;
@@ -89,18 +88,6 @@ FrontScene<dim> build_front_scene(const SceneSpec& spec) {
                           "end held by a heap cannot be fixed, loaded or driven",
                           heap.side, end.kind, k, heap.side, heap.s0));
   }
-  if (spec.solver.backend != "auto")
-    fail_at(spec, "solver.backend",
-            fmt::format("solver.backend = \"{}\" applies to scenes without fronts: a string with fronts solves one "
-                        "tridiagonal tension system per arc (allowed: auto)",
-                        spec.solver.backend));
-  if (spec.solver.check_slack)
-    fail_at(spec, "solver.check_slack",
-            "solver.check_slack = true applies to scenes without fronts: the front model has no slack check");
-  if (spec.output.select.tension && spec.locations.count("output.fields"))
-    fail_at(spec, "output.fields",
-            "output.fields lists \"tension\", which a run with fronts does not record; allowed with fronts: nodes, "
-            "energy, stats");
 
   // 3. Heaps: s0 inside the string, the shape through the heap point at s0, the point on its plane.
   double s_lo = 0, s_hi = ell;  // the moving part at t = 0
@@ -196,8 +183,7 @@ FrontScene<dim> build_front_scene(const SceneSpec& spec) {
   // 5. Stop events: a front reaching a material coordinate inside the string.
   const std::vector<std::string> names = scene_build::front_names(spec);
   const std::vector<int> stop_fronts = scene_build::front_stop_indices(spec);
-  FrontModelOptions options;
-  options.stabilization_time = parts.stabilization_time;
+  FrontOptions options;
   for (std::size_t k = 0; k < stop_fronts.size(); ++k) {
     const double s = spec.stop.fronts[k].s0;
     const std::string key = fmt::format("stop.front[{}].s0", k);
@@ -212,7 +198,7 @@ FrontScene<dim> build_front_scene(const SceneSpec& spec) {
     options.stop_at.push_back({stop_fronts[k], s});
   }
 
-  // 6. The model (FrontModel's own layout checks, located at the fronts) and the run options.
+  // 6. The model (the front tracker's own layout checks, located at the fronts) and the run options.
   FrontScene<dim> scene;
   scene.front_names = names;
   scene.characteristic_time = parts.characteristic_time;
@@ -225,19 +211,26 @@ FrontScene<dim> build_front_scene(const SceneSpec& spec) {
   for (const auto& force : parts.forces) d["effects"].push_back(force->name());
   d["prescribed"] = nlohmann::json::array();
   for (const auto& p : parts.prescribed) d["prescribed"].push_back(fmt::format("node {}: {}", p.node, p.path->description()));
+  StringModelOptions mo;
+  mo.stabilization_time = parts.stabilization_time;
+  mo.backend = spec.solver.backend;
+  mo.check_slack = spec.solver.check_slack;
+  mo.slack_tolerance = spec.solver.slack_tolerance;
   const std::string fit_key = fold && heaps.empty() ? "effects.fold.s0" : first_front;
   scene.model = at_key(spec, fit_key, [&] {
     try {
-      return std::make_unique<FrontModel<dim>>(std::move(parts.chain), std::move(parts.forces),
-                                               std::move(parts.prescribed), heaps, fold, options);
+      return std::make_unique<StringModel<dim>>(make_front_model<dim>(std::move(parts.chain), std::move(parts.forces),
+                                                                      std::move(parts.prescribed), heaps, fold,
+                                                                      options, mo));
     } catch (const RecoverableError& e) {  // a degenerate front geometry found while placing the fronts
       throw InputError(e.what());
     }
   });
+  const FrontTracker<dim>& tracker = *front_tracker(*scene.model);
   d["fronts"] = nlohmann::json::array();
   for (std::size_t k = 0; k < names.size(); ++k) {
-    const auto& front = scene.model->fronts()[k];
-    nlohmann::json f = {{"name", names[k]}, {"kind", front.kind == FrontModel<dim>::FrontKind::kFold ? "fold" : "heap"},
+    const auto& front = tracker.fronts()[k];
+    nlohmann::json f = {{"name", names[k]}, {"kind", front.kind == FrontTracker<dim>::FrontKind::kFold ? "fold" : "heap"},
                         {"f", front.dissipation}};
     if (names[k] == "fold") {
       f["s0"] = fold->s0;
@@ -258,27 +251,23 @@ FrontScene<dim> build_front_scene(const SceneSpec& spec) {
   d["stop_events"] = nlohmann::json::array();
   for (const auto& stop : options.stop_at)
     d["stop_events"].push_back({{"front", names[static_cast<std::size_t>(stop.front)]}, {"s0", stop.s}});
-  d["stabilization_time"] = options.stabilization_time;
+  d["stabilization_time"] = mo.stabilization_time;
 
   scene.output = spec.output.select;
-  scene.output.tension = false;  // not recorded with fronts (refused above when asked for explicitly)
-  scene.run.integrator = parts.integrator;
-  scene.run.t_end = spec.stop.t_end;
-  scene.run.record_nodes = scene.output.nodes;
-  scene.run.frame_interval = scene.output.nodes ? spec.output.interval : 0.0;
-  at_key(spec, "solver", [&] { scene.run.validate(); });
-  StringSolverOptions budget;
-  budget.t_end = spec.stop.t_end;
-  budget.output_interval = spec.output.interval;
-  at_key(spec, "output.interval", [&] { budget.check_frame_budget(scene.model->chain().num_nodes()); });
+  scene.solver.integrator = parts.integrator;
+  scene.solver.t_end = spec.stop.t_end;
+  scene.solver.output_interval = spec.output.interval;
+  scene.solver.record_steps = true;
+  at_key(spec, "solver", [&] { scene.solver.validate(); });
+  at_key(spec, "output.interval", [&] { scene.solver.check_frame_budget(scene.model->chain().num_nodes()); });
   return scene;
 }
 
 template <int dim>
-nlohmann::json front_summary(const FrontScene<dim>& scene, const FrontRun& run) {
+nlohmann::json front_summary(const FrontScene<dim>& scene, const RunSummary& run) {
   nlohmann::json j = to_json(run);
   j.update(scene.description);
-  j["t_end"] = scene.run.t_end;
+  j["t_end"] = scene.solver.t_end;
   j["stop_reason"] = name_fronts(run.stop_reason, scene.front_names);
   nlohmann::json final_s0 = nlohmann::json::object();
   if (!run.samples.empty())
@@ -288,59 +277,21 @@ nlohmann::json front_summary(const FrontScene<dim>& scene, const FrontRun& run) 
 }
 
 template <int dim>
-void write_front_outputs(const std::filesystem::path& dir, const FrontScene<dim>& scene, const FrontRun& run,
-                         const nlohmann::json& summary) {
-  const OutputSelection& select = scene.output;
-  ensure_directory(dir);
-  const Chain<dim>& chain = scene.model->chain();
-  // 1. CSV: the moving nodes at each frame, and the samples.
-  if (select.csv && select.nodes) {
-    const char* axes[] = {"x", "y", "z"};
-    std::vector<std::string> columns = {"t", "node", "s"};
-    for (int d = 0; d < dim; ++d) columns.emplace_back(axes[d]);
-    CsvTable nodes(columns);
-    for (std::size_t k = 0; k < run.frames.size(); ++k)
-      for (int i : run.frame_moving[k]) {
-        std::vector<double> row = {run.frame_times[k], static_cast<double>(i), chain.node_coordinate(i)};
-        for (int d = 0; d < dim; ++d) row.push_back(run.frames[k](d, i));
-        nodes.add_row(row);
-      }
-    nodes.write(dir / "nodes.csv");
+RunSummary run_front_scene(const SceneSpec& spec) {
+  FrontScene<dim> scene = build_front_scene<dim>(spec);
+  StringSolver<dim> solver(*scene.model, scene.solver);
+  try {
+    solver.run();
+  } catch (const NumericalError&) {  // the summary says "failed" and why
   }
-  if (select.csv && select.energy) samples_table(run).write(dir / "series.csv");
-  // 2. ParaView frames: the moving part as line cells, then their index.
-  if (select.vtk && select.nodes) {
-    ensure_directory(dir / "frames");
-    std::vector<std::pair<double, std::string>> index;
-    for (std::size_t k = 0; k < run.frames.size(); ++k) {
-      const std::vector<int>& moving = run.frame_moving[k];
-      VtkPolyline line;
-      line.points = Eigen::Matrix3Xd::Zero(3, static_cast<Eigen::Index>(moving.size()));
-      Eigen::MatrixXd s(1, static_cast<Eigen::Index>(moving.size()));
-      for (std::size_t q = 0; q < moving.size(); ++q) {
-        const auto col = static_cast<Eigen::Index>(q);
-        line.points.col(col).head(dim) = run.frames[k].col(moving[q]);
-        s(0, col) = chain.node_coordinate(moving[q]);
-        if (q > 0 && moving[q] == moving[q - 1] + 1) line.segments.emplace_back(static_cast<int>(q) - 1, static_cast<int>(q));
-      }
-      line.point_data = {{"s", s}};
-      const std::string name = fmt::format("frame_{:04d}.vtp", k);
-      write_vtp(dir / "frames" / name, line);
-      index.emplace_back(run.frame_times[k], "frames/" + name);
-    }
-    write_pvd(dir / "string.pvd", index);
-  }
-  // 3. The summary, last: its presence means the set is complete.
-  if (select.stats) write_json(dir / "stats.json", summary);
+  return solver.summary();
 }
 
 template FrontScene<2> build_front_scene<2>(const SceneSpec&);
 template FrontScene<3> build_front_scene<3>(const SceneSpec&);
-template nlohmann::json front_summary<2>(const FrontScene<2>&, const FrontRun&);
-template nlohmann::json front_summary<3>(const FrontScene<3>&, const FrontRun&);
-template void write_front_outputs<2>(const std::filesystem::path&, const FrontScene<2>&, const FrontRun&,
-                                     const nlohmann::json&);
-template void write_front_outputs<3>(const std::filesystem::path&, const FrontScene<3>&, const FrontRun&,
-                                     const nlohmann::json&);
+template nlohmann::json front_summary<2>(const FrontScene<2>&, const RunSummary&);
+template nlohmann::json front_summary<3>(const FrontScene<3>&, const RunSummary&);
+template RunSummary run_front_scene<2>(const SceneSpec&);
+template RunSummary run_front_scene<3>(const SceneSpec&);
 
 }  // namespace chainsim

@@ -1,7 +1,7 @@
 // chainsim_bench: cost of the string solver (not a test; not registered with CTest).
 //
 //   1. Tension solve, one factor-and-solve per call, for one open arc, one closed loop (cyclic), and
-//      8 arcs coupled by junction rows: tridiagonal (Thomas / Sherman–Morrison), KLU (klu_refactor),
+//      8 arcs (a string cut by fronts): tridiagonal (Thomas / Sherman–Morrison), KLU (klu_refactor),
 //      Eigen SparseLU. Median over repeats of the time per call, and the ratio to tridiagonal.
 //   2. Cost per step against the number of nodes: a swinging hanging chain integrated with ERK5 for
 //      a fixed number of steps; time per step and per right-hand side per node (flat = linear cost).
@@ -20,7 +20,6 @@
 
 #include "mesh/errors.hpp"
 #include "solver/integrator.hpp"
-#include "solver/junction.hpp"
 #include "solver/string_model.hpp"
 #include "solver/tension_system.hpp"
 
@@ -44,35 +43,6 @@ double time_per_call(const std::function<void()>& f, int calls, int repeats) {
   return median(samples);
 }
 
-/// Couples arc k's last link to arc k+1's first link through one extra unknown each (a junction row).
-class ChainJunction final : public Junction {
- public:
-  ChainJunction(int arc, int last_link) : arc_(arc), last_(last_link) {}
-  std::string name() const override { return "bench"; }
-  int num_unknowns() const override { return 1; }
-  void declare_entries(TensionPatternBuilder& b) override {
-    a_ = b.link_unknown(arc_, last_);
-    b_ = b.link_unknown(arc_ + 1, 0);
-    mu_ = b.first_own_unknown();
-    for (auto [r, c] : {std::pair{mu_, a_}, {mu_, b_}, {a_, mu_}, {b_, mu_}}) b.add_entry(r, c);
-  }
-  void bind(TensionSystem& s) override {
-    slots_ = {s.slot(mu_, a_), s.slot(mu_, b_), s.slot(a_, mu_), s.slot(b_, mu_), s.slot(mu_, mu_)};
-  }
-  void add_rows(double, TensionSystem& s) const override {
-    s.value(slots_[0]) += 0.5;
-    s.value(slots_[1]) += -0.5;
-    s.value(slots_[2]) += 0.5;
-    s.value(slots_[3]) += -0.5;
-    s.value(slots_[4]) += -2.0;
-    s.rhs(mu_) += 1.0;
-  }
-
- private:
-  int arc_, last_, a_ = 0, b_ = 0, mu_ = 0;
-  std::vector<int> slots_;
-};
-
 /// Values like a string's: diagonal −(w_a + w_b) with random masses, couplings w cosθ.
 void fill(TensionSystem& s, std::mt19937& rng) {
   std::uniform_real_distribution<double> u(0.5, 1.5), c(-1.0, 1.0);
@@ -84,7 +54,6 @@ void fill(TensionSystem& s, std::mt19937& rng) {
       if (i + 1 < arc.num_links || arc.closed) s.set_coupling(j, 0.9 * c(rng));
       s.rhs(j) = c(rng);
     }
-  s.add_junction_rows(0.0);
 }
 
 void bench_tension(bool quick) {
@@ -92,27 +61,17 @@ void bench_tension(bool quick) {
   std::printf("  %-12s %9s  %12s %12s %12s   %8s %8s\n", "system", "unknowns", "tridiagonal", "klu", "eigen",
               "klu/tri", "eig/tri");
   const std::vector<int> sizes = quick ? std::vector<int>{100, 1000, 10000} : std::vector<int>{100, 1000, 10000, 100000};
-  for (const char* kind : {"open arc", "closed loop", "8 arcs+junc"}) {
+  for (const char* kind : {"open arc", "closed loop", "8 arcs"}) {
     for (int n : sizes) {
       std::vector<double> us;
       for (const std::string backend : {"tridiagonal", "klu", "eigen"}) {
-        const bool coupled = std::strcmp(kind, "8 arcs+junc") == 0;
-        if (coupled && backend == "tridiagonal") {
-          us.push_back(NAN);
-          continue;
-        }
-        std::vector<std::unique_ptr<ChainJunction>> junctions;
-        std::vector<Junction*> raw;
+        const bool arcs = std::strcmp(kind, "8 arcs") == 0;
         std::vector<int> links;
         std::vector<bool> closed;
-        if (coupled) {
+        if (arcs) {
           for (int k = 0; k < 8; ++k) {
             links.push_back(n / 8);
             closed.push_back(false);
-          }
-          for (int k = 0; k < 7; ++k) {
-            junctions.push_back(std::make_unique<ChainJunction>(k, n / 8 - 1));
-            raw.push_back(junctions.back().get());
           }
         } else {
           links = {n};
@@ -120,7 +79,7 @@ void bench_tension(bool quick) {
         }
         std::unique_ptr<TensionSystem> s;
         try {
-          s = std::make_unique<TensionSystem>(links, closed, raw, backend);
+          s = std::make_unique<TensionSystem>(links, closed, backend);
         } catch (const InputError&) {
           us.push_back(NAN);  // backend not built
           continue;

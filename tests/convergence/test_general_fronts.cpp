@@ -107,7 +107,7 @@ TEST_CASE("a tilted falling chain slides its contact along the table as its thre
       REQUIRE(run.run.status == "stopped");
       const double t_stop_err = std::abs(run.run.t_stop - ref.back()[0]) / ref.back()[0];
       double err_s0 = 0, err_x = 0;
-      for (const FrontSample& sample : run.run.samples) {
+      for (const StepSample& sample : run.run.samples) {
         err_s0 = std::max(err_s0, std::abs(sample.s0[0] - at(ref, sample.t, 1)) / ell);
         err_x = std::max(err_x, std::abs(sample.position[0] - at(ref, sample.t, 2)) / ell);
         CHECK(std::abs(sample.position[1]) < 1e-12);  // the contact stays on the table
@@ -150,7 +150,7 @@ TEST_CASE("a curved falling chain with f = 1 falls freely and lays its heap wher
     INFO(run.run.error);
     REQUIRE(run.run.status == "stopped");
     double err = 0;
-    for (const FrontSample& sample : run.run.samples) {
+    for (const StepSample& sample : run.run.samples) {
       const double sigma = R * (std::asin(g * sample.t * sample.t / (2 * R) + std::sin(t_rad)) - t_rad);
       err = std::max(err, std::abs(sample.s0[0] - (ell - sigma)) / ell);
     }

@@ -1,5 +1,5 @@
 // A fold is a tight bight: the jump conditions allow a dissipative kink only where its two arms are
-// antiparallel (docs/shocks.md). FrontModel measures how far its arms are from that (the fold's
+// antiparallel (docs/shocks.md). the front tracker measures how far its arms are from that (the fold's
 // "opening") and stops the run, through an ARKODE root, when it passes kMaxFoldOpeningDeg; a fold
 // that starts wider is refused.
 #include <catch2/catch.hpp>
@@ -10,8 +10,7 @@
 #include "cases/scene/front_scene.hpp"
 #include "cases/scene/scene.hpp"
 #include "mesh/discretize.hpp"
-#include "shocks/front_model.hpp"
-#include "shocks/front_solver.hpp"
+#include "shocks/front_tracker.hpp"
 #include "mesh/errors.hpp"
 #include "test_scene_support.hpp"
 
@@ -23,14 +22,14 @@ const double kDeg = kPi / 180;
 
 /// A chain of 20 links folded at s0 = 0.2 m: arc A hangs straight down from the origin, arc B
 /// leaves the fold at `opening` from straight up (antiparallel = 0).
-FrontModel<2> folded(double opening) {
+StringModel<2> folded(double opening) {
   Points<2> vertices(2, 3);
   vertices << 0.0, 0.0, 0.8 * std::sin(opening), 0.0, -0.2, -0.2 + 0.8 * std::cos(opening);
   Chain<2> chain = discretize<2>(*polyline_curve<2>(vertices), 1.0, 1.0, 20, false);
   FoldSpec fold;
   fold.s0 = 0.2;
   fold.dissipation = 0.5;
-  return FrontModel<2>(std::move(chain), {}, {}, {}, fold, FrontModelOptions{});
+  return make_front_model<2>(std::move(chain), {}, {}, {}, fold, FrontOptions{});
 }
 
 }  // namespace
@@ -40,7 +39,7 @@ TEST_CASE("a fold's opening is the angle of its arms from antiparallel, and a fo
   // The nodes lie on the polyline, so the fold's end links are the two arms' directions: the
   // opening equals the angle built in (to round-off).
   for (const double degrees : {0.0, 5.0, 19.0}) {
-    FrontModel<2> model = folded(degrees * kDeg);
+    StringModel<2> model = folded(degrees * kDeg);
     const auto snap = model.snapshot(0.0, model.state_from_chain());
     REQUIRE(snap.fronts.size() == 1);
     CHECK(snap.fronts[0].opening / kDeg == Approx(degrees).margin(1e-9));
@@ -65,7 +64,7 @@ TEST_CASE("a fold whose arms swing apart stops the run when they are 20 degrees 
   const SceneSpec spec = parse_scene_text(text, "thrown_fold.toml");
   FrontScene<2> scene = build_front_scene<2>(spec);
   CHECK(scene.model->num_events() == 4);  // 2 crossings + the cutoff + the opening
-  const FrontRun run = run_fronts(*scene.model, scene.run);
+  const RunSummary run = test::run_front_spec(spec);
   CAPTURE(run.stop_reason, run.t_stop);
   CHECK(run.status == "stopped");
   CHECK(run.stop_reason.find("has opened: its arms leave it 20 degrees from antiparallel") != std::string::npos);

@@ -1,4 +1,4 @@
-// A heap front of FrontModel evaluated at single hand-built states (no time integration): its inflow
+// A heap front of the front tracker evaluated at single hand-built states (no time integration): its inflow
 // against a finite difference of the partial link's geometry, its reaction and powers against the
 // momentum and energy the string actually gains (from the model's accelerations), the paper's
 // external shock for a string moving along itself, and the reversal of the orientation of s.
@@ -8,7 +8,7 @@
 #include <memory>
 #include <vector>
 
-#include "shocks/front_model.hpp"
+#include "shocks/front_tracker.hpp"
 
 using namespace chainsim;
 
@@ -33,7 +33,7 @@ struct Setup {
     return std::max(sigma, 0.0) * kUp;
   }
   Vec<2> velocity(const Vec<2>& x) const { return V + omega * Vec<2>(-x.y(), x.x()); }
-  FrontModel<2> model() const {
+  StringModel<2> model() const {
     Chain<2> chain = Chain<2>::uniform(kLambda, kEll, kLinks, false);
     for (int i = 0; i <= kLinks; ++i) {
       chain.positions().col(i) = position(i);
@@ -45,7 +45,7 @@ struct Setup {
     heap.dissipation = kF;
     heap.s0 = end_side ? 0.6 : 0.4;
     if (on_plane) heap.plane_normal = Vec<2>(0.0, 1.0);
-    return FrontModel<2>(std::move(chain), {}, {}, {heap}, std::nullopt, FrontModelOptions{});
+    return make_front_model<2>(std::move(chain), {}, {}, {heap}, std::nullopt, FrontOptions{});
   }
   /// The arc's nodes: end node first, then its neighbour.
   int end_node() const { return end_side ? 1 : 3; }
@@ -80,7 +80,7 @@ TEST_CASE("heap front: the inflow is the rate of the partial link, the reaction 
       // with a velocity that is not along the string.
       if (!on_plane) setup.omega = 0.0;
       INFO("end_side " << end_side << ", on_plane " << on_plane);
-      FrontModel<2> model = setup.model();
+      StringModel<2> model = setup.model();
       const Eigen::VectorXd y = model.state_from_chain();
       const auto snap = model.snapshot(0.0, y);
       REQUIRE(snap.fronts.size() == 1);
@@ -131,11 +131,11 @@ TEST_CASE("heap front: a string moving along itself meets the paper's external s
       setup.omega = 0;
       setup.V = -1.7 * kUp;  // along itself, into the heap at 1.7 m/s
       INFO("end_side " << end_side << ", on_plane " << on_plane);
-      FrontModel<2> model = setup.model();
+      StringModel<2> model = setup.model();
       const auto front = model.snapshot(0.0, model.state_from_chain()).fronts[0];
       const double u = 1.7;
       CHECK(front.inflow == Approx(-u).epsilon(1e-12));
-      // Falling chain (DESIGN.md §2a): the table holds the string with f λ ẏ² back along it, the shock
+      // Falling chain (docs/model.md): the table holds the string with f λ ẏ² back along it, the shock
       // dissipates f λ |ẏ|³ and the heap's power is W*⁺ = −½ λ ẏ³ with ẏ = −u.
       CHECK((front.reaction - kF * kLambda * u * u * kUp).norm() < 1e-12);
       CHECK(front.power_shock == Approx(-kF * kLambda * u * u * u));

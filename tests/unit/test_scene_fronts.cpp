@@ -10,12 +10,14 @@
 
 #include <catch2/catch.hpp>
 #include <nlohmann/json.hpp>
+#include <fmt/format.h>
 
 #include "cases/canonical/canonical_string.hpp"
 #include "cases/reduced/exact_solutions.hpp"
 #include "cases/scene/reduced_scene.hpp"
 #include "cases/cli/run_command.hpp"
 #include "mesh/errors.hpp"
+#include "solver/tension_system.hpp"
 #include "test_scene_support.hpp"
 
 using namespace chainsim;
@@ -211,7 +213,7 @@ TEST_CASE("the canonical scenes on the string solver agree with chainsim compare
     if (c.problem != Problem::kSliding) CHECK_THAT(rs.eps, WithinAbs(c.eps, 1e-15));
 
     // The scene's run, and `chainsim compare` on the same problem built in C++ (same nodes, f, ε, η0).
-    const FrontRun run = test::run_front_spec(spec);
+    const RunSummary run = test::run_front_spec(spec);
     REQUIRE(run.status == "stopped");
     StringCaseSetup setup;
     setup.problem = c.problem;
@@ -227,7 +229,7 @@ TEST_CASE("the canonical scenes on the string solver agree with chainsim compare
 
     // η(t) at every sample against the quadrature's η(ξ).
     double worst = 0;
-    for (const FrontSample& s : run.samples) {
+    for (const StepSample& s : run.samples) {
       const double eta = c.problem == Problem::kSliding ? 1.0 - s.s0[0] : s.s0[0];
       const double xi = std::min(s.t / kT0, c.exact_t_stop);
       worst = std::max(worst, std::abs(eta - c.exact_eta(xi)));
@@ -319,11 +321,11 @@ TEST_CASE("a tilted falling chain with f = 1 falls freely while its contact slid
   // lowered line meets the table, x = sin θ (1 − L). Neither uses the front-tracking code.
   SceneSpec spec = parse_scene(scene_file("tilted_falling_chain"));
   spec.effects.heaps[0].dissipation = 1.0;
-  const FrontRun run = test::run_front_spec(spec);
+  const RunSummary run = test::run_front_spec(spec);
   REQUIRE(run.status == "stopped");
   const double theta = 25.0 * 3.14159265358979323846 / 180.0;
   double worst_s0 = 0, worst_x = 0;
-  for (const FrontSample& s : run.samples) {
+  for (const StepSample& s : run.samples) {
     const double L = 1.0 - kG * s.t * s.t / (2 * std::cos(theta));
     worst_s0 = std::max(worst_s0, std::abs(s.s0[0] - L));
     worst_x = std::max(worst_x, std::abs(s.position[0] - std::sin(theta) * (1 - L)));
@@ -348,11 +350,13 @@ TEST_CASE("chainsim run on a front scene writes its outputs, stats.json last, an
                           "fronts", "effects", "prescribed", "nodes", "dimension", "stabilization_time"})
     CHECK(j.contains(key));
   const auto out = dir / "out";
-  CHECK(first_line(out / "nodes.csv") == "t,node,s,x,y");
+  // One output writer for every string run: the moving nodes with their velocities, and the
+  // tensions of the arcs' links (the fields a plain string writes), plus series.csv.
+  CHECK(first_line(out / "nodes.csv") == "t,node,s,x,y,vx,vy");
   CHECK(first_line(out / "series.csv").rfind("t,s0_0,s0dot_0,", 0) == 0);
   CHECK(std::filesystem::exists(out / "string.pvd"));
   CHECK(std::filesystem::exists(out / "frames" / "frame_0000.vtp"));
-  CHECK_FALSE(std::filesystem::exists(out / "tension.csv"));
+  CHECK(first_line(out / "tension.csv") == "t,link,s_mid,T");
   CHECK(nlohmann::json::parse(read(out / "stats.json"))["stop_reason"] == j["stop_reason"]);
   for (const auto& entry : std::filesystem::recursive_directory_iterator(out))
     CHECK(entry.path().extension() != ".tmp");
@@ -384,4 +388,38 @@ TEST_CASE("a front run that fails writes its outputs up to the failure, then rep
   const nlohmann::json stats = nlohmann::json::parse(read(dir / "out" / "stats.json"));
   CHECK(stats["status"] == "failed");
   CHECK(std::filesystem::exists(dir / "out" / "series.csv"));
+}
+
+TEST_CASE("a scene with fronts takes every tension backend, the slack check and the tension field",
+          "[unit][scene]") {
+  // One discrete string: the options of a plain string work with fronts too. The folded chain
+  // released from rest: at t = 0 the fold carries no tension (ṡ0 = 0) and the resting arm hangs
+  // statically from the fixed start, so link 0 (midpoint s = h/2) holds the weight of the arm
+  // below it, λ g (y0 − h/2) (λ = 1 kg/m, y0 = 0.2 m, h = 0.05 m). The chain stays taut: no slack.
+  const auto dir = temp_dir("scene_fronts_options");
+  std::vector<double> t_stop;
+  for (const char* backend : {"tridiagonal", "klu", "eigen"}) {
+    if (std::string(backend) == "klu" && tension_backend_names().size() < 3) continue;  // built without KLU
+    INFO("backend " << backend);
+    const std::string text = test::kFoldedBase + fmt::format("[solver]\nbackend = \"{}\"\ncheck_slack = true\n"
+                                                             "[output]\nfields = [\"nodes\", \"tension\", \"stats\"]\n",
+                                                             backend);
+    const nlohmann::json j = run_json(dir, "folded", text);
+    CHECK(j["status"] == "stopped");
+    CHECK(j["tension_backend"] == backend);
+    t_stop.push_back(j["t_stop"].get<double>());
+    std::ifstream tension(dir / "out" / "tension.csv");
+    std::string line;
+    std::getline(tension, line);
+    REQUIRE(line == "t,link,s_mid,T");
+    std::getline(tension, line);  // t = 0, link 0
+    double t = 0, link = 0, s_mid = 0, T = 0;
+    char comma = 0;
+    std::istringstream(line) >> t >> comma >> link >> comma >> s_mid >> comma >> T;
+    CHECK(t == 0);
+    CHECK(link == 0);
+    CHECK_THAT(T, WithinRel(9.81 * (0.2 - 0.025), 1e-9));
+  }
+  // The backends solve the same system: the runs agree to the integrator's tolerance.
+  for (double t : t_stop) CHECK_THAT(t, WithinRel(t_stop.front(), 1e-8));
 }

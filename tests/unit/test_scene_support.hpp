@@ -29,13 +29,8 @@ inline std::string read(const std::filesystem::path& file) {
 }
 
 /// Builds a scene with fronts in its own dimension and runs it (no outputs written).
-inline FrontRun run_front_spec(const SceneSpec& spec) {
-  if (spec.dimension == 3) {
-    FrontScene<3> scene = build_front_scene<3>(spec);
-    return run_fronts(*scene.model, scene.run);
-  }
-  FrontScene<2> scene = build_front_scene<2>(spec);
-  return run_fronts(*scene.model, scene.run);
+inline RunSummary run_front_spec(const SceneSpec& spec) {
+  return spec.dimension == 3 ? run_front_scene<3>(spec) : run_front_scene<2>(spec);
 }
 
 inline const std::string kSceneBase = R"([string]

@@ -1,5 +1,5 @@
 // solver/tension_system.hpp: every backend gives the same tensions, the tensions reproduce the
-// constraint's second derivative, the pattern is assembled once, junction rows plug in, and a
+// constraint's second derivative, the pattern is assembled once (several arcs), and a
 // singular system is reported with the link and the time.
 #include <cmath>
 #include <memory>
@@ -9,7 +9,6 @@
 #include <catch2/catch.hpp>
 
 #include "mesh/errors.hpp"
-#include "solver/junction.hpp"
 #include "solver/string_model.hpp"
 #include "solver/tension_system.hpp"
 
@@ -123,44 +122,6 @@ void check_constraint_second_derivative(double tau_b) {
   }
 }
 
-/// A junction joining two open arcs: one extra unknown μ, and a row coupling the last link of arc 0,
-/// the first link of arc 1 and μ; μ also enters those links' rows.
-class TestJunction final : public Junction {
- public:
-  std::string name() const override { return "test"; }
-  int num_unknowns() const override { return 1; }
-  void declare_entries(TensionPatternBuilder& b) override {
-    last0_ = b.link_unknown(0, 4);
-    first1_ = b.link_unknown(1, 0);
-    mu_ = b.first_own_unknown();
-    for (auto [r, c] : {std::pair{mu_, last0_}, {mu_, first1_}, {last0_, mu_}, {first1_, mu_}, {last0_, first1_}})
-      b.add_entry(r, c);
-  }
-  void bind(TensionSystem& s) override {
-    s_mu_last_ = s.slot(mu_, last0_);
-    s_mu_first_ = s.slot(mu_, first1_);
-    s_last_mu_ = s.slot(last0_, mu_);
-    s_first_mu_ = s.slot(first1_, mu_);
-    s_mu_mu_ = s.slot(mu_, mu_);
-    s_last_first_ = s.slot(last0_, first1_);
-  }
-  void add_rows(double, TensionSystem& s) const override {
-    s.value(s_mu_last_) += 1.0;
-    s.value(s_mu_first_) += -0.5;
-    s.value(s_last_mu_) += 0.25;
-    s.value(s_first_mu_) += 0.75;
-    s.value(s_mu_mu_) += -3.0;
-    s.value(s_last_first_) += 0.1;
-    s.rhs(mu_) += 2.0;
-  }
-  void read_solution(const TensionSystem& s) override { mu_value = s.solution()[mu_]; }
-  double mu_value = 0;
-
- private:
-  int last0_ = 0, first1_ = 0, mu_ = 0;
-  int s_mu_last_ = 0, s_mu_first_ = 0, s_last_mu_ = 0, s_first_mu_ = 0, s_mu_mu_ = 0, s_last_first_ = 0;
-};
-
 /// Dense copy of the assembled system.
 Eigen::MatrixXd dense(const TensionSystem& s) {
   Eigen::MatrixXd A = Eigen::MatrixXd::Zero(s.size(), s.size());
@@ -200,7 +161,7 @@ TEST_CASE("the solved tensions reproduce the constraint's second derivative", "[
 TEST_CASE("several arcs: cyclic and open blocks solved per arc, equal to a dense solve", "[unit][tension]") {
   std::mt19937 rng(3);
   for (const std::string& backend : tension_backend_names()) {
-    TensionSystem s({5, 3, 1, 7}, {false, true, false, true}, {}, backend);
+    TensionSystem s({5, 3, 1, 7}, {false, true, false, true}, backend);
     CHECK(s.size() == 16);
     CHECK(s.pattern().nnz() == (5 + 8) + (3 + 6) + 1 + (7 + 14));
     for (int repeat = 0; repeat < 3; ++repeat) {  // same pattern, new values: refactor
@@ -214,34 +175,9 @@ TEST_CASE("several arcs: cyclic and open blocks solved per arc, equal to a dense
   }
 }
 
-TEST_CASE("a junction adds unknowns and rows coupling two arcs", "[unit][tension]") {
-  std::mt19937 rng(5);
-  for (const std::string& backend : tension_backend_names()) {
-    TestJunction junction;
-    if (backend == "tridiagonal") {
-      CHECK_THROWS_WITH(TensionSystem({5, 4}, {false, false}, {&junction}, backend), Contains("klu"));
-      continue;
-    }
-    TensionSystem s({5, 4}, {false, false}, {&junction}, backend);
-    CHECK(s.size() == 10);
-    CHECK(s.describe(9) == "unknown 0 of junction 'test'");
-    CHECK(s.describe(6) == "link 1 of arc 1");
-    fill_arcs(s, rng);
-    s.add_junction_rows(0.0);
-    const Eigen::VectorXd expected = dense(s).fullPivLu().solve(s.rhs_vector());
-    const Eigen::VectorXd T = s.solve(0.0);
-    INFO("backend " << backend);
-    CHECK((T - expected).cwiseAbs().maxCoeff() <= kBackendAgreement * expected.cwiseAbs().maxCoeff());
-    CHECK_THAT(junction.mu_value, WithinAbs(expected[9], kBackendAgreement));
-  }
-  TestJunction junction;
-  TensionSystem automatic({5, 4}, {false, false}, {&junction}, "auto");
-  CHECK(automatic.backend_name() != "tridiagonal");
-}
-
 TEST_CASE("a singular tension system names the link, the pivot and the time", "[unit][tension]") {
   for (const std::string& backend : tension_backend_names()) {
-    TensionSystem s({4}, {false}, {}, backend);
+    TensionSystem s({4}, {false}, backend);
     s.zero();
     for (int j = 0; j < 4; ++j) s.add_diagonal(j, -1.0);
     s.set_coupling(0, 1.0);  // rows 0 and 1 equal up to sign: singular at link 1

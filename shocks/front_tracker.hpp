@@ -1,0 +1,187 @@
+#pragma once
+/// @file front_tracker.hpp
+/// Front tracking: the module (solver/string_module.hpp) that makes the one discrete string
+/// (solver/string_model.hpp) carry shocks as moving fronts (docs/shocks.md, docs/model.md).
+///
+/// Material. An open string of N equal links (material length h = ℓ/N), nodes i = 0..N at material
+/// coordinate s_i = i h. The material line is cut at *fronts* into *arcs* (runs of moving nodes) and
+/// *heaps* (quiescent, shapeless reservoirs). Two kinds of front:
+///
+///   heap   a quiescent heap, either fed through a fixed point x0 (a pile under a hole, an edge:
+///          *pinned*) or lying on a plane (the table under a falling chain). The arc ends in a
+///          straight *partial link* of material length l from its end node k to the contact
+///          (s0 = s_k ± l), in direction e (from the arc into the heap):
+///              pinned     the contact is x0, l = |x0 − x_k|, e = (x0 − x_k)/l
+///              on a plane the arc's last full link continued to the plane (point p, normal n):
+///                         l = n·(p − x_k)/(n·e); the contact x_k + l e slides along the plane
+///          w = dl/dt is the rate at which the arc gains material (w < 0: it runs into the heap).
+///          Jump conditions (the internal shock of dissipation f at the contact plus the external
+///          shock at the heap, docs/shocks.md):
+///              end tension  τ = λ w² (1 + f sgn w)
+///              W_s = −f λ |w|³ (internal shock)
+///              reaction on the string  R = τ e + λ w v_k,  heap power W* = τ e·v_k + ½ λ w |v_k|² − W_s
+///          (R and W* are what the discrete string exchanges with the heap; for a string moving along
+///          itself they are the paper's (τ − λ w²) e and −½ λ w³). The heap is held at rest by its
+///          support: on a tilted string R has a component along the plane (friction, no slip).
+///          Falling chain: w = −ẏ < 0, τ = (1 − f) λ ẏ²; sliding chain: w = ẏ > 0, τ = (1 + f) λ ẏ².
+///
+///   fold   an internal shock at a fold (the bight of a folded chain) between arc A (s < s0) and
+///          arc B (s > s0). Momentum balance at a kink with f > 0 is only possible where the arcs
+///          are antiparallel (t⁺ = −t⁻): the fold. With e the direction into the fold (along arc A's
+///          end tangent), [v] = 2 ṡ0 e, so
+///              ṡ0 = ½ (v⁺ − v⁻)·e,   τ⁻ = λ ṡ0² (1 + f sgn ṡ0),   τ⁺ = λ ṡ0² (1 − f sgn ṡ0),
+///              W_s = −2 f λ |ṡ0|³,
+///          both ends pulled towards the fold along e. The folded link (a, b) holds the fold; its
+///          material splits into l_A = ½ (h + (x_b − x_a)·e) on arc A and l_B = h − l_A on arc B.
+///
+/// Discretization. The string lumps half of each full link of an arc on its nodes; the tracker adds
+/// the whole partial link to the arc's end node at a front (so an arc's mass is exactly λ × its
+/// material length), and the front forces as known loads of the tension system of each arc. For motions along a straight line (the paper's three problems) the scheme is
+/// exact: it reproduces the reduced ODE for every N.
+///
+/// Front crossings are ARKODE root events (two per front): a heap takes the end node in when the
+/// partial link shrinks to h/2 and gives out a new node when it grows to 3h/2; a fold moves the node
+/// it reaches from one arc to the other. Material moves with its momentum (mass parcels carry their
+/// velocity), so mass and momentum are conserved at every crossing; the kinetic energy a crossing
+/// removes is booked as W_remesh (zero for straight motions). Then the string rebuilds its arcs,
+/// projects positions and velocities onto the link constraints (StringModel::project) and the
+/// integration continues with the new state size.
+///
+/// The tracker's ledgers follow the string's state [ x | v | W_applied ]:
+///              [ W_shocks | W_heaps | impulse (dim) | heap moment (dim) ]
+///   W_shocks   Σ over internal shocks of W_s = −D (dissipation, ≤ 0)
+///   W_heaps    Σ over heaps of W* (external shocks)
+///   impulse    ∫ (all external forces on the string and heaps) dt: gravity, drag, loads, the
+///              reactions of fixed/driven nodes and of the planes under the heaps
+///   heap moment  change of Σ over heaps of ∫ x dm (kg m): material laid on a plane stays where the
+///              contact was when it arrived, so the heaps' potential energy needs their first moment
+/// Ledgers: K + V − (K0 + V0) − W_applied − W_shocks − W_heaps − W_remesh → 0 and
+///          p − p0 − impulse → 0 (p = Σ m_i v_i; heaps are at rest), to the discretization error.
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "solver/string_model.hpp"
+
+namespace chainsim {
+
+/// A quiescent heap holding the material on one side of a front.
+template <int dim>
+struct HeapSpec {
+  enum class Side { kBefore, kAfter };
+  Side side = Side::kAfter;  ///< kAfter: the heap holds s > s0 (string runs into it at its end, e.g.
+                             ///< falling chain); kBefore: it holds s < s0 (feeds the string, sliding chain)
+  Vec<dim> point = Vec<dim>::Zero();  ///< x0 (m)
+  double dissipation = 0;             ///< f of the internal shock at x0, in [0, 1]
+  double s0 = 0;                      ///< initial material coordinate of the front (m), in (0, ℓ)
+  /// Unset: the front is pinned at `point` (a hole or an edge the string runs through). Set: the
+  /// heap lies on the smooth plane through `point` with this normal (pointing to the string's side),
+  /// and the contact slides along the plane where the string meets it (a table under a falling chain).
+  std::optional<Vec<dim>> plane_normal;
+};
+
+/// A fold (internal shock) between the arc before and the arc after s0.
+struct FoldSpec {
+  double dissipation = 0;  ///< f, in [0, 1]
+  double s0 = 0;           ///< initial material coordinate of the fold (m), in [0, ℓ)
+};
+
+struct FrontOptions {
+  /// Stop when a front's material coordinate reaches this value (front index, s (m)); the run also
+  /// stops when a front reaches an end of the string or a heap runs empty.
+  struct StopAt {
+    int front = 0;
+    double s = 0;
+  };
+  std::vector<StopAt> stop_at;
+};
+
+template <int dim>
+class FrontTracker final : public StringModule<dim> {
+ public:
+  enum class FrontKind { kHeap, kFold };
+  struct Front {
+    FrontKind kind = FrontKind::kHeap;
+    double dissipation = 0;
+    Vec<dim> point = Vec<dim>::Zero();  ///< heap point x0 (on a plane: a point of the plane)
+    bool on_plane = false;               ///< the contact slides along the plane (point, normal)
+    Vec<dim> normal = Vec<dim>::Zero();  ///< unit normal of the plane, towards the string's side
+    Vec<dim> last_direction = Vec<dim>::Zero();  ///< on a plane, once the arc has no full link left:
+                                                 ///< the direction its partial link keeps
+    int arc_minus = -1, arc_plus = -1;  ///< arcs on either side (−1: the heap's side)
+  };
+
+  /// Heaps (at most one per side) and an optional fold, in any order; they are kept in order of s.
+  FrontTracker(std::vector<HeapSpec<dim>> heaps, std::optional<FoldSpec> fold, const FrontOptions& options);
+
+  const std::vector<Front>& fronts() const { return fronts_; }
+  int num_folds() const;
+  /// A fold is a tight bight: its arms leave it along one line. The jump conditions allow a
+  /// dissipative kink nowhere else (docs/shocks.md), so a run stops when the arms open wider than
+  /// this angle from antiparallel (and a fold that starts wider is refused).
+  static constexpr double kMaxFoldOpeningDeg = 20;
+
+  // --- StringModule ------------------------------------------------------------------------------
+  std::vector<ArcRange> initial_arcs(const Chain<dim>& chain) override;
+  void initialize(StringModel<dim>& model) override;
+  void add_mass_and_forces(const StringModel<dim>& model, Eigen::VectorXd& mass, Points<dim>& force) override;
+  int num_ledgers() const override { return 2 + 2 * dim; }
+  void ledger_rates(const StringModel<dim>& model, Eigen::Ref<Eigen::VectorXd> rates) const override;
+  Eigen::VectorXd ledger_scale(double mass, double speed, double length) const override;
+  double potential_correction(const StringModel<dim>& model, const Eigen::Ref<const Eigen::VectorXd>& ledger) const override;
+  void fill(const StringModel<dim>& model, const Eigen::Ref<const Eigen::VectorXd>& ledger,
+            ModuleLedger<dim>& out) const override;
+  /// Two per front (crossings), one per stop condition, one per fold (it opens past kMaxFoldOpeningDeg).
+  int num_events() const override {
+    return 2 * static_cast<int>(fronts_.size()) + static_cast<int>(options_.stop_at.size()) + num_folds();
+  }
+  void events(const StringModel<dim>& model, Eigen::Ref<Eigen::VectorXd> g) const override;
+  std::vector<int> event_directions() const override;
+  EventAction handle_events(StringModel<dim>& model, double t, Eigen::Ref<Eigen::VectorXd> ledger,
+                            const std::vector<int>& found) override;
+  long transfers() const override { return transfers_; }
+
+ private:
+  /// The arc end at a heap front: its end node, the node inside the arc next to it, the node that
+  /// comes out of the heap next, and whether the end node can be taken in / a node given out.
+  struct HeapEnd {
+    bool after = true;  ///< the heap holds s > s0
+    int arc = 0, node = 0, inner = 0, outer = 0;
+    bool removable = false, insertable = false;
+  };
+  HeapEnd heap_end(const StringModel<dim>& model, const Front& front) const;
+  double heap_mass(std::size_t front) const;  // needs the front states
+  std::string fold_opened_message(std::size_t front) const;  // needs the front states
+  /// Moves the node a front reached across it (heap: in or out; fold: from one arc to the other).
+  EventAction transfer(StringModel<dim>& model, std::size_t front, int e0, Eigen::Ref<Eigen::VectorXd> ledger);
+
+  std::vector<HeapSpec<dim>> heap_specs_;
+  std::optional<FoldSpec> fold_spec_;
+  FrontOptions options_;
+  double h_ = 0, lambda_ = 0, ell_ = 0;
+  int n_ = 0;
+  std::vector<Front> fronts_;
+  std::vector<double> expected_s0_;  // where each front is meant to start (m)
+  std::vector<FrontState<dim>> fs_;
+  long transfers_ = 0;
+  double w_remesh_ = 0;
+  Vec<dim> heap_moment0_ = Vec<dim>::Zero();  // Σ heap mass × point at t = 0
+};
+
+/// The string with fronts: a StringModel whose module is a FrontTracker. `prescribed` nodes must
+/// lie in an arc. Throws InputError when the layout is inconsistent.
+template <int dim>
+StringModel<dim> make_front_model(Chain<dim> chain, std::vector<std::unique_ptr<Force<dim>>> forces,
+                                  std::vector<PrescribedNode<dim>> prescribed, std::vector<HeapSpec<dim>> heaps,
+                                  std::optional<FoldSpec> fold, const FrontOptions& fronts,
+                                  const StringModelOptions& options = {});
+
+/// The tracker of a string with fronts (nullptr for a string without).
+template <int dim>
+const FrontTracker<dim>* front_tracker(const StringModel<dim>& model) {
+  return dynamic_cast<const FrontTracker<dim>*>(model.module());
+}
+
+}  // namespace chainsim

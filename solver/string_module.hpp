@@ -1,0 +1,117 @@
+#pragma once
+/// @file string_module.hpp
+/// What a module adds to the one discrete string (string_model.hpp): the interface through which
+/// front tracking (shocks/front_tracker.hpp) cuts the material into arcs and imposes the jump
+/// conditions of its fronts, without a second copy of the string.
+///
+/// The string owns everything a string has: nodes, links, lumped masses, the tension system of its
+/// arcs, the applied forces, the prescribed ends, the constraint projection, the energy ledger of
+/// the applied work, snapshots and outputs. A module owns what is particular to its fronts:
+///   - the layout: which nodes move, cut into arcs (runs of nodes that move together); the nodes in
+///     no arc (inside a heap) have no equation of motion;
+///   - at every evaluation, the mass and the force it puts on nodes (a partial link's material, the
+///     end tensions of the jump conditions) — known loads of the tension system, not new unknowns;
+///   - extra ledger components integrated with the ODE (dissipation at shocks, work exchanged with
+///     heaps, impulse of the supports, …), with their rates;
+///   - root functions and what happens at them (a node crossing a front: the layout changes, the
+///     string rebuilds its arcs and projects the state back onto the constraints);
+///   - its contributions to snapshots (fronts, supports, heaps).
+/// A string without a module runs the same code with one arc and none of these.
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "mesh/chain.hpp"
+
+namespace chainsim {
+
+template <int dim>
+class StringModel;
+
+/// A run of nodes first..last (inclusive) that move together; a closed arc's last link joins last to
+/// first.
+struct ArcRange {
+  int first = 0, last = 0;
+  bool closed = false;
+  int num_links() const { return closed ? last - first + 1 : last - first; }
+  int num_nodes() const { return last - first + 1; }
+};
+
+/// Geometry and jump quantities of one front at one state (what snapshots and outputs report).
+template <int dim>
+struct FrontState {
+  double s0 = 0;         ///< material coordinate of the front (m)
+  double s0_dot = 0;     ///< its speed in the material (m/s)
+  double l_minus = 0, l_plus = 0;  ///< partial-link lengths on either side (heap side: 0)
+  Vec<dim> direction = Vec<dim>::Zero();  ///< e: heap: from the arc to x0; fold: into the fold along arc A
+  Vec<dim> position = Vec<dim>::Zero();   ///< x0 (m)
+  double tension_minus = 0, tension_plus = 0;  ///< τ∓ at the front (N); heap side: 0
+  double inflow = 0;       ///< heap: w, speed of material entering the arc (m/s)
+  double power_shock = 0;  ///< W_s = −D (W)
+  double power_heap = 0;   ///< W* (W), heaps only
+  Vec<dim> reaction = Vec<dim>::Zero();  ///< heap: the support's reaction on the string at the front (N)
+  double opening = 0;  ///< fold: angle between arc A's end link and arc B's first link reversed (rad)
+};
+
+/// What a module adds to a snapshot: zero for a string without one.
+template <int dim>
+struct ModuleLedger {
+  std::vector<FrontState<dim>> fronts;
+  double w_shocks = 0, w_heaps = 0, w_remesh = 0;  ///< J
+  Vec<dim> impulse = Vec<dim>::Zero();      ///< of all external forces (N s), when the module keeps it
+  Vec<dim> heap_moment = Vec<dim>::Zero();  ///< Σ over heaps of ∫ x dm (kg m)
+  Vec<dim> support = Vec<dim>::Zero();      ///< force of the module's supports (heaps) on the system (N)
+  double heap_mass = 0;                     ///< kg
+  bool has_momentum_ledger = false;         ///< impulse is integrated: p − p0 − impulse → 0
+};
+
+/// What an event means.
+struct EventAction {
+  enum class Kind { kNone, kTransfer, kStop } kind = Kind::kNone;
+  std::string reason;  ///< for kStop: why the run ends
+};
+
+template <int dim>
+class StringModule {
+ public:
+  virtual ~StringModule() = default;
+
+  // --- set-up -----------------------------------------------------------------------------------
+  /// The arcs the material starts in (node ranges in increasing order). Throws InputError when the
+  /// module's layout does not fit the chain.
+  virtual std::vector<ArcRange> initial_arcs(const Chain<dim>& chain) = 0;
+  /// Checks that need the built string (its state, masses and arcs); called once, after the string
+  /// is built. Throws InputError.
+  virtual void initialize(StringModel<dim>& model) = 0;
+
+  // --- every evaluation ---------------------------------------------------------------------------
+  /// At the string's current positions and velocities: adds the mass (kg) and the force (N) the
+  /// module puts on each node. Throws RecoverableError for a trial state it cannot use.
+  virtual void add_mass_and_forces(const StringModel<dim>& model, Eigen::VectorXd& mass, Points<dim>& force) = 0;
+  /// Number of ledger components the module integrates (they follow W_applied in the state).
+  virtual int num_ledgers() const = 0;
+  /// Their rates, after an evaluation (accelerations, reactions known).
+  virtual void ledger_rates(const StringModel<dim>& model, Eigen::Ref<Eigen::VectorXd> rates) const = 0;
+  /// Their natural magnitudes, for the absolute tolerances (mass, speed and length scales given).
+  virtual Eigen::VectorXd ledger_scale(double mass, double speed, double length) const = 0;
+  /// The potential energy the lumped masses miss (J): V = Σ forces' V(lumped) + this.
+  virtual double potential_correction(const StringModel<dim>& model, const Eigen::Ref<const Eigen::VectorXd>& ledger) const = 0;
+  /// Fills the module's part of a snapshot.
+  virtual void fill(const StringModel<dim>& model, const Eigen::Ref<const Eigen::VectorXd>& ledger,
+                    ModuleLedger<dim>& out) const = 0;
+
+  // --- events ------------------------------------------------------------------------------------
+  virtual int num_events() const = 0;
+  virtual void events(const StringModel<dim>& model, Eigen::Ref<Eigen::VectorXd> g) const = 0;
+  virtual std::vector<int> event_directions() const = 0;
+  /// Acts on the events found (signs per root function) at the string's current state: moves
+  /// nodes across fronts (then calls model.rebuild() and model.project()) and books what the
+  /// change does to the ledgers, or reports a stop.
+  virtual EventAction handle_events(StringModel<dim>& model, double t, Eigen::Ref<Eigen::VectorXd> ledger,
+                                    const std::vector<int>& found) = 0;
+  /// Number of node transfers so far.
+  virtual long transfers() const = 0;
+};
+
+}  // namespace chainsim
