@@ -23,6 +23,21 @@ constexpr double kRoundoffUlps = 64;
 constexpr int kProjectionIterations = 60;
 }  // namespace
 
+const char* to_string(SlackPolicy policy) {
+  switch (policy) {
+    case SlackPolicy::kStop: return "stop";
+    case SlackPolicy::kWarn: return "warn";
+    case SlackPolicy::kIgnore: break;
+  }
+  return "ignore";
+}
+
+std::string SlackReport::message() const {
+  return fmt::format("slack at t = {:.9g} s: link {} (s = {:.6g} m from node 0) has tension T = {:.6g} N < 0 "
+                     "(largest |T| = {:.6g} N); an inextensible string cannot push, so the model does not apply",
+                     t, link, s_mid, tension, scale);
+}
+
 void StringModelOptions::validate() const {
   require_in_range("solver.stabilization_time", stabilization_time, 0.0, INFINITY);
   require_in_range("solver.slack_tolerance", slack_tolerance, 0.0, 1.0);
@@ -527,13 +542,11 @@ double StringModel<dim>::max_constraint_violation(double t, const Eigen::Ref<con
 }
 
 template <int dim>
-void StringModel<dim>::check_slack(double t, const Eigen::Ref<const Eigen::VectorXd>& y) {
-  if (!system_) return;
+std::optional<SlackReport> StringModel<dim>::find_slack(double t, const Eigen::Ref<const Eigen::VectorXd>& y) {
+  if (!system_) return std::nullopt;
   unpack_state(t, y);
   evaluate_current(t);
   const Eigen::VectorXd& T = system_->solution();
-  // Compare with a physical tension scale too, so that a string whose exact tension is zero (free
-  // fall, uniform motion) is not reported slack for round-off: λ (|g| ℓ + max |v|²).
   double v2_max = 0;
   for (int i = 0; i < v_.cols(); ++i)
     if (in_arc(i)) v2_max = std::max(v2_max, v_.col(i).squaredNorm());
@@ -544,12 +557,8 @@ void StringModel<dim>::check_slack(double t, const Eigen::Ref<const Eigen::Vecto
     if (worst < 0 || T[u] < T[link_unknown_[static_cast<std::size_t>(worst)]]) worst = j;
   });
   const double T_worst = T[link_unknown_[static_cast<std::size_t>(worst)]];
-  if (T_worst < -options_.slack_tolerance * scale)
-    throw NumericalError(fmt::format("slack at t = {:.9g} s: link {} (s = {:.6g} m from node 0) has tension "
-                                     "T = {:.6g} N < 0 (largest |T| = {:.6g} N); an inextensible string cannot "
-                                     "push, so the model does not apply",
-                                     t, worst, chain_.link_midpoint(worst), T_worst, scale),
-                         t);
+  if (!(T_worst < -options_.slack_tolerance * scale)) return std::nullopt;
+  return SlackReport{t, worst, chain_.link_midpoint(worst), T_worst, scale};
 }
 
 template <int dim>

@@ -35,6 +35,7 @@
 /// term adds eigenvalues −1/τ_b, harmless to an explicit method when τ_b ≫ h) and short compared
 /// with the run; it does not change the exact solution, for which C = C' = 0. τ_b = 0 turns it off.
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -48,13 +49,30 @@
 
 namespace chainsim {
 
+/// What a run does when the tension goes negative beyond round-off (slack: an inextensible string
+/// cannot push, so the model no longer applies): stop with a NumericalError, record the first
+/// occurrence and go on, or not check at all.
+enum class SlackPolicy { kStop, kWarn, kIgnore };
+/// "stop", "warn", "ignore".
+const char* to_string(SlackPolicy policy);
+
+/// Where and when a string first went slack.
+struct SlackReport {
+  double t = 0;        ///< s
+  int link = 0;        ///< the most negative link
+  double s_mid = 0;    ///< its midpoint's material coordinate (m)
+  double tension = 0;  ///< its tension (N), < 0
+  double scale = 0;    ///< the tension scale it is compared with (N)
+  std::string message() const;
+};
+
 struct StringModelOptions {
   /// Baumgarte time scale τ_b (s) of the link-constraint stabilisation (α = β = 1/τ_b); 0 = off.
   double stabilization_time = 0;
   /// Tension solver: "auto", "tridiagonal", "klu" or "eigen" (tension_system.hpp).
   std::string backend = "auto";
-  /// Check for slack (negative tension) at accepted steps (StringModel::check_slack).
-  bool check_slack = false;
+  /// Slack (negative tension) at accepted steps: stop, warn or ignore (StringSolver).
+  SlackPolicy slack = SlackPolicy::kIgnore;
   /// Slack means T_j < −slack_tolerance · max_k |T_k| (relative, so round-off is not slack).
   double slack_tolerance = 1e-8;
   void validate() const;
@@ -114,8 +132,10 @@ class StringModel final : public OdeSystem {
 
   /// max_j | |Δx_j| − h_j | / h_j at (t, y) over the links of the arcs, without a tension solve.
   double max_constraint_violation(double t, const Eigen::Ref<const Eigen::VectorXd>& y) const;
-  /// Throws NumericalError naming the link, its tension and t if some T_j < −slack_tolerance·scale.
-  void check_slack(double t, const Eigen::Ref<const Eigen::VectorXd>& y);
+  /// The most negative link if some T_j < −slack_tolerance·scale at (t, y), where scale is the larger
+  /// of max |T| and a physical tension λ (|g| ℓ + max |v|²) (so that a string whose exact tension is
+  /// zero, as in free fall, is not slack by round-off); nothing otherwise. One tension solve.
+  std::optional<SlackReport> find_slack(double t, const Eigen::Ref<const Eigen::VectorXd>& y);
   /// Acts on the root functions found at (t, y) (the module's events): `y` is replaced by the new,
   /// possibly longer or shorter, state after a transfer.
   EventAction handle_events(double t, Eigen::VectorXd& y, const std::vector<int>& found);

@@ -67,6 +67,14 @@ nlohmann::json to_json(const RunSummary& s) {
                       {"junction_unknowns", s.junction_unknowns},
                       {"stabilization_time", s.stabilization_time},
                       {"stats", to_json(s.stats)}};
+  nlohmann::json slack = {{"policy", to_string(s.slack_policy)}, {"detected", s.slack.has_value()}};
+  if (s.slack)
+    slack.update({{"t", s.slack->t},
+                  {"link", s.slack->link},
+                  {"s", s.slack->s_mid},
+                  {"T", s.slack->tension},
+                  {"message", s.slack->message()}});
+  j["slack"] = slack;
   if (!s.error.empty()) j["error"] = s.error;
   return j;
 }
@@ -133,6 +141,7 @@ void StringSolver<dim>::describe_model() {
   summary_.stabilization_time = model_.options().stabilization_time;
   summary_.tension_backend = model_.has_tension_system() ? model_.tension_system().backend_name() : "none";
   summary_.t_end = options_.t_end;
+  summary_.slack_policy = model_.options().slack;
 }
 
 template <int dim>
@@ -210,6 +219,16 @@ void StringSolver<dim>::record_sample(double t, const Eigen::VectorXd& y) {
 }
 
 template <int dim>
+void StringSolver<dim>::check_slack(double t, const Eigen::VectorXd& y) {
+  const SlackPolicy policy = model_.options().slack;
+  if (policy == SlackPolicy::kIgnore || (policy == SlackPolicy::kWarn && summary_.slack)) return;
+  const std::optional<SlackReport> slack = model_.find_slack(t, y);
+  if (!slack) return;
+  summary_.slack = slack;
+  if (policy == SlackPolicy::kStop) throw NumericalError(slack->message(), t);
+}
+
+template <int dim>
 const RunSummary& StringSolver<dim>::run() {
   frames_.clear();
   summary_ = RunSummary{};
@@ -238,7 +257,7 @@ const RunSummary& StringSolver<dim>::run() {
     integrator = std::make_unique<Integrator>(model_, t0, y0, options_.integrator);
     record_frame(t0, y0);
     if (options_.record_steps) record_sample(t0, y0);
-    if (model_.options().check_slack) model_.check_slack(t0, y0);
+    check_slack(t0, y0);
     // 2. Step by step to each output time: constraints (and slack) are checked at accepted steps,
     //    root functions acted on where they vanish.
     const auto n_out = static_cast<long>(std::ceil(options_.t_end / options_.output_interval - 1e-9));
@@ -266,7 +285,7 @@ const RunSummary& StringSolver<dim>::run() {
       const Eigen::VectorXd& y = integrator->state();
       summary_.max_constraint_violation =
           std::max(summary_.max_constraint_violation, model_.max_constraint_violation(t, y));
-      if (model_.options().check_slack) model_.check_slack(t, y);
+      check_slack(t, y);
       if (on_step) on_step(t, y);
       if (options_.record_steps) record_sample(t, y);
       if (outcome == Integrator::Outcome::kReachedTarget) {

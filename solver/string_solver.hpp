@@ -17,6 +17,7 @@
 ///   stats.json   the summary (to_json); written last, so its presence means the set is complete
 #include <filesystem>
 #include <functional>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -86,6 +87,8 @@ struct RunSummary {
   double energy_scale = 0;         ///< max of K + |V − V0| + |W_applied| + |W_shocks| + |W_heaps| (J)
   double max_momentum_residual = 0, momentum_scale = 0;  ///< with a momentum ledger (fronts)
   double max_constraint_violation = 0;  ///< max over accepted steps of | |Δx_j| − h_j | / h_j
+  SlackPolicy slack_policy = SlackPolicy::kIgnore;
+  std::optional<SlackReport> slack;  ///< the first slack found at an accepted step (checked unless ignored)
   long tension_solves = 0;
   long transfers = 0;              ///< nodes moved across fronts
   long frames = 0;
@@ -111,7 +114,7 @@ struct RunSummary {
 
 /// The summary as JSON: status, stop_reason, t_end, t_stop, steps, rhs_evals, wall_s, energy_drift
 /// (J) and relative_energy_drift, energy_residual (relative, the same number) and momentum_residual
-/// (relative), max_constraint_violation, transfers, tension_solves, frames, samples, the model's
+/// (relative), max_constraint_violation, slack ({policy, detected, t, link, s, T, message}), transfers, tension_solves, frames, samples, the model's
 /// description (dimension, nodes, links, effects, prescribed, root functions, tension unknowns,
 /// stabilization time, backend) and ARKODE's statistics.
 nlohmann::json to_json(const RunSummary& summary);
@@ -148,6 +151,7 @@ class StringSolver {
  private:
   void record_frame(double t, const Eigen::VectorXd& y);
   void record_sample(double t, const Eigen::VectorXd& y);
+  void check_slack(double t, const Eigen::VectorXd& y);
   void book(double t, const typename StringModel<dim>::Snapshot& snap);
   void describe_model();
 

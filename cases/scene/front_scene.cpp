@@ -214,7 +214,7 @@ FrontScene<dim> build_front_scene(const SceneSpec& spec) {
   StringModelOptions mo;
   mo.stabilization_time = parts.stabilization_time;
   mo.backend = spec.solver.backend;
-  mo.check_slack = spec.solver.check_slack;
+  mo.slack = spec.solver.check_slack ? SlackPolicy::kStop : SlackPolicy::kIgnore;
   mo.slack_tolerance = spec.solver.slack_tolerance;
   const std::string fit_key = fold && heaps.empty() ? "effects.fold.s0" : first_front;
   scene.model = at_key(spec, fit_key, [&] {

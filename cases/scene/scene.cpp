@@ -960,7 +960,7 @@ StringScene<dim> build_string_scene(const SceneSpec& spec) {
   StringModelOptions mo;
   mo.stabilization_time = parts.stabilization_time;
   mo.backend = so.backend;
-  mo.check_slack = so.check_slack;
+  mo.slack = so.check_slack ? SlackPolicy::kStop : SlackPolicy::kIgnore;
   mo.slack_tolerance = so.slack_tolerance;
   scene.solver.integrator = parts.integrator;
   scene.solver.t_end = spec.stop.t_end;
