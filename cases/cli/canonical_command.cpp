@@ -113,13 +113,21 @@ CsvTable thin_for_figure(const CsvTable& series) {
   return thin;
 }
 
-/// A string run must end at its stop event; a failure (or the safety stop) is a numerical failure.
-void require_stopped(const StringCaseRun& run, const std::string& what) {
+/// A string run must end at its stop event, at the η where the problem stops; a failure, the safety
+/// stop or an earlier end (a falling chain whose last node meets the heap before the cutoff, when the
+/// cutoff is shorter than about 1e-3 of a link) is a numerical failure.
+void require_stopped(const StringCaseRun& run, Problem p, double eps, const std::string& what) {
   if (run.run.status == "failed")
     throw NumericalError(fmt::format("{}: the string solver failed: {}", what, run.run.error), run.run.t_stop);
   if (run.run.status != "stopped")
     throw NumericalError(fmt::format("{}: the string solver did not reach the stop event ({}: {})", what,
                                      run.run.status, run.run.stop_reason),
+                         run.run.t_stop);
+  const double eta_end = stop_eta(p, eps);
+  if (run.eta.empty() || std::abs(run.eta.back() - eta_end) > 1e-9)
+    throw NumericalError(fmt::format("{}: the string run stopped at eta = {:.9g} instead of {:g} ({}); with eps = {:g} "
+                                     "it needs more nodes",
+                                     what, run.eta.empty() ? NAN : run.eta.back(), eta_end, run.run.stop_reason, eps),
                          run.run.t_stop);
 }
 
@@ -144,7 +152,7 @@ nlohmann::json three_way(Problem p, double f, int nodes, const fs::path& fig) {
   setup.nodes = nodes;
   const Comparison c = compare_with_reduced(setup);
   const std::string stem = fmt::format("{}_f{:.2f}", to_string(p), f);
-  require_stopped(c.string, stem);
+  require_stopped(c.string, p, setup.eps, stem);
   const double eta0 = *setup.eta0;
   const auto start = Clock::now();
   const ExactPoint q = exact_at(p, f, stop_eta(p, setup.eps), eta0);
@@ -232,7 +240,7 @@ std::vector<double> fall_time_string(const std::vector<double>& fs_list, int nod
       setup.eta0 = p == Problem::kFalling ? 1.0 : 0.0;
       setup.nodes = nodes;
       const StringCaseRun run = solve_string_case(setup);
-      require_stopped(run, fmt::format("fall time of the {} chain, f = {:g}", to_string(p), f));
+      require_stopped(run, p, setup.eps, fmt::format("fall time of the {} chain, f = {:g}", to_string(p), f));
       const double ts = run.summary["t_stop_over_t0"].get<double>();
       const double tq = exact_at(p, f, stop_eta(p, setup.eps), *setup.eta0).xi;
       worst[k] = std::max(worst[k], rel_diff(ts, tq));
