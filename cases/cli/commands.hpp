@@ -19,12 +19,18 @@ struct ReducedCommandOptions {
 };
 int run_reduced_command(ReducedCommandOptions options, std::ostream& out);
 
-/// `chainsim canonical --out DIR`: the main job. The three canonical problems with default
-/// parameters (series + summary), a summary table, and the data behind the paper's figures
-/// (fall time against f, η(ξ) and P/P0(ξ) for several f, each with its exact reference).
+/// `chainsim canonical --out DIR`: the main job. Each of the paper's three problems (falling η0 = 1,
+/// folded η0 = 0, sliding η0 = 0.25) at f = 0, 0.5, 0.83, 1 three ways: the string solver with front
+/// tracking (compare_with_reduced, `nodes` nodes), the reduced ODE and the exact quadrature; the stop
+/// times, their differences, the string run's ledgers and the wall times in DIR/summary.{csv,json}; the
+/// curves of the figures in DIR/figure_data/ (profiles, and the fall time against f with the string
+/// solver's points); each problem's reduced run with default parameters in DIR/<problem>/.
+/// Defined in canonical_command.cpp.
 struct CanonicalCommandOptions {
   std::string out = "results";
-  bool json = false;
+  int nodes = 41;       ///< nodes of the string runs (the straight problems are exact on any mesh)
+  bool quick = false;   ///< f = 0, 0.83 only, and the string's fall time at f = 0, 0.5, 1 (for tests)
+  bool json = false;    ///< print the summary rows as one JSON array
 };
 int run_canonical_command(const CanonicalCommandOptions& options, std::ostream& out);
 

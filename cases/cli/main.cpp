@@ -56,10 +56,15 @@ int main(int argc, char** argv) {
   // --- chainsim canonical ----------------------------------------------------------------------
   chainsim::CanonicalCommandOptions canonical;
   auto* cmd_canonical = app.add_subcommand(
-      "canonical", "The main job: the three canonical problems with default parameters, a summary table, and the data "
-                   "of the paper's figures (plot with scripts/plot_canonical.py)");
+      "canonical", "The main job: the three canonical problems, each on the string solver with front tracking, as the "
+                   "reduced ODE and as the exact quadrature; a summary table and the data of the paper's figures (plot "
+                   "with scripts/plot_canonical.py)");
   cmd_canonical->add_option("--out", canonical.out, "output directory")->capture_default_str();
-  cmd_canonical->add_flag("--json", canonical.json, "print the three summaries as a JSON array on stdout");
+  cmd_canonical->add_option("--nodes", canonical.nodes, "nodes of the string runs, 4 <= N <= 200001")
+      ->capture_default_str();
+  cmd_canonical->add_flag("--quick", canonical.quick,
+                          "fewer values of f: profiles at f = 0, 0.83, the string's fall time at f = 0, 0.5, 1");
+  cmd_canonical->add_flag("--json", canonical.json, "print the summary rows (one per problem and f) as a JSON array");
 
   // --- chainsim compare ------------------------------------------------------------------------
   chainsim::CompareCommandOptions compare;
