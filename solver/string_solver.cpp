@@ -9,6 +9,7 @@
 #include <nlohmann/json.hpp>
 
 #include "mesh/errors.hpp"
+#include "interrupt.hpp"
 #include "vtk_output.hpp"
 
 namespace chainsim {
@@ -291,6 +292,11 @@ const RunSummary& StringSolver<dim>::run() {
       if (outcome == Integrator::Outcome::kReachedTarget) {
         record_frame(t_out, y);
         ++k;
+      } else if (interrupt_requested()) {  // Ctrl-C: stop at this accepted state, outputs valid
+        record_frame(t, y);
+        finish("interrupted");
+        summary_.stop_reason = fmt::format("interrupted by the user at t = {:.9g} s", t);
+        return summary_;
       }
     }
   } catch (const RecoverableError& e) {

@@ -76,7 +76,8 @@ struct StepSample {
 
 /// What a run did.
 struct RunSummary {
-  std::string status = "not run";  ///< "completed" (t_end), "stopped" (a stop event) or "failed"
+  std::string status = "not run";  ///< "completed" (t_end), "stopped" (a stop event), "interrupted"
+                                   ///< (Ctrl-C, interrupt.hpp) or "failed"
   std::string error;               ///< the failure's message
   std::string stop_reason;         ///< "t_end" when completed
   double t_end = 0;                ///< the end time asked for (s)

@@ -95,6 +95,7 @@ int main(int argc, char** argv) {
   cmd_run->add_option("--out", run.out, "output directory (default results/<scene name>)");
   double run_t_end = 0;
   auto* opt_t_end = cmd_run->add_option("--t-end", run_t_end, "end time (s), > 0: replaces the scene's [stop] t_end");
+  cmd_run->add_flag("--quiet", run.quiet, "no progress line on stderr (there is none when stderr is not a terminal)");
   cmd_run->add_flag("--json", run.json,
                     "print the run summary as one JSON object on stdout (on failure: status \"failed\" and the error)");
 

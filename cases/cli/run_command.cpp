@@ -33,12 +33,17 @@
 #include "cases/scene/front_scene.hpp"
 #include "cases/scene/reduced_scene.hpp"
 #include "cases/scene/scene.hpp"
+#include "cases/cli/progress.hpp"
+#include "solver/interrupt.hpp"
 #include "mesh/errors.hpp"
 #include "solver/output.hpp"
 
 namespace chainsim {
 
 namespace {
+
+/// The exit code of a run stopped by Ctrl-C (128 + SIGINT, as a shell reports it).
+constexpr int kInterruptedExit = 130;
 
 std::string join_words(const std::vector<std::string>& words) {
   std::string out;
@@ -102,7 +107,8 @@ Built<dim> build(const SceneSpec& spec) {
 }
 
 template <int dim>
-int run_string_scene(const SceneSpec& spec, const std::filesystem::path& dir, bool json, std::ostream& out) {
+int run_string_scene(const SceneSpec& spec, const std::filesystem::path& dir, bool json, bool quiet,
+                     std::ostream& out) {
   // 2.-3. Model, checked; the output directory, before integrating.
   Built<dim> scene = build<dim>(spec);
   ensure_writable_directory(dir);
@@ -116,17 +122,24 @@ int run_string_scene(const SceneSpec& spec, const std::filesystem::path& dir, bo
     j["num_fronts"] = 0;
     return j;
   };
-  // 4.-5. Integrate (a numerical failure still writes what was done), write, summary last.
+  // 4.-5. Integrate (a numerical failure, or Ctrl-C, still writes what was done), write, summary last.
   std::optional<NumericalError> failure;
-  try {
-    solver.run();
-  } catch (const NumericalError& e) {
-    failure = e;
+  {
+    ProgressLine progress(scene.solver.t_end, progress_wanted(quiet));
+    solver.on_step = [&](double t, const Eigen::VectorXd&) { progress.update(t); };
+    install_sigint_handler();
+    try {
+      solver.run();
+    } catch (const NumericalError& e) {
+      failure = e;
+    }
   }
+  const bool interrupted = solver.summary().status == "interrupted";
   nlohmann::json summary = summary_json();
   clear_outputs(dir);
   solver.write_outputs(dir, scene.output, &summary);
   if (failure && json) summary["exit_code"] = 3;
+  if (interrupted && json) summary["exit_code"] = kInterruptedExit;
   // 6. Summary.
   const RunSummary& s = solver.summary();
   if (json) {
@@ -166,7 +179,7 @@ int run_string_scene(const SceneSpec& spec, const std::filesystem::path& dir, bo
     out << fmt::format("outputs    {}: {}\n", dir.string(), output_files(scene.output, fronts));
   }
   if (failure) throw *failure;
-  return 0;
+  return interrupted ? kInterruptedExit : 0;
 }
 
 int run_reduced_scene(const SceneSpec& spec, const std::filesystem::path& dir, bool json, std::ostream& out) {
@@ -206,9 +219,9 @@ int run_reduced_scene(const SceneSpec& spec, const std::filesystem::path& dir, b
 }
 
 template <int dim>
-int run_scene(const SceneSpec& spec, const std::filesystem::path& dir, bool json, std::ostream& out) {
+int run_scene(const SceneSpec& spec, const std::filesystem::path& dir, bool json, bool quiet, std::ostream& out) {
   if (spec.model == "reduced") return run_reduced_scene(spec, dir, json, out);
-  return run_string_scene<dim>(spec, dir, json, out);
+  return run_string_scene<dim>(spec, dir, json, quiet, out);
 }
 
 template <int dim>
@@ -240,8 +253,8 @@ int run_scene_command(const RunCommandOptions& options, std::ostream& out) {
     const std::filesystem::path dir =
         options.out.empty() ? std::filesystem::path("results") / std::filesystem::path(options.scene).stem()
                             : std::filesystem::path(options.out);
-    if (spec.dimension == 3) return run_scene<3>(spec, dir, options.json, out);
-    return run_scene<2>(spec, dir, options.json, out);
+    if (spec.dimension == 3) return run_scene<3>(spec, dir, options.json, options.quiet, out);
+    return run_scene<2>(spec, dir, options.json, options.quiet, out);
   } catch (const NumericalError&) {
     throw;  // already reported by run_scene (with the partial summary)
   } catch (const std::exception& e) {

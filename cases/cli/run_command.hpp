@@ -19,6 +19,7 @@ struct RunCommandOptions {
   std::string out;    ///< output directory ("" = "results/<scene stem>")
   std::optional<double> t_end;  ///< replaces the scene's [stop] t_end (s)
   bool json = false;  ///< print the summary object on stdout
+  bool quiet = false;  ///< no progress line on stderr (there is none when stderr is not a terminal)
 };
 
 /// Runs the scene, writes the outputs, prints a human summary (or JSON) to `out`.

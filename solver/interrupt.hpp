@@ -1,0 +1,19 @@
+#pragma once
+/// @file interrupt.hpp
+/// A run stopped by the user (Ctrl-C) ends cleanly: the runner checks this flag after every accepted
+/// step and stops with status "interrupted", so the outputs written so far stay valid.
+///
+/// The flag is process-wide and async-signal-safe (a lock-free atomic). `install_sigint_handler()`
+/// makes SIGINT set it (the command-line tool does this); a second SIGINT while the flag is still set
+/// restores the default action and re-raises, so a run that does not stop can still be killed.
+namespace chainsim {
+
+/// Asks every running StringSolver to stop at its next accepted step.
+void request_interrupt();
+/// True once an interrupt was requested (until clear_interrupt()).
+bool interrupt_requested();
+void clear_interrupt();
+/// SIGINT -> request_interrupt() (the second one kills the process).
+void install_sigint_handler();
+
+}  // namespace chainsim
