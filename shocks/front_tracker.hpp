@@ -142,6 +142,7 @@ class FrontTracker final : public StringModule<dim> {
   EventAction handle_events(StringModel<dim>& model, double t, Eigen::Ref<Eigen::VectorXd> ledger,
                             const std::vector<int>& found) override;
   long transfers() const override { return transfers_; }
+  int num_fronts() const override { return static_cast<int>(fronts_.size()); }
 
  private:
   /// The arc end at a heap front: its end node, the node inside the arc next to it, the node that

@@ -514,6 +514,14 @@ typename StringModel<dim>::Snapshot StringModel<dim>::snapshot(double t, const E
     s.max_rate_violation = std::max(s.max_rate_violation, std::abs(e_.col(j).dot(dv_.col(j))));
   });
   s.support = support_reaction();
+  for (const auto& p : prescribed_) {
+    s.end_reactions.push_back(reaction_.col(p.node));
+    double T = std::numeric_limits<double>::quiet_NaN();
+    for_each_link([&](int j, int, int) {
+      if (chain_.link_start(j) == p.node || chain_.link_end(j) == p.node) T = s.tension[j];
+    });
+    s.end_tensions.push_back(T);
+  }
   if (module_) {
     ModuleLedger<dim>& extra = s;
     const Vec<dim> prescribed_support = s.support;

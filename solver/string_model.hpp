@@ -127,6 +127,10 @@ class StringModel final : public OdeSystem {
     double max_rate_violation = 0;  ///< max_j |e_j·Δv_j| (m/s)
     Vec<dim> momentum = Vec<dim>::Zero();  ///< Σ m_i v_i (N s)
     double moving_mass = 0;                ///< Σ m_i over the moving nodes (kg)
+    /// Per prescribed node (in the order of prescribed()): the force its support or driver exerts on
+    /// the string (N), and the tension of the link at it (N; the pivot tension of a hanging chain).
+    std::vector<Vec<dim>> end_reactions;
+    std::vector<double> end_tensions;
   };
   Snapshot snapshot(double t, const Eigen::Ref<const Eigen::VectorXd>& y);
 

@@ -112,6 +112,8 @@ class StringModule {
                                     const std::vector<int>& found) = 0;
   /// Number of node transfers so far.
   virtual long transfers() const = 0;
+  /// Number of fronts (entries of ModuleLedger::fronts).
+  virtual int num_fronts() const = 0;
 };
 
 }  // namespace chainsim

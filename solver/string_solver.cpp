@@ -32,8 +32,8 @@ void StringSolverOptions::check_frame_budget(int nodes) const {
 }
 
 const std::vector<std::string>& run_output_files() {
-  static const std::vector<std::string> files = {"stats.json", "nodes.csv",  "tension.csv",
-                                                 "energy.csv", "series.csv", "string.pvd"};
+  static const std::vector<std::string> files = {"stats.json", "nodes.csv",  "tension.csv", "energy.csv",
+                                                 "forces.csv", "series.csv", "string.pvd"};
   return files;
 }
 
@@ -95,6 +95,7 @@ CsvTable samples_table(const RunSummary& run) {
     cols.emplace_back(c);
   for (std::size_t d = 0; d < dim; ++d) cols.push_back(std::string("support_") + axes[d]);
   for (const char* c : {"moving_mass", "heap_mass", "max_violation", "moving_nodes"}) cols.emplace_back(c);
+  cols.insert(cols.end(), run.force_columns.begin(), run.force_columns.end());
   CsvTable table(cols);
   for (const StepSample& s : run.samples) {
     std::vector<double> row = {s.t};
@@ -109,6 +110,7 @@ CsvTable samples_table(const RunSummary& run) {
     for (double v : s.support) row.push_back(v);
     for (double v : {s.moving_mass, s.heap_mass, s.max_violation, static_cast<double>(s.moving_nodes)})
       row.push_back(v);
+    row.insert(row.end(), s.forces.begin(), s.forces.end());
     table.add_row(row);
   }
   return table;
@@ -143,6 +145,27 @@ void StringSolver<dim>::describe_model() {
   summary_.tension_backend = model_.has_tension_system() ? model_.tension_system().backend_name() : "none";
   summary_.t_end = options_.t_end;
   summary_.slack_policy = model_.options().slack;
+  const char* axes[] = {"x", "y", "z"};
+  summary_.force_columns.clear();
+  for (const auto& p : model_.prescribed()) {
+    for (int d = 0; d < dim; ++d) summary_.force_columns.push_back(fmt::format("R_node{}_{}", p.node, axes[d]));
+    summary_.force_columns.push_back(fmt::format("T_node{}", p.node));
+  }
+  const int fronts = model_.module() ? model_.module()->num_fronts() : 0;
+  for (int k = 0; k < fronts; ++k)
+    for (int d = 0; d < dim; ++d) summary_.force_columns.push_back(fmt::format("R_front{}_{}", k, axes[d]));
+}
+
+template <int dim>
+std::vector<double> StringSolver<dim>::measured_forces(const typename StringModel<dim>::Snapshot& snap) const {
+  std::vector<double> out;
+  for (std::size_t k = 0; k < snap.end_reactions.size(); ++k) {
+    for (int d = 0; d < dim; ++d) out.push_back(snap.end_reactions[k][d]);
+    out.push_back(snap.end_tensions[k]);
+  }
+  for (const auto& front : snap.fronts)
+    for (int d = 0; d < dim; ++d) out.push_back(front.reaction[d]);
+  return out;
 }
 
 template <int dim>
@@ -183,6 +206,7 @@ void StringSolver<dim>::record_frame(double t, const Eigen::VectorXd& y) {
   f.w_remesh = snap.w_remesh;
   f.drift = summary_.final_energy_drift;
   f.max_violation = snap.max_violation;
+  f.forces = measured_forces(snap);
   for (int i = 0; i < model_.chain().num_nodes(); ++i)
     if (model_.in_arc(i)) f.moving.push_back(i);
   f.x = std::move(snap.x);
@@ -216,6 +240,7 @@ void StringSolver<dim>::record_sample(double t, const Eigen::VectorXd& y) {
   s.heap_mass = snap.heap_mass;
   s.max_violation = snap.max_violation;
   s.moving_nodes = model_.num_moving_nodes();
+  s.forces = measured_forces(snap);
   summary_.samples.push_back(std::move(s));
 }
 
@@ -340,6 +365,9 @@ void StringSolver<dim>::write_outputs(const std::filesystem::path& dir, const Ou
     std::vector<std::string> energy_columns = {"t", "K", "V", "W_applied", "drift"};
     if (fronts) energy_columns.insert(energy_columns.end(), {"W_shocks", "W_heaps", "W_remesh"});
     CsvTable energy(energy_columns);
+    std::vector<std::string> force_columns = {"t"};
+    force_columns.insert(force_columns.end(), summary_.force_columns.begin(), summary_.force_columns.end());
+    CsvTable forces(force_columns);
     std::vector<double> row;
     for (const auto& f : frames_) {
       for (int i : f.moving) {
@@ -355,10 +383,14 @@ void StringSolver<dim>::write_outputs(const std::filesystem::path& dir, const Ou
       row = {f.t, f.kinetic, f.potential, f.work, f.drift};
       if (fronts) row.insert(row.end(), {f.w_shocks, f.w_heaps, f.w_remesh});
       energy.add_row(row);
+      row = {f.t};
+      row.insert(row.end(), f.forces.begin(), f.forces.end());
+      forces.add_row(row);
     }
     if (select.nodes) nodes.write(dir / "nodes.csv");
     if (select.tension) tension.write(dir / "tension.csv");
     if (select.energy) energy.write(dir / "energy.csv");
+    if (select.forces && force_columns.size() > 1) forces.write(dir / "forces.csv");
     if (select.energy && !summary_.samples.empty()) samples_table(summary_).write(dir / "series.csv");
   }
   // 3. ParaView frames (the moving nodes, a line cell per link of an arc), then their index.

@@ -10,6 +10,7 @@
 ///   tension.csv  t, link, s_mid, T                       the links of the arcs; s_mid: material
 ///                                                        coordinate of the link midpoint
 ///   energy.csv   t, K, V, W_applied, drift[, W_shocks, W_heaps, W_remesh]    at every frame
+///   forces.csv   t and the forces people measure (RunSummary::force_columns) at every frame
 ///                drift = K + V − (K0 + V0) − W_applied − W_shocks − W_heaps − W_remesh
 ///   series.csv   one row per accepted step (StringSolverOptions::record_steps, on for runs with
 ///                fronts): samples_table()
@@ -41,11 +42,12 @@ struct StringSolverOptions {
 };
 
 /// Which outputs write_outputs() produces: fields × formats. A CSV file per field (nodes, tension,
-/// energy: energy.csv and, when steps are recorded, series.csv), the ParaView frames (geometry and
+/// energy: energy.csv and, when steps are recorded, series.csv; forces: forces.csv when the run has
+/// supports, drivers or fronts), the ParaView frames (geometry and
 /// velocities, plus the tension as cell data if the tension field is selected; they need the nodes
 /// field), and stats.json.
 struct OutputSelection {
-  bool nodes = true, tension = true, energy = true, stats = true;  ///< fields
+  bool nodes = true, tension = true, energy = true, forces = true, stats = true;  ///< fields
   bool csv = true, vtk = true;                                     ///< formats
 };
 
@@ -59,6 +61,7 @@ struct Frame {
   double kinetic = 0, potential = 0, work = 0, drift = 0;
   double w_shocks = 0, w_heaps = 0, w_remesh = 0;
   double max_violation = 0;
+  std::vector<double> forces;  ///< the forces people measure, in the order of force_columns()
 };
 
 /// One accepted step (or crossing, or the stop) of a run that records its steps.
@@ -72,6 +75,7 @@ struct StepSample {
   std::vector<double> support;     ///< force of all supports on the system (N), dim components
   double moving_mass = 0, heap_mass = 0, max_violation = 0;
   int moving_nodes = 0;
+  std::vector<double> forces;  ///< in the order of RunSummary::force_columns
 };
 
 /// What a run did.
@@ -105,6 +109,11 @@ struct RunSummary {
   double stabilization_time = 0;   ///< Baumgarte time scale used (s)
   IntegratorStats stats;
   std::vector<StepSample> samples;     ///< after every accepted step (StringSolverOptions::record_steps)
+  /// Names of the measured forces (forces.csv, the end of series.csv): per prescribed node i,
+  /// R_node<i>_x.. (its support's or driver's force on the string, N) and T_node<i> (the tension of the
+  /// link at it, N); per front k, R_front<k>_x.. (the force of the heap's support on the string at
+  /// the front, N; zero for a fold).
+  std::vector<std::string> force_columns;
   /// energy_drift / energy_scale (0 if the scale is 0).
   double relative_energy_drift() const { return energy_scale > 0 ? energy_drift / energy_scale : 0.0; }
   double relative_energy_residual() const { return relative_energy_drift(); }
@@ -155,6 +164,7 @@ class StringSolver {
   void check_slack(double t, const Eigen::VectorXd& y);
   void book(double t, const typename StringModel<dim>::Snapshot& snap);
   void describe_model();
+  std::vector<double> measured_forces(const typename StringModel<dim>::Snapshot& snap) const;
 
   StringModel<dim>& model_;
   StringSolverOptions options_;
