@@ -1,7 +1,7 @@
 #pragma once
 /// @file scene_build.hpp
-/// What every model built from a scene shares (internal to cases/: scene.cpp, front_scene.cpp,
-/// reduced_scene.cpp): errors located at the key at fault, vectors checked against the dimension,
+/// What every model built from a scene shares (internal to cases/scene/: scene_parts.cpp, string_scene.cpp,
+/// front_scene.cpp, reduced_scene.cpp): errors located at the key at fault, vectors checked against the dimension,
 /// and the string itself — the shape discretized, the initial velocity, the force effects and
 /// the held ends, exactly as the scene declares them.
 #include <memory>
@@ -17,6 +17,9 @@
 #include "solver/integrator.hpp"
 
 namespace chainsim::scene_build {
+
+/// The largest number of nodes a scene may ask for (memory: a few hundred bytes per node).
+inline constexpr long long kMaxNodes = 10000000;
 
 /// Throws InputError "<file:line:column of key>: <message>".
 [[noreturn]] inline void fail_at(const SceneSpec& spec, const std::string& key, const std::string& message) {

@@ -1,4 +1,4 @@
-// cases/scene/scene.cpp: a table of bad scenes, each refused with its exact message: the file:line:column
+// cases/scene/ (the scene parser and builders): a table of bad scenes, each refused with its exact message: the file:line:column
 // of the key at fault (the value, or the key itself when it is unknown, or the section header when
 // a key is missing), the key, the value as written, and what is allowed. Errors found while
 // building the model (dimensions, lengths, ends, frames) are located the same way.

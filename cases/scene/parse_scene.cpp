@@ -1,0 +1,73 @@
+// String scenes, step 1: TOML -> SceneSpec (scene.hpp). The file is read here and each section is
+// checked by its own parse function (parse_sections.hpp) through a checked view of its table
+// (checked_table.hpp); every key read is located in the scene text (scene_text.hpp).
+// See docs/scenes.md for every key.
+#include <fstream>
+#include <sstream>
+
+#include <fmt/format.h>
+#include <toml++/toml.h>
+
+#include "cases/scene/parse_sections.hpp"
+#include "cases/scene/scene.hpp"
+#include "mesh/errors.hpp"
+
+namespace chainsim {
+
+using scene_parse::Context;
+using scene_parse::Section;
+using scene_text::SourceText;
+
+namespace {
+
+SceneSpec parse_table(const toml::table& root, const SourceText& text) {
+  SceneSpec spec;
+  spec.source = text.name();
+  Context ctx{text, spec};
+  const Section top(root, "", ctx,
+                    {"string", "shape", "velocity", "ends", "effects", "solver", "output", "stop", "model"},
+                    {{"gravity", "[effects.gravity]"}, {"drag", "[effects.drag]"}, {"heap", "[[effects.heap]]"},
+                     {"fold", "[effects.fold]"}, {"plane", "[effects.plane]"}},
+                    "section");
+  scene_parse::parse_model(top, ctx);
+  scene_parse::parse_string(top, ctx);
+  scene_parse::parse_shape(top, ctx);
+  scene_parse::parse_velocity(top, ctx);
+  scene_parse::parse_ends(top, ctx);
+  scene_parse::parse_effects(top, ctx);
+  scene_parse::parse_solver(top, ctx);
+  scene_parse::parse_output(top, ctx);
+  scene_parse::parse_stop(top, ctx);
+  return spec;
+}
+
+}  // namespace
+
+std::string SceneSpec::where(const std::string& key) const {
+  for (std::string k = key; !k.empty();) {
+    if (const auto it = locations.find(k); it != locations.end()) return it->second.where;
+    const auto cut = k.find_last_of(".[");
+    k = cut == std::string::npos ? "" : k.substr(0, cut);
+  }
+  return source + ":1:1";
+}
+
+SceneSpec parse_scene_text(std::string_view text, const std::string& source) {
+  const SourceText src(source, text);
+  try {
+    toml::table root = toml::parse(text, source);
+    return parse_table(root, src);
+  } catch (const toml::parse_error& e) {
+    throw InputError(fmt::format("{}: {}", src.where(e.source()), e.description()));
+  }
+}
+
+SceneSpec parse_scene(const std::filesystem::path& file) {
+  std::ifstream in(file);
+  if (!in) throw InputError(fmt::format("cannot read the scene file '{}'", file.string()));
+  std::stringstream buffer;
+  buffer << in.rdbuf();
+  return parse_scene_text(buffer.str(), file.string());
+}
+
+}  // namespace chainsim

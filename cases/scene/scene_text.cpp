@@ -1,0 +1,88 @@
+// The scene text: positions, values as written, and the closest valid word (scene_text.hpp).
+#include "cases/scene/scene_text.hpp"
+
+#include <algorithm>
+
+#include <fmt/format.h>
+
+namespace chainsim::scene_text {
+
+std::string join(const std::vector<std::string>& words, const char* separator) {
+  std::string out;
+  for (const auto& w : words) out += (out.empty() ? "" : separator) + w;
+  return out;
+}
+
+SourceText::SourceText(std::string name, std::string_view text) : name_(std::move(name)) {
+  std::size_t start = 0;
+  while (start <= text.size()) {
+    const std::size_t stop = std::min(text.find('\n', start), text.size());
+    lines_.emplace_back(text.substr(start, stop - start));
+    start = stop + 1;
+  }
+}
+
+std::string SourceText::where(const toml::source_region& region) const {
+  if (region.begin.line == 0) return name_ + ":1:1";
+  return fmt::format("{}:{}:{}", name_, region.begin.line, region.begin.column);
+}
+
+std::string SourceText::quote(const toml::source_region& region) const {
+  if (region.begin.line == 0 || region.begin.line > lines_.size()) return "";
+  std::string raw;
+  const auto last = std::min<std::size_t>(region.end.line, lines_.size());
+  for (std::size_t line = region.begin.line; line <= last; ++line) {
+    const std::string& text = lines_[line - 1];
+    const std::size_t from = line == region.begin.line ? byte_offset(text, region.begin.column) : 0;
+    const std::size_t to = line == region.end.line ? byte_offset(text, region.end.column) : text.size();
+    if (to > from) raw += text.substr(from, to - from);
+    raw += ' ';
+  }
+  std::string out;
+  for (char c : raw) {
+    const bool space = c == ' ' || c == '\t' || c == '\r';
+    if (space && (out.empty() || out.back() == ' ')) continue;
+    out += space ? ' ' : c;
+  }
+  while (!out.empty() && out.back() == ' ') out.pop_back();
+  if (out.size() > kQuoteLength) out = out.substr(0, kQuoteLength - 3) + "...";
+  return out;
+}
+
+std::size_t SourceText::byte_offset(const std::string& line, std::size_t column) {
+  std::size_t seen = 0;
+  for (std::size_t i = 0; i < line.size(); ++i)
+    if ((static_cast<unsigned char>(line[i]) & 0xC0) != 0x80 && ++seen == column) return i;
+  return line.size();
+}
+
+std::size_t edit_distance(const std::string& a, const std::string& b) {
+  std::vector<std::vector<std::size_t>> d(a.size() + 1, std::vector<std::size_t>(b.size() + 1));
+  for (std::size_t i = 0; i <= a.size(); ++i) d[i][0] = i;
+  for (std::size_t j = 0; j <= b.size(); ++j) d[0][j] = j;
+  for (std::size_t i = 1; i <= a.size(); ++i)
+    for (std::size_t j = 1; j <= b.size(); ++j) {
+      const std::size_t cost = a[i - 1] == b[j - 1] ? 0 : 1;
+      d[i][j] = std::min({d[i - 1][j] + 1, d[i][j - 1] + 1, d[i - 1][j - 1] + cost});
+      if (i > 1 && j > 1 && a[i - 1] == b[j - 2] && a[i - 2] == b[j - 1]) d[i][j] = std::min(d[i][j], d[i - 2][j - 2] + 1);
+    }
+  return d[a.size()][b.size()];
+}
+
+std::string closest(const std::string& word, const std::vector<std::string>& valid) {
+  std::string best;
+  std::size_t best_distance = 3;
+  for (const auto& v : valid) {
+    const std::size_t d = edit_distance(word, v);
+    if (d < best_distance && 2 * d < std::max(word.size(), v.size())) {
+      best = v;
+      best_distance = d;
+    }
+  }
+  if (best.empty() && word.size() >= 3)
+    for (const auto& v : valid)
+      if (v.rfind(word, 0) == 0) return v;
+  return best;
+}
+
+}  // namespace chainsim::scene_text
