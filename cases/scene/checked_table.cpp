@@ -24,17 +24,16 @@ Section::Section(const toml::table& table, std::string name, Context& ctx, std::
     : table_(table), name_(std::move(name)), ctx_(ctx) {
   if (!name_.empty() && table.source().begin.line > 0)
     ctx_.spec.locations[name_] = {ctx_.text.where(table.source()), ""};
-  // The first unknown key in file order (toml++ iterates in key order).
+  // The first unknown key in file order, then in the order of the overrides (toml++ iterates in key
+  // order).
   const toml::key* unknown = nullptr;
   for (const auto& [key, node] : table) {
     const std::string k(key.str());
     if (std::find(allowed.begin(), allowed.end(), k) != allowed.end()) {
-      ctx_.spec.locations[full(k)] = {ctx_.text.where(node.source()), ctx_.text.quote(node.source())};
+      ctx_.spec.locations[full(k)] = {ctx_.text.where(node.source()), ctx_.text.quote(node)};
       continue;
     }
-    const auto& p = key.source().begin;
-    if (!unknown || std::pair(p.line, p.column) < std::pair(unknown->source().begin.line, unknown->source().begin.column))
-      unknown = &key;
+    if (!unknown || ctx_.text.order(key.source()) < ctx_.text.order(unknown->source())) unknown = &key;
   }
   if (!unknown) return;
   const std::string k(unknown->str());
@@ -69,7 +68,7 @@ std::string Section::at(const std::string& key) const {
 
 std::string Section::text(const std::string& key) const {
   const toml::node* n = node(key);
-  return n ? ctx_.text.quote(n->source()) : "";
+  return n ? ctx_.text.quote(*n) : "";
 }
 
 void Section::fail(const std::string& key, const std::string& message) const {
@@ -167,7 +166,7 @@ std::vector<std::vector<double>> Section::matrix(const std::string& key) const {
     const toml::array* r = row.as_array();
     if (!r || r->empty()) wrong_type(key, expected);
     ctx_.spec.locations[fmt::format("{}[{}]", full(key), out.size())] = {ctx_.text.where(row.source()),
-                                                                        ctx_.text.quote(row.source())};
+                                                                        ctx_.text.quote(row)};
     out.push_back(numbers(*r, key));
   }
   return out;
@@ -225,10 +224,17 @@ std::vector<const toml::table*> table_array(const Section& parent, const std::st
   const toml::node* n = parent.node(name);
   if (!n) return out;
   const toml::array* arr = n->as_array();
-  if (!arr || !arr->is_array_of_tables())
-    parent.fail(name, fmt::format("{} must be an array of tables: write [[{}]] once per {}", parent.full(name),
-                                  parent.full(name), what));
-  for (const auto& item : *arr) out.push_back(item.as_table());
+  const std::string full = parent.full(name);
+  if (!arr || arr->empty())
+    parent.fail(name, fmt::format("{} must be an array of tables: write [[{}]] once per {}", full, full, what));
+  for (std::size_t k = 0; k < arr->size(); ++k) {
+    const toml::node& item = *arr->get(k);
+    if (!item.is_table())  // e.g. an element set by an override: point at the element
+      throw InputError(fmt::format("{}: {}[{}] = {} must be a table: write [[{}]] once per {}",
+                                   parent.source_text().where(item.source()), full, k,
+                                   parent.source_text().quote(item), full, what));
+    out.push_back(item.as_table());
+  }
   return out;
 }
 

@@ -45,6 +45,8 @@ class Section {
   /// The key's value as written ("" if absent).
   std::string text(const std::string& key) const;
   const std::string& name() const { return name_; }
+  /// The scene's text (positions and values as written).
+  const SourceText& source_text() const { return ctx_.text; }
 
   /// Throws "<location of key>: <message>".
   [[noreturn]] void fail(const std::string& key, const std::string& message) const;

@@ -1,6 +1,7 @@
 // String scenes, step 1: TOML -> SceneSpec (scene.hpp). The file is read here and each section is
 // checked by its own parse function (parse_sections.hpp) through a checked view of its table
-// (checked_table.hpp); every key read is located in the scene text (scene_text.hpp).
+// (checked_table.hpp), after the command line's overrides (scene_overrides.hpp); every key read is
+// located in the scene text (scene_text.hpp).
 // See docs/scenes.md for every key.
 #include <fstream>
 #include <sstream>
@@ -10,6 +11,7 @@
 
 #include "cases/scene/parse_sections.hpp"
 #include "cases/scene/scene.hpp"
+#include "cases/scene/scene_overrides.hpp"
 #include "mesh/errors.hpp"
 
 namespace chainsim {
@@ -52,22 +54,27 @@ std::string SceneSpec::where(const std::string& key) const {
   return source + ":1:1";
 }
 
-SceneSpec parse_scene_text(std::string_view text, const std::string& source) {
-  const SourceText src(source, text);
+SceneSpec parse_scene_text(std::string_view text, const std::string& source) { return parse_scene_text(text, source, {}); }
+
+SceneSpec parse_scene_text(std::string_view text, const std::string& source, const std::vector<std::string>& overrides) {
+  SourceText src(source, text);
   try {
     toml::table root = toml::parse(text, source);
+    scene_parse::apply_overrides(root, overrides, src);
     return parse_table(root, src);
   } catch (const toml::parse_error& e) {
     throw InputError(fmt::format("{}: {}", src.where(e.source()), e.description()));
   }
 }
 
-SceneSpec parse_scene(const std::filesystem::path& file) {
+SceneSpec parse_scene(const std::filesystem::path& file) { return parse_scene(file, {}); }
+
+SceneSpec parse_scene(const std::filesystem::path& file, const std::vector<std::string>& overrides) {
   std::ifstream in(file);
   if (!in) throw InputError(fmt::format("cannot read the scene file '{}'", file.string()));
   std::stringstream buffer;
   buffer << in.rdbuf();
-  return parse_scene_text(buffer.str(), file.string());
+  return parse_scene_text(buffer.str(), file.string(), overrides);
 }
 
 }  // namespace chainsim

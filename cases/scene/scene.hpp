@@ -86,7 +86,8 @@ struct FrontStop {
 
 /// Where a key was written and how.
 struct KeyLocation {
-  std::string where;  ///< "file:line:column" of its value (of the header, for a section)
+  std::string where;  ///< "file:line:column" of its value (of the header, for a section), or the
+                      ///< "--set KEY=VALUE" that gave it
   std::string text;   ///< the value as written in the file (shortened if long)
 };
 
@@ -163,8 +164,14 @@ struct SceneSpec {
 /// Reads a scene file. Throws InputError (with file:line:column) on a syntax error, an unknown
 /// section or key, a missing required key, or a value of the wrong type or out of range.
 SceneSpec parse_scene(const std::filesystem::path& file);
+/// The same with the command line's overrides "KEY=VALUE" (`chainsim run --set`, in order; see
+/// docs/scenes.md): each sets a key of the scene, creating its section or array element if the scene
+/// has none, before any check, so that a bad value or unknown key is refused as in the file, located
+/// at "--set KEY=VALUE".
+SceneSpec parse_scene(const std::filesystem::path& file, const std::vector<std::string>& overrides);
 /// The same from text; `source` names it in messages.
 SceneSpec parse_scene_text(std::string_view text, const std::string& source);
+SceneSpec parse_scene_text(std::string_view text, const std::string& source, const std::vector<std::string>& overrides);
 
 /// A scene ready to run.
 template <int dim>

@@ -2,6 +2,7 @@
 #include "cases/scene/scene_text.hpp"
 
 #include <algorithm>
+#include <sstream>
 
 #include <fmt/format.h>
 
@@ -13,40 +14,75 @@ std::string join(const std::vector<std::string>& words, const char* separator) {
   return out;
 }
 
-SourceText::SourceText(std::string name, std::string_view text) : name_(std::move(name)) {
+namespace {
+
+std::vector<std::string> split_lines(std::string_view text) {
+  std::vector<std::string> lines;
   std::size_t start = 0;
   while (start <= text.size()) {
     const std::size_t stop = std::min(text.find('\n', start), text.size());
-    lines_.emplace_back(text.substr(start, stop - start));
+    lines.emplace_back(text.substr(start, stop - start));
     start = stop + 1;
   }
+  return lines;
 }
 
-std::string SourceText::where(const toml::source_region& region) const {
-  if (region.begin.line == 0) return name_ + ":1:1";
-  return fmt::format("{}:{}:{}", name_, region.begin.line, region.begin.column);
-}
-
-std::string SourceText::quote(const toml::source_region& region) const {
-  if (region.begin.line == 0 || region.begin.line > lines_.size()) return "";
-  std::string raw;
-  const auto last = std::min<std::size_t>(region.end.line, lines_.size());
-  for (std::size_t line = region.begin.line; line <= last; ++line) {
-    const std::string& text = lines_[line - 1];
-    const std::size_t from = line == region.begin.line ? byte_offset(text, region.begin.column) : 0;
-    const std::size_t to = line == region.end.line ? byte_offset(text, region.end.column) : text.size();
-    if (to > from) raw += text.substr(from, to - from);
-    raw += ' ';
-  }
+/// `raw` with runs of white space collapsed to one space, cut to kQuoteLength characters.
+std::string collapse(const std::string& raw) {
   std::string out;
   for (char c : raw) {
-    const bool space = c == ' ' || c == '\t' || c == '\r';
+    const bool space = c == ' ' || c == '\t' || c == '\r' || c == '\n';
     if (space && (out.empty() || out.back() == ' ')) continue;
     out += space ? ' ' : c;
   }
   while (!out.empty() && out.back() == ' ') out.pop_back();
   if (out.size() > kQuoteLength) out = out.substr(0, kQuoteLength - 3) + "...";
   return out;
+}
+
+}  // namespace
+
+SourceText::SourceText(std::string name, std::string_view text) { texts_.push_back({std::move(name), split_lines(text)}); }
+
+void SourceText::add(std::string path, std::string_view text) { texts_.push_back({std::move(path), split_lines(text)}); }
+
+std::size_t SourceText::text_of(const toml::source_region& region) const {
+  if (region.path)
+    for (std::size_t k = 1; k < texts_.size(); ++k)
+      if (texts_[k].path == *region.path) return k;
+  return 0;
+}
+
+std::string SourceText::where(const toml::source_region& region) const {
+  if (region.begin.line == 0) return name() + ":1:1";
+  const std::size_t k = text_of(region);
+  if (k > 0) return texts_[k].path;
+  return fmt::format("{}:{}:{}", name(), region.begin.line, region.begin.column);
+}
+
+std::tuple<std::size_t, std::size_t, std::size_t> SourceText::order(const toml::source_region& region) const {
+  return {text_of(region), region.begin.line, region.begin.column};
+}
+
+std::string SourceText::quote(const toml::node& node) const {
+  if (changed_.count(&node)) {
+    std::ostringstream now;
+    node.visit([&](const auto& concrete) { now << concrete; });
+    return collapse(now.str());
+  }
+  const toml::source_region& region = node.source();
+  const std::vector<std::string>& lines = texts_[text_of(region)].lines;
+  if (region.begin.line == 0 || region.begin.line > lines.size()) return "";
+  std::string raw;
+  const auto last = std::min<std::size_t>(region.end.line, lines.size());
+  for (std::size_t line = region.begin.line; line <= last; ++line) {
+    const std::string& text = lines[line - 1];
+    const std::size_t from = line == region.begin.line ? byte_offset(text, region.begin.column) : 0;
+    const std::size_t to = line == region.end.line ? byte_offset(text, region.end.column) : text.size();
+    if (to > from) raw += text.substr(from, to - from);
+    raw += ' ';
+  }
+  return collapse(raw);
 }
 
 std::size_t SourceText::byte_offset(const std::string& line, std::size_t column) {

@@ -13,21 +13,13 @@
 #include "test_scene_support.hpp"
 
 using namespace chainsim;
+using test::edit;
 
 namespace {
 
 // The messages below point into this text: lines 1-17 are test_scene_support.hpp's scene.
 const std::string& kBase = test::kSceneBase;
 const char* kPolyline = "kind = \"polyline\"\npoints = [[0.0, 0.0], [0.0, -1.0]]";
-
-/// `text` with its first `from` replaced by `to` (which must be there).
-std::string edit(const std::string& text, const std::string& from, const std::string& to) {
-  const auto at = text.find(from);
-  REQUIRE(at != std::string::npos);
-  std::string out = text;
-  out.replace(at, from.size(), to);
-  return out;
-}
 
 /// The message of the InputError that parsing `text` and building the model it asks for (string,
 /// string with fronts, or reduced) raises, or "" if none.
