@@ -16,31 +16,40 @@ std::string join(const std::vector<std::string>& words, const char* separator) {
 
 namespace {
 
-std::vector<std::string> split_lines(std::string_view text) {
-  std::vector<std::string> lines;
-  std::size_t start = 0;
-  while (start <= text.size()) {
-    const std::size_t stop = std::min(text.find('\n', start), text.size());
-    lines.emplace_back(text.substr(start, stop - start));
-    start = stop + 1;
-  }
-  return lines;
+/// Appends `c` to a quote, collapsing runs of white space; false once the quote, trailing space
+/// trimmed, is longer than kQuoteLength (it will be cut: the rest is not needed).
+bool append(std::string& out, char c) {
+  const bool space = c == ' ' || c == '\t' || c == '\r' || c == '\n';
+  if (space && (out.empty() || out.back() == ' ')) return true;
+  out += space ? ' ' : c;
+  return out.size() <= kQuoteLength || out.back() == ' ';
 }
 
-/// `raw` with runs of white space collapsed to one space, cut to kQuoteLength characters.
-std::string collapse(const std::string& raw) {
-  std::string out;
-  for (char c : raw) {
-    const bool space = c == ' ' || c == '\t' || c == '\r' || c == '\n';
-    if (space && (out.empty() || out.back() == ' ')) continue;
-    out += space ? ' ' : c;
-  }
+/// A collapsed quote, trimmed and cut to kQuoteLength characters.
+std::string finish(std::string out) {
   while (!out.empty() && out.back() == ' ') out.pop_back();
   if (out.size() > kQuoteLength) out = out.substr(0, kQuoteLength - 3) + "...";
   return out;
 }
 
 }  // namespace
+
+std::vector<SourceText::Line> SourceText::split_lines(std::string_view text) {
+  std::vector<Line> lines;
+  std::size_t start = 0;
+  while (start <= text.size()) {
+    const std::size_t stop = std::min(text.find('\n', start), text.size());
+    Line line{std::string(text.substr(start, stop - start)), {}};
+    const bool ascii = std::all_of(line.text.begin(), line.text.end(),
+                                   [](char c) { return (static_cast<unsigned char>(c) & 0x80) == 0; });
+    if (!ascii)
+      for (std::size_t i = 0; i < line.text.size(); ++i)
+        if ((static_cast<unsigned char>(line.text[i]) & 0xC0) != 0x80) line.starts.push_back(i);
+    lines.push_back(std::move(line));
+    start = stop + 1;
+  }
+  return lines;
+}
 
 SourceText::SourceText(std::string name, std::string_view text) { texts_.push_back({std::move(name), split_lines(text)}); }
 
@@ -65,31 +74,33 @@ std::tuple<std::size_t, std::size_t, std::size_t> SourceText::order(const toml::
 }
 
 std::string SourceText::quote(const toml::node& node) const {
+  std::string out;
   if (changed_.count(&node)) {
     std::ostringstream now;
     node.visit([&](const auto& concrete) { now << concrete; });
-    return collapse(now.str());
+    for (char c : now.str())
+      if (!append(out, c)) break;
+    return finish(out);
   }
   const toml::source_region& region = node.source();
-  const std::vector<std::string>& lines = texts_[text_of(region)].lines;
+  const std::vector<Line>& lines = texts_[text_of(region)].lines;
   if (region.begin.line == 0 || region.begin.line > lines.size()) return "";
-  std::string raw;
   const auto last = std::min<std::size_t>(region.end.line, lines.size());
   for (std::size_t line = region.begin.line; line <= last; ++line) {
-    const std::string& text = lines[line - 1];
+    const Line& text = lines[line - 1];
     const std::size_t from = line == region.begin.line ? byte_offset(text, region.begin.column) : 0;
-    const std::size_t to = line == region.end.line ? byte_offset(text, region.end.column) : text.size();
-    if (to > from) raw += text.substr(from, to - from);
-    raw += ' ';
+    const std::size_t to = line == region.end.line ? byte_offset(text, region.end.column) : text.text.size();
+    for (std::size_t i = from; i < to; ++i)
+      if (!append(out, text.text[i])) return finish(out);
+    if (!append(out, ' ')) break;
   }
-  return collapse(raw);
+  return finish(out);
 }
 
-std::size_t SourceText::byte_offset(const std::string& line, std::size_t column) {
-  std::size_t seen = 0;
-  for (std::size_t i = 0; i < line.size(); ++i)
-    if ((static_cast<unsigned char>(line[i]) & 0xC0) != 0x80 && ++seen == column) return i;
-  return line.size();
+std::size_t SourceText::byte_offset(const Line& line, std::size_t column) {
+  if (column == 0) return line.text.size();
+  if (line.starts.empty()) return std::min(column - 1, line.text.size());
+  return column <= line.starts.size() ? line.starts[column - 1] : line.text.size();
 }
 
 std::size_t edit_distance(const std::string& a, const std::string& b) {

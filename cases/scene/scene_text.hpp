@@ -40,7 +40,8 @@ class SourceText {
   std::string where(const toml::source_region& region) const;
 
   /// The text of `node` as written, with runs of white space collapsed (cut to kQuoteLength
-  /// characters); a table or array an override changed is shown as it is now.
+  /// characters); a table or array an override changed is shown as it is now. Reads only the
+  /// characters it shows: its cost does not grow with the length of the value or of its line.
   std::string quote(const toml::node& node) const;
 
   /// Sorts regions in the order they were given: the file by line and column, then each override.
@@ -50,14 +51,21 @@ class SourceText {
   void mark_changed(const toml::node* node) { changed_.insert(node); }
 
  private:
-  struct Text {
-    std::string path;                ///< source path of its regions
-    std::vector<std::string> lines;  ///< the text, by line
+  struct Line {
+    std::string text;
+    /// Byte offset of each code point, for a line that is not all ASCII (empty otherwise: the
+    /// column is the byte offset + 1), so that finding a column costs O(1), not O(line).
+    std::vector<std::size_t> starts;
   };
+  struct Text {
+    std::string path;         ///< source path of its regions
+    std::vector<Line> lines;  ///< the text, by line
+  };
+  static std::vector<Line> split_lines(std::string_view text);
   /// The text a region comes from (the file's if none matches).
   std::size_t text_of(const toml::source_region& region) const;
-  /// Byte offset of the 1-based column `column` (toml++ counts code points) in a UTF-8 line.
-  static std::size_t byte_offset(const std::string& line, std::size_t column);
+  /// Byte offset of the 1-based column `column` (toml++ counts code points) in a line.
+  static std::size_t byte_offset(const Line& line, std::size_t column);
 
   std::vector<Text> texts_;  ///< the file, then the overrides
   std::set<const toml::node*> changed_;
