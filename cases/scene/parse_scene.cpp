@@ -3,8 +3,10 @@
 // (checked_table.hpp), after the command line's overrides (scene_overrides.hpp); every key read is
 // located in the scene text (scene_text.hpp).
 // See docs/scenes.md for every key.
+#include <cstdint>
 #include <fstream>
-#include <sstream>
+#include <system_error>
+#include <vector>
 
 #include <fmt/format.h>
 #include <toml++/toml.h>
@@ -21,6 +23,10 @@ using scene_parse::Section;
 using scene_text::SourceText;
 
 namespace {
+
+/// The largest scene file read (bytes): far above any scene (a 100001-point polyline is 2 MB), far
+/// below what would exhaust memory.
+constexpr std::uintmax_t kMaxSceneBytes = std::uintmax_t{64} << 20;
 
 SceneSpec parse_table(const toml::table& root, const SourceText& text) {
   SceneSpec spec;
@@ -70,11 +76,29 @@ SceneSpec parse_scene_text(std::string_view text, const std::string& source, con
 SceneSpec parse_scene(const std::filesystem::path& file) { return parse_scene(file, {}); }
 
 SceneSpec parse_scene(const std::filesystem::path& file, const std::vector<std::string>& overrides) {
-  std::ifstream in(file);
-  if (!in) throw InputError(fmt::format("cannot read the scene file '{}'", file.string()));
-  std::stringstream buffer;
-  buffer << in.rdbuf();
-  return parse_scene_text(buffer.str(), file.string(), overrides);
+  const std::string name = file.string();
+  auto too_large = [&] {
+    return InputError(fmt::format("{}:1:1: the scene file is larger than {} MiB ({} bytes), the most a scene may have",
+                                  name, kMaxSceneBytes >> 20, kMaxSceneBytes));
+  };
+  std::error_code ec;
+  if (std::filesystem::is_directory(file, ec))
+    throw InputError(fmt::format("cannot read the scene file '{}': it is a directory", name));
+  // A regular file is measured first; anything else (a FIFO, a device such as /dev/zero) is read up
+  // to the limit and no further.
+  if (std::filesystem::is_regular_file(file, ec) && std::filesystem::file_size(file, ec) > kMaxSceneBytes && !ec)
+    throw too_large();
+  std::ifstream in(file, std::ios::binary);
+  if (!in) throw InputError(fmt::format("cannot read the scene file '{}'", name));
+  std::string text;
+  std::vector<char> chunk(std::size_t{1} << 16);
+  while (in.read(chunk.data(), static_cast<std::streamsize>(chunk.size())) || in.gcount() > 0) {
+    const auto n = static_cast<std::size_t>(in.gcount());
+    if (text.size() + n > kMaxSceneBytes) throw too_large();
+    text.append(chunk.data(), n);
+  }
+  if (in.bad()) throw InputError(fmt::format("cannot read the scene file '{}'", name));
+  return parse_scene_text(text, name, overrides);
 }
 
 }  // namespace chainsim
