@@ -185,7 +185,8 @@ struct StringScene {
 /// Builds the model of a parsed scene (dim must equal spec.dimension) with exactly the effects the
 /// scene declares, checks it physically and projects its initial state onto the constraints.
 /// Default Baumgarte time: τ_b = 0.1 t_char with t_char the shortest of sqrt(ℓ/|g|) (gravity),
-/// ℓ/max|v0| (moving start), 2π/ω (shaken or periodically loaded ends) and t_end.
+/// ℓ/v (v the largest initial speed or the speed of an end driven along a line) and 2π/ω (shaken or
+/// periodically loaded ends); t_end only when the scene has none of these.
 /// Throws InputError naming the file:line:column of the key at fault.
 template <int dim>
 StringScene<dim> build_string_scene(const SceneSpec& spec);
