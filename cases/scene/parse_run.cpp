@@ -11,7 +11,7 @@ void parse_solver(const Section& top, Context& ctx) {
   auto& so = ctx.spec.solver;
   Section s(subtable(top, "solver"), "solver", ctx,
             {"method", "rtol", "atol", "max_step", "initial_step", "max_steps", "stabilization_time", "backend",
-             "check_slack", "slack_tolerance"},
+             "check_slack", "slack_tolerance", "slack", "max_wall_s"},
             {{"t_end", "in [stop]"}, {"output_interval", "as interval in [output]"}, {"vtk", "as formats in [output]"}});
   // Each value is checked by the option struct that owns its range, one field at a time.
   auto integrator = [&](const char* key, auto set) {
@@ -46,8 +46,16 @@ void parse_solver(const Section& top, Context& ctx) {
   so.backend = s.string("backend").value_or(so.backend);
   model("backend", [&](StringModelOptions& o) { o.backend = so.backend; });
   so.check_slack = s.boolean("check_slack").value_or(so.check_slack);
+  so.slack = s.choice("slack", {"stop", "warn", "ignore"}, so.slack);
+  if (s.has("check_slack") && s.has("slack"))
+    s.fail("check_slack", fmt::format("solver.check_slack = {} and solver.slack = {} both say what a slack link does: "
+                                      "give one of them (check_slack = true is slack = \"stop\", false is slack = "
+                                      "\"ignore\")",
+                                      s.text("check_slack"), s.text("slack")));
+  if (s.has("check_slack")) so.slack = so.check_slack ? "stop" : "ignore";
   so.slack_tolerance = s.number("slack_tolerance").value_or(so.slack_tolerance);
   model("slack_tolerance", [&](StringModelOptions& o) { o.slack_tolerance = so.slack_tolerance; });
+  so.max_wall_s = s.positive("max_wall_s");
 }
 
 void parse_output(const Section& top, Context& ctx) {

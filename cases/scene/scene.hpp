@@ -23,7 +23,8 @@
 ///     [[effects.heap]] side = start | end, s0 (m), f, point (m), on_plane
 ///     [effects.fold]   s0 (m), f          [effects.plane] point (m), normal (the table of a heap)
 ///     [solver]   method, rtol, atol, max_step, initial_step, max_steps, stabilization_time, backend,
-///                check_slack, slack_tolerance
+///                slack = stop | warn | ignore (check_slack = true | false: its older form),
+///                slack_tolerance, max_wall_s (s)
 ///     [output]   interval (s), fields = [nodes, tension, energy, stats], formats = [csv, vtk]
 ///     [stop]     t_end (s), [[stop.front]] front = fold | heap_start | heap_end, s0 (m)
 ///     model      = "string" (default) | "reduced" (top-level key)
@@ -146,8 +147,15 @@ struct SceneSpec {
     long max_steps = 500000;
     std::optional<double> stabilization_time;  ///< s; default 0.1 t_char (see build_string_scene)
     std::string backend = "auto";
+    /// The older key check_slack as written (false when absent), which the builders read until
+    /// `slack` is wired into the solver; check_slack = true / false is also stored in `slack` as
+    /// "stop" / "ignore".
     bool check_slack = false;
     double slack_tolerance = 1e-8;
+    /// What a slack link (a negative tension at an accepted step) does: "stop" (a numerical failure),
+    /// "warn" (reported, the run goes on) or "ignore".
+    std::string slack = "stop";
+    std::optional<double> max_wall_s;  ///< s of wall-clock time the run may take (> 0); none: no limit
   } solver;
   // [output]
   struct Output {

@@ -127,8 +127,9 @@ json scene_to_json(const SceneSpec& spec) {
         {"max_steps", so.max_steps},
         {"stabilization_time", or_null(so.stabilization_time)},
         {"backend", so.backend},
-        {"check_slack", so.check_slack},
-        {"slack_tolerance", so.slack_tolerance}}},
+        {"slack", so.slack},  // check_slack, its older form, is not repeated
+        {"slack_tolerance", so.slack_tolerance},
+        {"max_wall_s", or_null(so.max_wall_s)}}},
       {"output", output_json(spec)},
       {"stop", {{"t_end", spec.stop.t_end}, {"front", stops}}},
   };

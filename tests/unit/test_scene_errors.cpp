@@ -68,7 +68,7 @@ TEST_CASE("bad scenes are refused with the location, the key, the value and what
        "s.toml:13:10: unknown effect [effects.gravty]; valid effects: gravity, drag, heap, fold, plane (did you mean [effects.gravity]?)"},
       {"a solver key of the old format",
        kBase + std::string("[solver]\nt_end = 1.0\n"),
-       "s.toml:19:1: unknown key 't_end' in [solver]; valid keys: method, rtol, atol, max_step, initial_step, max_steps, stabilization_time, backend, check_slack, slack_tolerance; t_end is now written in [stop]"},
+       "s.toml:19:1: unknown key 't_end' in [solver]; valid keys: method, rtol, atol, max_step, initial_step, max_steps, stabilization_time, backend, check_slack, slack_tolerance, slack, max_wall_s; t_end is now written in [stop]"},
       {"a top-level key",
        std::string("title = \"x\"\n") + kBase,
        "s.toml:1:1: unknown top-level key 'title'; valid sections: string, shape, velocity, ends, effects, solver, output, stop; valid top-level keys: model"},
@@ -339,6 +339,45 @@ TEST_CASE("bad scenes with fronts, and scenes the reduced model does not fit, ar
   CHECK(sizeof(cases) / sizeof(cases[0]) >= 12);
   for (const BadScene& c : cases) {
     CAPTURE(c.what, c.text);
+    CHECK(error_of(c.text) == c.message);
+  }
+}
+
+TEST_CASE("solver.slack and solver.max_wall_s are parsed and checked, and check_slack is the older form of slack",
+          "[unit][scene]") {
+  auto solver = [](const std::string& keys) {
+    return parse_scene_text(kBase + "\n[solver]\n" + keys, "s.toml").solver;  // [solver] keys from line 20
+  };
+  // Defaults: slack = "stop", no wall-clock limit.
+  CHECK(solver("").slack == "stop");
+  CHECK_FALSE(solver("").max_wall_s);
+  CHECK_FALSE(solver("").check_slack);
+  for (const char* value : {"stop", "warn", "ignore"}) CHECK(solver(std::string("slack = \"") + value + "\"\n").slack == value);
+  // check_slack: true is "stop", false is "ignore" (and the builders still read it as written).
+  CHECK(solver("check_slack = true\n").slack == "stop");
+  CHECK(solver("check_slack = true\n").check_slack);
+  CHECK(solver("check_slack = false\n").slack == "ignore");
+  CHECK(solver("max_wall_s = 30\n").max_wall_s == 30.0);
+  CHECK(solver("max_wall_s = 0.5\n").max_wall_s == 0.5);
+  const BadScene cases[] = {
+      {"slack misspelt", kBase + "\n[solver]\nslack = \"wran\"\n",
+       "s.toml:20:9: solver.slack = \"wran\" is not allowed; valid values: stop, warn, ignore (did you mean \"warn\"?)"},
+      {"slack as a boolean", kBase + "\n[solver]\nslack = true\n", "s.toml:20:9: solver.slack = true must be a string"},
+      {"slack and check_slack together", kBase + "\n[solver]\ncheck_slack = true\nslack = \"warn\"\n",
+       "s.toml:20:15: solver.check_slack = true and solver.slack = \"warn\" both say what a slack link does: give one of them (check_slack = true is slack = \"stop\", false is slack = \"ignore\")"},
+      {"a key misspelt", kBase + "\n[solver]\nslak = \"warn\"\n",
+       "s.toml:20:1: unknown key 'slak' in [solver]; valid keys: method, rtol, atol, max_step, initial_step, max_steps, stabilization_time, backend, check_slack, slack_tolerance, slack, max_wall_s (did you mean 'slack'?)"},
+      {"no wall time", kBase + "\n[solver]\nmax_wall_s = 0\n",
+       "s.toml:20:14: solver.max_wall_s = 0 is out of range: allowed max_wall_s > 0"},
+      {"a negative wall time", kBase + "\n[solver]\nmax_wall_s = -5.0\n",
+       "s.toml:20:14: solver.max_wall_s = -5 is out of range: allowed max_wall_s > 0"},
+      {"an infinite wall time", kBase + "\n[solver]\nmax_wall_s = inf\n",
+       "s.toml:20:14: solver.max_wall_s = inf must be a finite number"},
+      {"a wall time in words", kBase + "\n[solver]\nmax_wall_s = \"1 h\"\n",
+       "s.toml:20:14: solver.max_wall_s = \"1 h\" must be a number"},
+  };
+  for (const auto& c : cases) {
+    INFO(c.what);
     CHECK(error_of(c.text) == c.message);
   }
 }

@@ -265,6 +265,9 @@ TEST_CASE("the effective scene as JSON has every key with its default, and writt
   CHECK(j["solver"]["max_steps"] == 500000);
   CHECK(j["solver"]["stabilization_time"].is_null());  // derived when the model is built
   CHECK(j["solver"]["backend"] == "auto");
+  CHECK(j["solver"]["slack"] == "stop");
+  CHECK(j["solver"]["max_wall_s"].is_null());  // no limit
+  CHECK_FALSE(j["solver"].contains("check_slack"));  // written as slack
   CHECK(j["output"]["interval"] == 0.05);
   CHECK(j["output"]["fields"] == nlohmann::json({"nodes", "tension", "energy", "stats"}));
   CHECK(j["output"]["formats"] == nlohmann::json({"csv", "vtk"}));
