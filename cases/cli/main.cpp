@@ -96,6 +96,11 @@ int main(int argc, char** argv) {
   double run_t_end = 0;
   auto* opt_t_end = cmd_run->add_option("--t-end", run_t_end, "end time (s), > 0: replaces the scene's [stop] t_end");
   cmd_run->add_flag("--quiet", run.quiet, "no progress line on stderr (there is none when stderr is not a terminal)");
+  cmd_run->add_option("--set", run.overrides,
+                      "KEY=VALUE: sets a scene key, checked as in the file (repeatable; a later one wins), e.g. "
+                      "--set string.nodes=201 --set effects.heap[0].f=0.5 --set effects.drag.coefficient=0.1; VALUE is "
+                      "a TOML value (a bare word is a string); a missing section or element is created")
+      ->allow_extra_args(false);
   cmd_run->add_flag("--json", run.json,
                     "print the run summary as one JSON object on stdout (on failure: status \"failed\" and the error)");
 

@@ -32,6 +32,7 @@
 
 #include "cases/scene/front_scene.hpp"
 #include "cases/scene/reduced_scene.hpp"
+#include "cases/scene/scene_json.hpp"
 #include "cases/scene/scene.hpp"
 #include "cases/cli/progress.hpp"
 #include "solver/interrupt.hpp"
@@ -73,6 +74,7 @@ void clear_outputs(const std::filesystem::path& dir) {
 
 void print_json(std::ostream& out, nlohmann::json j, const SceneSpec& spec, const std::filesystem::path& dir) {
   j["scene"] = spec.source;
+  j["scene_effective"] = scene_to_json(spec);
   j["out"] = dir.string();
   out << j.dump() << '\n';
 }
@@ -244,7 +246,7 @@ void check_scene(const SceneSpec& spec) {
 int run_scene_command(const RunCommandOptions& options, std::ostream& out) {
   try {
     // 1. Scene (and the command line's overrides).
-    SceneSpec spec = parse_scene(options.scene);
+    SceneSpec spec = parse_scene(options.scene, options.overrides);
     if (options.t_end) {
       if (!(*options.t_end > 0 && std::isfinite(*options.t_end)))
         throw InputError(fmt::format("--t-end = {:g} is out of range: allowed t_end > 0", *options.t_end));

@@ -211,11 +211,7 @@ FrontScene<dim> build_front_scene(const SceneSpec& spec) {
   for (const auto& force : parts.forces) d["effects"].push_back(force->name());
   d["prescribed"] = nlohmann::json::array();
   for (const auto& p : parts.prescribed) d["prescribed"].push_back(fmt::format("node {}: {}", p.node, p.path->description()));
-  StringModelOptions mo;
-  mo.stabilization_time = parts.stabilization_time;
-  mo.backend = spec.solver.backend;
-  mo.slack = spec.solver.check_slack ? SlackPolicy::kStop : SlackPolicy::kIgnore;
-  mo.slack_tolerance = spec.solver.slack_tolerance;
+  const StringModelOptions mo = parts.model;
   const std::string fit_key = fold && heaps.empty() ? "effects.fold.s0" : first_front;
   scene.model = at_key(spec, fit_key, [&] {
     try {
@@ -254,12 +250,8 @@ FrontScene<dim> build_front_scene(const SceneSpec& spec) {
   d["stabilization_time"] = mo.stabilization_time;
 
   scene.output = spec.output.select;
-  scene.solver.integrator = parts.integrator;
-  scene.solver.t_end = spec.stop.t_end;
-  scene.solver.output_interval = spec.output.interval;
+  scene.solver = parts.solver;
   scene.solver.record_steps = true;
-  at_key(spec, "solver", [&] { scene.solver.validate(); });
-  at_key(spec, "output.interval", [&] { scene.solver.check_frame_budget(scene.model->chain().num_nodes()); });
   return scene;
 }
 

@@ -23,7 +23,8 @@
 ///     [[effects.heap]] side = start | end, s0 (m), f, point (m), on_plane
 ///     [effects.fold]   s0 (m), f          [effects.plane] point (m), normal (the table of a heap)
 ///     [solver]   method, rtol, atol, max_step, initial_step, max_steps, stabilization_time, backend,
-///                check_slack, slack_tolerance
+///                slack = stop | warn | ignore (check_slack = true | false: its older form),
+///                slack_tolerance, max_wall_s (s)
 ///     [output]   interval (s), fields = [nodes, tension, energy, stats], formats = [csv, vtk]
 ///     [stop]     t_end (s), [[stop.front]] front = fold | heap_start | heap_end, s0 (m)
 ///     model      = "string" (default) | "reduced" (top-level key)
@@ -86,7 +87,8 @@ struct FrontStop {
 
 /// Where a key was written and how.
 struct KeyLocation {
-  std::string where;  ///< "file:line:column" of its value (of the header, for a section)
+  std::string where;  ///< "file:line:column" of its value (of the header, for a section), or the
+                      ///< "--set KEY=VALUE" that gave it
   std::string text;   ///< the value as written in the file (shortened if long)
 };
 
@@ -135,7 +137,7 @@ struct SceneSpec {
     std::optional<FoldEntry> fold;               ///< [effects.fold]
     std::optional<PlaneEntry> plane;             ///< [effects.plane]
   } effects;
-  /// The scene has a heap or a fold: it runs on FrontModel.
+  /// The scene has a heap or a fold: the string runs with front tracking.
   bool has_fronts() const { return !effects.heaps.empty() || effects.fold.has_value(); }
   // [solver]
   struct Solver {
@@ -145,8 +147,12 @@ struct SceneSpec {
     long max_steps = 500000;
     std::optional<double> stabilization_time;  ///< s; default 0.1 t_char (see build_string_scene)
     std::string backend = "auto";
-    bool check_slack = false;
     double slack_tolerance = 1e-8;
+    /// What a slack link (a negative tension at an accepted step) does: "stop" (a numerical failure),
+    /// "warn" (reported, the run goes on) or "ignore". The older key check_slack = true / false is
+    /// read as "stop" / "ignore".
+    std::string slack = "stop";
+    std::optional<double> max_wall_s;  ///< s of wall-clock time the run may take (> 0); none: no limit
   } solver;
   // [output]
   struct Output {
@@ -163,8 +169,14 @@ struct SceneSpec {
 /// Reads a scene file. Throws InputError (with file:line:column) on a syntax error, an unknown
 /// section or key, a missing required key, or a value of the wrong type or out of range.
 SceneSpec parse_scene(const std::filesystem::path& file);
+/// The same with the command line's overrides "KEY=VALUE" (`chainsim run --set`, in order; see
+/// docs/scenes.md): each sets a key of the scene, creating its section or array element if the scene
+/// has none, before any check, so that a bad value or unknown key is refused as in the file, located
+/// at "--set KEY=VALUE".
+SceneSpec parse_scene(const std::filesystem::path& file, const std::vector<std::string>& overrides);
 /// The same from text; `source` names it in messages.
 SceneSpec parse_scene_text(std::string_view text, const std::string& source);
+SceneSpec parse_scene_text(std::string_view text, const std::string& source, const std::vector<std::string>& overrides);
 
 /// A scene ready to run.
 template <int dim>
@@ -178,7 +190,8 @@ struct StringScene {
 /// Builds the model of a parsed scene (dim must equal spec.dimension) with exactly the effects the
 /// scene declares, checks it physically and projects its initial state onto the constraints.
 /// Default Baumgarte time: τ_b = 0.1 t_char with t_char the shortest of sqrt(ℓ/|g|) (gravity),
-/// ℓ/max|v0| (moving start), 2π/ω (shaken or periodically loaded ends) and t_end.
+/// ℓ/v (v the largest initial speed or the speed of an end driven along a line) and 2π/ω (shaken or
+/// periodically loaded ends); t_end only when the scene has none of these.
 /// Throws InputError naming the file:line:column of the key at fault.
 template <int dim>
 StringScene<dim> build_string_scene(const SceneSpec& spec);

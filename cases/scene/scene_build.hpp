@@ -1,7 +1,7 @@
 #pragma once
 /// @file scene_build.hpp
-/// What every model built from a scene shares (internal to cases/: scene.cpp, front_scene.cpp,
-/// reduced_scene.cpp): errors located at the key at fault, vectors checked against the dimension,
+/// What every model built from a scene shares (internal to cases/scene/: scene_parts.cpp, string_scene.cpp,
+/// front_scene.cpp, reduced_scene.cpp): errors located at the key at fault, vectors checked against the dimension,
 /// and the string itself — the shape discretized, the initial velocity, the force effects and
 /// the held ends, exactly as the scene declares them.
 #include <memory>
@@ -15,8 +15,12 @@
 #include "mesh/errors.hpp"
 #include "solver/forces.hpp"
 #include "solver/integrator.hpp"
+#include "solver/string_solver.hpp"
 
 namespace chainsim::scene_build {
+
+/// The largest number of nodes a scene may ask for (memory: a few hundred bytes per node).
+inline constexpr long long kMaxNodes = 10000000;
 
 /// Throws InputError "<file:line:column of key>: <message>".
 [[noreturn]] inline void fail_at(const SceneSpec& spec, const std::string& key, const std::string& message) {
@@ -62,8 +66,11 @@ struct SceneParts {
   std::vector<std::unique_ptr<Force<dim>>> forces;  ///< gravity, drag, end loads: those declared
   std::vector<PrescribedNode<dim>> prescribed;      ///< fixed and driven ends
   double characteristic_time = 0;     ///< t_char (s), see build_string_scene
-  IntegratorOptions integrator;       ///< from [solver]
-  double stabilization_time = 0;      ///< [solver] stabilization_time or 0.1 t_char (s)
+  /// The string's options from [solver]: stabilization_time (or 0.1 t_char), backend, slack policy
+  /// and tolerance.
+  StringModelOptions model;
+  /// The run's options from [solver], [output] and [stop], checked (the frame budget too).
+  StringSolverOptions solver;
 };
 
 /// Builds the string of a scene (dim must equal spec.dimension) with the effects and ends it

@@ -1,4 +1,4 @@
-// cases/scene/scene.cpp: a table of bad scenes, each refused with its exact message: the file:line:column
+// cases/scene/ (the scene parser and builders): a table of bad scenes, each refused with its exact message: the file:line:column
 // of the key at fault (the value, or the key itself when it is unknown, or the section header when
 // a key is missing), the key, the value as written, and what is allowed. Errors found while
 // building the model (dimensions, lengths, ends, frames) are located the same way.
@@ -13,21 +13,13 @@
 #include "test_scene_support.hpp"
 
 using namespace chainsim;
+using test::edit;
 
 namespace {
 
 // The messages below point into this text: lines 1-17 are test_scene_support.hpp's scene.
 const std::string& kBase = test::kSceneBase;
 const char* kPolyline = "kind = \"polyline\"\npoints = [[0.0, 0.0], [0.0, -1.0]]";
-
-/// `text` with its first `from` replaced by `to` (which must be there).
-std::string edit(const std::string& text, const std::string& from, const std::string& to) {
-  const auto at = text.find(from);
-  REQUIRE(at != std::string::npos);
-  std::string out = text;
-  out.replace(at, from.size(), to);
-  return out;
-}
 
 /// The message of the InputError that parsing `text` and building the model it asks for (string,
 /// string with fronts, or reduced) raises, or "" if none.
@@ -76,7 +68,7 @@ TEST_CASE("bad scenes are refused with the location, the key, the value and what
        "s.toml:13:10: unknown effect [effects.gravty]; valid effects: gravity, drag, heap, fold, plane (did you mean [effects.gravity]?)"},
       {"a solver key of the old format",
        kBase + std::string("[solver]\nt_end = 1.0\n"),
-       "s.toml:19:1: unknown key 't_end' in [solver]; valid keys: method, rtol, atol, max_step, initial_step, max_steps, stabilization_time, backend, check_slack, slack_tolerance; t_end is now written in [stop]"},
+       "s.toml:19:1: unknown key 't_end' in [solver]; valid keys: method, rtol, atol, max_step, initial_step, max_steps, stabilization_time, backend, check_slack, slack_tolerance, slack, max_wall_s; t_end is now written in [stop]"},
       {"a top-level key",
        std::string("title = \"x\"\n") + kBase,
        "s.toml:1:1: unknown top-level key 'title'; valid sections: string, shape, velocity, ends, effects, solver, output, stop; valid top-level keys: model"},
@@ -192,7 +184,7 @@ TEST_CASE("bad scenes are refused with the location, the key, the value and what
        "s.toml:19:11: solver.backend = \"lu\" is not a tension solver: allowed auto, " + backends},
       {"an unknown output field",
        kBase + std::string("[output]\nfields = [\"nodes\", \"strain\"]\n"),
-       "s.toml:19:20: output.fields[1] = \"strain\" is not allowed; valid values: nodes, tension, energy, stats"},
+       "s.toml:19:20: output.fields[1] = \"strain\" is not allowed; valid values: nodes, tension, energy, forces, stats"},
       {"ParaView frames without nodes",
        kBase + std::string("[output]\nfields = [\"energy\"]\n"),
        "s.toml:19:10: output.formats includes \"vtk\" (the default), which draws the string from its nodes: output.fields must include \"nodes\" (or set formats = [\"csv\"])"},
@@ -343,6 +335,43 @@ TEST_CASE("bad scenes with fronts, and scenes the reduced model does not fit, ar
   CHECK(sizeof(cases) / sizeof(cases[0]) >= 12);
   for (const BadScene& c : cases) {
     CAPTURE(c.what, c.text);
+    CHECK(error_of(c.text) == c.message);
+  }
+}
+
+TEST_CASE("solver.slack and solver.max_wall_s are parsed and checked, and check_slack is the older form of slack",
+          "[unit][scene]") {
+  auto solver = [](const std::string& keys) {
+    return parse_scene_text(kBase + "\n[solver]\n" + keys, "s.toml").solver;  // [solver] keys from line 20
+  };
+  // Defaults: slack = "stop", no wall-clock limit.
+  CHECK(solver("").slack == "stop");
+  CHECK_FALSE(solver("").max_wall_s);
+  for (const char* value : {"stop", "warn", "ignore"}) CHECK(solver(std::string("slack = \"") + value + "\"\n").slack == value);
+  // check_slack, the older key: true is "stop", false is "ignore".
+  CHECK(solver("check_slack = true\n").slack == "stop");
+  CHECK(solver("check_slack = false\n").slack == "ignore");
+  CHECK(solver("max_wall_s = 30\n").max_wall_s == 30.0);
+  CHECK(solver("max_wall_s = 0.5\n").max_wall_s == 0.5);
+  const BadScene cases[] = {
+      {"slack misspelt", kBase + "\n[solver]\nslack = \"wran\"\n",
+       "s.toml:20:9: solver.slack = \"wran\" is not allowed; valid values: stop, warn, ignore (did you mean \"warn\"?)"},
+      {"slack as a boolean", kBase + "\n[solver]\nslack = true\n", "s.toml:20:9: solver.slack = true must be a string"},
+      {"slack and check_slack together", kBase + "\n[solver]\ncheck_slack = true\nslack = \"warn\"\n",
+       "s.toml:20:15: solver.check_slack = true and solver.slack = \"warn\" both say what a slack link does: give one of them (check_slack = true is slack = \"stop\", false is slack = \"ignore\")"},
+      {"a key misspelt", kBase + "\n[solver]\nslak = \"warn\"\n",
+       "s.toml:20:1: unknown key 'slak' in [solver]; valid keys: method, rtol, atol, max_step, initial_step, max_steps, stabilization_time, backend, check_slack, slack_tolerance, slack, max_wall_s (did you mean 'slack'?)"},
+      {"no wall time", kBase + "\n[solver]\nmax_wall_s = 0\n",
+       "s.toml:20:14: solver.max_wall_s = 0 is out of range: allowed max_wall_s > 0"},
+      {"a negative wall time", kBase + "\n[solver]\nmax_wall_s = -5.0\n",
+       "s.toml:20:14: solver.max_wall_s = -5 is out of range: allowed max_wall_s > 0"},
+      {"an infinite wall time", kBase + "\n[solver]\nmax_wall_s = inf\n",
+       "s.toml:20:14: solver.max_wall_s = inf must be a finite number"},
+      {"a wall time in words", kBase + "\n[solver]\nmax_wall_s = \"1 h\"\n",
+       "s.toml:20:14: solver.max_wall_s = \"1 h\" must be a number"},
+  };
+  for (const auto& c : cases) {
+    INFO(c.what);
     CHECK(error_of(c.text) == c.message);
   }
 }

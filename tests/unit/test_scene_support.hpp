@@ -7,6 +7,8 @@
 #include <sstream>
 #include <string>
 
+#include <catch2/catch.hpp>
+
 #include "cases/scene/front_scene.hpp"
 #include "cases/scene/scene.hpp"
 
@@ -26,6 +28,15 @@ inline std::string read(const std::filesystem::path& file) {
   std::stringstream text;
   text << in.rdbuf();
   return text.str();
+}
+
+/// `text` with its first `from` replaced by `to` (which must be there).
+inline std::string edit(const std::string& text, const std::string& from, const std::string& to) {
+  const auto at = text.find(from);
+  REQUIRE(at != std::string::npos);
+  std::string out = text;
+  out.replace(at, from.size(), to);
+  return out;
 }
 
 /// Builds a scene with fronts in its own dimension and runs it (no outputs written).

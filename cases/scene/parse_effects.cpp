@@ -1,0 +1,76 @@
+// [effects.*]: gravity, drag, heaps, fold and plane, each existing only if its section is written
+// (parse_sections.hpp).
+#include "cases/scene/parse_sections.hpp"
+
+namespace chainsim::scene_parse {
+
+namespace {
+
+/// [[effects.heap]]: one table per heap, at most one per side.
+void parse_heaps(const Section& effects, Context& ctx) {
+  auto& heaps = ctx.spec.effects.heaps;
+  const auto tables = table_array(effects, "heap", "heap");
+  for (std::size_t k = 0; k < tables.size(); ++k) {
+    Section h(*tables[k], fmt::format("effects.heap[{}]", k), ctx, {"side", "s0", "f", "point", "on_plane"});
+    if (!h.has("side")) h.missing("side", "\"start\" (the heap holds s < s0 and feeds the string) or \"end\" (it holds s > s0)");
+    if (!h.has("s0")) h.missing("s0", "m, the material coordinate of the front at t = 0");
+    if (!h.has("point")) h.missing("point", "m, the hole or edge the front sits at, or the contact point on the plane at t = 0");
+    HeapEntry heap;
+    heap.side = h.choice("side", {"start", "end"}, "");
+    for (std::size_t j = 0; j < heaps.size(); ++j)
+      if (heaps[j].side == heap.side)
+        h.fail("side", fmt::format("effects.heap[{}].side = \"{}\": effects.heap[{}] already holds that side of the "
+                                   "string; allowed at most one heap per side",
+                                   k, heap.side, j));
+    heap.s0 = *h.number("s0");
+    heap.dissipation = h.number_in("f", 0.0, 0.0, 1.0);
+    heap.point = h.vector("point");
+    heap.on_plane = h.boolean("on_plane").value_or(false);
+    heaps.push_back(heap);
+  }
+}
+
+}  // namespace
+
+void parse_effects(const Section& top, Context& ctx) {
+  auto& fx = ctx.spec.effects;
+  Section s(subtable(top, "effects"), "effects", ctx, {"gravity", "drag", "heap", "fold", "plane"}, {}, "effect");
+  if (s.has("gravity")) {
+    Section g(subtable(s, "gravity"), "effects.gravity", ctx, {"g"});
+    if (!g.has("g")) g.missing("g", "m/s^2, a vector [gx, gy] or [gx, gy, gz]");
+    fx.gravity = g.vector("g");
+  }
+  if (s.has("drag")) {
+    Section d(subtable(s, "drag"), "effects.drag", ctx, {"coefficient"});
+    if (!d.has("coefficient")) d.missing("coefficient", "1/s, >= 0: the force -coefficient m v on every node");
+    fx.drag = d.number_in("coefficient", 0.0, 0.0, INFINITY);
+  }
+  parse_heaps(s, ctx);
+  if (s.has("fold")) {
+    Section f(subtable(s, "fold"), "effects.fold", ctx, {"s0", "f"});
+    if (!f.has("s0")) f.missing("s0", "m, the material coordinate of the fold at t = 0");
+    fx.fold = FoldEntry{*f.number("s0"), f.number_in("f", 0.0, 0.0, 1.0)};
+  }
+  if (s.has("plane")) {
+    Section p(subtable(s, "plane"), "effects.plane", ctx, {"point", "normal"});
+    if (!p.has("point")) p.missing("point", "m, a point of the plane");
+    if (!p.has("normal")) p.missing("normal", "a vector normal to the plane, pointing to the string's side");
+    fx.plane = PlaneEntry{p.vector("point"), p.vector("normal")};
+  }
+  // The plane is the table of a heap: it exists for on_plane heaps only (the string itself does not
+  // collide with it), and an on_plane heap needs it.
+  bool on_plane = false;
+  for (std::size_t k = 0; k < fx.heaps.size(); ++k) {
+    on_plane = on_plane || fx.heaps[k].on_plane;
+    if (fx.heaps[k].on_plane && !fx.plane)
+      throw InputError(fmt::format("{}: effects.heap[{}].on_plane = true needs [effects.plane] (point, normal): the "
+                                   "table the heap lies on",
+                                   ctx.spec.where(fmt::format("effects.heap[{}].on_plane", k)), k));
+  }
+  if (fx.plane && !on_plane)
+    throw InputError(fmt::format("{}: [effects.plane] is the table under a heap, but no [[effects.heap]] has on_plane = "
+                                 "true (the string itself does not collide with the plane)",
+                                 ctx.spec.where("effects.plane")));
+}
+
+}  // namespace chainsim::scene_parse

@@ -1,0 +1,253 @@
+// String scenes, step 2: SceneSpec -> the string every model is built on (scene_build.hpp): the
+// shape discretized, the initial velocity, the effects and ends the scene declares, the solver
+// options. Every InputError names the location of the key at fault.
+#include <algorithm>
+#include <cmath>
+
+#include <fmt/format.h>
+
+#include "cases/scene/scene_build.hpp"
+#include "cases/scene/scene_text.hpp"
+#include "mesh/discretize.hpp"
+#include "mesh/errors.hpp"
+
+namespace chainsim::scene_build {
+
+using scene_text::join;
+
+namespace {
+
+/// Prescribed ends closer than this fraction of the string's length to being pulled taut are refused.
+constexpr double kTautFraction = 1e-9;
+/// Instants at which two prescribed end paths are sampled for their distance (over [0, t_end]).
+constexpr int kEndPathSamples = 2001;
+
+template <int dim>
+Points<dim> as_points(const SceneSpec& spec, const std::vector<std::vector<double>>& rows, const std::string& key) {
+  Points<dim> out(dim, static_cast<Eigen::Index>(rows.size()));
+  for (std::size_t k = 0; k < rows.size(); ++k)
+    out.col(static_cast<Eigen::Index>(k)) = as_vec<dim>(spec, rows[k], fmt::format("{}[{}]", key, k));
+  return out;
+}
+
+template <int dim>
+Vec<dim> unit(int axis) {
+  Vec<dim> e = Vec<dim>::Zero();
+  e[axis] = 1;
+  return e;
+}
+
+/// The initial shape as a curve.
+template <int dim>
+std::unique_ptr<Curve<dim>> build_curve(const SceneSpec& spec, bool closed, const Vec<dim>& down) {
+  const auto& sh = spec.shape;
+  if (sh.kind == "polyline" || sh.kind == "points") {
+    const Points<dim> points = as_points<dim>(spec, sh.points, "shape.points");
+    auto polyline = at_key(spec, "shape.points", [&] { return polyline_curve<dim>(points, closed); });
+    if (!sh.corner_radius) return polyline;
+    if (closed)
+      fail_at(spec, "shape.corner_radius",
+              "shape.corner_radius does not apply to a closed string (string.closed = true): only the interior "
+              "points of an open polyline are rounded");
+    return at_key(spec, "shape.corner_radius", [&] { return rounded_polyline_curve<dim>(points, *sh.corner_radius); });
+  }
+  if (sh.kind == "arc" || sh.kind == "circle") {
+    const Vec<dim> center = as_vec<dim>(spec, sh.center, "shape.center");
+    const Vec<dim> axis1 = sh.axis1.empty() ? unit<dim>(0) : as_vec<dim>(spec, sh.axis1, "shape.axis1");
+    const Vec<dim> axis2 = sh.axis2.empty() ? unit<dim>(1) : as_vec<dim>(spec, sh.axis2, "shape.axis2");
+    const std::string axes = sh.axis2.empty() ? "shape.axis1" : "shape.axis2";
+    if (sh.kind == "circle")
+      return at_key(spec, axes, [&] { return circle_curve<dim>(center, sh.radius, axis1, axis2); });
+    return at_key(spec, axes, [&] {
+      return circle_arc_curve<dim>(center, sh.radius, sh.start_angle_deg * kPi / 180, sh.sweep_deg * kPi / 180, axis1,
+                                   axis2);
+    });
+  }
+  CHAINSIM_VERIFY(sh.kind == "catenary", "parse_shape admits only the kinds built here");
+  if (!spec.length) fail_at(spec, "shape.kind", "a catenary shape needs string.length (the sag follows from it)");
+  const Vec<dim> start = as_vec<dim>(spec, sh.start, "shape.start");
+  const Vec<dim> end = as_vec<dim>(spec, sh.end, "shape.end");
+  return at_key(spec, "shape.end", [&] { return catenary_curve<dim>(start, end, *spec.length, down); });
+}
+
+/// The number of links: string.nodes, or the length over string.link_length rounded (default 41 nodes).
+int link_count(const SceneSpec& spec, double length, bool closed) {
+  const int minimum = closed ? 3 : 1;
+  if (spec.link_length) {
+    const double links = std::round(length / *spec.link_length);
+    if (links > kMaxNodes)
+      fail_at(spec, "string.link_length",
+              fmt::format("string.link_length = {:g} m asks for {:.3g} links on {:g} m: allowed at most {} nodes",
+                          *spec.link_length, links, length, kMaxNodes));
+    return std::max(minimum, static_cast<int>(links));
+  }
+  const int nodes = spec.nodes.value_or(41);
+  const int links = closed ? nodes : nodes - 1;
+  if (links < minimum)
+    fail_at(spec, "string.nodes", fmt::format("string.nodes = {} is too small: a closed string needs at least 3 nodes",
+                                              nodes));
+  return links;
+}
+
+/// Two prescribed ends may never be pulled as far apart as the string is long (it would have to
+/// stretch); sampled over [0, t_end].
+template <int dim>
+void check_prescribed_ends(const SceneSpec& spec, const std::vector<PrescribedNode<dim>>& prescribed, double length) {
+  if (prescribed.size() < 2) return;
+  const EndPath<dim>& a = *prescribed[0].path;
+  const EndPath<dim>& b = *prescribed[1].path;
+  for (int k = 0; k < kEndPathSamples; ++k) {
+    const double t = spec.stop.t_end * k / (kEndPathSamples - 1);
+    const double distance = (b.position(t) - a.position(t)).norm();
+    if (distance > (1 - kTautFraction) * length)
+      fail_at(spec, "ends.end",
+              fmt::format("ends.start ({}) and ends.end ({}) are {:.6g} m apart at t = {:.6g} s, but the string is "
+                          "{:.6g} m long: prescribed ends may not pull an inextensible string taut",
+                          a.description(), b.description(), distance, t, length));
+  }
+}
+
+}  // namespace
+
+template <int dim>
+SceneParts<dim> build_scene_parts(const SceneSpec& spec) {
+  CHAINSIM_VERIFY(spec.dimension == dim, "build_scene_parts<dim> called for another dimension");
+  const auto& sh = spec.shape;
+
+  // 1. Gravity (its direction also orients a catenary).
+  Vec<dim> g = Vec<dim>::Zero();
+  if (spec.effects.gravity) g = as_vec<dim>(spec, *spec.effects.gravity, "effects.gravity.g");
+  const Vec<dim> down = g.norm() > 0 ? Vec<dim>(g) : Vec<dim>(-unit<dim>(1));
+
+  // 2. The shape, and the string on it.
+  const bool closed = spec.closed.value_or(sh.kind == "circle");
+  std::unique_ptr<Curve<dim>> curve = build_curve<dim>(spec, closed, down);
+  if (curve->closed() != closed)
+    fail_at(spec, spec.closed ? "string.closed" : "shape.kind",
+            fmt::format("string.closed = {} but the shape ({}) is {}", closed, curve->description(),
+                        curve->closed() ? "a closed curve" : "an open curve"));
+  const double length = spec.length.value_or(curve->length());
+  if (std::abs(curve->length() - length) > sh.length_tolerance * length)
+    fail_at(spec, "string.length",
+            fmt::format("string.length = {:.9g} m but the shape ({}) is {:.9g} m long: they differ by {:.3g} m, more "
+                        "than shape.length_tolerance = {:g} (relative)",
+                        length, curve->description(), curve->length(), curve->length() - length,
+                        sh.length_tolerance));
+  const int links = link_count(spec, length, closed);
+  Chain<dim> chain =
+      at_key(spec, "shape", [&] { return discretize(*curve, length, spec.density, links, closed, sh.length_tolerance); });
+  const auto& vel = spec.velocity;
+  if (vel.kind == "uniform") set_uniform_velocity(chain, as_vec<dim>(spec, vel.value, "velocity.value"));
+  if (vel.kind == "tangential") at_key(spec, "velocity.speed", [&] { set_tangential_velocity(chain, vel.speed); });
+  if (vel.kind == "nodes") {
+    const Points<dim> values = as_points<dim>(spec, vel.values, "velocity.values");
+    at_key(spec, "velocity.values", [&] { set_node_velocities(chain, values); });
+  }
+
+  // 3. Effects and ends: exactly those the scene declares.
+  std::vector<std::unique_ptr<Force<dim>>> forces;
+  std::vector<PrescribedNode<dim>> prescribed;
+  if (spec.effects.gravity) forces.push_back(std::make_unique<Gravity<dim>>(g));
+  if (spec.effects.drag) forces.push_back(std::make_unique<Drag<dim>>(*spec.effects.drag));
+  double forcing_period = INFINITY;
+  double driven_speed = 0;  // of ends driven along a line (m/s)
+  auto add_end = [&](const EndSpec& end, int node, const std::string& key) {
+    if (end.kind == "free") return;
+    if (closed)
+      fail_at(spec, key, fmt::format("{} = \"{}\": a closed string has no ends (string.closed = true)", key, end.kind));
+    const Vec<dim> x0 = chain.positions().col(node);
+    if (end.kind == "fixed") {
+      prescribed.push_back({node, std::make_shared<FixedPoint<dim>>(x0)});
+    } else if (end.kind == "driven" && end.path == "linear") {
+      const Vec<dim> velocity = as_vec<dim>(spec, end.velocity, key + ".velocity");
+      prescribed.push_back({node, std::make_shared<LinearPath<dim>>(x0, velocity)});
+      driven_speed = std::max(driven_speed, velocity.norm());
+    } else if (end.kind == "driven") {
+      const Vec<dim> amplitude = as_vec<dim>(spec, end.amplitude, key + ".amplitude");
+      prescribed.push_back({node, std::make_shared<HarmonicPath<dim>>(x0, amplitude, end.omega, end.path == "shake")});
+      forcing_period = std::min(forcing_period, 2 * kPi / end.omega);
+    } else {
+      CHAINSIM_VERIFY(end.kind == "loaded", "parse_end admits only the kinds built here");
+      const Vec<dim> f0 = end.force.empty() ? Vec<dim>::Zero() : as_vec<dim>(spec, end.force, key + ".force");
+      const Vec<dim> amp = end.amplitude.empty() ? Vec<dim>::Zero() : as_vec<dim>(spec, end.amplitude, key + ".amplitude");
+      if (!end.amplitude.empty()) forcing_period = std::min(forcing_period, 2 * kPi / end.omega);
+      forces.push_back(std::make_unique<EndLoad<dim>>(node, f0, amp, end.omega));
+    }
+  };
+  add_end(spec.start, 0, "ends.start");
+  add_end(spec.end, chain.num_nodes() - 1, "ends.end");
+  if (prescribed.size() == 2 && chain.num_nodes() < 3)
+    fail_at(spec, "string.nodes",
+            fmt::format("string.nodes = {} but both ends are prescribed: the link between them could not move and "
+                        "its tension would be undetermined; allowed nodes >= 3",
+                        chain.num_nodes()));
+  check_prescribed_ends<dim>(spec, prescribed, length);
+
+  // 4. Options. Default Baumgarte time: a tenth of the shortest physical time scale: the pendulum
+  // time sqrt(ℓ/|g|), the transit time ℓ/v of the fastest initial or driven motion, the period 2π/ω
+  // of shaken or periodically loaded ends. The length of the run is no physical scale and counts
+  // only when the scene has none of these: a short run must not shorten τ_b, since C''/τ_b² turns
+  // the round-off left in the constraints into tensions (t_end = 1e-9 s gave -155 N for 0.3 N).
+  const auto& so = spec.solver;
+  double t_char = forcing_period;
+  if (g.norm() > 0) t_char = std::min(t_char, std::sqrt(length / g.norm()));
+  const double v_max = std::max(chain.velocities().colwise().norm().maxCoeff(), driven_speed);
+  if (v_max > 0) t_char = std::min(t_char, length / v_max);
+  if (!std::isfinite(t_char)) t_char = spec.stop.t_end;
+  IntegratorOptions io;
+  io.method = so.method;
+  io.rtol = so.rtol;
+  io.atol = so.atol;
+  io.max_step = so.max_step;
+  io.initial_step = so.initial_step;
+  io.max_steps = so.max_steps;
+  at_key(spec, "solver", [&] { io.validate(); });
+  StringModelOptions mo;
+  mo.stabilization_time = so.stabilization_time.value_or(0.1 * t_char);
+  mo.backend = so.backend;
+  mo.slack = so.slack == "warn" ? SlackPolicy::kWarn : so.slack == "ignore" ? SlackPolicy::kIgnore : SlackPolicy::kStop;
+  mo.slack_tolerance = so.slack_tolerance;
+  StringSolverOptions run;
+  run.integrator = io;
+  run.t_end = spec.stop.t_end;
+  run.output_interval = spec.output.interval;
+  at_key(spec, "solver", [&] { run.validate(); });
+  at_key(spec, "output.interval", [&] { run.check_frame_budget(chain.num_nodes()); });
+  return SceneParts<dim>{std::move(curve), std::move(chain), length, g, std::move(forces), std::move(prescribed),
+                         t_char, mo, run};
+}
+
+template SceneParts<2> build_scene_parts<2>(const SceneSpec&);
+template SceneParts<3> build_scene_parts<3>(const SceneSpec&);
+
+std::vector<std::string> front_names(const SceneSpec& spec) {
+  auto has_heap = [&](const char* side) {
+    return std::any_of(spec.effects.heaps.begin(), spec.effects.heaps.end(),
+                       [&](const HeapEntry& heap) { return heap.side == side; });
+  };
+  std::vector<std::string> names;
+  if (has_heap("start")) names.push_back("heap_start");
+  if (spec.effects.fold) names.push_back("fold");
+  if (has_heap("end")) names.push_back("heap_end");
+  return names;
+}
+
+std::vector<int> front_stop_indices(const SceneSpec& spec) {
+  const std::vector<std::string> names = front_names(spec);
+  std::vector<int> out;
+  for (std::size_t k = 0; k < spec.stop.fronts.size(); ++k) {
+    const std::string& front = spec.stop.fronts[k].front;
+    const auto it = std::find(names.begin(), names.end(), front);
+    if (it == names.end()) {
+      const std::string what = front == "fold" ? "fold ([effects.fold])"
+                                               : fmt::format("heap on side \"{}\"", front.substr(5));
+      fail_at(spec, fmt::format("stop.front[{}].front", k),
+              fmt::format("stop.front[{}].front = \"{}\" but the scene has no {}; {}", k, front, what,
+                          names.empty() ? "it has no fronts" : "its fronts: " + join(names)));
+    }
+    out.push_back(static_cast<int>(it - names.begin()));
+  }
+  return out;
+}
+
+}  // namespace chainsim::scene_build
