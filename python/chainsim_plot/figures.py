@@ -62,7 +62,7 @@ def choose_times(times, wanted=None, count=6):
         for t in wanted:
             if t < lo - 1e-12 * max(1.0, abs(lo)) or t > hi + 1e-12 * max(1.0, abs(hi)):
                 raise RunError(f"--times: t = {t:g} s is outside the run: allowed {lo:g} <= t <= {hi:g} s")
-        return [int(np.argmin(np.abs(times - t))) for t in wanted]
+        return sorted({int(np.argmin(np.abs(times - t))) for t in wanted})
     n = min(count, len(times))
     return sorted({int(np.argmin(np.abs(times - t))) for t in np.linspace(times[0], times[-1], n)})
 
@@ -216,7 +216,8 @@ def space_axes(ax, proj, adjustable="datalim"):
 # --- snapshots ------------------------------------------------------------------------------------
 
 def draw_snapshots(axes, run, picks, layout=None):
-    """The string at the frames `picks` on each projection's axes; heaps, the plane, fronts marked."""
+    """The string at the frames `picks` on each projection's axes; heaps, the plane, fronts marked.
+    Returns the layout (its notes() say what was shifted)."""
     layout = layout or Layout(run)
     frames = run.nodes
     colors = time_colors(len(picks))
@@ -243,6 +244,7 @@ def draw_snapshots(axes, run, picks, layout=None):
                 labelled.add(f.name)
         space_axes(ax, proj)
         ax.legend(fontsize=6, loc="best")
+    return layout
 
 
 def snapshots_figure(run, out_dir, wanted=None, prefix=""):
@@ -289,27 +291,29 @@ WORK_LABELS = {"W_applied": "W_applied (forces, driven ends)", "W_shocks": "W_sh
                "E_shock": "work of the shock", "E_heap": "work of the heap", "E_force": "work of the end force"}
 
 
+def draw_ledger(ax, run, table, works):
+    """K, V, K + V - (K0 + V0) and each work term that is not zero, against t."""
+    t, K, V = table["t"], table["K"], table["V"]
+    ax.plot(t, K, label="K (kinetic)")
+    ax.plot(t, V, label="V (potential)")
+    ax.plot(t, K + V - K[0] - V[0], "k-", lw=1.8, label="K + V - (K0 + V0)")
+    styles = ["--", ":", "-.", (0, (5, 1, 1, 1))]
+    for q, c in enumerate(works):
+        if np.max(np.abs(table[c])) > 0 or c == "W_applied":
+            ax.plot(t, table[c], linestyle=styles[q % len(styles)], label=WORK_LABELS.get(c, c))
+    if len(works) > 1:
+        ax.plot(t, sum(table[c] for c in works), "--", color="0.4", lw=1, label="sum of the works")
+    decorate(ax, "t (s)", "J", "energy ledger")
+
+
 def energy_figure(run, out_dir, prefix=""):
     table, works, residual, note = ledger_columns(run)
     if table is None:
         return None
-    t = table["t"]
-    K, V = table["K"], table["V"]
     fig, (ax1, ax2) = plt.subplots(1, 2, figsize=(13, 4.5))
-    ax1.plot(t, K, label="K (kinetic)")
-    ax1.plot(t, V, label="V (potential)")
-    ax1.plot(t, K + V - K[0] - V[0], "k-", lw=1.8, label="K + V - (K0 + V0)")
-    total = np.zeros_like(t)
-    styles = ["--", ":", "-.", (0, (5, 1, 1, 1))]
-    for q, c in enumerate(works):
-        total = total + table[c]
-        if np.max(np.abs(table[c])) > 0 or c == "W_applied":
-            ax1.plot(t, table[c], linestyle=styles[q % len(styles)], label=WORK_LABELS.get(c, c))
-    if len(works) > 1:
-        ax1.plot(t, total, "--", color="0.4", lw=1, label="sum of the works")
-    decorate(ax1, "t (s)", "J", "energy ledger")
+    draw_ledger(ax1, run, table, works)
     if residual is not None:
-        worst = semilogy_abs(ax2, t, table[residual], lw=1)
+        worst = semilogy_abs(ax2, table["t"], table[residual], lw=1)
         scale = run.summary.get("energy_scale") if isinstance(run.summary, dict) else None
         title = f"|{residual}|: max {worst:.2e} J"
         if scale:
