@@ -4,7 +4,6 @@
 /// Each returns the process exit code and throws InputError / NumericalError on failure.
 #include <iosfwd>
 #include <string>
-#include <vector>
 
 #include "cases/canonical/canonical_string.hpp"
 #include "cases/reduced/reduced_models.hpp"
@@ -47,8 +46,6 @@ struct PlotCommandOptions {
   bool animate = false;
   std::string speed, fps, times, format;
 };
-/// The interpreter's arguments after the interpreter: -m chainsim_plot RUN_DIR [--option=value ...].
-std::vector<std::string> plot_arguments(const PlotCommandOptions& options);
 /// Runs /usr/bin/python3 (else python3 on PATH) -m chainsim_plot with PYTHONPATH set to the source
 /// tree's python/; returns its exit code (1 if it cannot be started).
 int run_plot_command(const PlotCommandOptions& options);

@@ -30,8 +30,7 @@ std::string python_interpreter() {
   return access(debian, X_OK) == 0 ? debian : "python3";
 }
 
-}  // namespace
-
+/// The interpreter's arguments after the interpreter: -m chainsim_plot RUN_DIR [--option=value ...].
 std::vector<std::string> plot_arguments(const PlotCommandOptions& options) {
   std::vector<std::string> args = {"-m", "chainsim_plot", options.run_dir};
   if (options.animate) args.emplace_back("--animate");
@@ -41,6 +40,8 @@ std::vector<std::string> plot_arguments(const PlotCommandOptions& options) {
     if (!value->empty()) args.push_back(std::string(name) + "=" + *value);
   return args;
 }
+
+}  // namespace
 
 int run_plot_command(const PlotCommandOptions& options) {
   const std::filesystem::path package = std::filesystem::path(CHAINSIM_PYTHON_DIR) / "chainsim_plot";

@@ -101,12 +101,33 @@ def plot(directory, *options):
     return chainsim("plot", directory, *options)
 
 
-def check_plot(kind, expected, *options):
-    """chainsim plot exits 0, prints exactly the expected files of RUN_DIR/figures, and each is a PNG."""
+def plot_here(directory, *options, stdout=False):
+    """The package's entry point in this process (what `chainsim plot` runs, without starting Python again):
+    (exit code, stderr), or (exit code, stdout) with stdout=True."""
+    import contextlib
+    import io
+    from chainsim_plot.cli import main
+    out, err = io.StringIO(), io.StringIO()
+    with contextlib.redirect_stderr(err), contextlib.redirect_stdout(out):
+        try:
+            code = main([directory, *options])
+        except SystemExit as e:  # argparse
+            code = e.code
+    return code, (out if stdout else err).getvalue()
+
+
+def check_plot(kind, expected, *options, here=False):
+    """chainsim plot exits 0, prints exactly the expected files of RUN_DIR/figures, and each is a PNG.
+    here=True: the package's entry point in this process instead of the binary (quicker)."""
     directory = run_dir(kind)
-    r = plot(directory, *options)
-    assert r.returncode == 0, r.stderr
-    listed = r.stdout.split()
+    if here:
+        code, out = plot_here(directory, *options, stdout=True)
+        assert code == 0
+        listed = out.split()
+    else:
+        r = plot(directory, *options)
+        assert r.returncode == 0, r.stderr
+        listed = r.stdout.split()
     assert sorted(os.path.basename(p) for p in listed) == sorted(expected)
     for path in listed:
         assert os.path.dirname(os.path.abspath(path)) == os.path.abspath(os.path.join(directory, "figures"))
@@ -124,38 +145,38 @@ def frame_times(directory):
 
 # --- each kind of run -----------------------------------------------------------------------------
 
-def test_string_run_at_chosen_times():
+def test_kind_string_run_at_chosen_times():
     check_plot("string", ["snapshots.png", "energy.png", "tension.png"], "--times", "0,0.1,0.25")
 
 
-def test_run_with_fronts():
+def test_kind_run_with_fronts():
     check_plot("fronts", ["snapshots.png", "energy.png", "fronts.png"])
 
 
-def test_run_with_a_fold():
-    check_plot("fold", ["snapshots.png", "energy.png", "fronts.png"])
+def test_kind_run_with_a_fold():
+    check_plot("fold", ["snapshots.png", "energy.png", "fronts.png"], here=True)
 
 
-def test_3d_run():
-    listed = check_plot("string3d", ["snapshots.png", "energy.png", "tension.png"])
+def test_kind_3d_run():
+    listed = check_plot("string3d", ["snapshots.png", "energy.png", "tension.png"], here=True)
     with Image.open(next(p for p in listed if p.endswith("snapshots.png"))) as im:
         assert im.size[0] > 1.5 * im.size[1]  # two projections side by side
 
 
-def test_reduced_runs():
+def test_kind_reduced_runs():
     check_plot("reduced", ["reduced.png", "energy.png"])
-    check_plot("reduced_scene", ["reduced.png", "energy.png"])
+    check_plot("reduced_scene", ["reduced.png", "energy.png"], here=True)
 
 
-def test_compare_run():
-    check_plot("compare", ["compare.png", "energy.png", "fronts.png"])
+def test_kind_compare_run():
+    check_plot("compare", ["compare.png", "energy.png", "fronts.png"], here=True)
 
 
-def test_canonical_run():
+def test_kind_canonical_run():
     names = ["fall_time_vs_f.png", "falling_chain.png", "folded_chain.png", "sliding_chain.png"]
     for problem in ("falling", "folded", "sliding"):
         names += [f"{problem}_reduced.png", f"{problem}_energy.png"]
-    check_plot("canonical", names)
+    check_plot("canonical", names, here=True)
 
 
 # --- the animation --------------------------------------------------------------------------------
@@ -165,7 +186,7 @@ def expected_frames(directory, fps, speed):
     return int(math.floor((times[-1] - times[0]) * fps / speed + 1e-9)) + 1
 
 
-def test_gif_animation_has_the_frames_of_its_speed_and_rate():
+def test_animation_gif_has_the_frames_of_its_speed_and_rate():
     directory = run_dir("string")
     r = plot(directory, "--animate", "--format", "gif", "--fps", "10", "--speed", "0.5")
     assert r.returncode == 0, r.stderr
@@ -178,7 +199,7 @@ def test_gif_animation_has_the_frames_of_its_speed_and_rate():
         assert abs(im.info["duration"] - 100) <= 10  # ms per frame at 10 fps
 
 
-def test_mp4_animation_of_a_run_with_fronts():
+def test_animation_mp4_of_a_run_with_fronts():
     if shutil.which("ffmpeg") is None or shutil.which("ffprobe") is None:
         print("skipped: no ffmpeg")
         return
@@ -197,50 +218,52 @@ def test_mp4_animation_of_a_run_with_fronts():
 
 # --- bad input ------------------------------------------------------------------------------------
 
-def test_bad_paths_exit_2():
+def test_error_bad_paths_exit_2():
+    # Through the binary once (the exit code passes through), then in this process.
     missing = os.path.join(ROOT, "no_such_run")
     r = plot(missing)
-    assert r.returncode == 2 and f"RUN_DIR '{missing}' does not exist" in r.stderr
+    assert r.returncode == 2 and r.stderr.startswith(f"chainsim: error: RUN_DIR '{missing}' does not exist")
     a_file = os.path.join(ROOT, "a_file")
     open(a_file, "w").close()
-    r = plot(a_file)
-    assert r.returncode == 2 and "is not a directory" in r.stderr
+    code, err = plot_here(a_file)
+    assert code == 2 and f"RUN_DIR '{a_file}' is not a directory" in err
     empty = os.path.join(ROOT, "empty_dir")
     os.makedirs(empty, exist_ok=True)
-    r = plot(empty)
-    assert r.returncode == 2 and "holds none of the files chainsim writes" in r.stderr
+    code, err = plot_here(empty)
+    assert code == 2 and "holds none of the files chainsim writes" in err
     assert not os.path.exists(os.path.join(empty, "figures"))
 
 
-def test_malformed_file_exits_2_naming_the_line():
+def test_error_malformed_file_exits_2_naming_the_line():
     broken = os.path.join(ROOT, "broken")
-    shutil.copytree(run_dir("string"), broken)
+    shutil.copytree(run_dir("string"), broken, ignore=shutil.ignore_patterns("figures"))
     with open(os.path.join(broken, "energy.csv")) as fh:
         lines = fh.readlines()
     lines[3] = lines[3].split(",")[0] + ",oops\n"
     with open(os.path.join(broken, "energy.csv"), "w") as fh:
         fh.writelines(lines)
-    r = plot(broken)
-    assert r.returncode == 2
-    assert f"{os.path.join(broken, 'energy.csv')}:4: 2 fields, but the header has 5" in r.stderr
+    code, err = plot_here(broken)
+    assert code == 2
+    assert f"{os.path.join(broken, 'energy.csv')}:4: 2 fields, but the header has 5" in err
+    assert not os.path.exists(os.path.join(broken, "figures"))
 
 
-def test_bad_options_exit_2():
+def test_error_bad_options_exit_2():
     directory = run_dir("string")
     for options, message in [(["--speed", "0"], "--speed = 0 is out of range: allowed speed > 0"),
                              (["--fps", "x"], "--fps = 'x' is not an integer"),
                              (["--times", "0,9"], "--times: t = 9 s is outside the run: allowed 0 <= t <= 0.3 s"),
                              (["--format", "avi"], "--format = 'avi' is not a known format: allowed mp4, gif")]:
-        r = plot(directory, *options)
-        assert r.returncode == 2, options
-        assert r.stderr.startswith("chainsim: error: " + message), r.stderr
-    r = plot(run_dir("reduced"), "--animate")
-    assert r.returncode == 2 and "--animate needs nodes.csv" in r.stderr
+        code, err = plot_here(directory, *options)
+        assert code == 2, options
+        assert err.startswith("chainsim: error: " + message), err
+    code, err = plot_here(run_dir("reduced"), "--animate")
+    assert code == 2 and "--animate needs nodes.csv" in err
 
 
 # --- the readers and the interpolation against independent references ----------------------------
 
-def test_frames_match_the_csv_rows():
+def test_reader_frames_match_the_csv_rows():
     from chainsim_plot.readers import load_run
     directory = run_dir("fronts")
     run = load_run(directory)
@@ -255,7 +278,7 @@ def test_frames_match_the_csv_rows():
     assert [f.name for f in run.fronts] == ["heap_end"] and run.fronts[0].on_plane
 
 
-def test_hermite_interpolation_is_exact_for_cubics():
+def test_reader_hermite_interpolation_is_exact_for_cubics():
     from chainsim_plot.figures import hermite
     t = np.array([0.0, 0.3, 0.35, 1.0])
     q = 2 * t**3 - t**2 + 0.5 * t - 1

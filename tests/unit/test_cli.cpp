@@ -149,7 +149,7 @@ TEST_CASE("every command-line parse error exits 2 with 'chainsim: error:' and wh
   }
 }
 
-TEST_CASE("--json prints one error object on failure, for every command", "[unit][cli]") {
+TEST_CASE("with --json every failure of every command prints one error object", "[unit][cli]") {
   const std::string out = temp_dir("cli_json_errors");
   struct Case {
     const char* args;
@@ -183,7 +183,7 @@ TEST_CASE("--json prints one error object on failure, for every command", "[unit
   CHECK(j["exit_code"] == 2);
 }
 
-TEST_CASE("chainsim plot and compare have --help; plot refuses a missing run directory with exit code 2",
+TEST_CASE("chainsim plot and compare have --help and plot refuses a missing run directory with exit code 2",
           "[unit][cli]") {
   for (const char* cmd : {"compare", "plot"}) {
     CAPTURE(cmd);

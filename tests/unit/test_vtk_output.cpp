@@ -90,7 +90,7 @@ TEST_CASE("VTK frames read back exactly with VTK's reader, binary (default) and 
   CHECK(std::filesystem::file_size(dir / "binary.vtp") < std::filesystem::file_size(dir / "ascii.vtp"));
 }
 
-TEST_CASE("vtk_encoding names: binary, ascii; anything else is an InputError naming the key", "[unit][vtk]") {
+TEST_CASE("vtk_encoding is binary or ascii and anything else is an InputError naming the key", "[unit][vtk]") {
   CHECK(parse_vtk_encoding("binary") == VtkEncoding::kBinary);
   CHECK(parse_vtk_encoding("ascii") == VtkEncoding::kAscii);
   CHECK_THROWS_WITH(parse_vtk_encoding("base64", "output.vtk_encoding"),
