@@ -1,6 +1,6 @@
 #pragma once
 /// @file chain.hpp
-/// The Lagrangian discretization of an inextensible string (DESIGN.md §3, mesh/).
+/// The Lagrangian discretization of an inextensible string (docs/string_solver.md, Discretization).
 ///
 /// A chain of n material nodes x_i (i = 0..n-1) joined by rigid links. Link j joins node j and
 /// node j+1; on a closed string link n-1 joins node n-1 and node 0. Link j has material length h_j

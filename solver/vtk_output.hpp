@@ -5,7 +5,12 @@
 ///
 /// A string frame is a set of line cells, one per link (so per-link data such as the tension is
 /// cell data); node data (velocity, …) is point data. Points are always 3D for VTK: a 2D string is
-/// written with z = 0. Files are ASCII and written through AtomicFile.
+/// written with z = 0. Files are written through AtomicFile, in one of two encodings:
+///   - binary (default): every array as raw little- or big-endian (the machine's, declared in the file)
+///     bytes in one <AppendedData encoding="raw"> block, each preceded by its size in bytes (UInt64
+///     header); exact, and about a third of the ASCII size;
+///   - ascii: the values as text, each double in the shortest form that reads back to the same double
+///     (so also exact); readable by eye, larger and slower to read.
 #include <filesystem>
 #include <string>
 #include <utility>
@@ -24,8 +29,14 @@ struct VtkPolyline {
   std::vector<std::pair<std::string, Eigen::MatrixXd>> cell_data;
 };
 
+enum class VtkEncoding { kBinary, kAscii };
+
+/// "binary" | "ascii" -> the encoding; throws InputError naming `key` and the allowed values otherwise.
+VtkEncoding parse_vtk_encoding(const std::string& text, const std::string& key = "vtk_encoding");
+
 /// Writes one frame as a VTK XML PolyData file.
-void write_vtp(const std::filesystem::path& path, const VtkPolyline& line);
+void write_vtp(const std::filesystem::path& path, const VtkPolyline& line,
+               VtkEncoding encoding = VtkEncoding::kBinary);
 
 /// Writes the ParaView collection: (time in s, file name relative to the .pvd) per frame.
 void write_pvd(const std::filesystem::path& path, const std::vector<std::pair<double, std::string>>& frames);

@@ -44,4 +44,16 @@ struct CompareCommandOptions {
 };
 int run_compare_command(CompareCommandOptions options, std::ostream& out);
 
+/// `chainsim plot RUN_DIR ...`: draws a run directory with the Python package python/chainsim_plot
+/// (docs/plotting.md). The option values are passed on as written (the package checks them);
+/// "" = not given.
+struct PlotCommandOptions {
+  std::string run_dir;
+  bool animate = false;
+  std::string speed, fps, times, format;
+};
+/// Runs /usr/bin/python3 (else python3 on PATH) -m chainsim_plot with PYTHONPATH set to the source
+/// tree's python/; returns its exit code (1 if it cannot be started).
+int run_plot_command(const PlotCommandOptions& options);
+
 }  // namespace chainsim

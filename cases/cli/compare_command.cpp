@@ -22,8 +22,15 @@ int run_compare_command(CompareCommandOptions options, std::ostream& out) {
   samples_table(c.string.run).write(dir / "string_series.csv");
   c.reduced.series.write(dir / "reduced_series.csv");
   write_json(dir / "summary.json", c.summary);  // written last: its presence means the set is complete
+  const bool failed = c.string.run.status == "failed";
+  const std::string error = fmt::format("the string solver failed: {}", c.string.run.error);
   if (options.json) {
-    out << c.summary.dump() << '\n';
+    nlohmann::json j = c.summary;
+    if (failed) {
+      j["error"] = error;
+      j["exit_code"] = 3;
+    }
+    out << j.dump() << '\n';
   } else {
     const auto& s = c.summary;
     out << fmt::format("{} chain, f = {}, {} nodes: string solver vs reduced ODE\n", options.problem,
@@ -40,8 +47,7 @@ int run_compare_command(CompareCommandOptions options, std::ostream& out) {
                        s["transfers"].get<long>(), s["steps"].get<long>(), s["wall_s"].get<double>());
     out << fmt::format("  outputs in {}\n", dir.string());
   }
-  if (c.string.run.status == "failed")
-    throw NumericalError(fmt::format("the string solver failed: {}", c.string.run.error), c.string.run.t_stop);
+  if (failed) throw NumericalError(error, c.string.run.t_stop);
   return 0;
 }
 

@@ -3,9 +3,11 @@
 //
 // Exit codes: 0 success, 1 internal error, 2 bad input (option, value, scene), 3 numerical failure.
 #include <iostream>
+#include <sstream>
 
 #include <CLI/CLI.hpp>
 #include <fmt/format.h>
+#include <nlohmann/json.hpp>
 
 #include "cases/cli/commands.hpp"
 #include "cases/cli/run_command.hpp"
@@ -23,6 +25,73 @@ void add_integrator_options(CLI::App& cmd, IntegratorOptions& o) {
   cmd.add_option("--rtol", o.rtol, "relative tolerance, 1e-14 <= rtol <= 1e-2")->capture_default_str();
   cmd.add_option("--atol", o.atol, "absolute tolerance, relative to the state's natural scale")->capture_default_str();
   cmd.add_option("--max-step", o.max_step, "largest time step (s); 0 = the command's default")->capture_default_str();
+}
+
+/// The subcommand the command line entered (nullptr before one).
+const CLI::App* entered_subcommand(const CLI::App& app) {
+  for (const CLI::App* sub : app.get_subcommands([](const CLI::App* c) { return c->parsed(); })) return sub;
+  return nullptr;
+}
+
+std::string command_names(const CLI::App& app) {
+  std::string names;
+  for (const CLI::App* sub : app.get_subcommands([](const CLI::App*) { return true; }))
+    names += (names.empty() ? "" : ", ") + sub->get_name();
+  return names;
+}
+
+/// A CLI11 parse error in chainsim's words: the option, the value as written, and what is allowed (the
+/// option's help text carries its range).
+std::string describe_parse_error(const CLI::App& app, const CLI::ParseError& e, const std::string& first_argument) {
+  const CLI::App* sub = entered_subcommand(app);
+  const CLI::App& where = sub ? *sub : app;
+  const std::string command = sub ? "chainsim " + sub->get_name() : "chainsim";
+  const std::string what = e.what();
+  auto help_of = [&](const std::string& name) -> std::string {
+    for (const CLI::Option* o : where.get_options())
+      if (o->check_name(name) || o->get_name() == name) return o->get_description();
+    return "";
+  };
+  auto valid_options = [&] {
+    std::string names;
+    for (const CLI::Option* o : where.get_options())
+      if (!o->get_lnames().empty()) names += (names.empty() ? "--" : ", --") + o->get_lnames().front();
+    return names;
+  };
+  const std::string hint = fmt::format(" (see '{} --help')", command);
+  const auto code = static_cast<CLI::ExitCodes>(e.get_exit_code());
+  if (code == CLI::ExitCodes::ConversionError) {
+    // "Could not convert: --f = abc"
+    const auto colon = what.find(": "), eq = what.find(" = ");
+    if (colon != std::string::npos && eq != std::string::npos && eq > colon) {
+      const std::string name = what.substr(colon + 2, eq - colon - 2), value = what.substr(eq + 3);
+      const CLI::Option* o = nullptr;
+      for (const CLI::Option* c : where.get_options())
+        if (c->check_name(name)) o = c;
+      const std::string kind = o && o->get_type_name() == "INT" ? "an integer" : "a number";
+      return fmt::format("{} = '{}' is not {}: allowed {}", name, value, kind, help_of(name));
+    }
+  }
+  if (!sub && !first_argument.empty() && first_argument[0] != '-')
+    return fmt::format("unknown command '{}': allowed {}{}", first_argument, command_names(app), hint);
+  if (code == CLI::ExitCodes::ExtrasError) {
+    // "The following argument(s) was/were not expected: --bogus"
+    const std::string extras = what.substr(what.find(": ") + 2);
+    return fmt::format("unknown or extra argument{} {} for {}; valid options: {}", extras.find(' ') == std::string::npos ? "" : "s",
+                       extras, command, valid_options());
+  }
+  if (code == CLI::ExitCodes::RequiredError) {
+    if (!sub) return fmt::format("a command is required: {}{}", command_names(app), hint);
+    const std::string name = what.substr(0, what.find(" is required"));
+    return fmt::format("{} needs the argument '{}' ({}){}", command, name, help_of(name), hint);
+  }
+  if (code == CLI::ExitCodes::ArgumentMismatch) {
+    // "--f: 1 required FLOAT missing" or "Expected exactly 1 arguments to --f, got 0"
+    std::string name = what.substr(0, what.find(':'));
+    if (what.rfind("Expected", 0) == 0) name = what.substr(what.find(" to ") + 4, what.rfind(',') - what.find(" to ") - 4);
+    return fmt::format("{} needs a value: {}{}", name, help_of(name), hint);
+  }
+  return what + hint;
 }
 
 }  // namespace
@@ -104,29 +173,70 @@ int main(int argc, char** argv) {
   cmd_run->add_flag("--json", run.json,
                     "print the run summary as one JSON object on stdout (on failure: status \"failed\" and the error)");
 
+  // --- chainsim plot -----------------------------------------------------------------------------
+  chainsim::PlotCommandOptions plot;
+  auto* cmd_plot = app.add_subcommand(
+      "plot", "Draw a run directory (written by run, compare, reduced or canonical) into RUN_DIR/figures/ with "
+              "matplotlib, and print the paths of the files written");
+  cmd_plot->add_option("run_dir", plot.run_dir, "the run directory")->required();
+  cmd_plot->add_flag("--animate", plot.animate,
+                     "also write RUN_DIR/figures/animation.mp4 (ffmpeg), or .gif without ffmpeg, of the string moving");
+  cmd_plot->add_option("--speed", plot.speed, "animation speed in units of real time, > 0 (default 1)");
+  cmd_plot->add_option("--fps", plot.fps, "animation frames per second, an integer >= 1 (default 25)");
+  cmd_plot->add_option("--times", plot.times, "times of the snapshots and tension profiles (s), e.g. 0,0.1,0.2");
+  cmd_plot->add_option("--format", plot.format, "animation format: mp4 | gif (default mp4 if ffmpeg is installed)");
+
+  // With --json, every failure also prints one JSON object on stdout: the command's own (run, and
+  // compare after a numerical failure, print their summary), else {"status": "failed", "error", ...}.
+  const bool json = [&] {
+    for (int k = 1; k < argc; ++k)
+      if (std::string(argv[k]) == "--json") return true;
+    return false;
+  }();
+  // `printed`: the command has printed its own JSON object for this failure.
+  auto fail = [&](const std::string& command, const std::string& message, int code, bool printed = false) {
+    std::cerr << "chainsim: " << (code == 3 ? "numerical failure: " : "error: ") << message << '\n';
+    if (json && !printed) {
+      nlohmann::json j = {{"status", "failed"}, {"error", message}, {"exit_code", code}};
+      if (!command.empty()) j["command"] = command;
+      std::cout << j.dump() << '\n';
+    }
+    return code;
+  };
+
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
-    return app.exit(e);
+    if (e.get_exit_code() == 0) return app.exit(e);  // --help, --version
+    const CLI::App* sub = entered_subcommand(app);
+    return fail(sub ? sub->get_name() : "", describe_parse_error(app, e, argc > 1 ? argv[1] : ""), 2);
   }
+  if (*cmd_plot) return chainsim::run_plot_command(plot);
 
+  const CLI::App* sub = entered_subcommand(app);
+  const std::string command = sub ? sub->get_name() : "";
+  std::ostringstream buffered;  // with --json, the command's output, to know whether it printed its own
+  std::ostream& out = json ? static_cast<std::ostream&>(buffered) : std::cout;
+  auto failed = [&](const std::exception& e, int code) {
+    std::cout << buffered.str();
+    return fail(command, e.what(), code, !buffered.str().empty());
+  };
   try {
-    if (*cmd_reduced) return chainsim::run_reduced_command(reduced, std::cout);
-    if (*cmd_canonical) return chainsim::run_canonical_command(canonical, std::cout);
-    if (*cmd_compare) return chainsim::run_compare_command(compare, std::cout);
+    int code = 1;
+    if (*cmd_reduced) code = chainsim::run_reduced_command(reduced, out);
+    if (*cmd_canonical) code = chainsim::run_canonical_command(canonical, out);
+    if (*cmd_compare) code = chainsim::run_compare_command(compare, out);
     if (*cmd_run) {
       if (opt_t_end->count() > 0) run.t_end = run_t_end;
-      return chainsim::run_scene_command(run, std::cout);
+      code = chainsim::run_scene_command(run, out);
     }
+    std::cout << buffered.str();
+    return code;
   } catch (const chainsim::InputError& e) {
-    std::cerr << "chainsim: error: " << e.what() << '\n';
-    return 2;
+    return failed(e, 2);
   } catch (const chainsim::NumericalError& e) {
-    std::cerr << "chainsim: numerical failure: " << e.what() << '\n';
-    return 3;
+    return failed(e, 3);
   } catch (const std::exception& e) {
-    std::cerr << "chainsim: " << e.what() << '\n';
-    return 1;
+    return failed(e, 1);
   }
-  return 1;
 }

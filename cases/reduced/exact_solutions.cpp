@@ -1,4 +1,4 @@
-// Exact references for the reduced chain models of DESIGN.md §2; see exact_solutions.hpp.
+// Exact references for the reduced chain models of docs/model.md §4; see exact_solutions.hpp.
 //
 // @sect{The first integrals}
 // With u = η'² we have η'' = ½ du/dη, and each reduced equation becomes linear in u:

@@ -1,6 +1,6 @@
 #pragma once
 /// @file exact_solutions.hpp
-/// Exact references for the reduced models of the three canonical chain problems (DESIGN.md §2),
+/// Exact references for the reduced models of the three canonical chain problems (docs/model.md §4),
 /// in scaled, dimensionless variables:
 ///
 ///   η = y/ℓ,   ξ = t/t0,   t0 = sqrt(2ℓ/g),   P0 = λℓg,   ' = d/dξ,   f ∈ [0, 1] the shock dissipation.

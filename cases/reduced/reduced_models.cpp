@@ -1,4 +1,4 @@
-// The reduced models of DESIGN.md §2, integrated by ARKODE; see reduced_models.hpp.
+// The reduced models of docs/model.md §4, integrated by ARKODE; see reduced_models.hpp.
 #include "reduced_models.hpp"
 
 #include <chrono>

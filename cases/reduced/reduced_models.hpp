@@ -1,7 +1,7 @@
 #pragma once
 /// @file reduced_models.hpp
 /// The reduced (one-degree-of-freedom) models of the paper's three canonical chain problems,
-/// DESIGN.md §2, integrated with ARKODE in physical units.
+/// docs/model.md §4, integrated with ARKODE in physical units.
 ///
 ///  (a) falling chain onto a table, heap at the contact point; y = height of the falling part:
 ///        (1 + f sgn ẏ) ẏ² + (ÿ + g) y = 0                                   stop at y = ε ℓ

@@ -5,29 +5,27 @@ Usage: /usr/bin/python3 docs/figures/make_string_figures.py RESULTS_DIR
 where RESULTS_DIR/<scene>/ holds the outputs of `chainsim run cases/scenes/<scene>.toml --out RESULTS_DIR/<scene>`
 for hanging_chain, shaken_chain, damped_catenary and travelling_loop. Writes docs/figures/string_scenes.png.
 """
-import csv
 import os
 import sys
-from collections import defaultdict
 
 import matplotlib
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "python"))
+from chainsim_plot.readers import Frames, read_table  # noqa: E402
+
 
 def frames(path):
-    by_t = defaultdict(list)
-    with open(path, newline="") as fh:
-        for row in csv.DictReader(fh):
-            by_t[float(row["t"])].append((int(row["node"]), float(row["x"]), float(row["y"])))
-    return {t: sorted(v) for t, v in sorted(by_t.items())}
+    """{t: [(node, x, y), ...]} from nodes.csv."""
+    f = Frames(read_table(path))
+    return {t: [(int(i), x, y) for i, (x, y) in zip(f.nodes(k), f.positions(k))] for k, t in enumerate(f.times)}
 
 
 def energy(path):
-    with open(path, newline="") as fh:
-        rows = list(csv.DictReader(fh))
-    return [float(r["t"]) for r in rows], [float(r["drift"]) for r in rows]
+    table = read_table(path)
+    return table["t"], table["drift"]
 
 
 def draw(ax, data, picks, closed=False, title="", equal=True):
@@ -47,6 +45,10 @@ def draw(ax, data, picks, closed=False, title="", equal=True):
 
 
 def main():
+    if len(sys.argv) != 2:
+        sys.stderr.write("usage: make_string_figures.py RESULTS_DIR   (RESULTS_DIR/<scene>/ from chainsim run, "
+                         "for hanging_chain, shaken_chain, damped_catenary, travelling_loop)\n")
+        sys.exit(2)
     root = sys.argv[1]
     out = os.path.join(os.path.dirname(os.path.abspath(__file__)), "string_scenes.png")
     fig, axes = plt.subplots(1, 5, figsize=(18, 4.2), gridspec_kw={"width_ratios": [0.7, 0.7, 1.3, 1.1, 1.3]})

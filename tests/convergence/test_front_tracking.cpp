@@ -53,7 +53,7 @@ TEST_CASE("front tracking reproduces the reduced ODEs of the three problems for 
   // In the paper's geometry every arc moves along a straight line, and the discrete string with a
   // partial link at each front carries exactly the mass λ × (arc length): the scheme reproduces the
   // reduced ODE for every N. The error must therefore sit at the integrator's tolerance already on
-  // the coarsest mesh (order: none to measure, the mesh error is zero), far inside the issue's
+  // the coarsest mesh (order: none to measure, the mesh error is zero), far inside the acceptance
   // bounds rel_err_t_stop <= 1e-3 and max_rel_err_P <= 1e-2.
   std::printf("\n%-8s %5s %6s %12s %12s %12s %12s %12s %6s\n", "problem", "f", "nodes", "rel_err_t", "err_eta",
               "rel_err_P", "energy", "momentum", "cross");

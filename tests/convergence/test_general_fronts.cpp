@@ -1,4 +1,4 @@
-// General configurations of the canonical problems on the string solver (issue 4, item 4): a falling
+// General configurations of the canonical problems on the string solver: a falling
 // chain released tilted or curved onto a table, whose contact slides along the table. Each is checked
 // against a reference that does not use the front-tracking code: a three-equation ODE for the tilted
 // straight chain (integrated here by classical RK4), the closed-form free fall for f = 1, and

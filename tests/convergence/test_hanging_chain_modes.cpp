@@ -1,4 +1,4 @@
-// Small oscillations of a heavy chain hanging from a fixed point (DESIGN.md §5):
+// Small oscillations of a heavy chain hanging from a fixed point (docs/model.md §7.1):
 //   ω_n = (j_{0,n} / 2) sqrt(g/ℓ),  mode shape J0(2 ω_n sqrt(σ/g)) = J0(j_{0,n} sqrt(σ/ℓ)),
 // σ the distance from the free end. The chain starts at rest in the mode shape with a small amplitude;
 // the frequency is measured from the zero crossings of the modal projection

@@ -1,4 +1,4 @@
-// The static catenary as the rest state of a damped string (DESIGN.md §5).
+// The static catenary as the rest state of a damped string (docs/model.md §7.3).
 //
 // A string of length ℓ = 1 m between the fixed points (0, 0) and (0.8, 0.2) starts at rest as a V
 // (two straight legs) and relaxes under gravity with linear drag. Its rest state is compared with the

@@ -1,4 +1,4 @@
-// Independent checks of the exact references in cases/reduced/exact_solutions.hpp (DESIGN.md §2).
+// Independent checks of the exact references in cases/reduced/exact_solutions.hpp (docs/model.md §4).
 //
 // The implementation evaluates ξ(η) by tanh-sinh quadrature after sin/cosh substitutions. Here every
 // quadrature is instead written as an incomplete Beta function and evaluated with Boost's
@@ -225,7 +225,7 @@ TEST_CASE("classical special values", "[problems][exact]") {
   }
 }
 
-TEST_CASE("P/P0 against the closed forms of DESIGN.md section 2", "[problems][exact]") {
+TEST_CASE("P/P0 against the closed forms of docs/model.md section 4", "[problems][exact]") {
   for (double f : kDissipations) {
     // Stay off the far ends, where the falling and folded P diverge for f < 1.
     for (double s : {0.01, 0.2, 0.5, 0.8, 0.99, 1.0}) {

@@ -17,7 +17,7 @@ using Catch::Matchers::WithinRel;
 
 namespace {
 
-// The acceptance levels; the default integrator (order 8, rtol 1e-13) meets them with margin.
+// The acceptance levels; the default integrator (order 8, rtol 1e-13) meets them with margin.
 constexpr double kStopTimeRelTol = 1e-9;
 constexpr double kStopForceRelTol = 1e-7;
 // The integrated ledger K + V − E0 − ∫ΣW is a time-integration error: a few rtol of the energy scale.

@@ -1,4 +1,4 @@
-// Energy and constraints of the string solver (DESIGN.md §4, §5):
+// Energy and constraints of the string solver (docs/model.md §7.4):
 //  - no dissipation, no driver: K + V is conserved to the integrator's tolerance over many periods,
 //    the link constraints stay satisfied, and both errors fall as rtol is tightened;
 //  - Baumgarte stabilisation keeps the constraint drift at the tolerance level over long runs;

@@ -1,4 +1,4 @@
-// A closed loop travelling along its own tangent without gravity (DESIGN.md §5): a curve moving
+// A closed loop travelling along its own tangent without gravity (docs/model.md §7.2): a curve moving
 // with uniform speed v along itself under the tension τ = λ v² keeps its shape.
 //
 // Discrete check: the regular polygon with side h, node masses λh and every node moving with speed v

@@ -120,3 +120,79 @@ TEST_CASE("chainsim run: a numerical failure exits 3, says what and when, and wr
   CHECK_THAT(failed["error"].get<std::string>(), Catch::Matchers::StartsWith("slack at t = 0 s"));
   CHECK(failed["root_functions"] == 0);
 }
+
+TEST_CASE("every command-line parse error exits 2 with 'chainsim: error:' and what is allowed", "[unit][cli]") {
+  struct Case {
+    const char* args;
+    const char* message;
+  };
+  const Case cases[] = {
+      {"reduced falling --f abc",
+       "chainsim: error: --f = 'abc' is not a number: allowed shock dissipation parameter f, 0 <= f <= 1"},
+      {"compare folded --nodes 4.5",
+       "chainsim: error: --nodes = '4.5' is not an integer: allowed nodes of the string, 4 <= N <= 200001"},
+      {"reduced falling --bogus", "chainsim: error: unknown or extra argument --bogus for chainsim reduced; valid "
+                                  "options: --help, --f, --eps,"},
+      {"reduced falling --f", "chainsim: error: --f needs a value: shock dissipation parameter f, 0 <= f <= 1"},
+      {"reduced", "chainsim: error: chainsim reduced needs the argument 'problem' (falling | folded | sliding)"},
+      {"run", "chainsim: error: chainsim run needs the argument 'scene'"},
+      {"plot", "chainsim: error: chainsim plot needs the argument 'run_dir'"},
+      {"", "chainsim: error: a command is required: reduced, canonical, compare, run, plot"},
+      {"frob --f 1", "chainsim: error: unknown command 'frob': allowed reduced, canonical, compare, run, plot"},
+      {"canonical extra", "chainsim: error: unknown or extra argument extra for chainsim canonical"},
+  };
+  for (const Case& c : cases) {
+    CAPTURE(c.args);
+    const Result r = run(c.args);
+    CHECK(r.status == 2);
+    CHECK_THAT(r.output, Catch::Matchers::StartsWith(c.message));
+  }
+}
+
+TEST_CASE("with --json every failure of every command prints one error object", "[unit][cli]") {
+  const std::string out = temp_dir("cli_json_errors");
+  struct Case {
+    const char* args;
+    const char* command;
+    const char* error;
+  };
+  const Case cases[] = {
+      {"reduced falling --f 3 --json", "reduced", "--f = 3 is out of range: allowed 0 <= f <= 1"},
+      {"reduced falling --f abc --json", "reduced", "--f = 'abc' is not a number"},
+      {"compare falling --nodes 2 --json", "compare", "--nodes = 2 is out of range: allowed 4 <= nodes <= 200001"},
+      {"canonical --out /proc/chainsim_no --json", "canonical", "--out = '/proc/chainsim_no' cannot be used"},
+  };
+  for (const Case& c : cases) {
+    CAPTURE(c.args);
+    const Result r = run(c.args, true);
+    CHECK(r.status == 2);
+    const auto j = nlohmann::json::parse(r.output);  // exactly one object
+    CHECK(j["status"] == "failed");
+    CHECK(j["exit_code"] == 2);
+    CHECK(j["command"] == c.command);
+    CHECK_THAT(j["error"].get<std::string>(), Catch::Matchers::StartsWith(c.error));
+    // The message on stderr is the same.
+    const Result both = run(c.args);
+    CHECK_THAT(both.output, Catch::Matchers::StartsWith(std::string("chainsim: error: ") + c.error));
+  }
+  // `run` prints its own object (with the scene), once.
+  const Result r = run("run " + out + "/missing.toml --json", true);
+  CHECK(r.status == 2);
+  const auto j = nlohmann::json::parse(r.output);
+  CHECK(j["scene"] == out + "/missing.toml");
+  CHECK(j["exit_code"] == 2);
+}
+
+TEST_CASE("chainsim plot and compare have --help and plot refuses a missing run directory with exit code 2",
+          "[unit][cli]") {
+  for (const char* cmd : {"compare", "plot"}) {
+    CAPTURE(cmd);
+    const Result r = run(std::string(cmd) + " --help");
+    CHECK(r.status == 0);
+    CHECK_THAT(r.output, Catch::Matchers::Contains("Usage"));
+  }
+  const std::string missing = temp_dir("cli_plot_missing");
+  const Result r = run("plot " + missing);
+  CHECK(r.status == 2);
+  CHECK_THAT(r.output, Catch::Matchers::StartsWith("chainsim: error: RUN_DIR '" + missing + "' does not exist"));
+}

@@ -135,7 +135,7 @@ TEST_CASE("heap front: a string moving along itself meets the paper's external s
       const auto front = model.snapshot(0.0, model.state_from_chain()).fronts[0];
       const double u = 1.7;
       CHECK(front.inflow == Approx(-u).epsilon(1e-12));
-      // Falling chain (docs/model.md): the table holds the string with f λ ẏ² back along it, the shock
+      // Falling chain (docs/model.md §4.1): the table holds the string with f λ ẏ² back along it, the shock
       // dissipates f λ |ẏ|³ and the heap's power is W*⁺ = −½ λ ẏ³ with ẏ = −u.
       CHECK((front.reaction - kF * kLambda * u * u * kUp).norm() < 1e-12);
       CHECK(front.power_shock == Approx(-kF * kLambda * u * u * u));

@@ -1,5 +1,5 @@
 // Scenes with shocks (cases/scene/front_scene.hpp) and the model choice (cases/scene/reduced_scene.hpp), checked
-// against references that do not use the scene code: the exact quadratures of DESIGN.md §2
+// against references that do not use the scene code: the exact quadratures of docs/model.md §4
 // (cases/reduced/exact_solutions.hpp), `chainsim compare` on the same problem set up in C++, and the
 // closed-form free fall of a tilted chain with f = 1. The table of bad scenes is in
 // test_scene_errors.cpp.

@@ -1,0 +1,123 @@
+"""`chainsim plot RUN_DIR [--animate] [--speed X] [--times t1,t2,...] [--fps N] [--format mp4|gif]`.
+
+Draws the run in RUN_DIR into RUN_DIR/figures/ and prints the path of every file it writes. Exit codes as
+for every chainsim command: 0 success, 2 bad input (an option, a missing or unreadable run directory, a
+malformed output file), 1 anything else.
+"""
+import argparse
+import math
+import os
+import sys
+
+
+class _Parser(argparse.ArgumentParser):
+    def error(self, message):
+        # "argument --speed: --speed = -1 is out of range ..." -> "--speed = -1 is out of range ..."
+        head, _, rest = message.partition(": ")
+        if head.startswith("argument ") and rest.startswith(head[len("argument "):].split("/")[0]):
+            message = rest
+        sys.stderr.write(f"chainsim: error: {message} (see 'chainsim plot --help')\n")
+        sys.exit(2)
+
+
+def _positive(name, kind):
+    def parse(text):
+        try:
+            value = kind(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"{name} = '{text}' is not a{'n integer' if kind is int else ' number'}")
+        if not (value > 0 and math.isfinite(value)):
+            raise argparse.ArgumentTypeError(f"{name} = {text} is out of range: allowed {name[2:]} > 0")
+        return value
+    return parse
+
+
+def _times(text):
+    out = []
+    for part in text.split(","):
+        try:
+            value = float(part)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"--times = '{text}': '{part}' is not a number (give t1,t2,... in s)")
+        if not math.isfinite(value):
+            raise argparse.ArgumentTypeError(f"--times = '{text}': '{part}' is not a finite time")
+        out.append(value)
+    return out
+
+
+def _format(text):
+    if text not in ("mp4", "gif"):
+        raise argparse.ArgumentTypeError(f"--format = '{text}' is not a known format: allowed mp4, gif")
+    return text
+
+
+def parser():
+    p = _Parser(prog="chainsim plot", description="Draw the outputs of a chainsim run (run, compare, reduced, "
+                "canonical) into RUN_DIR/figures/ and print the paths of the files written.")
+    p.add_argument("run_dir", metavar="RUN_DIR", help="a directory written by chainsim run|compare|reduced|canonical")
+    p.add_argument("--animate", action="store_true", help="also write RUN_DIR/figures/animation.mp4 (ffmpeg) or "
+                   ".gif (without ffmpeg) of the string in motion")
+    p.add_argument("--speed", type=_positive("--speed", float), default=1.0,
+                   help="animation speed, in units of real time (default 1: real time), > 0")
+    p.add_argument("--fps", type=_positive("--fps", int), default=25, help="animation frames per second (default 25)")
+    p.add_argument("--format", type=_format, default=None,
+                   help="animation format (default: mp4 if ffmpeg is installed, else gif)")
+    p.add_argument("--times", type=_times, default=None,
+                   help="times (s) of the snapshots and tension profiles, e.g. 0,0.1,0.2 (default: 6 spread "
+                        "over the run)")
+    return p
+
+
+def plot_run(run_dir, times=None, animate=False, speed=1.0, fps=25, fmt=None, out_dir=None, prefix=""):
+    """Draws one run; returns the paths written. Raises RunError for what cannot be drawn."""
+    from . import figures
+    from .readers import RunError, is_canonical, load_run
+
+    out_dir = out_dir or os.path.join(run_dir, "figures")
+    if is_canonical(run_dir):
+        from .canonical import paper_figures
+        written = paper_figures(run_dir, out_dir)
+        for problem in ("falling", "folded", "sliding"):
+            sub = os.path.join(run_dir, problem)
+            if os.path.isdir(sub):
+                written += plot_run(sub, out_dir=out_dir, prefix=f"{problem}_")
+        return written
+    run = load_run(run_dir)
+    if times and run.nodes is None and run.tension is None:
+        raise RunError(f"--times needs node frames or tensions, and {run_dir} has neither (a {run.kind} run)")
+    if animate and run.nodes is None:
+        raise RunError(f"--animate needs nodes.csv, and {run_dir} has none (a {run.kind} run)")
+    written = []
+    if run.kind == "reduced":
+        written.append(figures.reduced_figure(run, out_dir, prefix))
+    if run.kind == "compare":
+        written.append(figures.compare_figure(run, out_dir, prefix))
+    if run.nodes is not None:
+        written.append(figures.snapshots_figure(run, out_dir, times, prefix))
+    written.append(figures.energy_figure(run, out_dir, prefix))
+    written.append(figures.tension_figure(run, out_dir, times, prefix))
+    written.append(figures.fronts_figure(run, out_dir, prefix))
+    if animate:
+        from .animate import animate as make_animation
+        path, _ = make_animation(run, os.path.join(out_dir, prefix + "animation"), speed=speed, fps=fps, fmt=fmt)
+        written.append(path)
+    return [path for path in written if path]
+
+
+def main(argv=None):
+    args = parser().parse_args(argv)
+    try:
+        import matplotlib  # noqa: F401
+        import numpy  # noqa: F401
+    except ImportError as e:
+        sys.stderr.write(f"chainsim: error: plot needs numpy and matplotlib ({e}): install the Debian packages "
+                         f"python3-numpy python3-matplotlib, or run with /usr/bin/python3\n")
+        return 1
+    from .readers import RunError
+    try:
+        for path in plot_run(args.run_dir, args.times, args.animate, args.speed, args.fps, args.format):
+            print(path)
+    except RunError as e:
+        sys.stderr.write(f"chainsim: error: {e}\n")
+        return 2
+    return 0

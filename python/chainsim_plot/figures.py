@@ -1,0 +1,450 @@
+"""The figures of a run: each function draws onto matplotlib axes or writes one PNG and returns its path.
+
+    snapshots.png  the string at several times (x-y; x-y and x-z in 3D), heaps, the plane and the fronts
+    energy.png     the energy ledger: K, V, each work term, and the residual of the balance
+    tension.png    the tension along s at the same times (and T(s, t) when the links do not change)
+    fronts.png     each front's s0 and speed ds0/dt over time
+    compare.png    chainsim compare: the string solver against the reduced ODE
+    reduced.png    a reduced run: eta(t) and P/P0
+"""
+import os
+import textwrap
+
+import numpy as np
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+
+from .readers import RunError  # noqa: E402
+
+DPI = 110
+HEAP_COLOR = "tab:brown"
+FRONT_COLOR = "tab:red"
+
+
+# --- helpers --------------------------------------------------------------------------------------
+
+def save(fig, out_dir, name):
+    os.makedirs(out_dir, exist_ok=True)
+    path = os.path.join(out_dir, name)
+    fig.savefig(path, dpi=DPI)
+    plt.close(fig)
+    return path
+
+
+def decorate(ax, xlabel, ylabel, title=None, legend=True):
+    ax.set_xlabel(xlabel)
+    ax.set_ylabel(ylabel)
+    if title:
+        ax.set_title(title, fontsize=10)
+    if legend and ax.get_legend_handles_labels()[0]:
+        ax.legend(fontsize=7, loc="best")
+    ax.grid(alpha=0.3, which="both")
+
+
+def semilogy_abs(ax, t, r, **kw):
+    """|r| on a log axis; exact zeros (e.g. the first sample) are drawn at the bottom of the axis."""
+    a = np.abs(np.asarray(r, dtype=float))
+    positive = a[a > 0]
+    floor = max(positive.min(), positive.max() * 1e-12) / 2 if positive.size else 1e-300
+    ax.semilogy(t, np.maximum(a, floor), **kw)
+    return float(a.max()) if a.size else 0.0
+
+
+def choose_times(times, wanted=None, count=6):
+    """Indices of the frames to draw: the nearest to each wanted time, or `count` frames spread evenly
+    from the first to the last."""
+    times = np.asarray(times)
+    if wanted:
+        lo, hi = times[0], times[-1]
+        for t in wanted:
+            if t < lo - 1e-12 * max(1.0, abs(lo)) or t > hi + 1e-12 * max(1.0, abs(hi)):
+                raise RunError(f"--times: t = {t:g} s is outside the run: allowed {lo:g} <= t <= {hi:g} s")
+        return sorted({int(np.argmin(np.abs(times - t))) for t in wanted})
+    n = min(count, len(times))
+    return sorted({int(np.argmin(np.abs(times - t))) for t in np.linspace(times[0], times[-1], n)})
+
+
+def time_colors(n):
+    cmap = plt.get_cmap("viridis")
+    return [cmap(k / max(1, n - 1)) for k in range(n)]
+
+
+PROJECTIONS = {2: [(0, 1)], 3: [(0, 1), (0, 2)]}
+AXIS_NAMES = "xyz"
+
+
+# --- the string's geometry: layout shared by the snapshots and the animation ----------------------
+
+class Layout:
+    """How a run's string is drawn: the projections, the partial links to the heaps' fronts, and two
+    optional offsets for motions that would hide themselves. `stagger`: a motion along one vertical line
+    (the canonical chains) draws each later snapshot further right; `aside`: the arm beyond a fold is
+    drawn shifted sideways (the two arms of a fold lie on one line)."""
+
+    def __init__(self, run, stagger_ok=True):
+        self.run = run
+        frames = run.nodes
+        self.dim = frames.dim
+        self.projections = PROJECTIONS[min(self.dim, 3)]
+        lo, hi = frames.bounds()
+        for f in run.fronts:
+            p = f.positions()
+            if p is not None:
+                lo, hi = np.minimum(lo, p.min(axis=0)), np.maximum(hi, p.max(axis=0))
+            if f.point is not None:
+                lo, hi = np.minimum(lo, f.point), np.maximum(hi, f.point)
+        self.lo, self.hi = lo, hi
+        self.size = float(max(np.max(hi - lo), 1e-12))
+        flat = self.dim == 2 and (hi[0] - lo[0]) < 0.05 * (hi[1] - lo[1])
+        self.stagger = 0.15 * (hi[1] - lo[1]) if (flat and stagger_ok) else 0.0
+        self.fold = next((f for f in run.fronts if f.kind == "fold"), None)
+        self.aside = 0.03 * (hi[1] - lo[1]) if (flat and self.fold is not None) else 0.0
+
+    def notes(self):
+        out = []
+        if self.stagger:
+            out.append(f"each later snapshot drawn {self.stagger:.2g} m further right")
+        if self.aside:
+            out.append(f"the arm past the fold drawn {self.aside:.2g} m aside")
+        return out
+
+    def curve(self, k, t=None):
+        """Frame k as an (m x dim) array of points to draw (NaN rows break the line), with the partial
+        links to the heaps' fronts, the fold's arm shifted, a closed string closed."""
+        frames, run = self.run.nodes, self.run
+        t = frames.times[k] if t is None else t
+        x = frames.positions(k).copy()
+        nodes = frames.nodes(k)
+        if self.aside:
+            s = frames.s(k)
+            s = s if s is not None else nodes.astype(float)
+            s_fold = self.fold.s0_at(t)
+            x[s > s_fold, 0] += self.aside
+        pieces = np.split(x, np.flatnonzero(np.diff(nodes) != 1) + 1)  # gaps: a heap inside the listing
+        if run.closed and len(pieces) == 1:
+            pieces = [np.vstack([x, x[:1]])]
+        for f in run.fronts:
+            if f.kind != "heap":
+                continue
+            p = f.position_at(t)
+            if p is None:
+                continue
+            if f.side == "end":
+                pieces[-1] = np.vstack([pieces[-1], p])
+            else:
+                pieces[0] = np.vstack([p, pieces[0]])
+        out = []
+        for q, piece in enumerate(pieces):
+            if q:
+                out.append(np.full((1, x.shape[1]), np.nan))
+            out.append(piece)
+        return np.vstack(out)
+
+    def front_markers(self, t):
+        """[(front, position)] of the fronts at time t (positions from the series)."""
+        out = []
+        for f in self.run.fronts:
+            p = f.position_at(t)
+            if p is not None:
+                if f.kind == "fold" and self.aside:
+                    p = p.copy()
+                    p[0] += 0.5 * self.aside
+                out.append((f, p))
+        return out
+
+    def draw_planes(self, ax, proj, extra=0.0, label=True):
+        """The plane (table) under each heap on a plane, as its trace on the projection `proj` (only where
+        the projection sees it edge-on). `extra`: how much further right it must reach (staggered
+        snapshots)."""
+        a, b = proj
+        for f in self.run.fronts:
+            if f.kind != "heap" or not f.on_plane or f.plane_normal is None or f.point is None:
+                continue
+            n = f.plane_normal
+            if self.dim == 3 and abs(n[3 - a - b]) > 1e-9 * np.linalg.norm(n):
+                continue
+            d = np.array([-n[b], n[a]])
+            d = d / np.linalg.norm(d)
+            if d[0] < 0:
+                d = -d
+            p = f.point[[a, b]]
+            centre = p + np.dot(0.5 * (self.lo[[a, b]] + self.hi[[a, b]]) - p, d) * d
+            half = 0.6 * self.size
+            ends = np.array([centre - half * d, centre + (half + extra) * d])
+            ax.plot(ends[:, 0], ends[:, 1], "k-", lw=2.5, alpha=0.45, label="plane (table)" if label else None)
+
+    def heaps(self, t):
+        """[(front, position, marker size)] of the heaps at time t: a heap on a plane sits at the moving
+        contact, a pinned heap at its point; the marker's area grows with the mass in the heaps."""
+        series = self.run.series
+        frac = 0.5
+        if series is not None and "heap_mass" in series and "moving_mass" in series:
+            h = np.interp(t, series["t"], series["heap_mass"])
+            m = np.interp(t, series["t"], series["moving_mass"])
+            frac = h / (h + m) if h + m > 0 else 0.0
+        out = []
+        for f in self.run.fronts:
+            if f.kind != "heap":
+                continue
+            p = f.position_at(t) if f.on_plane else f.point
+            if p is None:
+                p = f.point
+            if p is not None:
+                out.append((f, p, 3.0 + 13.0 * np.sqrt(max(frac, 0.0))))
+        return out
+
+    def limits(self, ax, proj, shift=0.0):
+        a, b = proj
+        pad = 0.08 * self.size
+        ax.set_xlim(self.lo[a] - pad - (self.aside if self.aside else 0), self.hi[a] + pad + shift + self.aside)
+        ax.set_ylim(self.lo[b] - pad, self.hi[b] + pad)
+
+
+def space_axes(ax, proj, adjustable="datalim"):
+    """Labels and equal scales for a panel of the string in space; `adjustable="box"` keeps limits that
+    were set (the animation)."""
+    a, b = proj
+    ax.set_xlabel(f"{AXIS_NAMES[a]} (m)")
+    ax.set_ylabel(f"{AXIS_NAMES[b]} (m)")
+    ax.set_aspect("equal", adjustable=adjustable)
+    ax.grid(alpha=0.3)
+
+
+# --- snapshots ------------------------------------------------------------------------------------
+
+def draw_snapshots(axes, run, picks, layout=None):
+    """The string at the frames `picks` on each projection's axes; heaps, the plane, fronts marked.
+    Returns the layout (its notes() say what was shifted)."""
+    layout = layout or Layout(run)
+    frames = run.nodes
+    colors = time_colors(len(picks))
+    shifts = [q * layout.stagger for q in range(len(picks))]
+    for ax, proj in zip(axes, layout.projections):
+        a, b = proj
+        layout.draw_planes(ax, proj, extra=shifts[-1])
+        for q, k in enumerate(picks):
+            pts = layout.curve(k)
+            ax.plot(pts[:, a] + shifts[q], pts[:, b], "-", lw=1.3, color=colors[q],
+                    label=f"t = {frames.times[k]:.4g} s")
+            ax.plot(pts[0, a] + shifts[q], pts[0, b], "o", ms=4, color=colors[q])
+        labelled = set()
+        for q, k in enumerate(picks):
+            t = frames.times[k]
+            for f, p, size in layout.heaps(t):
+                ax.plot(p[a] + shifts[q], p[b], "o", ms=size, color=HEAP_COLOR, alpha=0.6, mew=0,
+                        label=f"heap ({f.name})" if "heap " + f.name not in labelled else None)
+                labelled.add("heap " + f.name)
+            for f, p in layout.front_markers(t):
+                marker = "D" if f.kind == "fold" else "o"
+                ax.plot(p[a] + shifts[q], p[b], marker, ms=5, mfc="none", color=FRONT_COLOR,
+                        label=f"front {f.name}" if f.name not in labelled else None)
+                labelled.add(f.name)
+        space_axes(ax, proj)
+        ax.legend(fontsize=6, loc="best")
+    return layout
+
+
+def snapshots_figure(run, out_dir, wanted=None, prefix=""):
+    frames = run.nodes
+    picks = choose_times(frames.times, wanted)
+    layout = Layout(run)
+    n = len(layout.projections)
+    fig, axes = plt.subplots(1, n, figsize=(6.5 * n, 5.5), squeeze=False)
+    draw_snapshots(axes[0], run, picks, layout)
+    notes = layout.notes()
+    notes.append("small dot: the first node drawn" + (" (s = 0)" if not run.fronts else ""))
+    if run.fronts:
+        notes.append("open markers: the fronts")
+    if any(f.kind == "heap" for f in run.fronts):
+        notes.append("brown discs: the heaps (area grows with their mass)")
+    title = f"{run.name}: the string at {len(picks)} times\n" + textwrap.fill("; ".join(notes), 70 * n)
+    fig.suptitle(title, fontsize=9)
+    fig.tight_layout()
+    return save(fig, out_dir, prefix + "snapshots.png")
+
+
+# --- energy ledger ---------------------------------------------------------------------------------
+
+def ledger_columns(run):
+    """(table, works, residual, note): the table with K and V, its cumulative work columns, its residual
+    column and how the residual is defined."""
+    if run.kind == "reduced":
+        table = run.reduced
+        works = [c for c in table.columns if c.startswith("E_")]
+        return table, works, "ledger", "ledger = K + V - (K0 + V0) - sum of the works"
+    if run.kind == "compare":
+        table = run.series
+    else:
+        table = run.energy if run.energy is not None and "K" in run.energy else run.series
+    if table is None or "K" not in table or "V" not in table:
+        return None, [], None, ""
+    works = [c for c in table.columns if c.startswith("W_")]
+    residual = next((c for c in ("energy_residual", "drift", "ledger") if c in table), None)
+    return table, works, residual, f"{residual} = K + V - (K0 + V0) - sum of the works"
+
+
+WORK_LABELS = {"W_applied": "W_applied (forces, driven ends)", "W_shocks": "W_shocks (dissipated at the shocks)",
+               "W_heaps": "W_heaps (external shocks at the heaps)", "W_remesh": "W_remesh (node transfers)",
+               "E_shock": "work of the shock", "E_heap": "work of the heap", "E_force": "work of the end force"}
+
+
+def draw_ledger(ax, run, table, works):
+    """K, V, K + V - (K0 + V0) and each work term that is not zero, against t."""
+    t, K, V = table["t"], table["K"], table["V"]
+    ax.plot(t, K, label="K (kinetic)")
+    ax.plot(t, V, label="V (potential)")
+    ax.plot(t, K + V - K[0] - V[0], "k-", lw=1.8, label="K + V - (K0 + V0)")
+    styles = ["--", ":", "-.", (0, (5, 1, 1, 1))]
+    for q, c in enumerate(works):
+        if np.max(np.abs(table[c])) > 0 or c == "W_applied":
+            ax.plot(t, table[c], linestyle=styles[q % len(styles)], label=WORK_LABELS.get(c, c))
+    if len(works) > 1:
+        ax.plot(t, sum(table[c] for c in works), "--", color="0.4", lw=1, label="sum of the works")
+    decorate(ax, "t (s)", "J", "energy ledger")
+
+
+def energy_figure(run, out_dir, prefix=""):
+    table, works, residual, note = ledger_columns(run)
+    if table is None:
+        return None
+    fig, (ax1, ax2) = plt.subplots(1, 2, figsize=(13, 4.5))
+    draw_ledger(ax1, run, table, works)
+    if residual is not None:
+        worst = semilogy_abs(ax2, table["t"], table[residual], lw=1)
+        scale = run.summary.get("energy_scale") if isinstance(run.summary, dict) else None
+        title = f"|{residual}|: max {worst:.2e} J"
+        if scale:
+            title += f" ({worst / scale:.1e} of the energy scale {scale:.3g} J)"
+        decorate(ax2, "t (s)", "J", title + f"\n{note}", legend=False)
+    else:
+        ax2.axis("off")
+    fig.suptitle(f"{run.name}: energy", fontsize=10)
+    fig.tight_layout()
+    return save(fig, out_dir, prefix + "energy.png")
+
+
+# --- tension ---------------------------------------------------------------------------------------
+
+def tension_figure(run, out_dir, wanted=None, prefix=""):
+    tab = run.tension
+    if tab is None or len(tab) == 0 or "T" not in tab or "s_mid" not in tab:
+        return None
+    t = tab["t"]
+    starts = np.flatnonzero(np.r_[True, t[1:] != t[:-1]])
+    bounds = np.r_[starts, len(t)]
+    times = t[starts]
+    picks = choose_times(times, wanted)
+    same = len(set(np.diff(bounds))) == 1 and np.allclose(
+        tab["s_mid"][: bounds[1]], tab["s_mid"][bounds[-2]:bounds[-1]])
+    fig, axes = plt.subplots(1, 2 if same else 1, figsize=(13 if same else 7, 4.5), squeeze=False)
+    ax = axes[0][0]
+    for color, k in zip(time_colors(len(picks)), picks):
+        rows = slice(bounds[k], bounds[k + 1])
+        ax.plot(tab["s_mid"][rows], tab["T"][rows], ".-", ms=2, lw=1, color=color, label=f"t = {times[k]:.4g} s")
+    ax.axhline(0, color="k", lw=0.6)
+    decorate(ax, "s (m), link midpoints", "T (N)", "tension along the string")
+    if same:
+        n = bounds[1]
+        grid = tab["T"].reshape(len(times), n)
+        s = tab["s_mid"][:n]
+        lim = np.max(np.abs(grid)) or 1.0
+        neg = np.min(grid) < 0
+        m = axes[0][1].pcolormesh(s, times, grid, shading="nearest", cmap="RdBu_r" if neg else "viridis",
+                                  vmin=-lim if neg else None, vmax=lim if neg else None)
+        fig.colorbar(m, ax=axes[0][1], label="T (N)")
+        decorate(axes[0][1], "s (m)", "t (s)", "T(s, t)" + (" (blue: slack, T < 0)" if neg else ""), legend=False)
+    fig.suptitle(f"{run.name}: tension", fontsize=10)
+    fig.tight_layout()
+    return save(fig, out_dir, prefix + "tension.png")
+
+
+# --- fronts ----------------------------------------------------------------------------------------
+
+def fronts_figure(run, out_dir, prefix=""):
+    if not run.fronts:
+        return None
+    t = run.series["t"]
+    fig, (ax1, ax2) = plt.subplots(1, 2, figsize=(13, 4.5))
+    for f in run.fronts:
+        ax1.plot(t, f.s0, label=f"{f.name}" + (f" ({f.kind})" if f.kind and f.kind not in f.name else ""))
+        if f.s0dot is not None:
+            ax2.plot(t, f.s0dot, label=f.name)
+    decorate(ax1, "t (s)", "s0 (m)", "front positions in the material, s0(t)")
+    decorate(ax2, "t (s)", "ds0/dt (m/s)", "front speeds in the material")
+    fig.suptitle(f"{run.name}: fronts", fontsize=10)
+    fig.tight_layout()
+    return save(fig, out_dir, prefix + "fronts.png")
+
+
+# --- the reduced model and the comparison ----------------------------------------------------------
+
+def hermite(t, q, dq, at):
+    """Cubic Hermite interpolation of q (with derivative dq) given at increasing times t, at `at`."""
+    i = np.clip(np.searchsorted(t, at) - 1, 0, len(t) - 2)
+    h = t[i + 1] - t[i]
+    u = (at - t[i]) / h
+    h00, h10 = 2 * u**3 - 3 * u**2 + 1, u**3 - 2 * u**2 + u
+    h01, h11 = -2 * u**3 + 3 * u**2, u**3 - u**2
+    return h00 * q[i] + h10 * h * dq[i] + h01 * q[i + 1] + h11 * h * dq[i + 1]
+
+
+def reduced_figure(run, out_dir, prefix=""):
+    r = run.reduced
+    s = run.summary or {}
+    xi = r["xi"] if "xi" in r else r["t"]
+    fig, (ax1, ax2) = plt.subplots(1, 2, figsize=(13, 4.5))
+    ax1.plot(xi, r["eta"], label="reduced ODE (ARKODE)")
+    ax2.plot(xi, r["P_over_P0"] if "P_over_P0" in r else r["P"], label="reduced ODE (ARKODE)")
+    t_exact, P_exact = s.get("t_stop_over_t0_exact"), s.get("P_stop_over_P0_exact")
+    if isinstance(t_exact, (int, float)):
+        ax1.plot([t_exact], [s.get("eta_stop", r["eta"][-1])], "k*", ms=9, label="stop time, exact quadrature")
+        if isinstance(P_exact, (int, float)):
+            ax2.plot([t_exact], [P_exact], "k*", ms=9, label="P at the stop, exact quadrature")
+    problem = s.get("problem", "")
+    p = s.get("parameters", {})
+    what = {"falling": "height of the falling part", "folded": "length of the resting arm",
+            "sliding": "hanging length"}.get(problem, "y")
+    decorate(ax1, "t / t0", "eta = y / l", f"eta(t): {what}")
+    decorate(ax2, "t / t0", "P / P0", "dynamic weight P / P0 (force on the support)")
+    params = ", ".join(f"{k} = {p[k]:g}" for k in ("f", "eta0", "eps", "force") if isinstance(p.get(k), (int, float)))
+    fig.suptitle(f"{run.name}: the {problem} chain, reduced model" + (f" ({params})" if params else "") +
+                 (f"; stop: {s['stop_reason']}" if "stop_reason" in s else ""), fontsize=10)
+    fig.tight_layout()
+    return save(fig, out_dir, prefix + "reduced.png")
+
+
+def compare_figure(run, out_dir, prefix=""):
+    s, red = run.series, run.reduced
+    summary = run.summary or {}
+    problem = summary.get("problem", "")
+    nz = np.flatnonzero(red["eta"] != 0)
+    if not len(nz) or not run.fronts:
+        raise RunError(f"{run.path}: the compare series lack eta or a front (s0_0)")
+    ell = red["y"][nz[-1]] / red["eta"][nz[-1]]
+    s0 = run.fronts[0].s0
+    eta = 1.0 - s0 / ell if problem == "sliding" else s0 / ell
+    t = s["t"]
+    fig, axes = plt.subplots(1, 3, figsize=(17, 4.5))
+    axes[0].plot(red["t"], red["eta"], "k-", lw=2.5, alpha=0.4, label="reduced ODE")
+    axes[0].plot(t, eta, "-", lw=1, label="string solver (front tracking)")
+    decorate(axes[0], "t (s)", "eta = y / l", "eta(t)")
+    if "support_y" in s:
+        axes[1].plot(red["t"], red["P"], "k-", lw=2.5, alpha=0.4, label="reduced ODE")
+        axes[1].plot(t, s["support_y"], "-", lw=1, label="string solver: force on the support")
+        title = "P (N)"
+        if "max_rel_err_P" in summary:
+            title += f": max rel. difference {summary['max_rel_err_P']:.2e} ({summary.get('P_compared_at', '')})"
+        decorate(axes[1], "t (s)", "P (N)", title)
+    inside = (t >= red["t"][0]) & (t <= red["t"][-1])
+    ref = hermite(red["t"], red["y"] / ell, red["ydot"] / ell, t[inside])
+    worst = semilogy_abs(axes[2], t[inside], eta[inside] - ref, lw=1)
+    title = f"|eta_string - eta_reduced| at equal t: max {worst:.2e}"
+    decorate(axes[2], "t (s)", "", title + "\n(reduced ODE by cubic Hermite interpolation)", legend=False)
+    nodes = summary.get("nodes")
+    fig.suptitle(f"{run.name}: the {problem} chain, string solver" + (f" ({nodes} nodes)" if nodes else "") +
+                 " against the reduced ODE", fontsize=10)
+    fig.tight_layout()
+    return save(fig, out_dir, prefix + "compare.png")

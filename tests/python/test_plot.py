@@ -1,0 +1,302 @@
+"""`chainsim plot` on a run of each kind: the files it lists exist and are images, the animation has the
+frames its speed and rate ask for (read back with Pillow or ffprobe), bad paths exit 2.
+
+Run by CTest (tests/CMakeLists.txt) in three parts, with pytest when installed, else as a plain script:
+    CHAINSIM_BINARY=build/chainsim /usr/bin/python3 tests/python/test_plot.py [NAME_PART ...]
+"""
+import atexit
+import csv
+import math
+import os
+import re
+import shutil
+import subprocess
+import sys
+import tempfile
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+SOURCE = os.path.abspath(os.path.join(HERE, "..", ".."))
+BINARY = os.environ.get("CHAINSIM_BINARY", os.path.join(SOURCE, "build", "chainsim"))
+sys.path.insert(0, os.path.join(SOURCE, "python"))
+
+import numpy as np  # noqa: E402
+from PIL import Image  # noqa: E402
+
+ROOT = tempfile.mkdtemp(prefix="chainsim_plot_test_")
+atexit.register(shutil.rmtree, ROOT, True)
+_runs = {}
+
+
+def chainsim(*args):
+    return subprocess.run([BINARY, *args], capture_output=True, text=True)
+
+
+def scene(name, nodes, extra=None):
+    """cases/scenes/<name>.toml with `nodes` nodes (and other lines replaced), written to the temp dir."""
+    with open(os.path.join(SOURCE, "cases", "scenes", name + ".toml")) as fh:
+        text = fh.read()
+    text = re.sub(r"(?m)^nodes = \d+", f"nodes = {nodes}", text)
+    for pattern, line in (extra or {}).items():
+        text = re.sub(pattern, line, text)
+    path = os.path.join(ROOT, f"{name}_{len(_runs)}.toml")
+    with open(path, "w") as fh:
+        fh.write(text)
+    return path
+
+
+SCENE_3D = """
+[string]
+length = 0.7
+density = 0.1
+nodes = 15
+dimension = 3
+[shape]
+kind = "polyline"
+points = [[0.0, 0.0, 0.0], [0.7, 0.0, 0.0]]
+[velocity]
+kind = "uniform"
+value = [0.0, 0.0, 1.0]
+[ends]
+start = "fixed"
+[effects.gravity]
+g = [0.0, -9.81, 0.0]
+[output]
+interval = 0.02
+[stop]
+t_end = 0.2
+"""
+
+
+def run_dir(kind):
+    """A run of each kind, made once."""
+    if kind in _runs:
+        return _runs[kind]
+    out = os.path.join(ROOT, kind)
+    if kind == "string":
+        args = ["run", scene("whip_crack", 21, {r"(?m)^t_end = .*": "t_end = 0.3"}), "--out", out]
+    elif kind == "fronts":
+        args = ["run", scene("falling_chain", 21), "--out", out]
+    elif kind == "fold":
+        args = ["run", scene("folded_chain", 21), "--out", out]
+    elif kind == "string3d":
+        path = os.path.join(ROOT, "pendulum3d.toml")
+        with open(path, "w") as fh:
+            fh.write(SCENE_3D)
+        args = ["run", path, "--out", out]
+    elif kind == "reduced_scene":
+        args = ["run", scene("falling_chain", 21, {r"(?m)^model = \"string\"": 'model = "reduced"'}), "--out", out]
+    elif kind == "reduced":
+        args = ["reduced", "sliding", "--eta0", "0.25", "--out", out]
+    elif kind == "compare":
+        args = ["compare", "folded", "--nodes", "21", "--out", out]
+    elif kind == "canonical":
+        args = ["canonical", "--out", out]
+    r = chainsim(*args)
+    assert r.returncode == 0, r.stderr
+    _runs[kind] = out
+    return out
+
+
+def plot(directory, *options):
+    return chainsim("plot", directory, *options)
+
+
+def plot_here(directory, *options, stdout=False):
+    """The package's entry point in this process (what `chainsim plot` runs, without starting Python again):
+    (exit code, stderr), or (exit code, stdout) with stdout=True."""
+    import contextlib
+    import io
+    from chainsim_plot.cli import main
+    out, err = io.StringIO(), io.StringIO()
+    with contextlib.redirect_stderr(err), contextlib.redirect_stdout(out):
+        try:
+            code = main([directory, *options])
+        except SystemExit as e:  # argparse
+            code = e.code
+    return code, (out if stdout else err).getvalue()
+
+
+def check_plot(kind, expected, *options, here=False):
+    """chainsim plot exits 0, prints exactly the expected files of RUN_DIR/figures, and each is a PNG.
+    here=True: the package's entry point in this process instead of the binary (quicker)."""
+    directory = run_dir(kind)
+    if here:
+        code, out = plot_here(directory, *options, stdout=True)
+        assert code == 0
+        listed = out.split()
+    else:
+        r = plot(directory, *options)
+        assert r.returncode == 0, r.stderr
+        listed = r.stdout.split()
+    assert sorted(os.path.basename(p) for p in listed) == sorted(expected)
+    for path in listed:
+        assert os.path.dirname(os.path.abspath(path)) == os.path.abspath(os.path.join(directory, "figures"))
+        if path.endswith(".png"):
+            with Image.open(path) as im:
+                assert im.format == "PNG" and im.size[0] >= 400 and im.size[1] >= 300
+    return listed
+
+
+def frame_times(directory):
+    """The recorded frame times of nodes.csv, read here with the csv module."""
+    with open(os.path.join(directory, "nodes.csv"), newline="") as fh:
+        return sorted({float(row["t"]) for row in csv.DictReader(fh)})
+
+
+# --- each kind of run -----------------------------------------------------------------------------
+
+def test_kind_string_run_at_chosen_times():
+    check_plot("string", ["snapshots.png", "energy.png", "tension.png"], "--times", "0,0.1,0.25")
+
+
+def test_kind_run_with_fronts():
+    check_plot("fronts", ["snapshots.png", "energy.png", "fronts.png"])
+
+
+def test_kind_run_with_a_fold():
+    check_plot("fold", ["snapshots.png", "energy.png", "fronts.png"], here=True)
+
+
+def test_kind_3d_run():
+    listed = check_plot("string3d", ["snapshots.png", "energy.png", "tension.png"], here=True)
+    with Image.open(next(p for p in listed if p.endswith("snapshots.png"))) as im:
+        assert im.size[0] > 1.5 * im.size[1]  # two projections side by side
+
+
+def test_kind_reduced_runs():
+    check_plot("reduced", ["reduced.png", "energy.png"])
+    check_plot("reduced_scene", ["reduced.png", "energy.png"], here=True)
+
+
+def test_kind_compare_run():
+    check_plot("compare", ["compare.png", "energy.png", "fronts.png"], here=True)
+
+
+def test_kind_canonical_run():
+    names = ["fall_time_vs_f.png", "falling_chain.png", "folded_chain.png", "sliding_chain.png"]
+    for problem in ("falling", "folded", "sliding"):
+        names += [f"{problem}_reduced.png", f"{problem}_energy.png"]
+    check_plot("canonical", names, here=True)
+
+
+# --- the animation --------------------------------------------------------------------------------
+
+def expected_frames(directory, fps, speed):
+    times = frame_times(directory)
+    return int(math.floor((times[-1] - times[0]) * fps / speed + 1e-9)) + 1
+
+
+def test_animation_gif_has_the_frames_of_its_speed_and_rate():
+    directory = run_dir("string")
+    r = plot(directory, "--animate", "--format", "gif", "--fps", "10", "--speed", "0.5")
+    assert r.returncode == 0, r.stderr
+    gif = os.path.join(directory, "figures", "animation.gif")
+    assert gif in r.stdout.split()
+    n = expected_frames(directory, 10, 0.5)
+    assert n == 7  # 0.3 s at half speed, 10 frames per second: 0, 0.05, ..., 0.3 s
+    with Image.open(gif) as im:
+        assert im.n_frames == n
+        assert abs(im.info["duration"] - 100) <= 10  # ms per frame at 10 fps
+
+
+def test_animation_mp4_of_a_run_with_fronts():
+    if shutil.which("ffmpeg") is None or shutil.which("ffprobe") is None:
+        print("skipped: no ffmpeg")
+        return
+    directory = run_dir("fronts")
+    r = plot(directory, "--animate", "--fps", "20")
+    assert r.returncode == 0, r.stderr
+    mp4 = os.path.join(directory, "figures", "animation.mp4")
+    assert mp4 in r.stdout.split()
+    probe = subprocess.run(["ffprobe", "-v", "error", "-count_frames", "-select_streams", "v:0", "-show_entries",
+                            "stream=nb_read_frames,r_frame_rate", "-of", "csv=p=0", mp4],
+                           capture_output=True, text=True, check=True)
+    rate, frames = probe.stdout.strip().split(",")
+    assert rate == "20/1"
+    assert int(frames) == expected_frames(directory, 20, 1.0)
+
+
+# --- bad input ------------------------------------------------------------------------------------
+
+def test_error_bad_paths_exit_2():
+    # Through the binary once (the exit code passes through), then in this process.
+    missing = os.path.join(ROOT, "no_such_run")
+    r = plot(missing)
+    assert r.returncode == 2 and r.stderr.startswith(f"chainsim: error: RUN_DIR '{missing}' does not exist")
+    a_file = os.path.join(ROOT, "a_file")
+    open(a_file, "w").close()
+    code, err = plot_here(a_file)
+    assert code == 2 and f"RUN_DIR '{a_file}' is not a directory" in err
+    empty = os.path.join(ROOT, "empty_dir")
+    os.makedirs(empty, exist_ok=True)
+    code, err = plot_here(empty)
+    assert code == 2 and "holds none of the files chainsim writes" in err
+    assert not os.path.exists(os.path.join(empty, "figures"))
+
+
+def test_error_malformed_file_exits_2_naming_the_line():
+    broken = os.path.join(ROOT, "broken")
+    shutil.copytree(run_dir("string"), broken, ignore=shutil.ignore_patterns("figures"))
+    with open(os.path.join(broken, "energy.csv")) as fh:
+        lines = fh.readlines()
+    lines[3] = lines[3].split(",")[0] + ",oops\n"
+    with open(os.path.join(broken, "energy.csv"), "w") as fh:
+        fh.writelines(lines)
+    code, err = plot_here(broken)
+    assert code == 2
+    assert f"{os.path.join(broken, 'energy.csv')}:4: 2 fields, but the header has 5" in err
+    assert not os.path.exists(os.path.join(broken, "figures"))
+
+
+def test_error_bad_options_exit_2():
+    directory = run_dir("string")
+    for options, message in [(["--speed", "0"], "--speed = 0 is out of range: allowed speed > 0"),
+                             (["--fps", "x"], "--fps = 'x' is not an integer"),
+                             (["--times", "0,9"], "--times: t = 9 s is outside the run: allowed 0 <= t <= 0.3 s"),
+                             (["--format", "avi"], "--format = 'avi' is not a known format: allowed mp4, gif")]:
+        code, err = plot_here(directory, *options)
+        assert code == 2, options
+        assert err.startswith("chainsim: error: " + message), err
+    code, err = plot_here(run_dir("reduced"), "--animate")
+    assert code == 2 and "--animate needs nodes.csv" in err
+
+
+# --- the readers and the interpolation against independent references ----------------------------
+
+def test_reader_frames_match_the_csv_rows():
+    from chainsim_plot.readers import load_run
+    directory = run_dir("fronts")
+    run = load_run(directory)
+    with open(os.path.join(directory, "nodes.csv"), newline="") as fh:
+        rows = list(csv.DictReader(fh))
+    assert list(run.nodes.times) == frame_times(directory)
+    k = len(run.nodes) // 2
+    t = run.nodes.times[k]
+    mine = [r for r in rows if float(r["t"]) == t]
+    assert list(run.nodes.nodes(k)) == [int(r["node"]) for r in mine]
+    assert np.array_equal(run.nodes.positions(k), [[float(r["x"]), float(r["y"])] for r in mine])
+    assert [f.name for f in run.fronts] == ["heap_end"] and run.fronts[0].on_plane
+
+
+def test_reader_hermite_interpolation_is_exact_for_cubics():
+    from chainsim_plot.figures import hermite
+    t = np.array([0.0, 0.3, 0.35, 1.0])
+    q = 2 * t**3 - t**2 + 0.5 * t - 1
+    dq = 6 * t**2 - 2 * t + 0.5
+    at = np.linspace(0, 1, 41)
+    assert np.max(np.abs(hermite(t, q, dq, at) - (2 * at**3 - at**2 + 0.5 * at - 1))) < 1e-14
+
+
+if __name__ == "__main__":
+    # Without pytest: every test, or those whose name contains one of the arguments.
+    failures = 0
+    for name, test in sorted((n, f) for n, f in globals().items() if n.startswith("test_") and callable(f)):
+        if len(sys.argv) > 1 and not any(word in name for word in sys.argv[1:]):
+            continue
+        try:
+            test()
+            print("ok  ", name)
+        except Exception as e:  # noqa: BLE001
+            failures += 1
+            print("FAIL", name, repr(e))
+    sys.exit(1 if failures else 0)
