@@ -256,6 +256,8 @@ void FrontTracker<dim>::add_mass_and_forces(const StringModel<dim>& model, Eigen
       s.power_heap = tau * e.dot(v_end) + 0.5 * lambda_ * w * v_end.squaredNorm() - s.power_shock;
       // Momentum: the heap is at rest, so the supports give d(m v)/dt − (other forces) = τ e + λ w v.
       s.reaction = tau * e + lambda_ * w * v_end;
+      s.heap = true;
+      s.plane_normal = front.on_plane ? front.normal : Vec<dim>::Zero();
       mass[node] += lambda_ * l;
       force.col(node) += tau * e;
     } else {

@@ -1,6 +1,6 @@
 #pragma once
 /// @file jump_conditions.hpp
-/// The jump conditions at a shock (DESIGN.md §1; model.md §2–3) as pure pointwise functions of
+/// The jump conditions at a shock (docs/model.md §2–3) as pure pointwise functions of
 /// the states on the two sides. No mesh, no time integration: the front-tracking junctions build
 /// their rows from these, and the tests check them against hand-derived states.
 ///

@@ -52,6 +52,8 @@ struct FrontState {
   double power_heap = 0;   ///< W* (W), heaps only
   Vec<dim> reaction = Vec<dim>::Zero();  ///< heap: the support's reaction on the string at the front (N)
   double opening = 0;  ///< fold: angle between arc A's end link and arc B's first link reversed (rad)
+  bool heap = false;   ///< a heap's front (else a fold)
+  Vec<dim> plane_normal = Vec<dim>::Zero();  ///< a heap on a plane: the plane's unit normal; else zero
 };
 
 /// What a module adds to a snapshot: zero for a string without one.

@@ -207,6 +207,7 @@ void StringSolver<dim>::record_frame(double t, const Eigen::VectorXd& y) {
   f.drift = summary_.final_energy_drift;
   f.max_violation = snap.max_violation;
   f.forces = measured_forces(snap);
+  f.fronts = snap.fronts;
   for (int i = 0; i < model_.chain().num_nodes(); ++i)
     if (model_.in_arc(i)) f.moving.push_back(i);
   f.x = std::move(snap.x);
@@ -396,7 +397,8 @@ void StringSolver<dim>::write_outputs(const std::filesystem::path& dir, const Ou
   // 3. ParaView frames (the moving nodes, a line cell per link of an arc), then their index.
   if (select.vtk) {
     ensure_directory(dir / "frames");
-    std::vector<std::pair<double, std::string>> index;
+    std::vector<PvdEntry> index;
+    const VtkEncoding encoding = select.vtk_ascii ? VtkEncoding::kAscii : VtkEncoding::kBinary;
     for (std::size_t k = 0; k < frames_.size(); ++k) {
       const auto& f = frames_[k];
       const auto count = static_cast<Eigen::Index>(f.moving.size());
@@ -425,8 +427,30 @@ void StringSolver<dim>::write_outputs(const std::filesystem::path& dir, const Ou
             "tension", Eigen::Map<const Eigen::MatrixXd>(cell_tension.data(), 1,
                                                           static_cast<Eigen::Index>(cell_tension.size())));
       const std::string name = fmt::format("frame_{:04d}.vtp", k);
-      write_vtp(dir / "frames" / name, line);
-      index.emplace_back(f.t, "frames/" + name);
+      write_vtp(dir / "frames" / name, line, encoding);
+      index.push_back({f.t, "frames/" + name, 0});
+      if (!fronts) continue;
+      // The fronts: a point each, with what a user looks for (a heap's plane as its normal).
+      const auto nf = static_cast<Eigen::Index>(f.fronts.size());
+      VtkPolyline points;
+      points.vertices = true;
+      points.points = Eigen::Matrix3Xd::Zero(3, nf);
+      Eigen::MatrixXd s0(1, nf), s0_dot(1, nf), heap(1, nf), reaction = Eigen::MatrixXd::Zero(3, nf),
+          normal = Eigen::MatrixXd::Zero(3, nf);
+      for (Eigen::Index q = 0; q < nf; ++q) {
+        const FrontState<dim>& front = f.fronts[static_cast<std::size_t>(q)];
+        points.points.col(q).head(dim) = front.position;
+        s0(0, q) = front.s0;
+        s0_dot(0, q) = front.s0_dot;
+        heap(0, q) = front.heap ? 1.0 : 0.0;
+        reaction.col(q).head(dim) = front.reaction;
+        normal.col(q).head(dim) = front.plane_normal;
+      }
+      points.point_data = {{"s0", s0}, {"s0_dot", s0_dot}, {"heap", heap}, {"reaction", reaction},
+                           {"plane_normal", normal}};
+      const std::string fronts_name = fmt::format("fronts_{:04d}.vtp", k);
+      write_vtp(dir / "frames" / fronts_name, points, encoding);
+      index.push_back({f.t, "frames/" + fronts_name, 1});
     }
     write_pvd(dir / "string.pvd", index);
   }

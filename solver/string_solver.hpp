@@ -14,7 +14,9 @@
 ///                drift = K + V − (K0 + V0) − W_applied − W_shocks − W_heaps − W_remesh
 ///   series.csv   one row per accepted step (StringSolverOptions::record_steps, on for runs with
 ///                fronts): samples_table()
-///   frames/frame_XXXX.vtp and string.pvd                 ParaView time series
+///   frames/frame_XXXX.vtp and string.pvd                 ParaView time series: the moving string (part 0)
+///   frames/fronts_XXXX.vtp                               and, with fronts, the fronts as points (part 1:
+///                                                        s0, s0_dot, reaction, plane_normal, heap)
 ///   stats.json   the summary (to_json); written last, so its presence means the set is complete
 #include <filesystem>
 #include <functional>
@@ -49,6 +51,7 @@ struct StringSolverOptions {
 struct OutputSelection {
   bool nodes = true, tension = true, energy = true, forces = true, stats = true;  ///< fields
   bool csv = true, vtk = true;                                     ///< formats
+  bool vtk_ascii = false;  ///< ParaView files as text instead of raw binary ([output] vtk_encoding)
 };
 
 /// One recorded output time.
@@ -62,6 +65,7 @@ struct Frame {
   double w_shocks = 0, w_heaps = 0, w_remesh = 0;
   double max_violation = 0;
   std::vector<double> forces;  ///< the forces people measure, in the order of force_columns()
+  std::vector<FrontState<dim>> fronts;  ///< with front tracking
 };
 
 /// One accepted step (or crossing, or the stop) of a run that records its steps.

@@ -97,28 +97,36 @@ void write_vtp(const std::filesystem::path& path, const VtkPolyline& line, VtkEn
   for (const auto& [name, data] : line.cell_data)
     CHAINSIM_VERIFY(data.cols() == nc, "VTK cell data '" + name + "' needs one column per segment");
   CHAINSIM_VERIFY(2 * static_cast<double>(nc) < 2147483647.0, "too many VTK line cells for Int32 offsets");
+  CHAINSIM_VERIFY(!line.vertices || (line.segments.empty() && line.cell_data.empty()),
+                  "a vertex set has no line cells and no cell data");
   std::vector<std::int32_t> connectivity, offsets;
   for (const auto& [a, b] : line.segments) {
     connectivity.push_back(a);
     connectivity.push_back(b);
     offsets.push_back(static_cast<std::int32_t>(connectivity.size()));
   }
+  for (Eigen::Index q = 0; line.vertices && q < np; ++q) {
+    connectivity.push_back(static_cast<std::int32_t>(q));
+    offsets.push_back(static_cast<std::int32_t>(connectivity.size()));
+  }
+  const Eigen::Index nv = line.vertices ? np : 0;
   AtomicFile file(path);
   auto& out = file.stream();
   out << fmt::format("<?xml version=\"1.0\"?>\n"
                      "<VTKFile type=\"PolyData\" version=\"1.0\" byte_order=\"{}\" header_type=\"UInt64\">\n"
                      "  <PolyData>\n",
                      little_endian() ? "LittleEndian" : "BigEndian");
-  out << fmt::format("    <Piece NumberOfPoints=\"{}\" NumberOfVerts=\"0\" NumberOfLines=\"{}\" "
+  out << fmt::format("    <Piece NumberOfPoints=\"{}\" NumberOfVerts=\"{}\" NumberOfLines=\"{}\" "
                      "NumberOfStrips=\"0\" NumberOfPolys=\"0\">\n",
-                     np, nc);
+                     np, nv, nc);
   ArrayWriter arrays(out, encoding);
   out << "      <Points>\n";
   arrays.floats("Points", line.points);
-  out << "      </Points>\n      <Lines>\n";
+  const char* cells = line.vertices ? "Verts" : "Lines";
+  out << fmt::format("      </Points>\n      <{}>\n", cells);
   arrays.integers("connectivity", connectivity);
   arrays.integers("offsets", offsets);
-  out << "      </Lines>\n      <PointData>\n";
+  out << fmt::format("      </{}>\n      <PointData>\n", cells);
   for (const auto& [name, data] : line.point_data) arrays.floats(name, data);
   out << "      </PointData>\n      <CellData>\n";
   for (const auto& [name, data] : line.cell_data) arrays.floats(name, data);
@@ -128,14 +136,14 @@ void write_vtp(const std::filesystem::path& path, const VtkPolyline& line, VtkEn
   file.commit();
 }
 
-void write_pvd(const std::filesystem::path& path, const std::vector<std::pair<double, std::string>>& frames) {
+void write_pvd(const std::filesystem::path& path, const std::vector<PvdEntry>& frames) {
   AtomicFile file(path);
   auto& out = file.stream();
   out << "<?xml version=\"1.0\"?>\n"
          "<VTKFile type=\"Collection\" version=\"0.1\" byte_order=\"LittleEndian\">\n"
          "  <Collection>\n";
-  for (const auto& [t, name] : frames)
-    out << fmt::format("    <DataSet timestep=\"{}\" group=\"\" part=\"0\" file=\"{}\"/>\n", t, name);
+  for (const PvdEntry& f : frames)
+    out << fmt::format("    <DataSet timestep=\"{}\" group=\"\" part=\"{}\" file=\"{}\"/>\n", f.t, f.part, f.file);
   out << "  </Collection>\n</VTKFile>\n";
   file.commit();
 }

@@ -4,7 +4,9 @@
 /// lists them with their times, so ParaView plays the run as a time series.
 ///
 /// A string frame is a set of line cells, one per link (so per-link data such as the tension is
-/// cell data); node data (velocity, …) is point data. Points are always 3D for VTK: a 2D string is
+/// cell data); node data (velocity, …) is point data. A set of marked points (the fronts of a frame)
+/// is a PolyData of vertex cells, one per point. A collection (.pvd) may hold several parts per time
+/// (the string as part 0, its fronts as part 1). Points are always 3D for VTK: a 2D string is
 /// written with z = 0. Files are written through AtomicFile, in one of two encodings:
 ///   - binary (default): every array as raw little- or big-endian (the machine's, declared in the file)
 ///     bytes in one <AppendedData encoding="raw"> block, each preceded by its size in bytes (UInt64
@@ -23,6 +25,7 @@ namespace chainsim {
 struct VtkPolyline {
   Eigen::Matrix3Xd points;                    ///< one column per node (m)
   std::vector<std::pair<int, int>> segments;  ///< node pairs, one per link
+  bool vertices = false;                      ///< no lines: one vertex cell per point (cell data: none)
   /// Named point data: rows = components (1 or 3), one column per point.
   std::vector<std::pair<std::string, Eigen::MatrixXd>> point_data;
   /// Named cell data: rows = components, one column per segment.
@@ -38,7 +41,13 @@ VtkEncoding parse_vtk_encoding(const std::string& text, const std::string& key =
 void write_vtp(const std::filesystem::path& path, const VtkPolyline& line,
                VtkEncoding encoding = VtkEncoding::kBinary);
 
-/// Writes the ParaView collection: (time in s, file name relative to the .pvd) per frame.
-void write_pvd(const std::filesystem::path& path, const std::vector<std::pair<double, std::string>>& frames);
+/// One file of a ParaView collection.
+struct PvdEntry {
+  double t = 0;      ///< time (s)
+  std::string file;  ///< relative to the .pvd
+  int part = 0;      ///< which part of the scene at that time (0: the string, 1: its fronts)
+};
+/// Writes the ParaView collection.
+void write_pvd(const std::filesystem::path& path, const std::vector<PvdEntry>& frames);
 
 }  // namespace chainsim

@@ -60,6 +60,7 @@ std::string output_files(const OutputSelection& o, bool fronts) {
   add(o.csv && o.nodes, "nodes.csv");
   add(o.csv && o.tension, "tension.csv");
   add(o.csv && o.energy, fronts ? "energy.csv series.csv" : "energy.csv");
+  add(o.csv && o.forces, "forces.csv");
   add(o.vtk && o.nodes, "string.pvd frames/");
   add(o.stats, "stats.json");
   return files.empty() ? "(none)" : files;
@@ -178,6 +179,10 @@ int run_string_scene(const SceneSpec& spec, const std::filesystem::path& dir, bo
                               : "");
     out << fmt::format("links      max | |dx| - h | / h = {:.3e} (stabilization time {:g} s)\n",
                        s.max_constraint_violation, s.stabilization_time);
+    out << fmt::format("slack      {} (policy {})\n",
+                       s.slack ? s.slack->message()
+                               : s.slack_policy == SlackPolicy::kIgnore ? "not checked" : "none at any accepted step",
+                       to_string(s.slack_policy));
     out << fmt::format("outputs    {}: {}\n", dir.string(), output_files(scene.output, fronts));
   }
   if (failure) throw *failure;

@@ -60,7 +60,7 @@ void parse_solver(const Section& top, Context& ctx) {
 
 void parse_output(const Section& top, Context& ctx) {
   auto& out = ctx.spec.output;
-  Section s(subtable(top, "output"), "output", ctx, {"interval", "fields", "formats"});
+  Section s(subtable(top, "output"), "output", ctx, {"interval", "fields", "formats", "vtk_encoding"});
   out.interval = s.positive("interval").value_or(out.interval);
   if (s.has("fields")) {
     const auto fields = s.string_list("fields", {"nodes", "tension", "energy", "forces", "stats"});
@@ -76,6 +76,7 @@ void parse_output(const Section& top, Context& ctx) {
     out.select.csv = std::find(formats.begin(), formats.end(), "csv") != formats.end();
     out.select.vtk = std::find(formats.begin(), formats.end(), "vtk") != formats.end();
   }
+  out.select.vtk_ascii = s.choice("vtk_encoding", {"binary", "ascii"}, "binary") == "ascii";
   if (out.select.vtk && !out.select.nodes)
     s.fail(s.has("fields") ? "fields" : "formats",
            fmt::format("output.formats includes \"vtk\" (the default), which draws the string from its nodes: "

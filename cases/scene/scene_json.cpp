@@ -93,7 +93,10 @@ json output_json(const SceneSpec& spec) {
     if (on) fields.push_back(name);
   for (const auto& [on, name] : {std::pair{o.csv, "csv"}, {o.vtk, "vtk"}})
     if (on) formats.push_back(name);
-  return {{"interval", out.interval}, {"fields", fields}, {"formats", formats}};
+  return {{"interval", out.interval},
+          {"fields", fields},
+          {"formats", formats},
+          {"vtk_encoding", o.vtk_ascii ? "ascii" : "binary"}};
 }
 
 }  // namespace
