@@ -90,7 +90,7 @@ TEST_CASE("a run with fronts writes frames at the exact output times and the sta
   CHECK(read(dir / "out" / "frames" / "frame_0000.vtp").find("format=\"ascii\"") != std::string::npos);
 }
 
-TEST_CASE("slack is found by default and stops the run; with slack = warn it is recorded and the run goes on",
+TEST_CASE("slack is found by default and stops the run, and with slack = warn it is recorded and the run goes on",
           "[unit][scene]") {
   // A straight string at rest, fixed at its start and pushed along itself at its free end by 1 N
   // (no gravity): the exact tension is −1 N in every link from t = 0.
