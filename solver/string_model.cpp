@@ -157,28 +157,21 @@ Vec<dim> StringModel<dim>::gravity() const {
 
 template <int dim>
 void StringModel<dim>::unpack_state(double t, const Eigen::Ref<const Eigen::VectorXd>& y) {
-  const int n = chain_.num_nodes();
-  const int voff = dim * num_free_;
-  for (int i = 0; i < n; ++i) {
-    if (arc_of_[i] < 0) continue;
-    const int k = slot_[i];
-    if (k >= 0) {
-      x_.col(i) = y.template segment<dim>(dim * k);
-      v_.col(i) = y.template segment<dim>(voff + dim * k);
-    } else {
-      const EndPath<dim>& path = *prescribed_[static_cast<std::size_t>(path_of_[i])].path;
-      x_.col(i) = path.position(t);
-      v_.col(i) = path.velocity(t);
-    }
-  }
+  fill_moving(t, y, x_, v_);
 }
 
 template <int dim>
 void StringModel<dim>::unpack(double t, const Eigen::Ref<const Eigen::VectorXd>& y, Points<dim>& x,
                               Points<dim>& v) const {
-  const int n = chain_.num_nodes();
-  x = x_;
+  x = x_;  // nodes in no arc keep their last known state
   v = v_;
+  fill_moving(t, y, x, v);
+}
+
+template <int dim>
+void StringModel<dim>::fill_moving(double t, const Eigen::Ref<const Eigen::VectorXd>& y, Points<dim>& x,
+                                   Points<dim>& v) const {
+  const int n = chain_.num_nodes();
   const int voff = dim * num_free_;
   for (int i = 0; i < n; ++i) {
     if (arc_of_[i] < 0) continue;

@@ -212,6 +212,8 @@ class StringModel final : public OdeSystem {
   void assemble_matrix();
   Eigen::VectorXd pack(const Eigen::Ref<const Eigen::VectorXd>& ledgers) const;
   void unpack_state(double t, const Eigen::Ref<const Eigen::VectorXd>& y);
+  /// Positions and velocities of the nodes in an arc at (t, y) into x, v (the others untouched).
+  void fill_moving(double t, const Eigen::Ref<const Eigen::VectorXd>& y, Points<dim>& x, Points<dim>& v) const;
   double evaluate_current(double t);
   template <class Visit>
   void for_each_link(Visit&& visit) const;
