@@ -191,13 +191,11 @@ template <int dim>
 template <class Visit>
 void StringModel<dim>::for_each_link(Visit&& visit) const {
   // visit(j, u, next): link j, its tension unknown u, and the next link of its arc (−1 at an open end).
-  for (const ArcRange& arc : arcs_) {
-    const int nl = arc.num_links();
-    for (int q = 0; q < nl; ++q) {
-      const int j = arc.first + q;
-      const int next = q + 1 < nl ? j + 1 : (arc.closed ? arc.first : -1);
-      visit(j, link_unknown_[static_cast<std::size_t>(j)], next);
-    }
+  for (std::size_t k = 0; k < arcs_.size(); ++k) {
+    const ArcRange& arc = arcs_[k];
+    const int nl = arc.num_links(), u0 = first_unknown_[k];
+    for (int q = 0; q + 1 < nl; ++q) visit(arc.first + q, u0 + q, arc.first + q + 1);
+    if (nl > 0) visit(arc.first + nl - 1, u0 + nl - 1, arc.closed ? arc.first : -1);
   }
 }
 
