@@ -115,8 +115,8 @@ class Layout:
 
     def curve(self, k, t=None):
         """Frame k as an (m x dim) array of points to draw (NaN rows break the line), with the partial
-        links to the heaps' fronts, the folds' points between their arms (the arm past the first fold
-        shifted aside), a closed string closed."""
+        links to the heaps' fronts, the folds' positions between their arms (the arm past the first fold
+        shifted aside, joined to the other by a bar at the fold), a closed string closed."""
         frames, run = self.run.nodes, self.run
         t = frames.times[k] if t is None else t
         x = frames.positions(k).copy()
@@ -130,14 +130,17 @@ class Layout:
             pieces = [np.vstack([x, x[:1]])]
         if s is not None:  # a fold is a corner of the string at s0, between two nodes
             for f in run.fronts:
-                p = self.front_point(f, t)
+                p = f.position_at(t)
                 if f.kind != "fold" or p is None:
                     continue
+                corner = [p]
+                if f is self.fold and self.aside:  # the arms drawn apart: a short bar across at the fold
+                    corner.append(p + np.eye(len(p))[0] * self.aside)
                 s0 = f.s0_at(t)
                 for q, sq in enumerate(np.split(s, breaks)):
                     j = int(np.searchsorted(sq, s0, side="right"))
                     if 0 < j < len(sq):
-                        pieces[q] = np.insert(pieces[q], j, p, axis=0)
+                        pieces[q] = np.insert(pieces[q], j, corner, axis=0)
         for f in run.fronts:
             if f.kind != "heap":
                 continue
@@ -156,10 +159,10 @@ class Layout:
         return np.vstack(out)
 
     def front_point(self, f, t):
-        """Where front f is drawn at time t: its position from the series (a fold halfway between its arms
-        when the arm past it is drawn aside), or None if the series has no position."""
+        """Where front f is marked at time t: its position from the series (the first fold halfway between
+        its arms when the arm past it is drawn aside), or None if the series has no position."""
         p = f.position_at(t)
-        if p is not None and f.kind == "fold" and self.aside:
+        if p is not None and f is self.fold and self.aside:
             p = p.copy()
             p[0] += 0.5 * self.aside
         return p

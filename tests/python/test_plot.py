@@ -372,10 +372,10 @@ def test_reader_fold_drawn_between_its_arms():
         assert abs(np.linalg.norm(x[j] - fold) - (s[j] - s0)) < 1e-10
         drawn = x.copy()
         drawn[j:, 0] += layout.aside
-        corner = fold + [layout.aside / 2, 0]
-        assert np.allclose(layout.curve(k), np.vstack([drawn[:j], corner, drawn[j:]]), rtol=0, atol=1e-15)
+        bar = [fold, fold + [layout.aside, 0]]  # from the resting arm's side to the moving arm's
+        assert np.allclose(layout.curve(k), np.vstack([drawn[:j], bar, drawn[j:]]), rtol=0, atol=1e-15)
         [(front, marker)] = layout.front_markers(t)
-        assert front.kind == "fold" and np.allclose(marker, corner, rtol=0, atol=1e-15)
+        assert front.kind == "fold" and np.allclose(marker, fold + [layout.aside / 2, 0], rtol=0, atol=1e-15)
 
 
 def test_reader_hermite_interpolation_is_exact_for_cubics():
