@@ -68,20 +68,19 @@ def parser():
     return p
 
 
-def plot_run(run_dir, times=None, animate=False, speed=1.0, fps=25, fmt=None, out_dir=None, prefix=""):
+def plot_run(run_dir, times=None, animate=False, speed=1.0, fps=25, fmt=None, out_dir=None):
     """Draws one run; returns the paths written. Raises RunError for what cannot be drawn."""
     from . import figures
     from .readers import RunError, is_canonical, load_run
 
     out_dir = out_dir or os.path.join(run_dir, "figures")
     if is_canonical(run_dir):
-        from .canonical import paper_figures
-        written = paper_figures(run_dir, out_dir)
-        for problem in ("falling", "folded", "sliding"):
-            sub = os.path.join(run_dir, problem)
-            if os.path.isdir(sub):
-                written += plot_run(sub, out_dir=out_dir, prefix=f"{problem}_")
-        return written
+        if times or animate:
+            raise RunError(f"{'--times' if times else '--animate'} needs node frames, and {run_dir} is the output "
+                           f"of `chainsim canonical` (its figures have their own times; draw a run of "
+                           f"`chainsim run` for snapshots at chosen times or an animation)")
+        from .canonical import canonical_figures
+        return canonical_figures(run_dir, out_dir)
     run = load_run(run_dir)
     if times and run.nodes is None and run.tension is None:
         raise RunError(f"--times needs node frames or tensions, and {run_dir} has neither (a {run.kind} run)")
@@ -89,17 +88,17 @@ def plot_run(run_dir, times=None, animate=False, speed=1.0, fps=25, fmt=None, ou
         raise RunError(f"--animate needs nodes.csv, and {run_dir} has none (a {run.kind} run)")
     written = []
     if run.kind == "reduced":
-        written.append(figures.reduced_figure(run, out_dir, prefix))
+        written.append(figures.reduced_figure(run, out_dir))
     if run.kind == "compare":
-        written.append(figures.compare_figure(run, out_dir, prefix))
+        written.append(figures.compare_figure(run, out_dir))
     if run.nodes is not None:
-        written.append(figures.snapshots_figure(run, out_dir, times, prefix))
-    written.append(figures.energy_figure(run, out_dir, prefix))
-    written.append(figures.tension_figure(run, out_dir, times, prefix))
-    written.append(figures.fronts_figure(run, out_dir, prefix))
+        written.append(figures.snapshots_figure(run, out_dir, times))
+    written.append(figures.energy_figure(run, out_dir))
+    written.append(figures.tension_figure(run, out_dir, times))
+    written.append(figures.fronts_figure(run, out_dir))
     if animate:
         from .animate import animate as make_animation
-        path, _ = make_animation(run, os.path.join(out_dir, prefix + "animation"), speed=speed, fps=fps, fmt=fmt)
+        path, _ = make_animation(run, os.path.join(out_dir, "animation"), speed=speed, fps=fps, fmt=fmt)
         written.append(path)
     return [path for path in written if path]
 

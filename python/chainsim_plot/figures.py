@@ -2,7 +2,8 @@
 
     snapshots.png  the string at several times (x-y; x-y and x-z in 3D), heaps, the plane and the fronts
     energy.png     the energy ledger: K, V, each work term, and the residual of the balance
-    tension.png    the tension along s at the same times (and T(s, t) when the links do not change)
+    tension.png    the tension along s at the same times, the fronts' s0 dotted (and T(s, t) when the links
+                   do not change)
     fronts.png     each front's s0 and speed ds0/dt over time
     compare.png    chainsim compare: the string solver against the reduced ODE
     reduced.png    a reduced run: eta(t) and P/P0
@@ -26,10 +27,11 @@ FRONT_COLOR = "tab:red"
 
 # --- helpers --------------------------------------------------------------------------------------
 
-def save(fig, out_dir, name):
+def save(fig, out_dir, name, dpi=DPI):
+    """Writes fig to out_dir/name (creating out_dir), closes it and returns the path."""
     os.makedirs(out_dir, exist_ok=True)
     path = os.path.join(out_dir, name)
-    fig.savefig(path, dpi=DPI)
+    fig.savefig(path, dpi=dpi)
     plt.close(fig)
     return path
 
@@ -113,19 +115,32 @@ class Layout:
 
     def curve(self, k, t=None):
         """Frame k as an (m x dim) array of points to draw (NaN rows break the line), with the partial
-        links to the heaps' fronts, the fold's arm shifted, a closed string closed."""
+        links to the heaps' fronts, the folds' positions between their arms (the arm past the first fold
+        shifted aside, joined to the other by a bar at the fold), a closed string closed."""
         frames, run = self.run.nodes, self.run
         t = frames.times[k] if t is None else t
         x = frames.positions(k).copy()
         nodes = frames.nodes(k)
+        s = frames.s(k)
         if self.aside:
-            s = frames.s(k)
-            s = s if s is not None else nodes.astype(float)
-            s_fold = self.fold.s0_at(t)
-            x[s > s_fold, 0] += self.aside
-        pieces = np.split(x, np.flatnonzero(np.diff(nodes) != 1) + 1)  # gaps: a heap inside the listing
+            x[(s if s is not None else nodes.astype(float)) > self.fold.s0_at(t), 0] += self.aside
+        breaks = np.flatnonzero(np.diff(nodes) != 1) + 1  # gaps: a heap inside the listing
+        pieces = np.split(x, breaks)
         if run.closed and len(pieces) == 1:
             pieces = [np.vstack([x, x[:1]])]
+        if s is not None:  # a fold is a corner of the string at s0, between two nodes
+            for f in run.fronts:
+                p = f.position_at(t)
+                if f.kind != "fold" or p is None:
+                    continue
+                corner = [p]
+                if f is self.fold and self.aside:  # the arms drawn apart: a short bar across at the fold
+                    corner.append(p + np.eye(len(p))[0] * self.aside)
+                s0 = f.s0_at(t)
+                for q, sq in enumerate(np.split(s, breaks)):
+                    j = int(np.searchsorted(sq, s0, side="right"))
+                    if 0 < j < len(sq):
+                        pieces[q] = np.insert(pieces[q], j, corner, axis=0)
         for f in run.fronts:
             if f.kind != "heap":
                 continue
@@ -143,17 +158,18 @@ class Layout:
             out.append(piece)
         return np.vstack(out)
 
+    def front_point(self, f, t):
+        """Where front f is marked at time t: its position from the series (the first fold halfway between
+        its arms when the arm past it is drawn aside), or None if the series has no position."""
+        p = f.position_at(t)
+        if p is not None and f is self.fold and self.aside:
+            p = p.copy()
+            p[0] += 0.5 * self.aside
+        return p
+
     def front_markers(self, t):
         """[(front, position)] of the fronts at time t (positions from the series)."""
-        out = []
-        for f in self.run.fronts:
-            p = f.position_at(t)
-            if p is not None:
-                if f.kind == "fold" and self.aside:
-                    p = p.copy()
-                    p[0] += 0.5 * self.aside
-                out.append((f, p))
-        return out
+        return [(f, p) for f in self.run.fronts for p in [self.front_point(f, t)] if p is not None]
 
     def draw_planes(self, ax, proj, extra=0.0, label=True):
         """The plane (table) under each heap on a plane, as its trace on the projection `proj` (only where
@@ -247,12 +263,12 @@ def draw_snapshots(axes, run, picks, layout=None):
     return layout
 
 
-def snapshots_figure(run, out_dir, wanted=None, prefix=""):
+def snapshots_figure(run, out_dir, wanted=None):
     frames = run.nodes
     picks = choose_times(frames.times, wanted)
     layout = Layout(run)
     n = len(layout.projections)
-    fig, axes = plt.subplots(1, n, figsize=(6.5 * n, 5.5), squeeze=False)
+    fig, axes = plt.subplots(1, n, figsize=(6.5 * n, 5.5), squeeze=False, dpi=DPI)
     draw_snapshots(axes[0], run, picks, layout)
     notes = layout.notes()
     notes.append("small dot: the first node drawn" + (" (s = 0)" if not run.fronts else ""))
@@ -263,7 +279,7 @@ def snapshots_figure(run, out_dir, wanted=None, prefix=""):
     title = f"{run.name}: the string at {len(picks)} times\n" + textwrap.fill("; ".join(notes), 70 * n)
     fig.suptitle(title, fontsize=9)
     fig.tight_layout()
-    return save(fig, out_dir, prefix + "snapshots.png")
+    return save(fig, out_dir, "snapshots.png")
 
 
 # --- energy ledger ---------------------------------------------------------------------------------
@@ -306,11 +322,11 @@ def draw_ledger(ax, run, table, works):
     decorate(ax, "t (s)", "J", "energy ledger")
 
 
-def energy_figure(run, out_dir, prefix=""):
+def energy_figure(run, out_dir):
     table, works, residual, note = ledger_columns(run)
     if table is None:
         return None
-    fig, (ax1, ax2) = plt.subplots(1, 2, figsize=(13, 4.5))
+    fig, (ax1, ax2) = plt.subplots(1, 2, figsize=(13, 4.5), dpi=DPI)
     draw_ledger(ax1, run, table, works)
     if residual is not None:
         worst = semilogy_abs(ax2, table["t"], table[residual], lw=1)
@@ -323,12 +339,12 @@ def energy_figure(run, out_dir, prefix=""):
         ax2.axis("off")
     fig.suptitle(f"{run.name}: energy", fontsize=10)
     fig.tight_layout()
-    return save(fig, out_dir, prefix + "energy.png")
+    return save(fig, out_dir, "energy.png")
 
 
 # --- tension ---------------------------------------------------------------------------------------
 
-def tension_figure(run, out_dir, wanted=None, prefix=""):
+def tension_figure(run, out_dir, wanted=None):
     tab = run.tension
     if tab is None or len(tab) == 0 or "T" not in tab or "s_mid" not in tab:
         return None
@@ -339,11 +355,15 @@ def tension_figure(run, out_dir, wanted=None, prefix=""):
     picks = choose_times(times, wanted)
     same = len(set(np.diff(bounds))) == 1 and np.allclose(
         tab["s_mid"][: bounds[1]], tab["s_mid"][bounds[-2]:bounds[-1]])
-    fig, axes = plt.subplots(1, 2 if same else 1, figsize=(13 if same else 7, 4.5), squeeze=False)
+    fig, axes = plt.subplots(1, 2 if same else 1, figsize=(13 if same else 7, 4.5), squeeze=False, dpi=DPI)
     ax = axes[0][0]
     for color, k in zip(time_colors(len(picks)), picks):
         rows = slice(bounds[k], bounds[k + 1])
         ax.plot(tab["s_mid"][rows], tab["T"][rows], ".-", ms=2, lw=1, color=color, label=f"t = {times[k]:.4g} s")
+        for f in run.fronts:  # where the tension jumps: each front's s0 at that time, from the series
+            ax.axvline(f.s0_at(times[k]), color=color, ls=":", lw=1)
+    if run.fronts:
+        ax.plot([], [], "k:", lw=1, label="fronts: s0(t), dotted")
     ax.axhline(0, color="k", lw=0.6)
     decorate(ax, "s (m), link midpoints", "T (N)", "tension along the string")
     if same:
@@ -358,16 +378,16 @@ def tension_figure(run, out_dir, wanted=None, prefix=""):
         decorate(axes[0][1], "s (m)", "t (s)", "T(s, t)" + (" (blue: slack, T < 0)" if neg else ""), legend=False)
     fig.suptitle(f"{run.name}: tension", fontsize=10)
     fig.tight_layout()
-    return save(fig, out_dir, prefix + "tension.png")
+    return save(fig, out_dir, "tension.png")
 
 
 # --- fronts ----------------------------------------------------------------------------------------
 
-def fronts_figure(run, out_dir, prefix=""):
+def fronts_figure(run, out_dir):
     if not run.fronts:
         return None
     t = run.series["t"]
-    fig, (ax1, ax2) = plt.subplots(1, 2, figsize=(13, 4.5))
+    fig, (ax1, ax2) = plt.subplots(1, 2, figsize=(13, 4.5), dpi=DPI)
     for f in run.fronts:
         ax1.plot(t, f.s0, label=f"{f.name}" + (f" ({f.kind})" if f.kind and f.kind not in f.name else ""))
         if f.s0dot is not None:
@@ -376,7 +396,7 @@ def fronts_figure(run, out_dir, prefix=""):
     decorate(ax2, "t (s)", "ds0/dt (m/s)", "front speeds in the material")
     fig.suptitle(f"{run.name}: fronts", fontsize=10)
     fig.tight_layout()
-    return save(fig, out_dir, prefix + "fronts.png")
+    return save(fig, out_dir, "fronts.png")
 
 
 # --- the reduced model and the comparison ----------------------------------------------------------
@@ -391,11 +411,11 @@ def hermite(t, q, dq, at):
     return h00 * q[i] + h10 * h * dq[i] + h01 * q[i + 1] + h11 * h * dq[i + 1]
 
 
-def reduced_figure(run, out_dir, prefix=""):
+def reduced_figure(run, out_dir):
     r = run.reduced
     s = run.summary or {}
     xi = r["xi"] if "xi" in r else r["t"]
-    fig, (ax1, ax2) = plt.subplots(1, 2, figsize=(13, 4.5))
+    fig, (ax1, ax2) = plt.subplots(1, 2, figsize=(13, 4.5), dpi=DPI)
     ax1.plot(xi, r["eta"], label="reduced ODE (ARKODE)")
     ax2.plot(xi, r["P_over_P0"] if "P_over_P0" in r else r["P"], label="reduced ODE (ARKODE)")
     t_exact, P_exact = s.get("t_stop_over_t0_exact"), s.get("P_stop_over_P0_exact")
@@ -413,10 +433,10 @@ def reduced_figure(run, out_dir, prefix=""):
     fig.suptitle(f"{run.name}: the {problem} chain, reduced model" + (f" ({params})" if params else "") +
                  (f"; stop: {s['stop_reason']}" if "stop_reason" in s else ""), fontsize=10)
     fig.tight_layout()
-    return save(fig, out_dir, prefix + "reduced.png")
+    return save(fig, out_dir, "reduced.png")
 
 
-def compare_figure(run, out_dir, prefix=""):
+def compare_figure(run, out_dir):
     s, red = run.series, run.reduced
     summary = run.summary or {}
     problem = summary.get("problem", "")
@@ -427,7 +447,7 @@ def compare_figure(run, out_dir, prefix=""):
     s0 = run.fronts[0].s0
     eta = 1.0 - s0 / ell if problem == "sliding" else s0 / ell
     t = s["t"]
-    fig, axes = plt.subplots(1, 3, figsize=(17, 4.5))
+    fig, axes = plt.subplots(1, 3, figsize=(17, 4.5), dpi=DPI)
     axes[0].plot(red["t"], red["eta"], "k-", lw=2.5, alpha=0.4, label="reduced ODE")
     axes[0].plot(t, eta, "-", lw=1, label="string solver (front tracking)")
     decorate(axes[0], "t (s)", "eta = y / l", "eta(t)")
@@ -447,4 +467,4 @@ def compare_figure(run, out_dir, prefix=""):
     fig.suptitle(f"{run.name}: the {problem} chain, string solver" + (f" ({nodes} nodes)" if nodes else "") +
                  " against the reduced ODE", fontsize=10)
     fig.tight_layout()
-    return save(fig, out_dir, prefix + "compare.png")
+    return save(fig, out_dir, "compare.png")

@@ -90,7 +90,7 @@ def run_dir(kind):
     elif kind == "compare":
         args = ["compare", "folded", "--nodes", "21", "--out", out]
     elif kind == "canonical":
-        args = ["canonical", "--out", out]
+        args = ["canonical", "--out", out, "--quick"]
     r = chainsim(*args)
     assert r.returncode == 0, r.stderr
     _runs[kind] = out
@@ -150,11 +150,11 @@ def test_kind_string_run_at_chosen_times():
 
 
 def test_kind_run_with_fronts():
-    check_plot("fronts", ["snapshots.png", "energy.png", "fronts.png"])
+    check_plot("fronts", ["snapshots.png", "energy.png", "tension.png", "fronts.png"], here=True)
 
 
 def test_kind_run_with_a_fold():
-    check_plot("fold", ["snapshots.png", "energy.png", "fronts.png"], here=True)
+    check_plot("fold", ["snapshots.png", "energy.png", "tension.png", "fronts.png"], here=True)
 
 
 def test_kind_3d_run():
@@ -164,7 +164,7 @@ def test_kind_3d_run():
 
 
 def test_kind_reduced_runs():
-    check_plot("reduced", ["reduced.png", "energy.png"])
+    check_plot("reduced", ["reduced.png", "energy.png"], here=True)
     check_plot("reduced_scene", ["reduced.png", "energy.png"], here=True)
 
 
@@ -173,9 +173,11 @@ def test_kind_compare_run():
 
 
 def test_kind_canonical_run():
-    names = ["fall_time_vs_f.png", "falling_chain.png", "folded_chain.png", "sliding_chain.png"]
+    # The figures scripts/plot_canonical.py draws (the same package function), as tests/problems/
+    # test_canonical_job.cpp and the README name them.
+    names = ["fall_time_vs_f.png", "agreement.png"]
     for problem in ("falling", "folded", "sliding"):
-        names += [f"{problem}_reduced.png", f"{problem}_energy.png"]
+        names += [f"{problem}_chain.png", f"{problem}_snapshots.png"]
     check_plot("canonical", names, here=True)
 
 
@@ -248,6 +250,18 @@ def test_error_malformed_file_exits_2_naming_the_line():
     assert not os.path.exists(os.path.join(broken, "figures"))
 
 
+def test_error_canonical_directory_missing_a_file_exits_2():
+    fake = os.path.join(ROOT, "fake_canonical")
+    os.makedirs(os.path.join(fake, "figure_data"), exist_ok=True)
+    with open(os.path.join(fake, "summary.csv"), "w") as fh:
+        fh.write("problem,f,nodes\nfalling,0.5,41\n")
+    code, err = plot_here(fake)
+    assert code == 2 and f"{os.path.join(fake, 'figure_data', 'fall_time_vs_f.csv')}: missing" in err
+    assert not os.path.exists(os.path.join(fake, "figures"))
+    code, err = plot_here(fake, "--animate")
+    assert code == 2 and "--animate needs node frames" in err
+
+
 def test_error_bad_options_exit_2():
     directory = run_dir("string")
     for options, message in [(["--speed", "0"], "--speed = 0 is out of range: allowed speed > 0"),
@@ -276,6 +290,92 @@ def test_reader_frames_match_the_csv_rows():
     assert list(run.nodes.nodes(k)) == [int(r["node"]) for r in mine]
     assert np.array_equal(run.nodes.positions(k), [[float(r["x"]), float(r["y"])] for r in mine])
     assert [f.name for f in run.fronts] == ["heap_end"] and run.fronts[0].on_plane
+
+
+def csv_frames(directory):
+    """nodes.csv read here with the csv module: {t: [row, ...]} in file order."""
+    frames = {}
+    with open(os.path.join(directory, "nodes.csv"), newline="") as fh:
+        for row in csv.DictReader(fh):
+            frames.setdefault(float(row["t"]), []).append(row)
+    return frames
+
+
+def csv_series(directory):
+    """series.csv read here with the csv module: {t: row} (a frame's time is one of its rows)."""
+    with open(os.path.join(directory, "series.csv"), newline="") as fh:
+        return {float(row["t"]): row for row in csv.DictReader(fh)}
+
+
+def test_reader_frames_carry_s_and_velocities():
+    from chainsim_plot.readers import load_run
+    directory = run_dir("fronts")
+    frames = load_run(directory).nodes
+    rows = csv_frames(directory)
+    assert frames.has_s and frames.has_velocity
+    for k in (0, len(frames) // 2, len(frames) - 1):
+        mine = rows[frames.times[k]]
+        assert np.array_equal(frames.s(k), [float(r["s"]) for r in mine])
+        assert np.array_equal(frames.velocities(k), [[float(r["vx"]), float(r["vy"])] for r in mine])
+
+
+def test_reader_heap_drawn_at_the_contact_of_the_series():
+    """The falling chain's snapshots: the string drawn from nodes.csv ends at the contact of series.csv,
+    on the table of stats.json, by a partial link as long as the material between the last moving node
+    and the front (the link is straight and inextensible); the heap sits at the contact and grows."""
+    from chainsim_plot.figures import Layout
+    from chainsim_plot.readers import load_run
+    import json
+    directory = run_dir("fronts")
+    run = load_run(directory)
+    layout = Layout(run)
+    with open(os.path.join(directory, "stats.json")) as fh:
+        info = json.load(fh)["fronts"][0]
+    point, normal = np.array(info["point"]), np.array(info["plane_normal"])
+    rows, series = csv_frames(directory), csv_series(directory)
+    sizes = []
+    for k, t in enumerate(run.nodes.times):
+        row, last = series[t], rows[t][-1]
+        contact = np.array([float(row["front_0_x"]), float(row["front_0_y"])])
+        node = np.array([float(last["x"]), float(last["y"])])
+        curve = layout.curve(k)
+        assert np.array_equal(curve[-1], contact) and np.array_equal(curve[-2], node)
+        assert abs(np.dot(contact - point, normal)) < 1e-12
+        assert abs(np.linalg.norm(contact - node) - (float(row["s0_0"]) - float(last["s"]))) < 1e-10
+        [(front, where, size)] = layout.heaps(t)
+        assert front.name == info["name"] and np.array_equal(where, contact)
+        sizes.append(size)
+    assert sizes == sorted(sizes) and sizes[-1] > sizes[0]
+
+
+def test_reader_fold_drawn_between_its_arms():
+    """The folded chain's snapshots: the fold of series.csv is the corner of the drawn string, between
+    the nodes either side of s0 (each at its material distance from the fold), the arm past it drawn
+    aside by the amount the figure states."""
+    from chainsim_plot.figures import Layout
+    from chainsim_plot.readers import load_run
+    directory = run_dir("fold")
+    run = load_run(directory)
+    layout = Layout(run)
+    assert layout.aside > 0
+    rows, series = csv_frames(directory), csv_series(directory)
+    for k, t in enumerate(run.nodes.times):
+        s0 = float(series[t]["s0_0"])
+        fold = np.array([float(series[t]["front_0_x"]), float(series[t]["front_0_y"])])
+        s = np.array([float(r["s"]) for r in rows[t]])
+        x = np.array([[float(r["x"]), float(r["y"])] for r in rows[t]])
+        j = int(np.sum(s <= s0))  # nodes 0..j-1: the resting arm; j..: the moving arm
+        if j == len(s):
+            continue
+        if j > 0:
+            assert abs(np.linalg.norm(x[j - 1] - fold) - (s0 - s[j - 1])) < 1e-10
+        assert abs(np.linalg.norm(x[j] - fold) - (s[j] - s0)) < 1e-10
+        drawn = x.copy()
+        drawn[j:, 0] += layout.aside
+        bar = [fold, fold + [layout.aside, 0]]  # from the resting arm's side to the moving arm's
+        assert np.allclose(layout.curve(k), np.vstack([drawn[:j], bar, drawn[j:]]), rtol=0, atol=1e-15)
+        [(front, marker)] = layout.front_markers(t)
+        assert front.kind == "fold" and np.allclose(marker, fold + [layout.aside / 2, 0], rtol=0, atol=1e-15)
 
 
 def test_reader_hermite_interpolation_is_exact_for_cubics():
