@@ -35,7 +35,10 @@ TEST_CASE("front tracking stays exact on fine meshes: 1600 nodes", "[convergence
     double f;
   } cases[] = {{Problem::kFalling, 0.0}, {Problem::kFolded, 0.5}, {Problem::kSliding, 1.0}};
   for (const auto& c : cases) {
-    const Comparison run = compare_with_reduced(setup_for(c.problem, c.f, 1600));
+    // Half of each run (cutoff at half the chain) is 800 crossings at h = ℓ/1600: what failed before.
+    StringCaseSetup setup = setup_for(c.problem, c.f, 1600);
+    setup.eps = 0.5;
+    const Comparison run = compare_with_reduced(setup);
     const auto& s = run.summary;
     std::printf("%-8s f = %4.2f, 1600 nodes: rel_err_t_stop %.3e, max_constraint_violation %.3e, %ld crossings\n",
                 to_string(c.problem).c_str(), c.f, s["rel_err_t_stop"].get<double>(),
@@ -43,8 +46,8 @@ TEST_CASE("front tracking stays exact on fine meshes: 1600 nodes", "[convergence
     INFO(to_string(c.problem) << " f = " << c.f);
     REQUIRE(s["status"] == "stopped");
     CHECK(s["rel_err_t_stop"].get<double>() <= 1e-10);
-    // Every node crosses a front once, but those within the cutoff ε ℓ = 0.01 ℓ of the end.
-    CHECK(s["transfers"].get<long>() >= static_cast<long>(0.99 * 1600) - 2);
+    // Every node up to the cutoff crosses a front once.
+    CHECK(s["transfers"].get<long>() >= static_cast<long>(0.5 * 1600) - 2);
   }
 }
 
