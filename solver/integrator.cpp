@@ -1,6 +1,7 @@
 // The only translation unit that includes ARKODE: see integrator.hpp.
 #include "integrator.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdlib>
@@ -425,8 +426,10 @@ void Integrator::polish_event(double t_step_start, const Eigen::VectorXd& y_step
     const double slope = (g_ahead[k] - g[k]) / dt_probe;
     if (!(slope != 0.0) || !std::isfinite(slope)) break;
     const double t_next = std::max(t_event - g[k] / slope, t_step_start);
-    if (std::abs(t_next - t_event) <= 8 * std::numeric_limits<double>::epsilon() * std::max(1.0, std::abs(t_event)))
-      break;
+    // Converged to a few units of round-off of t (relative: an absolute floor in seconds would
+    // stop early on a short time scale, e.g. a 1 mm chain under 1000 m/s²).
+    const double t_unit = std::max({std::abs(t_event), std::abs(t_step_start), d.system.time_scale()});
+    if (std::abs(t_next - t_event) <= 8 * std::numeric_limits<double>::epsilon() * t_unit) break;
     t_event = t_next;
   }
 

@@ -11,6 +11,32 @@
 
 namespace chainsim {
 
+namespace exact {
+namespace {
+struct References {
+  double (*xi)(double, double, double);
+  double (*eta_prime_squared)(double, double, double);
+  double (*P)(double, double, double);
+  double (*fall_time)(double, double);
+};
+const References& references(Problem problem) {
+  static const References table[] = {
+      {falling_xi, falling_eta_prime_squared, falling_P, falling_fall_time},
+      {folded_xi, folded_eta_prime_squared, folded_P, folded_fall_time},
+      {sliding_xi, sliding_eta_prime_squared, sliding_P, sliding_fall_time}};
+  static_assert(static_cast<int>(Problem::kFalling) == 0 && static_cast<int>(Problem::kFolded) == 1 &&
+                static_cast<int>(Problem::kSliding) == 2);
+  return table[static_cast<int>(problem)];
+}
+}  // namespace
+double xi(Problem p, double f, double eta, double eta0) { return references(p).xi(f, eta, eta0); }
+double eta_prime_squared(Problem p, double f, double eta, double eta0) {
+  return references(p).eta_prime_squared(f, eta, eta0);
+}
+double P(Problem p, double f, double eta, double eta0) { return references(p).P(f, eta, eta0); }
+double fall_time(Problem p, double f, double eta0) { return references(p).fall_time(f, eta0); }
+}  // namespace exact
+
 Problem parse_problem(const std::string& name, const std::string& what) {
   if (name == "falling") return Problem::kFalling;
   if (name == "folded") return Problem::kFolded;
@@ -265,7 +291,7 @@ class SeriesRecorder {
  private:
   void push(std::vector<double> row) {
     if (rows_.size() >= max_rows_) {  // keep rows 0, 2, 4, …: steps 0, 2k, 4k, …
-      for (std::size_t i = 0; 2 * i < rows_.size(); ++i) rows_[i] = std::move(rows_[2 * i]);
+      for (std::size_t i = 1; 2 * i < rows_.size(); ++i) rows_[i] = std::move(rows_[2 * i]);
       rows_.resize((rows_.size() + 1) / 2);
       stride_ *= 2;
     }
@@ -377,24 +403,11 @@ ReducedRun solve_reduced(const ReducedSetup& setup) {
   const double eta_stop = q.y / l;
   nlohmann::json ref = nullptr;
   double xi_ref = NAN, P_ref = NAN, fall_ref = NAN;
-  switch (setup.problem) {
-    case Problem::kFalling:
-      xi_ref = exact::falling_xi(f, eta_stop, eta0);
-      P_ref = exact::falling_P(f, eta_stop, eta0);
-      fall_ref = exact::falling_fall_time(f, eta0);
-      break;
-    case Problem::kFolded:
-      if (setup.force == 0.0) {
-        xi_ref = exact::folded_xi(f, eta_stop, eta0);
-        P_ref = exact::folded_P(f, eta_stop, eta0);
-        fall_ref = exact::folded_fall_time(f, eta0);
-      }
-      break;
-    case Problem::kSliding:
-      xi_ref = exact::sliding_xi(f, std::min(eta_stop, 1.0), eta0);
-      P_ref = exact::sliding_P(f, std::min(eta_stop, 1.0), eta0);
-      fall_ref = exact::sliding_fall_time(f, eta0);
-      break;
+  if (setup.problem != Problem::kFolded || setup.force == 0.0) {  // no quadrature with an end force
+    const double eta_ref = std::min(eta_stop, 1.0);
+    xi_ref = exact::xi(setup.problem, f, eta_ref, eta0);
+    P_ref = exact::P(setup.problem, f, eta_ref, eta0);
+    fall_ref = exact::fall_time(setup.problem, f, eta0);
   }
   auto num_or_null = [](double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr); };
   const bool has_ref = std::isfinite(xi_ref) && stop_reason != "t_max";

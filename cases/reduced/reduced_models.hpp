@@ -93,6 +93,15 @@ std::vector<std::string> series_columns();
 /// NumericalError if the integration fails.
 ReducedRun solve_reduced(const ReducedSetup& setup);
 
+/// The exact references of exact_solutions.hpp for a problem released from rest at η0 (F = 0):
+/// the scaled time ξ(η), the squared scaled speed η'², P/P0 at η, and the full fall time ξ_f.
+namespace exact {
+double xi(Problem problem, double f, double eta, double eta0);
+double eta_prime_squared(Problem problem, double f, double eta, double eta0);
+double P(Problem problem, double f, double eta, double eta0);
+double fall_time(Problem problem, double f, double eta0);
+}  // namespace exact
+
 /// The sliding chain started from η0 = 0 follows the non-trivial branch y = a t²/2,
 /// a = g/(3 + 2f); the ODE is singular at y = 0, so the integration starts on that branch at
 /// η = kSlidingStartEta (an attracting solution: deviations decay like y^(−2(1+f))).
