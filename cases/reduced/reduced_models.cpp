@@ -3,6 +3,7 @@
 
 #include <chrono>
 #include <cmath>
+#include <string>
 
 #include <fmt/format.h>
 
@@ -97,10 +98,11 @@ TimeToEnd time_to_end(Problem problem, double f, double eta0) {
   return {};
 }
 
-/// x rounded up to two significant digits (so that the printed limit is the limit checked).
+/// x rounded up to two significant digits, as the double nearest to that decimal (so that the
+/// limit printed, and typed back by a user, is exactly the limit checked).
 double round_up_2(double x) {
   const double unit = std::pow(10.0, std::floor(std::log10(x)) - 1.0);
-  return std::ceil(x / unit * (1 - 1e-12)) * unit;
+  return std::stod(fmt::format("{:.1e}", std::ceil(x / unit * (1 - 1e-12)) * unit));
 }
 
 }  // namespace
