@@ -1,7 +1,10 @@
 // The only translation unit that includes ARKODE: see integrator.hpp.
 #include "integrator.hpp"
 
+#include <algorithm>
+#include <chrono>
 #include <cmath>
+#include <cstdlib>
 #include <exception>
 #include <limits>
 #include <map>
@@ -75,6 +78,14 @@ void load_table(const std::string& name, ARKodeButcherTable& erk, ARKodeButcherT
   dirk = listed(name, kDirkTables) ? ARKodeButcherTable_LoadDIRKByName(name.c_str()) : nullptr;
 }
 
+/// ARKODE's name of a return flag. ARKStepGetReturnFlagName allocates the string: the caller frees it.
+std::string flag_name(int flag) {
+  char* name = ARKStepGetReturnFlagName(flag);
+  std::string out = name ? name : "unknown flag";
+  std::free(name);
+  return out;
+}
+
 std::string valid_methods() {
   std::string list;
   for (const auto& [alias, entry] : aliases()) list += (list.empty() ? "" : ", ") + alias;
@@ -105,6 +116,7 @@ void IntegratorOptions::validate() const {
   require_in_range("initial_step", initial_step, 0.0, INFINITY);
   if (max_steps < 1)
     throw InputError(fmt::format("max_steps = {} is out of range: allowed max_steps >= 1", max_steps));
+  require_in_range("max_wall_s", max_wall_s, 0.0, INFINITY);
 }
 
 // ------------------------------------------------------------------------------------------------
@@ -123,6 +135,12 @@ struct Integrator::Impl {
   std::exception_ptr pending;  // exception thrown inside a callback, re-thrown after ARKStepEvolve
   std::string last_error;      // ARKODE's own message for the last failure
   std::string last_recoverable;  // what the model said when it last refused a trial state
+  // Watchdog (see integrator.hpp).
+  long max_steps = 0;
+  double max_wall_s = 0;
+  long steps_total = 0;        // accepted steps over the Integrator's life
+  int short_steps = 0;         // accepted steps in a row below the step-size floor
+  std::chrono::steady_clock::time_point wall_start = std::chrono::steady_clock::now();
 
   explicit Impl(OdeSystem& s) : system(s) {}
   ~Impl() {
@@ -135,8 +153,7 @@ struct Integrator::Impl {
 
   void check(int flag, const char* call) const {
     if (flag < 0)
-      throw Error(fmt::format("internal error: {} failed with {} ({})", call, flag,
-                              ARKStepGetReturnFlagName(flag)));
+      throw Error(fmt::format("internal error: {} failed with {} ({})", call, flag, flag_name(flag)));
   }
 
   /// Scalar tolerances, or atol * state_scale() per component when the system provides a scale.
@@ -236,6 +253,8 @@ Integrator::Integrator(OdeSystem& system, double t0, const Eigen::VectorXd& y0,
   d.rtol = options.rtol;
   d.atol = options.atol;
   d.apply_tolerances();
+  d.max_steps = options.max_steps;
+  d.max_wall_s = options.max_wall_s;
   d.check(ARKStepSetMaxNumSteps(d.mem, options.max_steps), "ARKStepSetMaxNumSteps");
   if (options.max_step > 0) d.check(ARKStepSetMaxStep(d.mem, options.max_step), "ARKStepSetMaxStep");
   if (options.initial_step > 0)
@@ -257,24 +276,86 @@ Integrator::Integrator(OdeSystem& system, double t0, const Eigen::VectorXd& y0,
 
 Integrator::~Integrator() = default;
 
+// The method, tolerance and last step, for the watchdog's messages.
+std::string Integrator::diagnosis() const {
+  const Impl& d = *impl_;
+  sunrealtype h = 0;
+  ARKStepGetLastStep(d.mem, &h);
+  return fmt::format("last step h = {:.3g} s, {} accepted steps, method {} ({}, order {}), rtol = {:g}", h,
+                     d.steps_total, d.table, d.implicit ? "implicit" : "explicit", d.order, d.rtol);
+}
+
 // One ARKStepEvolve call towards t_target (never past it); throws on failure. Returns ARKODE's flag.
+// Counts the accepted steps against the run's budget and checks the wall-clock budget first.
 int Integrator::evolve(double t_target, bool one_step) {
   Impl& d = *impl_;
+  if (d.steps_total >= d.max_steps)
+    throw NumericalError(fmt::format("time integration stopped at t = {:.12g} s with ARK_TOO_MUCH_WORK: the step "
+                                     "budget max_steps = {} of the run is used up ({}). Raise max_steps if the steps "
+                                     "are merely many (a low-order method at a tight rtol needs very many: loosen "
+                                     "rtol or pick a higher-order method such as erk8); if they are tiny the "
+                                     "solution may be singular near this time",
+                                     t_, d.max_steps, diagnosis()),
+                         t_);
+  if (d.max_wall_s > 0) {
+    const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - d.wall_start).count();
+    if (wall > d.max_wall_s)
+      throw NumericalError(fmt::format("time integration stopped at t = {:.12g} s: the wall-clock budget "
+                                       "max_wall_s = {:g} s is used up after {:.3g} s ({}). Raise max_wall_s, "
+                                       "loosen rtol, or pick a cheaper method",
+                                       t_, d.max_wall_s, wall, diagnosis()),
+                           t_);
+  }
   d.check(ARKStepSetStopTime(d.mem, t_target), "ARKStepSetStopTime");
+  // ARKODE's own per-call limit (it matters in normal mode, e.g. an event polish) is what is left.
+  d.check(ARKStepSetMaxNumSteps(d.mem, d.max_steps - d.steps_total), "ARKStepSetMaxNumSteps");
+  long steps_before = 0, steps_after = 0;
+  ARKStepGetNumSteps(d.mem, &steps_before);
   sunrealtype tret = t_;
   d.pending = nullptr;
   d.last_error.clear();
   const int flag = ARKStepEvolve(d.mem, t_target, d.y, &tret, one_step ? ARK_ONE_STEP : ARK_NORMAL);
+  ARKStepGetNumSteps(d.mem, &steps_after);
+  d.steps_total += std::max(0L, steps_after - steps_before);
   if (d.pending) std::rethrow_exception(d.pending);
   if (flag == ARK_UNREC_RHSFUNC_ERR) return flag;  // advance() retries from the step's start
   if (flag < 0)
-    throw NumericalError(fmt::format("time integration failed at t = {:.9g} s with {}{}{}", tret,
-                                     ARKStepGetReturnFlagName(flag), d.last_error.empty() ? "" : ": ",
-                                     d.last_error),
+    throw NumericalError(fmt::format("time integration failed at t = {:.12g} s with {}{}{} ({})", tret,
+                                     flag_name(flag), d.last_error.empty() ? "" : ": ", d.last_error, diagnosis()),
                          tret);
   t_ = flag == ARK_TSTOP_RETURN ? t_target : tret;
   y_ = Eigen::Map<Eigen::VectorXd>(N_VGetArrayPointer(d.y), N_VGetLength(d.y));
   return flag;
+}
+
+// After an accepted step that ended neither at the stop time nor at a root: the step size must stay
+// above kStepFloor · max(|t|, time_scale()) and t must move, or kStallSteps such steps in a row end the run.
+void Integrator::watchdog(double t_before, int flag) {
+  Impl& d = *impl_;
+  if (flag != ARK_SUCCESS) {
+    d.short_steps = 0;
+    return;
+  }
+  sunrealtype h = 0;
+  ARKStepGetLastStep(d.mem, &h);
+  const double floor = kStepFloor * std::max(std::abs(t_), d.system.time_scale());
+  const bool stalled = !(t_ > t_before);
+  if (!stalled && std::abs(h) >= floor) {
+    d.short_steps = 0;
+    return;
+  }
+  if (++d.short_steps < kStallSteps) return;
+  throw NumericalError(
+      fmt::format("time integration stalled at t = {:.15g} s: {} accepted steps in a row {} ({}). The solution is "
+                  "probably singular near this time (a speed or a tension that diverges, a cutoff too close to a "
+                  "singular end), or the method is unstable at this tolerance: tighten rtol, pick another method "
+                  "(e.g. erk8 or dirk5), or stop the run before this time",
+                  t_, kStallSteps,
+                  stalled ? "did not advance the time in floating point"
+                          : fmt::format("were shorter than the step-size floor {:.3g} s = {:.0e} max(|t|, {:.3g} s)",
+                                        floor, kStepFloor, d.system.time_scale()),
+                  diagnosis()),
+      t_);
 }
 
 Integrator::Outcome Integrator::advance(double t_target, bool one_step) {
@@ -307,6 +388,7 @@ Integrator::Outcome Integrator::advance(double t_target, bool one_step) {
     if (retries > 0) impl_->check(ARKStepSetInitStep(impl_->mem, 0.0), "ARKStepSetInitStep");  // estimate again
     retries = 0;
     h_retry = 0;
+    watchdog(t_step_start, flag);
     if (flag == ARK_ROOT_RETURN) {
       impl_->check(ARKStepGetRootInfo(impl_->mem, events_found_.data()), "ARKStepGetRootInfo");
       polish_event(t_step_start, y_step_start);
@@ -344,8 +426,10 @@ void Integrator::polish_event(double t_step_start, const Eigen::VectorXd& y_step
     const double slope = (g_ahead[k] - g[k]) / dt_probe;
     if (!(slope != 0.0) || !std::isfinite(slope)) break;
     const double t_next = std::max(t_event - g[k] / slope, t_step_start);
-    if (std::abs(t_next - t_event) <= 8 * std::numeric_limits<double>::epsilon() * std::max(1.0, std::abs(t_event)))
-      break;
+    // Converged to a few units of round-off of t (relative: an absolute floor in seconds would
+    // stop early on a short time scale, e.g. a 1 mm chain under 1000 m/s²).
+    const double t_unit = std::max({std::abs(t_event), std::abs(t_step_start), d.system.time_scale()});
+    if (std::abs(t_next - t_event) <= 8 * std::numeric_limits<double>::epsilon() * t_unit) break;
     t_event = t_next;
   }
 

@@ -37,6 +37,10 @@ class OdeSystem {
   /// speed for a velocity). The absolute tolerance of component i is atol * scale[i], so atol is
   /// dimensionless and results do not depend on the choice of units. Empty = all ones.
   virtual Eigen::VectorXd state_scale() const { return {}; }
+  /// Natural time scale of the motion (s), e.g. a free-fall time; 0 = none. The integrator's
+  /// step-size floor is kStepFloor · max(|t|, time_scale()), so a system that starts at t = 0 and
+  /// gives its scale is also watched over during its first instants.
+  virtual double time_scale() const { return 0.0; }
 };
 
 /// How the integrator advances the ODE. validate() throws InputError naming the bad field.
@@ -50,7 +54,12 @@ struct IntegratorOptions {
   double atol = 1e-12;   ///< absolute tolerance relative to OdeSystem::state_scale(), > 0
   double max_step = 0;   ///< largest step (s); 0 = no limit
   double initial_step = 0;  ///< first step (s); 0 = ARKODE's estimate
-  long max_steps = 500000;  ///< steps allowed per advance() call before it gives up
+  /// Accepted steps allowed in total over the Integrator's life (every advance() call and every
+  /// event polish counted), >= 1. Past it the run ends with NumericalError (ARK_TOO_MUCH_WORK).
+  long max_steps = 500000;
+  /// Wall-clock budget (s) of the Integrator from its construction; 0 = none. Past it the run ends
+  /// with NumericalError naming the time reached.
+  double max_wall_s = 0;
   void validate() const;
 };
 
@@ -76,12 +85,24 @@ struct IntegratorStats {
 };
 
 /// Advances one OdeSystem from (t0, y0). Not copyable; owns its ARKODE memory.
+///
+/// Watchdog: no integration can run forever. advance() throws NumericalError, naming the time, the
+/// step size, the method and what to change, when
+///   - the accepted steps of the whole run exceed IntegratorOptions::max_steps;
+///   - the step size collapses: kStallSteps accepted steps in a row shorter than
+///     kStepFloor · max(|t|, OdeSystem::time_scale()), or that leave t unchanged in floating point;
+///   - the wall-clock time exceeds IntegratorOptions::max_wall_s (if set).
 class Integrator {
  public:
   Integrator(OdeSystem& system, double t0, const Eigen::VectorXd& y0, const IntegratorOptions& options);
   ~Integrator();
   Integrator(const Integrator&) = delete;
   Integrator& operator=(const Integrator&) = delete;
+
+  /// Relative step-size floor of the watchdog, and how many accepted steps in a row below it (or
+  /// that do not advance t) end the run.
+  static constexpr double kStepFloor = 1e-14;
+  static constexpr int kStallSteps = 5;
 
   enum class Outcome {
     kReachedTarget,  ///< t == t_target
@@ -91,7 +112,8 @@ class Integrator {
 
   /// Advance towards t_target (never past it). In one_step mode return after each internal step,
   /// which lets a caller record the adaptive steps. Throws NumericalError when ARKODE fails (the
-  /// message carries ARKODE's flag name and the time reached).
+  /// message carries ARKODE's flag name and the time reached), or when the watchdog (see the class
+  /// comment) stops the run.
   Outcome advance(double t_target, bool one_step = false);
 
   /// Current time and state of the integrator.
@@ -117,6 +139,8 @@ class Integrator {
 
  private:
   int evolve(double t_target, bool one_step);
+  void watchdog(double t_before, int flag);
+  std::string diagnosis() const;
   void polish_event(double t_step_start, const Eigen::VectorXd& y_step_start);
 
   struct Impl;

@@ -3,6 +3,7 @@
 
 #include <chrono>
 #include <cmath>
+#include <string>
 
 #include <fmt/format.h>
 
@@ -10,6 +11,32 @@
 #include "mesh/errors.hpp"
 
 namespace chainsim {
+
+namespace exact {
+namespace {
+struct References {
+  double (*xi)(double, double, double);
+  double (*eta_prime_squared)(double, double, double);
+  double (*P)(double, double, double);
+  double (*fall_time)(double, double);
+};
+const References& references(Problem problem) {
+  static const References table[] = {
+      {falling_xi, falling_eta_prime_squared, falling_P, falling_fall_time},
+      {folded_xi, folded_eta_prime_squared, folded_P, folded_fall_time},
+      {sliding_xi, sliding_eta_prime_squared, sliding_P, sliding_fall_time}};
+  static_assert(static_cast<int>(Problem::kFalling) == 0 && static_cast<int>(Problem::kFolded) == 1 &&
+                static_cast<int>(Problem::kSliding) == 2);
+  return table[static_cast<int>(problem)];
+}
+}  // namespace
+double xi(Problem p, double f, double eta, double eta0) { return references(p).xi(f, eta, eta0); }
+double eta_prime_squared(Problem p, double f, double eta, double eta0) {
+  return references(p).eta_prime_squared(f, eta, eta0);
+}
+double P(Problem p, double f, double eta, double eta0) { return references(p).P(f, eta, eta0); }
+double fall_time(Problem p, double f, double eta0) { return references(p).fall_time(f, eta0); }
+}  // namespace exact
 
 Problem parse_problem(const std::string& name, const std::string& what) {
   if (name == "falling") return Problem::kFalling;
@@ -50,9 +77,47 @@ double ReducedSetup::initial_eta() const {
   return problem == Problem::kFalling ? 1.0 : 0.0;
 }
 
+namespace {
+
+/// Δξ(ε) = C ε^p, the leading term of the exact time (units of t0) between the cutoff ε and the
+/// singular end of the fall, from the first integrals of exact_solutions.hpp near the end.
+struct TimeToEnd {
+  double C = 0, p = 1;
+  double at(double eps) const { return C * std::pow(eps, p); }
+};
+
+TimeToEnd time_to_end(Problem problem, double f, double eta0) {
+  switch (problem) {
+    case Problem::kFalling:  // η'² ≈ 4/(3−2f) η0^(3−2f) η^(2f−2) as η → 0
+      return {0.5 * std::sqrt(3.0 - 2.0 * f) * std::pow(eta0, -(3.0 - 2.0 * f) / 2.0) / (2.0 - f), 2.0 - f};
+    case Problem::kFolded:  // η'² ≈ 2/(2−f) (1−η0)^(2−f) z^(f−1) as z = 1 − η → 0
+      return {std::sqrt(1.0 - f / 2.0) * std::pow(1.0 - eta0, -(2.0 - f) / 2.0) / ((3.0 - f) / 2.0), (3.0 - f) / 2.0};
+    case Problem::kSliding:
+      break;
+  }
+  return {};
+}
+
+/// x rounded up to two significant digits, as the double nearest to that decimal (so that the
+/// limit printed, and typed back by a user, is exactly the limit checked).
+double round_up_2(double x) {
+  const double unit = std::pow(10.0, std::floor(std::log10(x)) - 1.0);
+  return std::stod(fmt::format("{:.1e}", std::ceil(x / unit * (1 - 1e-12)) * unit));
+}
+
+}  // namespace
+
+double ReducedSetup::min_cutoff() const {
+  if (problem == Problem::kSliding) return 0.0;
+  const TimeToEnd law = time_to_end(problem, chain.dissipation, initial_eta());
+  return round_up_2(std::pow(kMinTimeToEnd / law.C, 1.0 / law.p));
+}
+
 void ReducedSetup::validate() const {
   chain.validate();
   require_in_range("--eps", eps, 0.0, 1.0, Bound::kOpen, Bound::kOpen);
+  if (max_rows < 16)
+    throw InputError(fmt::format("max_rows = {} is out of range: allowed max_rows >= 16", max_rows));
   const double e0 = initial_eta();
   switch (problem) {
     case Problem::kFalling:
@@ -65,9 +130,25 @@ void ReducedSetup::validate() const {
       require_in_range("--eta0", e0, 0.0, 1.0, Bound::kClosed, Bound::kOpen);
       break;
   }
-  if (problem == Problem::kFolded)
+  if (problem != Problem::kSliding && eps < min_cutoff()) {
+    const double f = chain.dissipation;
+    throw InputError(fmt::format(
+        "--eps = {:g} is out of range for the {} chain with f = {:g}, eta0 = {:g}: allowed {:g} <= eps < {:g}. The "
+        "exact time left between that cutoff and the singular end of the fall is {:.2g} t0, less than {:g} t0 "
+        "(about 10^3 round-off units of t): the run cannot resolve the cutoff",
+        eps, to_string(problem), f, e0, min_cutoff(), problem == Problem::kFalling ? e0 : 1.0 - e0,
+        time_to_end(problem, f, e0).at(eps), kMinTimeToEnd));
+  }
+  if (problem == Problem::kFolded) {
     require_in_range("--force", force, 0.0, INFINITY);
-  else if (force != 0.0)
+    const double weight = chain.density * chain.gravity * chain.length;
+    if (e0 == 0.0 && force > weight)
+      throw InputError(fmt::format(
+          "--force = {:g} N exceeds the chain's weight lambda g l = {:g} N: released at eta0 = 0, the free end would "
+          "rise above its start at once, out of the model's domain eta >= 0; allowed 0 <= force <= {:g} N at "
+          "eta0 = 0 (from eta0 > 0 a larger force lifts the fold to the fixed end, where the run stops)",
+          force, weight, weight));
+  } else if (force != 0.0)
     throw InputError(fmt::format("--force = {:g} applies to the folded chain only (the {} chain has no loaded end): "
                                  "allowed force = 0",
                                  force, to_string(problem)));
@@ -180,9 +261,50 @@ class ReducedOde : public OdeSystem {
     return scale;
   }
 
+  double time_scale() const override { return s_.chain.t0(); }
+
  private:
   const ReducedSetup& s_;
   double l_, lam_, g_, f_;
+};
+
+/// The recorded series, bounded before the run: rows of accepted steps 0, k, 2k, … (stride k), the
+/// stride doubling (every other row dropped) whenever max_rows is reached; the last state offered is
+/// always the last row (finish()).
+class SeriesRecorder {
+ public:
+  explicit SeriesRecorder(long max_rows) : max_rows_(static_cast<std::size_t>(max_rows / 2 * 2)) {}
+
+  void offer(std::vector<double> row) {
+    kept_last_ = offered_++ % stride_ == 0;
+    if (kept_last_)
+      push(std::move(row));
+    else
+      last_ = std::move(row);
+  }
+  CsvTable finish() {
+    if (!kept_last_) push(std::move(last_));
+    CsvTable table(series_columns());
+    for (const auto& row : rows_) table.add_row(row);
+    return table;
+  }
+  long stride() const { return stride_; }
+
+ private:
+  void push(std::vector<double> row) {
+    if (rows_.size() >= max_rows_) {  // keep rows 0, 2, 4, …: steps 0, 2k, 4k, …
+      for (std::size_t i = 1; 2 * i < rows_.size(); ++i) rows_[i] = std::move(rows_[2 * i]);
+      rows_.resize((rows_.size() + 1) / 2);
+      stride_ *= 2;
+    }
+    rows_.push_back(std::move(row));
+  }
+
+  std::size_t max_rows_;
+  long stride_ = 1, offered_ = 0;
+  bool kept_last_ = true;
+  std::vector<double> last_;
+  std::vector<std::vector<double>> rows_;
 };
 
 }  // namespace
@@ -212,13 +334,15 @@ ReducedRun solve_reduced(const ReducedSetup& setup) {
     u0[1] = a * t_start;
   }
 
-  // 2. Integrator: record every accepted step, with steps no longer than t0/500 by default.
+  // 2. Integrator: record the accepted steps (thinned to max_rows), with steps no longer than t0/500
+  //    by default.
   ReducedOde ode(setup);
   IntegratorOptions opts = setup.integrator;
   if (opts.max_step == 0) opts.max_step = t0 / 500.0;
   Integrator integrator(ode, t_start, u0, opts);
 
   ReducedRun run{CsvTable(series_columns()), {}};
+  SeriesRecorder series(setup.max_rows);
   const Snapshot q0 = ode.snapshot(u0[0], u0[1]);
   const double E0 = q0.K + q0.V;
   double ledger_max = 0, energy_scale = 0;
@@ -229,7 +353,7 @@ ReducedRun solve_reduced(const ReducedSetup& setup) {
     energy_scale = std::max(energy_scale, std::abs(q.K) + std::abs(q.V) + std::abs(u[2]) + std::abs(u[3]) +
                                               std::abs(u[4]));
     const double speed_scale = l / t0, energy_unit = P0 * l;
-    run.series.add_row({t, q.y, q.yd, q.ydd, q.P, q.K, q.V, q.W_shock, q.W_heap, q.W_force, u[2], u[3], u[4],
+    series.offer({t, q.y, q.yd, q.ydd, q.P, q.K, q.V, q.W_shock, q.W_heap, q.W_force, u[2], u[3], u[4],
                         ledger, t / t0, q.y / l, q.yd / speed_scale, q.ydd * t0 * t0 / l, q.P / P0,
                         q.K / energy_unit, q.V / energy_unit});
   };
@@ -238,6 +362,8 @@ ReducedRun solve_reduced(const ReducedSetup& setup) {
   // 3. Advance step by step until a stop event (or the safety time).
   const double t_max = t_start + setup.t_max_over_t0 * t0;
   std::string stop_reason = "t_max";
+  std::string stop_detail = fmt::format("the safety stop t_max = {:g} t0 was reached before a stop event",
+                                        setup.t_max_over_t0);
   int turning_points = 0;
   for (;;) {
     const auto outcome = integrator.advance(t_max, /*one_step=*/true);
@@ -247,10 +373,16 @@ ReducedRun solve_reduced(const ReducedSetup& setup) {
     const auto& ev = integrator.events_found();
     if (ev[0] != 0) {
       stop_reason = setup.problem == Problem::kSliding ? "chain_fully_hanging" : "cutoff";
+      stop_detail = setup.problem == Problem::kSliding ? "the whole chain hangs (eta = 1)"
+                    : setup.problem == Problem::kFalling
+                        ? fmt::format("the falling part reached the cutoff eta = eps = {:g}", setup.eps)
+                        : fmt::format("the resting arm reached the cutoff eta = 1 - eps, eps = {:g}", setup.eps);
       break;
     }
     if (setup.problem == Problem::kFolded && ev[1] != 0) {
       stop_reason = "front_reached_fixed_end";
+      stop_detail = "the fold reached the fixed end (eta = 0, the boundary of the model's domain): the free end is "
+                    "back at the height l above the support it starts from when eta0 = 0";
       break;
     }
     if (setup.problem == Problem::kFolded && ev.size() > 2 && ev[2] != 0) {
@@ -260,6 +392,8 @@ ReducedRun solve_reduced(const ReducedSetup& setup) {
       integrator.restart(integrator.time(), u);
     }
   }
+
+  run.series = series.finish();
 
   // 4. Summary, with the exact references where the problem has one.
   const double t_stop = integrator.time();
@@ -271,24 +405,11 @@ ReducedRun solve_reduced(const ReducedSetup& setup) {
   const double eta_stop = q.y / l;
   nlohmann::json ref = nullptr;
   double xi_ref = NAN, P_ref = NAN, fall_ref = NAN;
-  switch (setup.problem) {
-    case Problem::kFalling:
-      xi_ref = exact::falling_xi(f, eta_stop, eta0);
-      P_ref = exact::falling_P(f, eta_stop, eta0);
-      fall_ref = exact::falling_fall_time(f, eta0);
-      break;
-    case Problem::kFolded:
-      if (setup.force == 0.0) {
-        xi_ref = exact::folded_xi(f, eta_stop, eta0);
-        P_ref = exact::folded_P(f, eta_stop, eta0);
-        fall_ref = exact::folded_fall_time(f, eta0);
-      }
-      break;
-    case Problem::kSliding:
-      xi_ref = exact::sliding_xi(f, std::min(eta_stop, 1.0), eta0);
-      P_ref = exact::sliding_P(f, std::min(eta_stop, 1.0), eta0);
-      fall_ref = exact::sliding_fall_time(f, eta0);
-      break;
+  if (setup.problem != Problem::kFolded || setup.force == 0.0) {  // no quadrature with an end force
+    const double eta_ref = std::min(eta_stop, 1.0);
+    xi_ref = exact::xi(setup.problem, f, eta_ref, eta0);
+    P_ref = exact::P(setup.problem, f, eta_ref, eta0);
+    fall_ref = exact::fall_time(setup.problem, f, eta0);
   }
   auto num_or_null = [](double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr); };
   const bool has_ref = std::isfinite(xi_ref) && stop_reason != "t_max";
@@ -302,6 +423,7 @@ ReducedRun solve_reduced(const ReducedSetup& setup) {
       {"t0", t0},
       {"P0", P0},
       {"stop_reason", stop_reason},
+      {"stop_detail", stop_detail},
       {"t_start", t_start},
       {"t_stop", t_stop},
       {"t_stop_over_t0", t_stop / t0},
@@ -316,6 +438,7 @@ ReducedRun solve_reduced(const ReducedSetup& setup) {
       {"energy_residual", energy_scale > 0 ? ledger_max / energy_scale : 0.0},
       {"turning_points", turning_points},
       {"samples", run.series.rows()},
+      {"sample_stride", series.stride()},
       {"integrator", to_json(integrator.stats())},
       {"wall_s", wall_s},
   };
