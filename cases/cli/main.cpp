@@ -164,6 +164,9 @@ int main(int argc, char** argv) {
   cmd_run->add_option("--out", run.out, "output directory (default results/<scene name>)");
   double run_t_end = 0;
   auto* opt_t_end = cmd_run->add_option("--t-end", run_t_end, "end time (s), > 0: replaces the scene's [stop] t_end");
+  double run_max_wall = 0;
+  auto* opt_max_wall = cmd_run->add_option(
+      "--max-wall", run_max_wall, "wall-clock budget (s), > 0: replaces the scene's [solver] max_wall_s");
   cmd_run->add_flag("--quiet", run.quiet, "no progress line on stderr (there is none when stderr is not a terminal)");
   cmd_run->add_option("--set", run.overrides,
                       "KEY=VALUE: sets a scene key, checked as in the file (repeatable; a later one wins), e.g. "
@@ -228,6 +231,7 @@ int main(int argc, char** argv) {
     if (*cmd_compare) code = chainsim::run_compare_command(compare, out);
     if (*cmd_run) {
       if (opt_t_end->count() > 0) run.t_end = run_t_end;
+      if (opt_max_wall->count() > 0) run.max_wall = run_max_wall;
       code = chainsim::run_scene_command(run, out);
     }
     std::cout << buffered.str();

@@ -257,6 +257,11 @@ int run_scene_command(const RunCommandOptions& options, std::ostream& out) {
         throw InputError(fmt::format("--t-end = {:g} is out of range: allowed t_end > 0", *options.t_end));
       spec.stop.t_end = *options.t_end;
     }
+    if (options.max_wall) {
+      if (!(*options.max_wall > 0 && std::isfinite(*options.max_wall)))
+        throw InputError(fmt::format("--max-wall = {:g} is out of range: allowed max_wall > 0 (s)", *options.max_wall));
+      spec.solver.max_wall_s = *options.max_wall;
+    }
     const std::filesystem::path dir =
         options.out.empty() ? std::filesystem::path("results") / std::filesystem::path(options.scene).stem()
                             : std::filesystem::path(options.out);

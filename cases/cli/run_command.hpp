@@ -19,6 +19,7 @@ struct RunCommandOptions {
   std::string scene;  ///< path of the scene file
   std::string out;    ///< output directory ("" = "results/<scene stem>")
   std::optional<double> t_end;  ///< replaces the scene's [stop] t_end (s)
+  std::optional<double> max_wall;  ///< replaces the scene's [solver] max_wall_s (s of wall-clock time)
   std::vector<std::string> overrides;  ///< --set KEY=VALUE, applied to the scene in order
   bool json = false;  ///< print the summary object on stdout
   bool quiet = false;  ///< no progress line on stderr (there is none when stderr is not a terminal)

@@ -1,6 +1,7 @@
 // What every string run writes, with or without fronts: frames at the exact multiples of
 // [output] interval plus the state at the stop, the fronts as a second ParaView part, the VTK
 // encoding chosen by the scene, and slack reported by default (stop) or recorded (warn).
+#include <chrono>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -122,4 +123,21 @@ TEST_CASE("slack is found by default and stops the run, and with slack = warn it
   const auto [code_ignore, ignore] = run_json(dir, pushed + "[solver]\nslack = \"ignore\"\n");
   CHECK(code_ignore == 0);
   CHECK(ignore["slack"]["detected"] == false);
+}
+
+TEST_CASE("[solver] max_wall_s ends a scene's run after that wall-clock time, with its outputs", "[unit][scene]") {
+  const auto dir = temp_dir("outputs_max_wall");
+  // A hanging chain asked for 1e4 s of motion at rtol 1e-12: minutes of work, cut at 0.2 s of wall time.
+  const std::string text = test::kSceneBase.substr(0, test::kSceneBase.find("[stop]")) +
+                           "[solver]\nrtol = 1e-12\natol = 1e-14\nmax_wall_s = 0.2\n[stop]\nt_end = 1e4\n";
+  const auto start = std::chrono::steady_clock::now();
+  const auto [code, j] = run_json(dir, text);
+  const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  CHECK(code == 3);
+  CHECK(j["status"] == "failed");
+  CHECK_THAT(j["error"].get<std::string>(), Catch::Matchers::Contains("wall-clock budget max_wall_s = 0.2 s"));
+  CHECK(j["t_stop"].get<double>() > 0);
+  CHECK(j["t_stop"].get<double>() < 1e4);
+  CHECK(wall < 10);
+  CHECK(std::filesystem::exists(dir / "out" / "stats.json"));
 }
