@@ -34,7 +34,8 @@ const char* to_string(SlackPolicy policy) {
 
 std::string SlackReport::message() const {
   return fmt::format("slack at t = {:.9g} s: link {} (s = {:.6g} m from node 0) has tension T = {:.6g} N < 0 "
-                     "(largest |T| = {:.6g} N); an inextensible string cannot push, so the model does not apply",
+                     "(tension scale {:.6g} N, the larger of max |T| and lambda (|g| l + max |v|^2)); an inextensible string "
+                     "cannot push, so the model does not apply",
                      t, link, s_mid, tension, scale);
 }
 
