@@ -525,8 +525,6 @@ typename StringModel<dim>::Snapshot StringModel<dim>::snapshot(double t, const E
 
 template <int dim>
 double StringModel<dim>::max_constraint_violation(double t, const Eigen::Ref<const Eigen::VectorXd>& y) const {
-  const int voff = dim * num_free_;
-  (void)voff;
   auto position = [&](int i) -> Vec<dim> {
     const int k = slot_[i];
     if (k >= 0) return y.template segment<dim>(dim * k);
