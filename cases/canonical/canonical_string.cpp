@@ -44,6 +44,7 @@ void StringCaseSetup::validate() const {
                                  "degrees of the vertical (its height must grow along the string)",
                                  tilt_deg + bend_deg));
   require_in_range("t_max_over_t0", t_max_over_t0, 0.0, INFINITY, Bound::kOpen);
+  require_in_range("frame_interval", frame_interval, 0.0, INFINITY);
   integrator.validate();
 }
 
@@ -134,7 +135,8 @@ StringCaseRun solve_string_case(const StringCaseSetup& setup) {
   StringSolverOptions run_options;
   run_options.integrator = setup.integrator;
   run_options.t_end = setup.t_max_over_t0 * t0;
-  run_options.output_interval = run_options.t_end;  // the samples after every step are what is compared
+  // The samples after every step are what is compared; frames only when asked for.
+  run_options.output_interval = setup.frame_interval > 0 ? setup.frame_interval : run_options.t_end;
   run_options.record_steps = true;
   StringSolver<2> solver(model, run_options);
   try {
@@ -142,6 +144,7 @@ StringCaseRun solve_string_case(const StringCaseSetup& setup) {
   } catch (const NumericalError&) {  // the run's status says "failed" and why
   }
   out.run = solver.summary();
+  out.frames = solver.frames();
   // η, dη/dt and P per sample.
   for (const StepSample& s : out.run.samples) {
     const double s0 = s.s0[0], sd = s.s0_dot[0];

@@ -38,6 +38,7 @@ struct StringCaseSetup {
   double tilt_deg = 0;            ///< general variant (see the file comment); 0 = the paper's geometry
   double bend_deg = 0;            ///< falling only: curved release (see the file comment)
   double t_max_over_t0 = 50.0;    ///< safety stop
+  double frame_interval = 0;      ///< s between recorded frames of the string's nodes (0: only the start and stop)
   IntegratorOptions integrator = default_integrator();
   static IntegratorOptions default_integrator();
   /// The reduced model's setup of the same problem (its own default integrator).
@@ -49,6 +50,7 @@ struct StringCaseSetup {
 struct StringCaseRun {
   RunSummary run;
   std::vector<double> t, eta, eta_dot, P;  ///< t (s), η, dη/dt (1/s), P (N)
+  std::vector<Frame<2>> frames;  ///< the nodes at the start, every frame_interval and the stop (solver time)
   double t_offset = 0;  ///< time of the string's start on the reduced solution (sliding from η0 = 0)
   nlohmann::json summary;
 };

@@ -150,6 +150,7 @@ nlohmann::json three_way(Problem p, double f, int nodes, const fs::path& fig) {
   setup.chain.dissipation = f;
   setup.eta0 = profile_eta0(p);
   setup.nodes = nodes;
+  setup.frame_interval = 0.05 * setup.chain.t0();  // the nodes for the snapshot figures
   const Comparison c = compare_with_reduced(setup);
   const std::string stem = fmt::format("{}_f{:.2f}", to_string(p), f);
   require_stopped(c.string, p, setup.eps, stem);
@@ -162,6 +163,13 @@ nlohmann::json three_way(Problem p, double f, int nodes, const fs::path& fig) {
   exact_curve(p, f, eta0, setup.eps).write(fig / (stem + "_exact.csv"));
   string_curve(c.string, setup.chain).write(fig / (stem + "_string.csv"));
   samples_table(c.string.run).write(fig / (stem + "_string_series.csv"));
+  // The string's own nodes at its frames (times on the reduced solution's clock, as in _string.csv).
+  CsvTable positions({"t", "node", "s", "x", "y"});
+  for (const Frame<2>& frame : c.string.frames)
+    for (int i : frame.moving)
+      positions.add_row({frame.t + c.string.t_offset, static_cast<double>(i), i * setup.chain.length / (setup.nodes - 1),
+                     frame.x(0, i), frame.x(1, i)});
+  positions.write(fig / (stem + "_string_nodes.csv"));
 
   const double ts = c.summary["t_stop_over_t0"].get<double>();
   const double tr = c.reduced.summary["t_stop_over_t0"].get<double>();

@@ -174,7 +174,7 @@ def heap(ax, x, y, mass):
     ax.fill(x + r * np.cos(angles), y + r * np.sin(angles), color="0.6", lw=0)
 
 
-def snapshot_figure(string, out_dir, problem, f, count=7):
+def snapshot_figure(string, out_dir, problem, f, count=7, nodes=None):
     """The string at `count` times from the start to the stop, side by side (one column per time).
 
     The string run's front position s0(t) (the height y = eta l of the moving part) places the string:
@@ -184,15 +184,28 @@ def snapshot_figure(string, out_dir, problem, f, count=7):
     """
     xi, eta = string["xi"], string["eta"]
     picks = [int(np.argmin(np.abs(xi - xi[-1] * j / (count - 1)))) for j in range(count)]
+    frames = []  # with the run's node frames: the solver's own nodes at the frame times
+    if nodes is not None:
+        times = np.unique(nodes["t"])
+        chosen = times[[int(round(j * (len(times) - 1) / (count - 1))) for j in range(count)]]
+        picks = [int(np.argmin(np.abs(string["t"] - T))) for T in chosen]
+        length = float(np.max(nodes["s"])) if len(nodes["s"]) else 1.0
+        for T in chosen:
+            at = nodes["t"] == T
+            frames.append((nodes["s"][at] / length, nodes["x"][at] / length, nodes["y"][at] / length))
     gap = 0.55  # horizontal distance between two snapshots (units of l)
     fig, ax = plt.subplots(figsize=(8.8, 5.6) if problem == "folded" else (11, 4.4), dpi=DPI)
     marks = np.linspace(0.0, 1.0, 11)
     for j, k in enumerate(picks):
         x0, y = gap * j, eta[k]
+        node_s, node_x, node_y = frames[j] if frames else (None, None, None)
         if problem == "falling":  # moving part s in [0, y] above the contact, s at height y - s
             above = marks[marks < y]
             ax.plot([x0, x0], [0, y], "-", color="tab:blue", lw=2)
-            ax.plot(np.full(len(above), x0), y - above, ".", color="k", ms=4)
+            if frames:
+                ax.plot(x0 + node_x, node_y, ".", color="k", ms=3)
+            else:
+                ax.plot(np.full(len(above), x0), y - above, ".", color="k", ms=4)
             heap(ax, x0, 0.0, 1 - y)
             ax.plot([x0], [0], **SHOCK)
         elif problem == "folded":  # resting arm s in [0, y] down to the fold at depth y, moving arm s - 2y
@@ -201,14 +214,22 @@ def snapshot_figure(string, out_dir, problem, f, count=7):
             ax.plot([x0, x0], [0, -y], "-", color="tab:gray", lw=2)
             ax.plot([x0 + d, x0 + d], [-y, 1 - 2 * y], "-", color="tab:blue", lw=2)
             ax.plot([x0, x0 + d], [-y, -y], "-", color="tab:blue", lw=1)
-            ax.plot(np.full(len(resting), x0), -resting, ".", color="k", ms=4)
-            ax.plot(np.full(len(moving), x0 + d), moving - 2 * y, ".", color="k", ms=4)
+            if frames:  # the arms share one line: the nodes past the fold drawn d aside
+                past = node_s > y
+                ax.plot(x0 + node_x[~past], node_y[~past], ".", color="k", ms=3)
+                ax.plot(x0 + d + node_x[past], node_y[past], ".", color="k", ms=3)
+            else:
+                ax.plot(np.full(len(resting), x0), -resting, ".", color="k", ms=4)
+                ax.plot(np.full(len(moving), x0 + d), moving - 2 * y, ".", color="k", ms=4)
             ax.plot([x0 - 0.05, x0 + 0.05], [0, 0], "-", color="k", lw=3)  # the fixed end
             ax.plot([x0 + d / 2], [-y], **SHOCK)
         else:  # sliding: hanging part s in [1 - y, 1] below the hole, s at depth s - (1 - y)
             hanging = marks[marks >= 1 - y]
             ax.plot([x0, x0], [0, -y], "-", color="tab:blue", lw=2)
-            ax.plot(np.full(len(hanging), x0), -(hanging - (1 - y)), ".", color="k", ms=4)
+            if frames:
+                ax.plot(x0 + node_x, node_y, ".", color="k", ms=3)
+            else:
+                ax.plot(np.full(len(hanging), x0), -(hanging - (1 - y)), ".", color="k", ms=4)
             heap(ax, x0 - 0.2, 0.0, 1 - y)
             ax.plot([x0], [0], **SHOCK)
         ax.text(x0, 1.08 if problem != "sliding" else 0.32, f"$t/t_0$={xi[k]:.3f}\n$\\eta$={eta[k]:.3f}",
@@ -223,9 +244,11 @@ def snapshot_figure(string, out_dir, problem, f, count=7):
     how = {"falling": "moving part blue, heap on the table grey, contact shock red",
            "folded": "moving arm blue, resting arm grey, fold red (arms on one line, drawn apart)",
            "sliding": "hanging part blue, heap on the table grey, shock at the hole red"}[problem]
-    ax.set_title(f"{problem.capitalize()} chain, $f={f:g}$, on the string solver with front tracking: {how}\n"
-                 "placed by the run's front position $s_0(t)$ (the string stays straight); "
-                 "dots: material points every $0.1\\,\\ell$", fontsize=8)
+    dots = ("dots: the solver's nodes at its frames" if frames else
+            "placed by the run's front position $s_0(t)$ (the string stays straight); "
+            "dots: material points every $0.1\\,\\ell$")
+    ax.set_title(f"{problem.capitalize()} chain, $f={f:g}$, on the string solver with front tracking: {how}\n{dots}",
+                 fontsize=8)
     fig.tight_layout()
     return save(fig, out_dir, f"{problem}_snapshots.png", DPI)
 
@@ -353,12 +376,17 @@ def canonical_figures(root, out_dir=None, scene=None):
     if lacking:
         raise RunError(f"{os.path.join(root, 'summary.csv')}: lacks the column(s) {', '.join(lacking)}")
     scene_data = read_scene(root, scene) if scene else None
+    node_frames = {}  # the string's nodes of the snapshot runs (written by chainsim canonical since it records them)
+    for problem in PROBLEMS:
+        f = 0.83 if 0.83 in data[problem] else list(data[problem])[-1]
+        path = os.path.join(data_dir, f"{problem}_f{f:.2f}_string_nodes.csv")
+        node_frames[problem] = read(path, ("t", "s", "x", "y")) if os.path.exists(path) else None
 
     written = [fall_time_figure(fall_times, out_dir)]
     written += [problem_figure(data[p], out_dir, p, rows[0]["nodes"]) for p in PROBLEMS]
     for problem in PROBLEMS:
         f = 0.83 if 0.83 in data[problem] else list(data[problem])[-1]
-        written.append(snapshot_figure(data[problem][f][2], out_dir, problem, f))
+        written.append(snapshot_figure(data[problem][f][2], out_dir, problem, f, nodes=node_frames[problem]))
     written.append(agreement_figure(rows, out_dir))
     if scene_data:
         written.append(scene_figure(scene_data, out_dir))
