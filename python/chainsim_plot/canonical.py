@@ -174,7 +174,7 @@ def heap(ax, x, y, mass):
     ax.fill(x + r * np.cos(angles), y + r * np.sin(angles), color="0.6", lw=0)
 
 
-def snapshot_figure(string, out_dir, problem, f, count=7, nodes=None):
+def snapshot_figure(string, out_dir, problem, f, count=7, nodes=None, chain_nodes=None):
     """The string at `count` times from the start to the stop, side by side (one column per time).
 
     The string run's front position s0(t) (the height y = eta l of the moving part) places the string:
@@ -189,7 +189,9 @@ def snapshot_figure(string, out_dir, problem, f, count=7, nodes=None):
         times = np.unique(nodes["t"])
         chosen = times[[int(round(j * (len(times) - 1) / (count - 1))) for j in range(count)]]
         picks = [int(np.argmin(np.abs(string["t"] - T))) for T in chosen]
-        length = float(np.max(nodes["s"])) if len(nodes["s"]) else 1.0
+        # the chain's length from its link length: s = node * l / (nodes - 1), and the last node may be in a heap
+        first = nodes["node"] > 0
+        length = float(np.median(nodes["s"][first] / nodes["node"][first])) * (chain_nodes - 1)
         for T in chosen:
             at = nodes["t"] == T
             frames.append((nodes["s"][at] / length, nodes["x"][at] / length, nodes["y"][at] / length))
@@ -380,13 +382,14 @@ def canonical_figures(root, out_dir=None, scene=None):
     for problem in PROBLEMS:
         f = 0.83 if 0.83 in data[problem] else list(data[problem])[-1]
         path = os.path.join(data_dir, f"{problem}_f{f:.2f}_string_nodes.csv")
-        node_frames[problem] = read(path, ("t", "s", "x", "y")) if os.path.exists(path) else None
+        node_frames[problem] = read(path, ("t", "node", "s", "x", "y")) if os.path.exists(path) else None
 
     written = [fall_time_figure(fall_times, out_dir)]
     written += [problem_figure(data[p], out_dir, p, rows[0]["nodes"]) for p in PROBLEMS]
     for problem in PROBLEMS:
         f = 0.83 if 0.83 in data[problem] else list(data[problem])[-1]
-        written.append(snapshot_figure(data[problem][f][2], out_dir, problem, f, nodes=node_frames[problem]))
+        written.append(snapshot_figure(data[problem][f][2], out_dir, problem, f, nodes=node_frames[problem],
+                                       chain_nodes=int(rows[0]["nodes"])))
     written.append(agreement_figure(rows, out_dir))
     if scene_data:
         written.append(scene_figure(scene_data, out_dir))
