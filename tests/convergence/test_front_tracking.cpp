@@ -10,20 +10,10 @@
 #include <nlohmann/json.hpp>
 
 #include "cases/canonical/canonical_string.hpp"
+#include "canonical_test_support.hpp"
 
 using namespace chainsim;
-
-namespace {
-
-StringCaseSetup setup_for(Problem problem, double f, int nodes) {
-  StringCaseSetup s;
-  s.problem = problem;
-  s.chain.dissipation = f;
-  s.nodes = nodes;
-  return s;
-}
-
-}  // namespace
+using test::setup_for;
 
 TEST_CASE("front tracking stays exact on fine meshes: 1600 nodes", "[convergence][shocks]") {
   // Fine meshes used to fail after the first crossings ("the links cannot be projected back"): the

@@ -8,19 +8,13 @@
 #include <catch2/catch.hpp>
 
 #include "cases/canonical/canonical_string.hpp"
+#include "../convergence/canonical_test_support.hpp"
 
 using namespace chainsim;
+using test::setup_for;
 using Catch::Matchers::Contains;
 
 namespace {
-
-StringCaseSetup setup_for(Problem problem, double f, int nodes) {
-  StringCaseSetup s;
-  s.problem = problem;
-  s.chain.dissipation = f;
-  s.nodes = nodes;
-  return s;
-}
 
 /// The checks every run of a canonical problem in the paper's geometry must pass against its reduced
 /// ODE: the scheme is exact for every mesh (docs/shocks.md), so only the integrator's error remains.
