@@ -136,6 +136,7 @@ std::vector<ArcRange> FrontTracker<dim>::initial_arcs(const Chain<dim>& chain) {
     if (stop.front < 0 || stop.front >= static_cast<int>(fronts_.size()))
       throw InputError(fmt::format("stop condition on front {}: the string has {} fronts", stop.front, fronts_.size()));
   fs_.assign(fronts_.size(), FrontState<dim>{});
+  fold_chord_.assign(fronts_.size(), 0.0);
   return arcs;
 }
 
@@ -194,6 +195,35 @@ std::string FrontTracker<dim>::fold_opened_message(std::size_t front) const {
       "at most {:g}; a dissipative fold needs both arms along one line, and a bight that opens, as in a folded chain "
       "whose ends are apart, is resolved by the string solver without [effects.fold]: docs/shocks.md)",
       fs_[front].s0, fs_[front].opening * 180 / kPi, kMaxFoldOpeningDeg);
+}
+
+template <int dim>
+std::string FrontTracker<dim>::fold_apart_message(const StringModel<dim>& model, std::size_t front, double t) const {
+  const FrontState<dim>& s = fs_[front];
+  const int a = model.arcs()[static_cast<std::size_t>(fronts_[front].arc_minus)].last;
+  const int b = model.arcs()[static_cast<std::size_t>(fronts_[front].arc_plus)].first;
+  // The arms at the fold: arc A's end link and arc B's first link (an arc without a full link: its
+  // partial link to the fold point x0), on one line for a tight fold; and the transverse force the
+  // momentum balance needs there for dissipation f: F0 = f λ ṡ0 |ṡ0| (t⁺ + t⁻) (docs/shocks.md).
+  const ArcRange& A = model.arcs()[static_cast<std::size_t>(fronts_[front].arc_minus)];
+  const ArcRange& B = model.arcs()[static_cast<std::size_t>(fronts_[front].arc_plus)];
+  const Points<dim>& x = model.x();
+  const Vec<dim> t_minus =
+      (A.num_links() > 0 ? Vec<dim>(x.col(a) - x.col(a - 1)) : Vec<dim>(s.position - x.col(a))).normalized();
+  const Vec<dim> t_plus =
+      (B.num_links() > 0 ? Vec<dim>(x.col(b + 1) - x.col(b)) : Vec<dim>(x.col(b) - s.position)).normalized();
+  const double angle = std::acos(std::clamp(-t_minus.dot(t_plus), -1.0, 1.0));
+  const double missing = fronts_[front].dissipation * lambda_ * s.s0_dot * s.s0_dot * (t_plus + t_minus).norm();
+  return fmt::format(
+      "the fold at s0 = {:.6g} m has come apart at t = {:.9g} s: the ends of its folded link, nodes {} and {} (s = {:.6g} "
+      "and {:.6g} m), are {:.5g} h apart (h = {:.6g} m): the link's material no longer reaches across, and a tight fold "
+      "(arms within {:g} degrees of antiparallel) needs at most {:.5g} h to cross a node; its arms leave it {:.3g} degrees from antiparallel, ds0/dt = {:.4g} m/s, tension {:.4g} N before the fold and {:.4g} N after it. "
+      "Across a kink whose arms are not antiparallel the momentum balance needs a transverse force f lambda "
+      "ds0/dt |ds0/dt| |t+ + t-| = {:.3g} N at the fold, zero only for f = 0, and the fold has none: a tight fold "
+      "cannot form here. For f = 0 run the scene without [effects.fold] (the string resolves the kink); for f > 0 a "
+      "tight fold needs its arms on one line (docs/shocks.md, \"A fold whose arms turn apart\")",
+      s.s0, t, a, b, model.chain().node_coordinate(a), model.chain().node_coordinate(b), fold_chord_[front], h_,
+      kMaxFoldOpeningDeg, max_fold_chord(), angle * 180 / kPi, s.s0_dot, s.tension_minus, s.tension_plus, missing);
 }
 
 template <int dim>
@@ -285,6 +315,7 @@ void FrontTracker<dim>::add_mass_and_forces(const StringModel<dim>& model, Eigen
       const Vec<dim> e_rate = (d_rate - e * e.dot(d_rate)) / d.norm();
       s.opening = has_A && has_B ? std::acos(std::clamp(-tA.dot(tB), -1.0, 1.0)) : 0.0;
       const double c = (x.col(b) - x.col(a)).dot(e);
+      fold_chord_[k] = (x.col(b) - x.col(a)).norm() / h_;
       const double lA = 0.5 * (h_ + c), lB = 0.5 * (h_ - c);
       const double sd = 0.5 * (v.col(b) - v.col(a)).dot(e);
       const double sg = jump::sign(sd);
@@ -422,10 +453,13 @@ void FrontTracker<dim>::events(const StringModel<dim>& model, Eigen::Ref<Eigen::
     const auto& stop = options_.stop_at[k];
     g[2 * static_cast<int>(fronts_.size()) + static_cast<int>(k)] = fs_[static_cast<std::size_t>(stop.front)].s0 - stop.s;
   }
-  // Each fold: positive while its arms are within kMaxFoldOpeningDeg of antiparallel.
+  // Each fold: positive while its arms are within kMaxFoldOpeningDeg of antiparallel and its folded
+  // link's material spans its chord.
   int q = 2 * static_cast<int>(fronts_.size()) + static_cast<int>(options_.stop_at.size());
   for (std::size_t k = 0; k < fronts_.size(); ++k)
-    if (fronts_[k].kind == FrontKind::kFold) g[q++] = std::cos(fs_[k].opening) - std::cos(kMaxFoldOpeningDeg * kPi / 180);
+    if (fronts_[k].kind == FrontKind::kFold)
+      g[q++] = std::min(std::cos(fs_[k].opening) - std::cos(kMaxFoldOpeningDeg * kPi / 180),
+                        max_fold_chord() - fold_chord_[k]);
 }
 
 template <int dim>
@@ -450,7 +484,10 @@ EventAction FrontTracker<dim>::handle_events(StringModel<dim>& model, double t, 
               fmt::format("front {} reached s0 = {:.9g} m", options_.stop_at[k].front, options_.stop_at[k].s)};
   for (std::size_t k = 0, q = static_cast<std::size_t>(2 * nf) + options_.stop_at.size(); k < fronts_.size(); ++k) {
     if (fronts_[k].kind != FrontKind::kFold) continue;
-    if (found[q++] != 0) return {EventAction::Kind::kStop, fold_opened_message(k)};
+    if (found[q++] == 0) continue;
+    const bool apart = max_fold_chord() - fold_chord_[k] <=
+                       std::cos(fs_[k].opening) - std::cos(kMaxFoldOpeningDeg * kPi / 180);
+    return {EventAction::Kind::kStop, apart ? fold_apart_message(model, k, t) : fold_opened_message(k)};
   }
   // Energy and momentum before, to book what the crossing changes.
   const double E_before = model.kinetic_energy() + model.potential_energy(ledger);

@@ -57,6 +57,7 @@
 ///              contact was when it arrived, so the heaps' potential energy needs their first moment
 /// Ledgers: K + V − (K0 + V0) − W_applied − W_shocks − W_heaps − W_remesh → 0 and
 ///          p − p0 − impulse → 0 (p = Σ m_i v_i; heaps are at rest), to the discretization error.
+#include <cmath>
 #include <optional>
 #include <string>
 #include <vector>
@@ -122,6 +123,12 @@ class FrontTracker final : public StringModule<dim> {
   /// dissipative kink nowhere else (docs/shocks.md), so a run stops when the arms open wider than
   /// this angle from antiparallel (and a fold that starts wider is refused).
   static constexpr double kMaxFoldOpeningDeg = 20;
+  /// The folded link's material (length h) must span its chord |x_b − x_a|. The fold crosses a node
+  /// when the chord's component along the fold direction (the bisector of the arms) reaches h: with
+  /// arms on one line the chord is then h, with arms within kMaxFoldOpeningDeg of antiparallel at
+  /// most h / cos(kMaxFoldOpeningDeg / 2). The run stops when the chord passes that (the fold has come
+  /// apart, docs/shocks.md "A fold whose arms turn apart").
+  static double max_fold_chord() { return 1 / std::cos(0.5 * kMaxFoldOpeningDeg * kPi / 180); }
 
   // --- StringModule ------------------------------------------------------------------------------
   std::vector<ArcRange> initial_arcs(const Chain<dim>& chain) override;
@@ -133,7 +140,8 @@ class FrontTracker final : public StringModule<dim> {
   double potential_correction(const StringModel<dim>& model, const Eigen::Ref<const Eigen::VectorXd>& ledger) const override;
   void fill(const StringModel<dim>& model, const Eigen::Ref<const Eigen::VectorXd>& ledger,
             ModuleLedger<dim>& out) const override;
-  /// Two per front (crossings), one per stop condition, one per fold (it opens past kMaxFoldOpeningDeg).
+  /// Two per front (crossings), one per stop condition, one per fold (it opens past kMaxFoldOpeningDeg
+  /// or comes apart: its chord passes max_fold_chord() h).
   int num_events() const override {
     return 2 * static_cast<int>(fronts_.size()) + static_cast<int>(options_.stop_at.size()) + num_folds();
   }
@@ -155,6 +163,7 @@ class FrontTracker final : public StringModule<dim> {
   HeapEnd heap_end(const StringModel<dim>& model, const Front& front) const;
   double heap_mass(std::size_t front) const;  // needs the front states
   std::string fold_opened_message(std::size_t front) const;  // needs the front states
+  std::string fold_apart_message(const StringModel<dim>& model, std::size_t front, double t) const;
   /// Moves the node a front reached across it (heap: in or out; fold: from one arc to the other).
   EventAction transfer(StringModel<dim>& model, std::size_t front, int e0, Eigen::Ref<Eigen::VectorXd> ledger);
 
@@ -166,6 +175,7 @@ class FrontTracker final : public StringModule<dim> {
   std::vector<Front> fronts_;
   std::vector<double> expected_s0_;  // where each front is meant to start (m)
   std::vector<FrontState<dim>> fs_;
+  std::vector<double> fold_chord_;  // per front: a fold's |x_b − x_a| / h (0 for a heap)
   long transfers_ = 0;
   double w_remesh_ = 0;
   Vec<dim> heap_moment0_ = Vec<dim>::Zero();  // Σ heap mass × point at t = 0
