@@ -110,6 +110,8 @@ class FrontTracker final : public StringModule<dim> {
     Vec<dim> normal = Vec<dim>::Zero();  ///< unit normal of the plane, towards the string's side
     Vec<dim> last_direction = Vec<dim>::Zero();  ///< on a plane, once the arc has no full link left:
                                                  ///< the direction its partial link keeps
+    Vec<dim> last_curvature = Vec<dim>::Zero();  ///< on a plane, once the arc has one full link left:
+                                                 ///< the second derivative x'' its end keeps
     int arc_minus = -1, arc_plus = -1;  ///< arcs on either side (−1: the heap's side)
   };
 
@@ -156,7 +158,7 @@ class FrontTracker final : public StringModule<dim> {
   double heap_mass(std::size_t front) const;  // needs the front states
   std::string fold_opened_message(std::size_t front) const;  // needs the front states
   /// Moves the node a front reached across it (heap: in or out; fold: from one arc to the other).
-  EventAction transfer(StringModel<dim>& model, std::size_t front, int e0, Eigen::Ref<Eigen::VectorXd> ledger);
+  EventAction transfer(StringModel<dim>& model, std::size_t front, int e0);
 
   std::vector<HeapSpec<dim>> heap_specs_;
   std::optional<FoldSpec> fold_spec_;
@@ -166,6 +168,7 @@ class FrontTracker final : public StringModule<dim> {
   std::vector<Front> fronts_;
   std::vector<double> expected_s0_;  // where each front is meant to start (m)
   std::vector<FrontState<dim>> fs_;
+  std::vector<Vec<dim>> partial_mid_;  // per heap front: the midpoint of the string from the end node to it
   long transfers_ = 0;
   double w_remesh_ = 0;
   Vec<dim> heap_moment0_ = Vec<dim>::Zero();  // Σ heap mass × point at t = 0
