@@ -9,11 +9,12 @@
 ///
 ///   heap   a quiescent heap, either fed through a fixed point x0 (a pile under a hole, an edge:
 ///          *pinned*) or lying on a plane (the table under a falling chain). The arc ends in a
-///          straight *partial link* of material length l from its end node k to the contact
-///          (s0 = s_k ± l), in direction e (from the arc into the heap):
-///              pinned     the contact is x0, l = |x0 − x_k|, e = (x0 − x_k)/l
-///              on a plane the arc's last full link continued to the plane (point p, normal n):
-///                         l = n·(p − x_k)/(n·e); the contact x_k + l e slides along the plane
+///          *partial link* of material length l from its end node k to the contact (s0 = s_k ± l):
+///          the string there is the quadratic interpolant x(s) (docs/shocks.md, "Second order at a
+///          moving front"), e its unit tangent at the contact (from the arc into the heap):
+///              pinned     through x_{k∓1}, x_k and the contact x0; l = |x0 − x_k|
+///              on a plane through the last three nodes (point p, normal n), s0 its root of
+///                         n·(x(s0) − p) = 0; the contact x(s0) slides along the plane
 ///          w = dl/dt is the rate at which the arc gains material (w < 0: it runs into the heap).
 ///          Jump conditions (the internal shock of dissipation f at the contact plus the external
 ///          shock at the heap, docs/shocks.md):
@@ -40,19 +41,20 @@
 /// exact: it reproduces the reduced ODE for every N.
 ///
 /// Front crossings are ARKODE root events (two per front): a heap takes the end node in when the
-/// partial link shrinks to h/2 and gives out a new node when it grows to 3h/2; a fold moves the node
-/// it reaches from one arc to the other. Material moves with its momentum (mass parcels carry their
-/// velocity), so mass and momentum are conserved at every crossing; the kinetic energy a crossing
-/// removes is booked as W_remesh (zero for straight motions). Then the string rebuilds its arcs,
-/// projects positions and velocities onto the link constraints (StringModel::project) and the
-/// integration continues with the new state size.
+/// partial link shrinks to h/2 (every other node keeps its state) and gives out a new node when it
+/// grows to 3h/2 (at the interpolant's position and velocity there); a fold moves the node it reaches
+/// from one arc to the other, its material moving with its momentum (mass parcels). What a crossing
+/// changes in the lumped momentum and energy is booked (heap impulse, W_remesh; zero for straight
+/// motions). Then the string rebuilds its arcs, projects positions and velocities onto the link
+/// constraints (StringModel::project) and the integration continues with the new state size.
 ///
 /// The tracker's ledgers follow the string's state [ x | v | W_applied ]:
 ///              [ W_shocks | W_heaps | impulse (dim) | heap moment (dim) ]
 ///   W_shocks   Σ over internal shocks of W_s = −D (dissipation, ≤ 0)
 ///   W_heaps    Σ over heaps of W* (external shocks)
 ///   impulse    ∫ (all external forces on the string and heaps) dt: gravity, drag, loads, the
-///              reactions of fixed/driven nodes and of the planes under the heaps
+///              reactions of fixed/driven nodes and of the planes under the heaps, plus what the
+///              crossings change in Σ m_i v_i (the re-lumped end's momentum, taken by the heap's support)
 ///   heap moment  change of Σ over heaps of ∫ x dm (kg m): material laid on a plane stays where the
 ///              contact was when it arrived, so the heaps' potential energy needs their first moment
 /// Ledgers: K + V − (K0 + V0) − W_applied − W_shocks − W_heaps − W_remesh → 0 and

@@ -147,6 +147,6 @@ TEST_CASE("a swinging sliding chain converges at second order in space (stop tim
                                                : std::vector<double>{0.0, 0.0});
     }
   };
-  check_second_order("swinging_sliding_chain", {"stop.front[0].front=heap_start", "stop.front[0].s0=0.3"},
+  check_second_order("swinging_sliding_chain_moving", {"stop.front[0].front=heap_start", "stop.front[0].s0=0.3"},
                      compatible_start);
 }
