@@ -93,8 +93,9 @@ struct HeapGeometry {
 /// with `links` full links in the arc. Pinned: the front is the point, l = |x0 − x_k| (the chord,
 /// O(h³) from the arc length), and the curve runs through x_{k∓1}, x_k, x0 (the material leaves x0 along
 /// the tangent at the speed of the front in the material). On a plane: the curve through the last three
-/// nodes (two with one full link; with none, the kept direction) continued to the plane; s0 is its
-/// crossing (Newton's method from the last link's), w follows from differentiating n·(x(s0) − p) = 0.
+/// nodes (with one full link, the last two and the second derivative it last had; with none, the kept
+/// direction) continued to the plane; s0 is its crossing (Newton's method from the last link's), and
+/// w follows from differentiating n·(x(s0) − p) = 0.
 template <int dim>
 HeapGeometry<dim> heap_geometry(const Points<dim>& x, const Points<dim>& v, const typename FrontTracker<dim>::Front& front,
                                 int node, bool after, int links, double h) {
@@ -141,11 +142,13 @@ HeapGeometry<dim> heap_geometry(const Points<dim>& x, const Points<dim>& v, cons
     throw RecoverableError(
         fmt::format("the string meets the heap's plane at a grazing angle (n·t = {:.3g} at node {})", n.dot(e_last), node));
   double t = sigma * n.dot(point - x.col(node)) / n.dot(e_last);  // the last link's crossing
-  for (int it = 0; it < 30; ++it) {
+  bool converged = false;
+  for (int it = 0; it < 30 && !converged; ++it) {
     const double dt = -n.dot(c.position(t) - point) / n.dot(c.slope(t));
     t += dt;
-    if (std::abs(dt) <= 1e-14 * h) break;
+    converged = std::abs(dt) <= 1e-14 * h;
   }
+  if (!converged) throw RecoverableError(fmt::format("the string near node {} does not meet the heap's plane", node));
   g.l = sigma * t;
   if (!(g.l > 1e-9 * h) || !std::isfinite(g.l)) throw RecoverableError(fmt::format("node {} has gone through the heap's plane", node));
   const Vec<dim> slope = c.slope(t);
@@ -339,15 +342,16 @@ void FrontTracker<dim>::add_mass_and_forces(const StringModel<dim>& model, Eigen
       // tangent e at the front (from the arc into the heap), the front point and w = dl/dt, the rate
       // at which the arc gains material (w < 0: it runs into the heap).
       const int links = model.arcs()[static_cast<std::size_t>(end.arc)].num_links();
-      const HeapGeometry<dim> geo =
-          heap_geometry<dim>(x, v, front, node, after, links, h_);
+      const HeapGeometry<dim> geo = heap_geometry<dim>(x, v, front, node, after, links, h_);
       const double l = geo.l, w = geo.w;
       s.direction = geo.e;
       s.position = geo.position;
       if (front.on_plane) {
         // kept for when crossings leave the arc with one full link (its curvature) or none (its direction)
-        if (links > 0) front.last_direction = geo.e;
-        if (links > 0) front.last_curvature = geo.curvature;
+        if (links > 0) {
+          front.last_direction = geo.e;
+          front.last_curvature = geo.curvature;
+        }
         for (const ArcRange& arc : model.arcs())
           for (int i = arc.first; i <= arc.last; ++i)
             if (front.normal.dot(x.col(i) - front.point) < 0)
