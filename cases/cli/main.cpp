@@ -176,6 +176,19 @@ int main(int argc, char** argv) {
   cmd_run->add_flag("--json", run.json,
                     "print the run summary as one JSON object on stdout (on failure: status \"failed\" and the error)");
 
+  // --- chainsim plot -----------------------------------------------------------------------------
+  chainsim::PlotCommandOptions plot;
+  auto* cmd_plot = app.add_subcommand(
+      "plot", "Draw a run directory (written by run, compare, reduced or canonical) into RUN_DIR/figures/ with "
+              "matplotlib, and print the paths of the files written");
+  cmd_plot->add_option("run_dir", plot.run_dir, "the run directory")->required();
+  cmd_plot->add_flag("--animate", plot.animate,
+                     "also write RUN_DIR/figures/animation.mp4 (ffmpeg), or .gif without ffmpeg, of the string moving");
+  cmd_plot->add_option("--speed", plot.speed, "animation speed in units of real time, > 0 (default 1)");
+  cmd_plot->add_option("--fps", plot.fps, "animation frames per second, an integer >= 1 (default 25)");
+  cmd_plot->add_option("--times", plot.times, "times of the snapshots and tension profiles (s), e.g. 0,0.1,0.2");
+  cmd_plot->add_option("--format", plot.format, "animation format: mp4 | gif (default mp4 if ffmpeg is installed)");
+
   // --- chainsim sweep --------------------------------------------------------------------------
   chainsim::SweepCommandOptions sweep;
   auto* cmd_sweep = app.add_subcommand(
@@ -195,19 +208,6 @@ int main(int argc, char** argv) {
   cmd_sweep->add_option("--jobs", sweep.jobs, "threads, >= 1 (default: every core)");
   cmd_sweep->add_option("--out", sweep.out, "output directory (default results/sweep/<scene name>)");
   cmd_sweep->add_flag("--json", sweep.json, "print the sweep's counts as one JSON object on stdout");
-
-  // --- chainsim plot -----------------------------------------------------------------------------
-  chainsim::PlotCommandOptions plot;
-  auto* cmd_plot = app.add_subcommand(
-      "plot", "Draw a run directory (written by run, compare, reduced or canonical) into RUN_DIR/figures/ with "
-              "matplotlib, and print the paths of the files written");
-  cmd_plot->add_option("run_dir", plot.run_dir, "the run directory")->required();
-  cmd_plot->add_flag("--animate", plot.animate,
-                     "also write RUN_DIR/figures/animation.mp4 (ffmpeg), or .gif without ffmpeg, of the string moving");
-  cmd_plot->add_option("--speed", plot.speed, "animation speed in units of real time, > 0 (default 1)");
-  cmd_plot->add_option("--fps", plot.fps, "animation frames per second, an integer >= 1 (default 25)");
-  cmd_plot->add_option("--times", plot.times, "times of the snapshots and tension profiles (s), e.g. 0,0.1,0.2");
-  cmd_plot->add_option("--format", plot.format, "animation format: mp4 | gif (default mp4 if ffmpeg is installed)");
 
   // With --json, every failure also prints one JSON object on stdout: the command's own (run, and
   // compare after a numerical failure, print their summary), else {"status": "failed", "error", ...}.

@@ -260,7 +260,8 @@ def sweep(target, grid, *, t_end=None, workers=None, client=None):
              the name of a canonical problem for the reduced model (grid keys: the keywords of reduced()).
     grid     {key: [values]}; the points are all combinations (the last key varies fastest).
     t_end    replaces the scene's [stop] t_end (s) at every point.
-    workers  local threads (default: every core); the C++ runs release the GIL and share nothing.
+    workers  local threads (default: every core this process may use); the C++ runs release the GIL and share
+             nothing.
     client   a dask.distributed.Client: the points go to its workers instead (one task per point).
 
     Columns: the grid keys, status (completed | stopped | failed | error | interrupted), error, wall_time_s,
@@ -284,7 +285,7 @@ def sweep(target, grid, *, t_end=None, workers=None, client=None):
     else:
         raise ChainsimInputError(f"sweep() runs a Scene or a problem name (falling, folded, sliding), not {target!r}")
 
-    workers = workers or os.cpu_count() or 1
+    workers = workers or len(os.sched_getaffinity(0)) or 1
     if client is not None:
         rows = client.gather(client.map(point, tasks, pure=False))
     elif point is _scene_point:

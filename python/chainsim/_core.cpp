@@ -181,7 +181,7 @@ class Run {
           if constexpr (std::is_same_v<std::decay_t<decltype(r)>, ReducedRun>)
             return r.summary.dump();
           else
-            return summary_of(*r).dump();
+            return r->summary().dump();
         },
         run_);
   }
@@ -200,18 +200,15 @@ class Run {
         run_);
   }
 
-  /// The run directory, as `chainsim run --out DIR` writes it.
+  /// The run directory, as `chainsim run --out DIR` writes it (string runs; a reduced run's arrays and
+  /// summary are all it has).
   void write(const std::filesystem::path& dir) const {
     std::visit(
         [&](const auto& r) {
-          if constexpr (std::is_same_v<std::decay_t<decltype(r)>, ReducedRun>) {
-            ensure_directory(dir);
-            for (const std::string& name : run_output_files()) std::filesystem::remove(dir / name);
-            r.series.write(dir / "series.csv");
-            write_json(dir / "stats.json", r.summary);
-          } else {
-            r->write(dir, summary_of(*r));
-          }
+          if constexpr (std::is_same_v<std::decay_t<decltype(r)>, ReducedRun>)
+            throw InputError("write(): a reduced run has no run directory here (chainsim run writes one)");
+          else
+            r->write(dir, r->summary());
         },
         run_);
   }
@@ -219,10 +216,6 @@ class Run {
   std::string error;  ///< a numerical failure's message ("" if none)
 
  private:
-  template <int dim>
-  static nlohmann::json summary_of(const SceneRun<dim>& r) {
-    return r.summary();
-  }
   Variant run_;
 };
 
