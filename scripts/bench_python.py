@@ -62,7 +62,7 @@ def main():
 
     # 2. a sweep of 8 points
     falling = chainsim.Scene.from_file(os.path.join(SOURCE, "cases", "scenes", "falling_chain.toml"))
-    grid = {"f": [0.0, 0.25, 0.5, 1.0], "string.nodes": [41, 61]}
+    grid = {"f": [0.0, 0.25, 0.5, 1.0], "string.nodes": [101, 161]}
     tasks = [(falling.text, falling.source, falling.overrides, None, p)
              for p in chainsim._core.sweep_points([(k, [chainsim._toml_value(v) for v in vs]) for k, vs in grid.items()])]
     from dask.distributed import Client, LocalCluster
@@ -73,7 +73,7 @@ def main():
     list(pool1.map(chainsim._scene_point, tasks[:1]))
     list(pool2.map(chainsim._scene_point, tasks[:2]))
     times = {"threads 1": [], "threads 2": [], "processes 1": [], "processes 2": [], "dask 2 workers": []}
-    for k in range(max(3, args.rounds // 2)):
+    for k in range(max(3, args.rounds // 3)):
         times["threads 1"].append(timed(lambda: chainsim.sweep(falling, grid, workers=1))[0])
         times["threads 2"].append(timed(lambda: chainsim.sweep(falling, grid, workers=2))[0])
         times["processes 1"].append(timed(lambda: list(pool1.map(chainsim._scene_point, tasks)))[0])
@@ -82,7 +82,7 @@ def main():
     client.close()
     cluster.close()
     base = med(times["threads 1"])
-    print(f"\nsweep: falling_chain.toml, 8 points (f x nodes 41, 61, to the cutoff), {len(times['threads 1'])} "
+    print(f"\nsweep: falling_chain.toml, 8 points (f x nodes 101, 161, to the cutoff), {len(times['threads 1'])} "
           f"alternating rounds, medians")
     for name, ts in times.items():
         print(f"  {name:16s} {med(ts):7.3f} s   speed-up vs 1 thread {base / med(ts):5.2f}")

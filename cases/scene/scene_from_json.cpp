@@ -36,9 +36,10 @@ void convert(const nlohmann::json& value, const std::string& at, Put&& put) {
 
 toml::table to_table(const nlohmann::json& object, const std::string& at) {
   toml::table table;
-  for (const auto& [key, value] : object.items()) {
+  for (const auto& item : object.items()) {
+    const std::string key = item.key();  // a named copy: a lambda may not capture a structured binding in C++17
     const std::string name = at.empty() ? key : at + "." + key;
-    convert(value, name, [&](auto&& v) { table.insert_or_assign(key, std::forward<decltype(v)>(v)); });
+    convert(item.value(), name, [&](auto&& v) { table.insert_or_assign(key, std::forward<decltype(v)>(v)); });
   }
   return table;
 }
