@@ -288,8 +288,40 @@ const RunSummary& StringSolver<dim>::run() {
     // 2. Step by step to each output time: constraints (and slack) are checked at accepted steps,
     //    root functions acted on where they vanish.
     const auto n_out = static_cast<long>(std::ceil(options_.t_end / options_.output_interval - 1e-9));
-    for (long k = 1; k <= n_out;) {
-      const double t_out = std::min(options_.t_end, k * options_.output_interval);
+    auto output_time = [&](long k) { return std::min(options_.t_end, k * options_.output_interval); };
+    // Without root functions the frames come from ARKODE's dense output and never force a step:
+    // the integrator runs to t_end, and every output time inside an accepted step is interpolated
+    // on that step, then projected onto the link constraints (projected_state). With root functions
+    // the output times stay stop times: an event's polish recomputes its step, after which the
+    // interpolant no longer covers the frames before it.
+    if (model_.num_events() == 0) {
+      for (long k = 1; k <= n_out;) {
+        const Integrator::Outcome outcome = integrator->advance(options_.t_end, /*one_step=*/true);
+        const double t = integrator->time();
+        const Eigen::VectorXd& y = integrator->state();
+        summary_.max_constraint_violation =
+            std::max(summary_.max_constraint_violation, model_.max_constraint_violation(t, y));
+        check_slack(t, y);
+        if (on_step) on_step(t, y);
+        if (options_.record_steps) record_sample(t, y);
+        const bool at_end = outcome == Integrator::Outcome::kReachedTarget;
+        for (; k <= n_out && (output_time(k) <= t || (at_end && k == n_out)); ++k) {
+          const double t_out = output_time(k);
+          if (t_out == t || (at_end && k == n_out))
+            record_frame(t_out, y);
+          else
+            record_frame(t_out, model_.projected_state(t_out, integrator->interpolate(t_out)));
+        }
+        if (k <= n_out && interrupt_requested()) {  // Ctrl-C: stop at this accepted state, outputs valid
+          record_frame(t, y);
+          finish("interrupted");
+          summary_.stop_reason = fmt::format("interrupted by the user at t = {:.9g} s", t);
+          return summary_;
+        }
+      }
+    }
+    for (long k = 1; k <= n_out && model_.num_events() > 0;) {
+      const double t_out = output_time(k);
       const Integrator::Outcome outcome = integrator->advance(t_out, /*one_step=*/true);
       const double t = integrator->time();
       if (outcome == Integrator::Outcome::kEvent) {

@@ -38,9 +38,10 @@ inline std::unique_ptr<StringModel<2>> hanging_chain(int links, double length, c
 }
 
 /// Times at which q(t, y) changes sign over [0, t_end], located on ARKODE's dense output by
-/// bisection to ~1e-13 of the step.
+/// bisection to ~1e-13 of the step. `stats`, if given, receives the integrator's counters.
 inline std::vector<double> zero_crossings(OdeSystem& system, const Eigen::VectorXd& y0, const IntegratorOptions& options,
-                                          double t_end, const std::function<double(const Eigen::VectorXd&)>& q) {
+                                          double t_end, const std::function<double(const Eigen::VectorXd&)>& q,
+                                          IntegratorStats* stats = nullptr) {
   Integrator integrator(system, 0.0, y0, options);
   std::vector<double> crossings;
   double t_prev = 0.0, q_prev = q(y0);
@@ -63,6 +64,7 @@ inline std::vector<double> zero_crossings(OdeSystem& system, const Eigen::Vector
     t_prev = t;
     q_prev = q_now;
   }
+  if (stats) *stats = integrator.stats();
   return crossings;
 }
 
