@@ -91,7 +91,7 @@ std::string flag_name(int flag) {
 std::string valid_methods() {
   std::string list;
   for (const auto& [alias, entry] : aliases()) list += (list.empty() ? "" : ", ") + alias;
-  return list + ", auto, or an ARKODE_* Butcher table name";
+  return list + ", or an ARKODE_* Butcher table name";
 }
 
 }  // namespace
@@ -220,7 +220,8 @@ struct Integrator::Impl {
     jv_work = nullptr;
   }
 
-  // J·v by a difference quotient of the right-hand side, (F(y + σv) − F(y)) / σ with the unweighted
+  // J·v from the system's linearisation if it has one (OdeSystem::jacobian_times), else by a
+  // difference quotient of the right-hand side, (F(y + σv) − F(y)) / σ with the unweighted
   // increment σ = √ε (1 + ‖y‖∞) / ‖v‖∞. ARKODE's own quotient takes σ = 1/‖v‖_WRMS, a step of the
   // size of the error tolerance: at rtol 1e-4 that moves a node by a few per cent of a short link,
   // and the product is then too inexact for the Newton iteration of a fine string.
@@ -230,6 +231,7 @@ struct Integrator::Impl {
     Eigen::Map<const Eigen::VectorXd> vm(N_VGetArrayPointer(v), n), ym(N_VGetArrayPointer(y), n),
         fm(N_VGetArrayPointer(fy), n);
     Eigen::Map<Eigen::VectorXd> out(N_VGetArrayPointer(Jv), n);
+    if (self->system.jacobian_times(vm, out)) return 0;
     const double vmax = vm.cwiseAbs().maxCoeff();
     if (!(vmax > 0)) {
       out.setZero();
@@ -250,21 +252,14 @@ struct Integrator::Impl {
                               sunrealtype gamma, void* data) {
     auto* self = static_cast<Impl*>(data);
     Eigen::Map<const Eigen::VectorXd> ym(N_VGetArrayPointer(y), N_VGetLength(y));
-    try {
+    return self->guarded([&] {
       const bool fresh = !jok || !self->newton_ready;
       self->system.newton_setup(t, ym, fresh, gamma);
       *jcur = fresh ? SUNTRUE : SUNFALSE;
       self->newton_ready = true;
       if (fresh) ++self->newton_setups;
       return 0;
-    } catch (const RecoverableError& e) {
-      ++self->recoverable_failures;
-      self->last_recoverable = e.what();
-      return 1;
-    } catch (...) {
-      self->pending = std::current_exception();
-      return -1;
-    }
+    });
   }
 
   // z = (I − γJ)⁻¹ r from the system's Newton solver (ARKODE's preconditioner solve).
@@ -274,18 +269,11 @@ struct Integrator::Impl {
     const long n = N_VGetLength(r);
     Eigen::Map<const Eigen::VectorXd> rm(N_VGetArrayPointer(r), n);
     Eigen::Map<Eigen::VectorXd> zm(N_VGetArrayPointer(z), n);
-    try {
+    return self->guarded([&] {
       self->system.newton_solve(rm, zm);
       ++self->newton_solves;
       return zm.allFinite() ? 0 : 1;
-    } catch (const RecoverableError& e) {
-      ++self->recoverable_failures;
-      self->last_recoverable = e.what();
-      return 1;
-    } catch (...) {
-      self->pending = std::current_exception();
-      return -1;
-    }
+    });
   }
 
   /// A new state vector: fused vector operations on (ARKODE's stage sums become one pass over
@@ -302,20 +290,27 @@ struct Integrator::Impl {
     const long n = N_VGetLength(y);
     Eigen::Map<const Eigen::VectorXd> ym(N_VGetArrayPointer(y), n);
     Eigen::Map<Eigen::VectorXd> dm(N_VGetArrayPointer(ydot), n);
-    try {
+    return self->guarded([&] {
       self->system.rhs(t, ym, dm);
-      if (!dm.allFinite()) {
-        ++self->recoverable_failures;
-        self->last_recoverable = "the right-hand side is not finite";
-        return 1;  // a non-finite trial stage: let ARKODE retry with a smaller step
-      }
+      // a non-finite trial stage: let ARKODE retry with a smaller step
+      if (!dm.allFinite()) throw RecoverableError("the right-hand side is not finite");
       return 0;
+    });
+  }
+
+  /// Runs the body of an ARKODE callback: a RecoverableError (a trial state the system cannot use)
+  /// returns 1, so that ARKODE retries with a smaller step; any other exception is kept for
+  /// re-throwing after ARKStepEvolve and returns −1.
+  template <class Body>
+  int guarded(Body&& body) {
+    try {
+      return body();
     } catch (const RecoverableError& e) {
-      ++self->recoverable_failures;
-      self->last_recoverable = e.what();
+      ++recoverable_failures;
+      last_recoverable = e.what();
       return 1;
     } catch (...) {
-      self->pending = std::current_exception();
+      pending = std::current_exception();
       return -1;
     }
   }

@@ -44,9 +44,9 @@ class OdeSystem {
 
   // --- Newton systems of implicit methods (optional) -----------------------------------------
   /// True if the system solves its own Newton systems (I − γ J) z = r, J = ∂F/∂y: implicit methods
-  /// then solve their Newton systems with GMRES preconditioned by newton_solve() (products J·v from
-  /// difference quotients of rhs(), so what newton_solve() leaves out of J is still honoured);
-  /// otherwise with a dense difference-quotient Jacobian.
+  /// then solve their Newton systems with GMRES preconditioned by newton_solve(), with products J·v
+  /// from jacobian_times() or difference quotients of rhs(); otherwise with a dense
+  /// difference-quotient Jacobian.
   virtual bool has_newton_solver() const { return false; }
   /// Prepares newton_solve() for γ at (t, y). `relinearize` false: keep the linearisation of the last
   /// call and only change γ (y is then not used). Throw RecoverableError if (t, y) cannot be
@@ -55,6 +55,11 @@ class OdeSystem {
                             double /*gamma*/) {}
   /// z ≈ (I − γ J)⁻¹ r with the γ of the last newton_setup().
   virtual void newton_solve(const Eigen::Ref<const Eigen::VectorXd>& r, Eigen::Ref<Eigen::VectorXd> z) { z = r; }
+  /// Jv = J v at the last linearisation, if the system has it analytically (true); false: GMRES
+  /// takes J v from a difference quotient of rhs().
+  virtual bool jacobian_times(const Eigen::Ref<const Eigen::VectorXd>& /*v*/, Eigen::Ref<Eigen::VectorXd> /*Jv*/) {
+    return false;
+  }
   /// How many explicit steps the stability of an explicit method forces per natural time of the
   /// motion (e.g. links of a string: the fastest wave crosses a link, the motion crosses the
   /// string); 0 = unknown. IntegratorOptions::method = "auto" picks an implicit method when it
@@ -132,7 +137,7 @@ class Integrator {
   static constexpr int kStallSteps = 5;
   /// "auto" picks an implicit method from this OdeSystem::explicit_stiffness() on (measured
   /// crossover: docs/string_solver.md, "The implicit path").
-  static constexpr double kAutoImplicitStiffness = 400;
+  static constexpr double kAutoImplicitStiffness = 200;
   /// The method "auto" resolves to for `system` (any other name is returned unchanged).
   static std::string resolve_method(const std::string& method, const OdeSystem& system);
 

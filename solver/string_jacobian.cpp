@@ -11,6 +11,7 @@
 #endif
 
 #include "mesh/errors.hpp"
+#include "forces.hpp"
 #include "string_model.hpp"
 
 namespace chainsim {
@@ -26,6 +27,8 @@ struct StringJacobian<dim>::Factor {
   // The pattern the symbolic analysis was done for.
   std::vector<int> outer, inner;
   bool analyzed = false;
+  /// Factors `matrix` (compressed), redoing the symbolic analysis only when the pattern changed.
+  void factorize(const SpMat& matrix);
   bool same_pattern() const {
     const auto no = static_cast<std::size_t>(M.outerSize()) + 1;
     const auto ni = static_cast<std::size_t>(M.nonZeros());
@@ -36,7 +39,8 @@ struct StringJacobian<dim>::Factor {
 };
 
 template <int dim>
-StringJacobian<dim>::StringJacobian(StringModel<dim>& model) : model_(model), factor_(std::make_unique<Factor>()) {}
+StringJacobian<dim>::StringJacobian(StringModel<dim>& model)
+    : model_(model), factor_(std::make_unique<Factor>()), a_factor_(std::make_unique<Factor>()) {}
 
 template <int dim>
 StringJacobian<dim>::~StringJacobian() = default;
@@ -141,18 +145,43 @@ void StringJacobian<dim>::linearize(double t, const Eigen::Ref<const Eigen::Vect
       at.emplace_back(pattern.row_index[static_cast<std::size_t>(k)], c, values[static_cast<std::size_t>(k)]);
   A_.resize(nt_, nt_);
   A_.setFromTriplets(at.begin(), at.end());
+  A_.makeCompressed();
+  a_factor_->factorize(A_);
+  exact_ = !m.module_;
+  for (const auto& force : m.forces_)
+    if (!dynamic_cast<const Gravity<dim>*>(force.get()) && !dynamic_cast<const EndLoad<dim>*>(force.get())) exact_ = false;
+}
+
+template <int dim>
+void StringJacobian<dim>::Factor::factorize(const SpMat& matrix) {
+  M = matrix;
+  if (!same_pattern()) {
+    lu.analyzePattern(M);
+    outer.assign(M.outerIndexPtr(), M.outerIndexPtr() + M.outerSize() + 1);
+    inner.assign(M.innerIndexPtr(), M.innerIndexPtr() + M.nonZeros());
+    analyzed = true;
+  }
+  lu.factorize(M);
+  if (lu.info() != Eigen::Success) {
+    analyzed = false;
+    throw RecoverableError("a Newton matrix of the string is singular");
+  }
 }
 
 template <int dim>
 Eigen::VectorXd StringJacobian<dim>::apply(const Eigen::Ref<const Eigen::VectorXd>& d) const {
-  Eigen::SparseLU<SpMat> lu(A_);
-  CHAINSIM_VERIFY(lu.info() == Eigen::Success, "the tension matrix is singular");
-  const Eigen::VectorXd dx = d.head(nv_), dv = d.segment(nv_, nv_);
-  const Eigen::VectorXd w = lu.solve(Eigen::VectorXd(Qx_ * dx + Qv_ * dv));
-  Eigen::VectorXd out = Eigen::VectorXd::Zero(d.size());
+  Eigen::VectorXd out(d.size());
+  apply(d, out);
+  return out;
+}
+
+template <int dim>
+void StringJacobian<dim>::apply(const Eigen::Ref<const Eigen::VectorXd>& d, Eigen::Ref<Eigen::VectorXd> out) const {
+  const auto dx = d.head(nv_), dv = d.segment(nv_, nv_);
+  const Eigen::VectorXd w = a_factor_->lu.solve(Eigen::VectorXd(Qx_ * dx + Qv_ * dv));
+  out.setZero();
   out.head(nv_) = dv;
   out.segment(nv_, nv_) = P_ * dx - WGt_ * w;
-  return out;
 }
 
 template <int dim>
@@ -173,21 +202,10 @@ void StringJacobian<dim>::factor(double gamma) {
   add(Qx_, nv_, 0, gamma);
   add(Qv_, nv_, 0, 1.0);
   add(A_, nv_, nv_, -1.0);
-  Factor& f = *factor_;
-  f.M.resize(n, n);
-  f.M.setFromTriplets(tr.begin(), tr.end());
-  f.M.makeCompressed();
-  if (!f.same_pattern()) {
-    f.lu.analyzePattern(f.M);
-    f.outer.assign(f.M.outerIndexPtr(), f.M.outerIndexPtr() + f.M.outerSize() + 1);
-    f.inner.assign(f.M.innerIndexPtr(), f.M.innerIndexPtr() + f.M.nonZeros());
-    f.analyzed = true;
-  }
-  f.lu.factorize(f.M);
-  if (f.lu.info() != Eigen::Success) {
-    f.analyzed = false;
-    throw RecoverableError(fmt::format("the Newton matrix of the string (γ = {:.3g} s) is singular", gamma));
-  }
+  SpMat M(n, n);
+  M.setFromTriplets(tr.begin(), tr.end());
+  M.makeCompressed();
+  factor_->factorize(M);
 }
 
 template <int dim>
@@ -225,6 +243,13 @@ void StringModel<dim>::newton_solve(const Eigen::Ref<const Eigen::VectorXd>& r, 
 }
 
 template <int dim>
+bool StringModel<dim>::jacobian_times(const Eigen::Ref<const Eigen::VectorXd>& v, Eigen::Ref<Eigen::VectorXd> Jv) {
+  if (!jacobian_ || !jacobian_->exact() || jacobian_->velocity_unknowns() != dim * num_free_) return false;
+  jacobian_->apply(v, Jv);
+  return true;
+}
+
+template <int dim>
 double StringModel<dim>::explicit_stiffness() const {
   if (!system_) return 0.0;
   double h_min = INFINITY;
@@ -238,6 +263,8 @@ template void StringModel<2>::newton_setup(double, const Eigen::Ref<const Eigen:
 template void StringModel<3>::newton_setup(double, const Eigen::Ref<const Eigen::VectorXd>&, bool, double);
 template void StringModel<2>::newton_solve(const Eigen::Ref<const Eigen::VectorXd>&, Eigen::Ref<Eigen::VectorXd>);
 template void StringModel<3>::newton_solve(const Eigen::Ref<const Eigen::VectorXd>&, Eigen::Ref<Eigen::VectorXd>);
+template bool StringModel<2>::jacobian_times(const Eigen::Ref<const Eigen::VectorXd>&, Eigen::Ref<Eigen::VectorXd>);
+template bool StringModel<3>::jacobian_times(const Eigen::Ref<const Eigen::VectorXd>&, Eigen::Ref<Eigen::VectorXd>);
 template double StringModel<2>::explicit_stiffness() const;
 template double StringModel<3>::explicit_stiffness() const;
 

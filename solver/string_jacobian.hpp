@@ -45,6 +45,11 @@ class StringJacobian {
   /// J·d for the position and velocity parts of a state-sized d at the last linearisation (the ledger
   /// rows are zero). Exact for forces that depend on neither x nor v (gravity, drivers).
   Eigen::VectorXd apply(const Eigen::Ref<const Eigen::VectorXd>& d) const;
+  /// The same into `out` (state-sized), with the factorisation of A made by linearize().
+  void apply(const Eigen::Ref<const Eigen::VectorXd>& d, Eigen::Ref<Eigen::VectorXd> out) const;
+  /// True if the model's applied forces are all state-independent (gravity, loads, drivers) and it
+  /// has no module: J is then exact.
+  bool exact() const { return exact_; }
   /// Factors the augmented system of I − γ J. Throws RecoverableError if it is singular.
   void factor(double gamma);
   /// z = (I − γ J)⁻¹ r (ledger components: z = r) with the γ of the last factor().
@@ -59,8 +64,9 @@ class StringJacobian {
   int nv_ = 0, nt_ = 0;  // dim · free nodes; tension unknowns
   SpMat P_, Qx_, Qv_, WGt_, A_;
   double gamma_ = 0;
+  bool exact_ = false;
   struct Factor;
-  std::unique_ptr<Factor> factor_;
+  std::unique_ptr<Factor> factor_, a_factor_;  // the augmented system; A alone (for apply)
 };
 
 }  // namespace chainsim

@@ -289,6 +289,14 @@ const RunSummary& StringSolver<dim>::run() {
     //    root functions acted on where they vanish.
     const auto n_out = static_cast<long>(std::ceil(options_.t_end / options_.output_interval - 1e-9));
     auto output_time = [&](long k) { return std::min(options_.t_end, k * options_.output_interval); };
+    // At every accepted step: the constraints, slack, the caller's hook and the step record.
+    auto after_step = [&](double t, const Eigen::VectorXd& y) {
+      summary_.max_constraint_violation =
+          std::max(summary_.max_constraint_violation, model_.max_constraint_violation(t, y));
+      check_slack(t, y);
+      if (on_step) on_step(t, y);
+      if (options_.record_steps) record_sample(t, y);
+    };
     // Without root functions the frames come from ARKODE's dense output and never force a step:
     // the integrator runs to t_end, and every output time inside an accepted step is interpolated
     // on that step, then projected onto the link constraints (projected_state). With root functions
@@ -299,11 +307,7 @@ const RunSummary& StringSolver<dim>::run() {
         const Integrator::Outcome outcome = integrator->advance(options_.t_end, /*one_step=*/true);
         const double t = integrator->time();
         const Eigen::VectorXd& y = integrator->state();
-        summary_.max_constraint_violation =
-            std::max(summary_.max_constraint_violation, model_.max_constraint_violation(t, y));
-        check_slack(t, y);
-        if (on_step) on_step(t, y);
-        if (options_.record_steps) record_sample(t, y);
+        after_step(t, y);
         const bool at_end = outcome == Integrator::Outcome::kReachedTarget;
         for (; k <= n_out && (output_time(k) <= t || (at_end && k == n_out)); ++k) {
           const double t_out = output_time(k);
@@ -342,11 +346,7 @@ const RunSummary& StringSolver<dim>::run() {
         continue;
       }
       const Eigen::VectorXd& y = integrator->state();
-      summary_.max_constraint_violation =
-          std::max(summary_.max_constraint_violation, model_.max_constraint_violation(t, y));
-      check_slack(t, y);
-      if (on_step) on_step(t, y);
-      if (options_.record_steps) record_sample(t, y);
+      after_step(t, y);
       if (outcome == Integrator::Outcome::kReachedTarget) {
         record_frame(t_out, y);
         ++k;
