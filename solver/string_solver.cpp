@@ -297,21 +297,23 @@ const RunSummary& StringSolver<dim>::run() {
       if (on_step) on_step(t, y);
       if (options_.record_steps) record_sample(t, y);
     };
-    // Without root functions the frames come from ARKODE's dense output and never force a step:
-    // the integrator runs to t_end, and every output time inside an accepted step is interpolated
-    // on that step, then projected onto the link constraints (projected_state). With root functions
-    // the output times stay stop times: an event's polish recomputes its step, after which the
-    // interpolant no longer covers the frames before it.
+    // Without root functions, frames closer together than the integrator's steps come from ARKODE's
+    // dense output and never shorten a step: the integrator runs towards t_end, and every output
+    // time inside an accepted step is interpolated on that step, then projected onto the link
+    // constraints (projected_state). Frames further apart than the steps are stop times (exact
+    // states; at most one shortened step per frame). With root functions the output times stay
+    // stop times: an event's polish recomputes its step, after which the interpolant no longer
+    // covers the frames before it.
     if (model_.num_events() == 0) {
       for (long k = 1; k <= n_out;) {
-        const Integrator::Outcome outcome = integrator->advance(options_.t_end, /*one_step=*/true);
+        const bool dense = integrator->stats().last_step > options_.output_interval;
+        integrator->advance(dense ? options_.t_end : output_time(k), /*one_step=*/true);
         const double t = integrator->time();
         const Eigen::VectorXd& y = integrator->state();
         after_step(t, y);
-        const bool at_end = outcome == Integrator::Outcome::kReachedTarget;
-        for (; k <= n_out && (output_time(k) <= t || (at_end && k == n_out)); ++k) {
+        for (; k <= n_out && output_time(k) <= t; ++k) {
           const double t_out = output_time(k);
-          if (t_out == t || (at_end && k == n_out))
+          if (t_out == t)
             record_frame(t_out, y);
           else
             record_frame(t_out, model_.projected_state(t_out, integrator->interpolate(t_out)));
