@@ -14,6 +14,11 @@
 
 namespace chainsim {
 
+namespace {
+/// Frames are interpolated for methods up to this order (docs/string_solver.md, "The implicit path").
+constexpr int kMaxDenseOrder = 5;
+}  // namespace
+
 void StringSolverOptions::validate() const {
   integrator.validate();
   require_positive("stop.t_end", t_end);
@@ -301,12 +306,14 @@ const RunSummary& StringSolver<dim>::run() {
     // dense output and never shorten a step: the integrator runs towards t_end, and every output
     // time inside an accepted step is interpolated on that step, then projected onto the link
     // constraints (projected_state). Frames further apart than the steps are stop times (exact
-    // states; at most one shortened step per frame). With root functions the output times stay
+    // states; at most one shortened step per frame), and so are all frames of methods of order above
+    // kMaxDenseOrder, whose steps are far more accurate than ARKODE's Hermite interpolant (degree <= 5). With root functions the output times stay
     // stop times: an event's polish recomputes its step, after which the interpolant no longer
     // covers the frames before it.
     if (model_.num_events() == 0) {
       for (long k = 1; k <= n_out;) {
-        const bool dense = integrator->stats().last_step > options_.output_interval;
+        const IntegratorStats st = integrator->stats();
+        const bool dense = st.last_step > options_.output_interval && st.order <= kMaxDenseOrder;
         integrator->advance(dense ? options_.t_end : output_time(k), /*one_step=*/true);
         const double t = integrator->time();
         const Eigen::VectorXd& y = integrator->state();

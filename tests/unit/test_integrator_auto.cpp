@@ -9,9 +9,9 @@ using namespace chainsim;
 using namespace chainsim::testing;
 
 TEST_CASE("method = auto: implicit from 200 links on, explicit below", "[unit][integrator][implicit]") {
-  auto flat = [](double) { return 0.0; };
-  auto coarse = hanging_chain(199, 1.0, flat, 0.03);
-  auto fine = hanging_chain(200, 1.0, flat, 0.03);
+  auto tilted = [](double sigma) { return 1e-3 * sigma; };  // off equilibrium, so Newton has work
+  auto coarse = hanging_chain(199, 1.0, tilted, 0.03);
+  auto fine = hanging_chain(200, 1.0, tilted, 0.03);
   // ℓ / h_min is the number of links of a uniform chain.
   CHECK(coarse->explicit_stiffness() == Approx(199));
   CHECK(fine->explicit_stiffness() == Approx(200));
