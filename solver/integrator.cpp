@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <exception>
 #include <limits>
@@ -15,6 +16,7 @@
 #include <fmt/format.h>
 #include <nvector/nvector_serial.h>
 #include <sunlinsol/sunlinsol_dense.h>
+#include <sunlinsol/sunlinsol_spgmr.h>
 #include <sunmatrix/sunmatrix_dense.h>
 
 #include "mesh/errors.hpp"
@@ -104,7 +106,7 @@ std::vector<std::pair<std::string, std::string>> method_aliases() {
 void IntegratorOptions::validate() const {
   ARKodeButcherTable erk = nullptr, dirk = nullptr;
   load_table(table_name(method), erk, dirk);
-  const bool ok = erk || dirk;
+  const bool ok = erk || dirk || method == "auto";
   ARKodeButcherTable_Free(erk);
   ARKodeButcherTable_Free(dirk);
   if (!ok)
@@ -134,6 +136,11 @@ struct Integrator::Impl {
   std::string table;
   int order = 0;
   long recoverable_failures = 0;
+  // The system's Newton solver: whether it is set up, and counters.
+  bool newton_ready = false;
+  long jv_evals = 0;  // right-hand sides of jac_times()
+  N_Vector jv_work = nullptr;  // the shifted state of jac_times()
+  long newton_setups = 0, newton_solves = 0;
   std::exception_ptr pending;  // exception thrown inside a callback, re-thrown after ARKStepEvolve
   std::string last_error;      // ARKODE's own message for the last failure
   std::string last_recoverable;  // what the model said when it last refused a trial state
@@ -147,8 +154,7 @@ struct Integrator::Impl {
   explicit Impl(OdeSystem& s) : system(s) {}
   ~Impl() {
     if (mem) ARKStepFree(&mem);
-    if (ls) SUNLinSolFree(ls);
-    if (jac) SUNMatDestroy(jac);
+    free_linear_solver();
     if (y) N_VDestroy(y);
     if (ctx) SUNContext_Free(&ctx);
   }
@@ -175,13 +181,110 @@ struct Integrator::Impl {
     check(flag, "ARKStepSVtolerances");
   }
 
-  void attach_dense_solver() {
-    if (ls) SUNLinSolFree(ls);
-    if (jac) SUNMatDestroy(jac);
+  /// Krylov dimension of GMRES: with the system's Newton solver as preconditioner one or two
+  /// iterations suffice; the rest is room for what it leaves out (drag, a module's loads).
+  static constexpr int kKrylovDimension = 10;
+  /// Newton iterations per stage before ARKODE calls it a convergence failure (its default is 3).
+  static constexpr int kNewtonIterations = 8;
+
+  /// The linear solver of an implicit method (after creation and after every resize): GMRES
+  /// (SUNDIALS SPGMR) preconditioned by the system's Newton solver when it has one, with products
+  /// J·v from jac_times(); else a dense difference-quotient Jacobian.
+  void attach_linear_solver() {
+    free_linear_solver();
+    if (system.has_newton_solver()) {
+      ls = SUNLinSol_SPGMR(y, SUN_PREC_LEFT, kKrylovDimension, ctx);
+      if (!ls) throw Error("SUNLinSol_SPGMR failed");
+      jv_work = N_VClone(y);
+      newton_ready = false;
+      check(ARKStepSetLinearSolver(mem, ls, nullptr), "ARKStepSetLinearSolver");
+      check(ARKStepSetPreconditioner(mem, Impl::newton_linearize, Impl::newton_solve), "ARKStepSetPreconditioner");
+      check(ARKStepSetJacTimes(mem, nullptr, Impl::jac_times), "ARKStepSetJacTimes");
+      // A fresh linearisation at every step: it costs a few right-hand sides, and a stale one is far
+      // off on the fast modes of a fine string (γ ω² ≫ 1), where Newton then fails and cuts the step.
+      check(ARKStepSetLSetupFrequency(mem, 1), "ARKStepSetLSetupFrequency");
+      check(ARKStepSetJacEvalFrequency(mem, 1), "ARKStepSetJacEvalFrequency");
+      check(ARKStepSetMaxNonlinIters(mem, kNewtonIterations), "ARKStepSetMaxNonlinIters");
+      return;
+    }
     const sunindextype n = N_VGetLength(y);
     jac = SUNDenseMatrix(n, n, ctx);
     ls = SUNLinSol_Dense(y, jac, ctx);
     check(ARKStepSetLinearSolver(mem, ls, jac), "ARKStepSetLinearSolver");
+  }
+
+  void free_linear_solver() {
+    if (ls) SUNLinSolFree(ls);
+    if (jac) SUNMatDestroy(jac);
+    if (jv_work) N_VDestroy(jv_work);
+    ls = nullptr;
+    jac = nullptr;
+    jv_work = nullptr;
+  }
+
+  // J·v from the system's linearisation if it has one (OdeSystem::jacobian_times), else by a
+  // difference quotient of the right-hand side, (F(y + σv) − F(y)) / σ with the unweighted
+  // increment σ = √ε (1 + ‖y‖∞) / ‖v‖∞. ARKODE's own quotient takes σ = 1/‖v‖_WRMS, a step of the
+  // size of the error tolerance: at rtol 1e-4 that moves a node by a few per cent of a short link,
+  // and the product is then too inexact for the Newton iteration of a fine string.
+  static int jac_times(N_Vector v, N_Vector Jv, sunrealtype t, N_Vector y, N_Vector fy, void* data, N_Vector) {
+    auto* self = static_cast<Impl*>(data);
+    const long n = N_VGetLength(y);
+    Eigen::Map<const Eigen::VectorXd> vm(N_VGetArrayPointer(v), n), ym(N_VGetArrayPointer(y), n),
+        fm(N_VGetArrayPointer(fy), n);
+    Eigen::Map<Eigen::VectorXd> out(N_VGetArrayPointer(Jv), n);
+    if (self->system.jacobian_times(vm, out)) return 0;
+    const double vmax = vm.cwiseAbs().maxCoeff();
+    if (!(vmax > 0)) {
+      out.setZero();
+      return 0;
+    }
+    const double sigma = std::sqrt(std::numeric_limits<double>::epsilon()) * (1 + ym.cwiseAbs().maxCoeff()) / vmax;
+    Eigen::Map<Eigen::VectorXd>(N_VGetArrayPointer(self->jv_work), n) = ym + sigma * vm;
+    ++self->jv_evals;
+    const int flag = rhs(t, self->jv_work, Jv, data);
+    if (flag != 0) return flag;
+    out = (out - fm) / sigma;
+    return 0;
+  }
+
+  // The linearisation (ARKODE's preconditioner set-up: first step, every few steps, after a
+  // convergence failure, or when γ has changed much); jok = the last linearisation may be kept.
+  static int newton_linearize(sunrealtype t, N_Vector y, N_Vector, sunbooleantype jok, sunbooleantype* jcur,
+                              sunrealtype gamma, void* data) {
+    auto* self = static_cast<Impl*>(data);
+    Eigen::Map<const Eigen::VectorXd> ym(N_VGetArrayPointer(y), N_VGetLength(y));
+    return self->guarded([&] {
+      const bool fresh = !jok || !self->newton_ready;
+      self->system.newton_setup(t, ym, fresh, gamma);
+      *jcur = fresh ? SUNTRUE : SUNFALSE;
+      self->newton_ready = true;
+      if (fresh) ++self->newton_setups;
+      return 0;
+    });
+  }
+
+  // z = (I − γJ)⁻¹ r from the system's Newton solver (ARKODE's preconditioner solve).
+  static int newton_solve(sunrealtype, N_Vector, N_Vector, N_Vector r, N_Vector z, sunrealtype, sunrealtype, int,
+                          void* data) {
+    auto* self = static_cast<Impl*>(data);
+    const long n = N_VGetLength(r);
+    Eigen::Map<const Eigen::VectorXd> rm(N_VGetArrayPointer(r), n);
+    Eigen::Map<Eigen::VectorXd> zm(N_VGetArrayPointer(z), n);
+    return self->guarded([&] {
+      self->system.newton_solve(rm, zm);
+      ++self->newton_solves;
+      return zm.allFinite() ? 0 : 1;
+    });
+  }
+
+  /// A new state vector: fused vector operations on (ARKODE's stage sums become one pass over
+  /// the data instead of one per term).
+  N_Vector new_vector(sunindextype n) const {
+    N_Vector v = N_VNew_Serial(n, ctx);
+    if (!v) throw Error("N_VNew_Serial failed");
+    N_VEnableFusedOps_Serial(v, SUNTRUE);
+    return v;
   }
 
   static int rhs(sunrealtype t, N_Vector y, N_Vector ydot, void* data) {
@@ -189,20 +292,27 @@ struct Integrator::Impl {
     const long n = N_VGetLength(y);
     Eigen::Map<const Eigen::VectorXd> ym(N_VGetArrayPointer(y), n);
     Eigen::Map<Eigen::VectorXd> dm(N_VGetArrayPointer(ydot), n);
-    try {
+    return self->guarded([&] {
       self->system.rhs(t, ym, dm);
-      if (!dm.allFinite()) {
-        ++self->recoverable_failures;
-        self->last_recoverable = "the right-hand side is not finite";
-        return 1;  // a non-finite trial stage: let ARKODE retry with a smaller step
-      }
+      // a non-finite trial stage: let ARKODE retry with a smaller step
+      if (!dm.allFinite()) throw RecoverableError("the right-hand side is not finite");
       return 0;
+    });
+  }
+
+  /// Runs the body of an ARKODE callback: a RecoverableError (a trial state the system cannot use)
+  /// returns 1, so that ARKODE retries with a smaller step; any other exception is kept for
+  /// re-throwing after ARKStepEvolve and returns −1.
+  template <class Body>
+  int guarded(Body&& body) {
+    try {
+      return body();
     } catch (const RecoverableError& e) {
-      ++self->recoverable_failures;
-      self->last_recoverable = e.what();
+      ++recoverable_failures;
+      last_recoverable = e.what();
       return 1;
     } catch (...) {
-      self->pending = std::current_exception();
+      pending = std::current_exception();
       return -1;
     }
   }
@@ -233,10 +343,10 @@ Integrator::Integrator(OdeSystem& system, double t0, const Eigen::VectorXd& y0,
   CHAINSIM_VERIFY(y0.size() == system.size(), "initial state has the wrong length");
   Impl& d = *impl_;
   if (SUNContext_Create(nullptr, &d.ctx) != 0) throw Error("SUNContext_Create failed");
-  d.y = N_VNew_Serial(y0.size(), d.ctx);
+  d.y = d.new_vector(y0.size());
   Eigen::Map<Eigen::VectorXd>(N_VGetArrayPointer(d.y), y0.size()) = y0;
 
-  d.table = table_name(options.method);
+  d.table = table_name(resolve_method(options.method, system));
   ARKodeButcherTable erk = nullptr, dirk = nullptr;
   load_table(d.table, erk, dirk);
   d.implicit = dirk != nullptr;
@@ -261,7 +371,7 @@ Integrator::Integrator(OdeSystem& system, double t0, const Eigen::VectorXd& y0,
   if (options.max_step > 0) d.check(ARKStepSetMaxStep(d.mem, options.max_step), "ARKStepSetMaxStep");
   if (options.initial_step > 0)
     d.check(ARKStepSetInitStep(d.mem, options.initial_step), "ARKStepSetInitStep");
-  if (d.implicit) d.attach_dense_solver();
+  if (d.implicit) d.attach_linear_solver();
 
   const int nev = system.num_events();
   if (nev > 0) {
@@ -277,6 +387,12 @@ Integrator::Integrator(OdeSystem& system, double t0, const Eigen::VectorXd& y0,
 }
 
 Integrator::~Integrator() = default;
+
+std::string Integrator::resolve_method(const std::string& method, const OdeSystem& system) {
+  if (method != "auto") return method;
+  const bool stiff = system.explicit_stiffness() >= kAutoImplicitStiffness && system.num_events() == 0;
+  return stiff ? kAutoImplicit : kAutoExplicit;
+}
 
 // The method, tolerance and last step, for the watchdog's messages.
 std::string Integrator::diagnosis() const {
@@ -462,14 +578,14 @@ void Integrator::restart(double t, const Eigen::VectorXd& y) {
 void Integrator::resize(double t, const Eigen::VectorXd& y) {
   Impl& d = *impl_;
   CHAINSIM_VERIFY(y.size() == d.system.size(), "resize() needs the system to report the new size");
-  N_Vector ynew = N_VNew_Serial(y.size(), d.ctx);
+  N_Vector ynew = d.new_vector(y.size());
   Eigen::Map<Eigen::VectorXd>(N_VGetArrayPointer(ynew), y.size()) = y;
   const int flag = ARKStepResize(d.mem, ynew, 1.0, t, nullptr, nullptr);
   N_VDestroy(d.y);
   d.y = ynew;
   d.check(flag, "ARKStepResize");
   d.apply_tolerances();
-  if (d.implicit) d.attach_dense_solver();
+  if (d.implicit) d.attach_linear_solver();
   t_ = t;
   y_ = y;
 }
@@ -491,7 +607,12 @@ IntegratorStats Integrator::stats() const {
     ARKStepGetNumJacEvals(d.mem, &s.jac_evals);
     ARKStepGetNumLinSolvSetups(d.mem, &s.lin_setups);
     ARKStepGetNumLinRhsEvals(d.mem, &nfe_ls);
-    s.rhs_evals += nfe_ls;  // difference-quotient Jacobian columns
+    s.rhs_evals += nfe_ls + d.jv_evals;  // difference-quotient Jacobian columns, products J·v
+    if (d.system.has_newton_solver()) {
+      ARKStepGetNumLinIters(d.mem, &s.lin_iters);
+      s.jac_evals = d.newton_setups;
+      s.lin_solves = d.newton_solves;
+    }
   }
   sunrealtype h = 0;
   ARKStepGetLastStep(d.mem, &h);

@@ -41,6 +41,30 @@ class OdeSystem {
   /// step-size floor is kStepFloor · max(|t|, time_scale()), so a system that starts at t = 0 and
   /// gives its scale is also watched over during its first instants.
   virtual double time_scale() const { return 0.0; }
+
+  // --- Newton systems of implicit methods (optional) -----------------------------------------
+  /// True if the system solves its own Newton systems (I − γ J) z = r, J = ∂F/∂y: implicit methods
+  /// then solve their Newton systems with GMRES preconditioned by newton_solve(), with products J·v
+  /// from jacobian_times() or difference quotients of rhs(); otherwise with a dense
+  /// difference-quotient Jacobian.
+  virtual bool has_newton_solver() const { return false; }
+  /// Prepares newton_solve() for γ at (t, y). `relinearize` false: keep the linearisation of the last
+  /// call and only change γ (y is then not used). Throw RecoverableError if (t, y) cannot be
+  /// linearised (ARKODE retries with a smaller step).
+  virtual void newton_setup(double /*t*/, const Eigen::Ref<const Eigen::VectorXd>& /*y*/, bool /*relinearize*/,
+                            double /*gamma*/) {}
+  /// z ≈ (I − γ J)⁻¹ r with the γ of the last newton_setup().
+  virtual void newton_solve(const Eigen::Ref<const Eigen::VectorXd>& r, Eigen::Ref<Eigen::VectorXd> z) { z = r; }
+  /// Jv = J v at the last linearisation, if the system has it analytically (true); false: GMRES
+  /// takes J v from a difference quotient of rhs().
+  virtual bool jacobian_times(const Eigen::Ref<const Eigen::VectorXd>& /*v*/, Eigen::Ref<Eigen::VectorXd> /*Jv*/) {
+    return false;
+  }
+  /// How many explicit steps the stability of an explicit method forces per natural time of the
+  /// motion (e.g. links of a string: the fastest wave crosses a link, the motion crosses the
+  /// string); 0 = unknown. IntegratorOptions::method = "auto" picks an implicit method when it
+  /// reaches Integrator::kAutoImplicitStiffness and the system has no event functions.
+  virtual double explicit_stiffness() const { return 0.0; }
 };
 
 /// How the integrator advances the ODE. validate() throws InputError naming the bad field.
@@ -48,7 +72,9 @@ struct IntegratorOptions {
   /// ARKODE Butcher table by name (ARKODE_ERK_* explicit, ARKODE_*DIRK* implicit), or one of the
   /// short aliases listed by method_aliases(): "erk8" (Fehlberg 13-7-8, default), "erk6" (Verner
   /// 8-5-6), "erk5" (Dormand–Prince 7-4-5), "erk4" (Zonneveld 5-3-4), "erk3" (Bogacki–Shampine),
-  /// "dirk5" (Kvaerno 7-4-5), "dirk4" (ARK 4-3-6 DIRK), "dirk3" (ARK 3-2-4 DIRK), "dirk2" (SDIRK 2-1-2).
+  /// "dirk5" (Kvaerno 7-4-5), "dirk4" (ARK 4-3-6 DIRK), "dirk3" (ARK 3-2-4 DIRK), "dirk2" (SDIRK 2-1-2),
+  /// or "auto": kAutoImplicit when OdeSystem::explicit_stiffness() >= Integrator::kAutoImplicitStiffness
+  /// and the system has no event functions, kAutoExplicit otherwise.
   std::string method = "erk8";
   double rtol = 1e-10;   ///< relative tolerance, in [1e-14, 1e-2]
   double atol = 1e-12;   ///< absolute tolerance relative to OdeSystem::state_scale(), > 0
@@ -63,6 +89,10 @@ struct IntegratorOptions {
   void validate() const;
 };
 
+/// The methods "auto" chooses between (integrator.hpp, IntegratorOptions::method).
+inline constexpr const char* kAutoExplicit = "erk8";
+inline constexpr const char* kAutoImplicit = "dirk4";
+
 /// Short names of the built-in methods, e.g. "erk8", with a one-line description each.
 std::vector<std::pair<std::string, std::string>> method_aliases();
 
@@ -75,8 +105,10 @@ struct IntegratorStats {
   long event_evals = 0;       ///< evaluations of the event functions
   long nonlin_iters = 0;      ///< Newton iterations (implicit methods only)
   long nonlin_conv_fails = 0;
-  long jac_evals = 0;         ///< Jacobian evaluations (implicit methods only)
+  long jac_evals = 0;         ///< Jacobian evaluations or linearisations (implicit methods only)
   long lin_setups = 0;
+  long lin_iters = 0;         ///< GMRES iterations (implicit methods with the system's Newton solver)
+  long lin_solves = 0;        ///< solves of the system's Newton solver (GMRES preconditioner)
   long recoverable_failures = 0;  ///< RHS calls that asked for a smaller step
   double last_step = 0;       ///< size of the last accepted step (s)
   std::string method;         ///< the Butcher table used
@@ -103,6 +135,11 @@ class Integrator {
   /// that do not advance t) end the run.
   static constexpr double kStepFloor = 1e-14;
   static constexpr int kStallSteps = 5;
+  /// "auto" picks an implicit method from this OdeSystem::explicit_stiffness() on (measured
+  /// crossover: docs/string_solver.md, "The implicit path").
+  static constexpr double kAutoImplicitStiffness = 200;
+  /// The method "auto" resolves to for `system` (any other name is returned unchanged).
+  static std::string resolve_method(const std::string& method, const OdeSystem& system);
 
   enum class Outcome {
     kReachedTarget,  ///< t == t_target

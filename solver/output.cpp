@@ -141,6 +141,8 @@ nlohmann::json to_json(const IntegratorStats& s) {
           {"nonlin_conv_fails", s.nonlin_conv_fails},
           {"jac_evals", s.jac_evals},
           {"lin_setups", s.lin_setups},
+          {"lin_iters", s.lin_iters},
+          {"lin_solves", s.lin_solves},
           {"recoverable_failures", s.recoverable_failures},
           {"last_step", s.last_step}};
 }

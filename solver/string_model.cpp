@@ -189,18 +189,6 @@ void StringModel<dim>::fill_moving(double t, const Eigen::Ref<const Eigen::Vecto
 }
 
 template <int dim>
-template <class Visit>
-void StringModel<dim>::for_each_link(Visit&& visit) const {
-  // visit(j, u, next): link j, its tension unknown u, and the next link of its arc (−1 at an open end).
-  for (std::size_t k = 0; k < arcs_.size(); ++k) {
-    const ArcRange& arc = arcs_[k];
-    const int nl = arc.num_links(), u0 = first_unknown_[k];
-    for (int q = 0; q + 1 < nl; ++q) visit(arc.first + q, u0 + q, arc.first + q + 1);
-    if (nl > 0) visit(arc.first + nl - 1, u0 + nl - 1, arc.closed ? arc.first : -1);
-  }
-}
-
-template <int dim>
 void StringModel<dim>::links() {
   for_each_link([&](int j, int, int) {
     const int a = chain_.link_start(j), b = chain_.link_end(j);
@@ -391,6 +379,14 @@ void StringModel<dim>::project(double t) {
   assemble_matrix();
   for_each_link([&](int j, int u, int) { system_->rhs(u) = e_.col(j).dot(dv_.col(j)); });
   correct(v_, system_->solve(t));
+}
+
+template <int dim>
+Eigen::VectorXd StringModel<dim>::projected_state(double t, const Eigen::Ref<const Eigen::VectorXd>& y) {
+  unpack_state(t, y);
+  refresh();
+  project(t);
+  return pack(y.tail(1 + num_ledgers_));
 }
 
 template <int dim>

@@ -49,6 +49,9 @@
 
 namespace chainsim {
 
+template <int dim>
+class StringJacobian;
+
 /// What a run does when the tension goes negative beyond round-off (slack: an inextensible string
 /// cannot push, so the model no longer applies): stop with a NumericalError, record the first
 /// occurrence and go on, or not check at all.
@@ -99,6 +102,14 @@ class StringModel final : public OdeSystem {
   /// With a module: positions scale with ℓ, velocities with a reference speed, ledgers with the
   /// matching energies; without one, plain absolute tolerances (empty).
   Eigen::VectorXd state_scale() const override;
+  /// Implicit methods: the exact Newton systems of the string (string_jacobian.hpp), O(N) each.
+  bool has_newton_solver() const override { return system_ != nullptr; }
+  void newton_setup(double t, const Eigen::Ref<const Eigen::VectorXd>& y, bool relinearize, double gamma) override;
+  void newton_solve(const Eigen::Ref<const Eigen::VectorXd>& r, Eigen::Ref<Eigen::VectorXd> z) override;
+  /// J v of the last linearisation; only without a module (whose loads it leaves out).
+  bool jacobian_times(const Eigen::Ref<const Eigen::VectorXd>& v, Eigen::Ref<Eigen::VectorXd> Jv) override;
+  /// ℓ / h_min: the fastest transverse wave crosses a link in ~h/c, the motion the string in ~ℓ/c.
+  double explicit_stiffness() const override;
 
   // --- set-up -------------------------------------------------------------------------------
   /// Puts the prescribed nodes on their paths at t0, then projects the positions and velocities of
@@ -206,6 +217,9 @@ class StringModel final : public OdeSystem {
   /// is right to the round-off of its coordinates), then onto e_j·Δv_j = 0. Throws NumericalError
   /// naming t and the residual if it does not converge.
   void project(double t);
+  /// The state y at t with its positions and velocities projected onto the link constraints by
+  /// project() (the ledgers unchanged): an interpolated output frame made consistent.
+  Eigen::VectorXd projected_state(double t, const Eigen::Ref<const Eigen::VectorXd>& y);
 
  private:
   void links();
@@ -217,6 +231,8 @@ class StringModel final : public OdeSystem {
   double evaluate_current(double t);
   template <class Visit>
   void for_each_link(Visit&& visit) const;
+  friend class StringJacobian<dim>;
+  std::shared_ptr<StringJacobian<dim>> jacobian_;  // built by the first newton_setup()
 
   Chain<dim> chain_;
   std::vector<std::unique_ptr<Force<dim>>> forces_;
@@ -243,5 +259,17 @@ class StringModel final : public OdeSystem {
   Points<dim> dx_, dv_, e_;
   Eigen::VectorXd l_;
 };
+
+template <int dim>
+template <class Visit>
+void StringModel<dim>::for_each_link(Visit&& visit) const {
+  // visit(j, u, next): link j, its tension unknown u, and the next link of its arc (−1 at an open end).
+  for (std::size_t k = 0; k < arcs_.size(); ++k) {
+    const ArcRange& arc = arcs_[k];
+    const int nl = arc.num_links(), u0 = first_unknown_[k];
+    for (int q = 0; q + 1 < nl; ++q) visit(arc.first + q, u0 + q, arc.first + q + 1);
+    if (nl > 0) visit(arc.first + nl - 1, u0 + nl - 1, arc.closed ? arc.first : -1);
+  }
+}
 
 }  // namespace chainsim

@@ -14,6 +14,11 @@
 
 namespace chainsim {
 
+namespace {
+/// Frames are interpolated for methods up to this order (docs/string_solver.md, "The implicit path").
+constexpr int kMaxDenseOrder = 5;
+}  // namespace
+
 void StringSolverOptions::validate() const {
   integrator.validate();
   require_positive("stop.t_end", t_end);
@@ -343,8 +348,48 @@ const RunSummary& StringSolver<dim>::run() {
     // 2. Step by step to each output time: constraints (and slack) are checked at accepted steps,
     //    root functions acted on where they vanish.
     const auto n_out = static_cast<long>(std::ceil(options_.t_end / options_.output_interval - 1e-9));
-    for (long k = 1; k <= n_out;) {
-      const double t_out = std::min(options_.t_end, k * options_.output_interval);
+    auto output_time = [&](long k) { return std::min(options_.t_end, k * options_.output_interval); };
+    // At every accepted step: the constraints, slack, the caller's hook and the step record.
+    auto after_step = [&](double t, const Eigen::VectorXd& y) {
+      summary_.max_constraint_violation =
+          std::max(summary_.max_constraint_violation, model_.max_constraint_violation(t, y));
+      check_slack(t, y);
+      if (on_step) on_step(t, y);
+      if (options_.record_steps) record_sample(t, y);
+    };
+    // Without root functions, frames closer together than the integrator's steps come from ARKODE's
+    // dense output and never shorten a step: the integrator runs towards t_end, and every output
+    // time inside an accepted step is interpolated on that step, then projected onto the link
+    // constraints (projected_state). Frames further apart than the steps are stop times (exact
+    // states; at most one shortened step per frame), and so are all frames of methods of order above
+    // kMaxDenseOrder, whose steps are far more accurate than ARKODE's Hermite interpolant (degree <= 5). With root functions the output times stay
+    // stop times: an event's polish recomputes its step, after which the interpolant no longer
+    // covers the frames before it.
+    if (model_.num_events() == 0) {
+      for (long k = 1; k <= n_out;) {
+        const IntegratorStats st = integrator->stats();
+        const bool dense = st.last_step > options_.output_interval && st.order <= kMaxDenseOrder;
+        integrator->advance(dense ? options_.t_end : output_time(k), /*one_step=*/true);
+        const double t = integrator->time();
+        const Eigen::VectorXd& y = integrator->state();
+        after_step(t, y);
+        for (; k <= n_out && output_time(k) <= t; ++k) {
+          const double t_out = output_time(k);
+          if (t_out == t)
+            record_frame(t_out, y);
+          else
+            record_frame(t_out, model_.projected_state(t_out, integrator->interpolate(t_out)));
+        }
+        if (k <= n_out && interrupt_requested()) {  // Ctrl-C: stop at this accepted state, outputs valid
+          record_frame(t, y);
+          finish("interrupted");
+          summary_.stop_reason = fmt::format("interrupted by the user at t = {:.9g} s", t);
+          return summary_;
+        }
+      }
+    }
+    for (long k = 1; k <= n_out && model_.num_events() > 0;) {
+      const double t_out = output_time(k);
       const Integrator::Outcome outcome = integrator->advance(t_out, /*one_step=*/true);
       const double t = integrator->time();
       if (outcome == Integrator::Outcome::kEvent) {
@@ -365,11 +410,7 @@ const RunSummary& StringSolver<dim>::run() {
         continue;
       }
       const Eigen::VectorXd& y = integrator->state();
-      summary_.max_constraint_violation =
-          std::max(summary_.max_constraint_violation, model_.max_constraint_violation(t, y));
-      check_slack(t, y);
-      if (on_step) on_step(t, y);
-      if (options_.record_steps) record_sample(t, y);
+      after_step(t, y);
       if (outcome == Integrator::Outcome::kReachedTarget) {
         record_frame(t_out, y);
         ++k;

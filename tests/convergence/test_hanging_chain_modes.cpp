@@ -32,28 +32,12 @@ struct Measured {
 };
 
 Measured measure(int links, int mode, double periods) {
-  const double length = 1.0;
-  const double j = boost::math::cyl_bessel_j_zero(0.0, mode);
-  const double omega = 0.5 * j * std::sqrt(kG / length);
-  auto phi = [&](double sigma) { return boost::math::cyl_bessel_j(0, j * std::sqrt(std::max(sigma, 0.0) / length)); };
-  auto model = hanging_chain(links, length, [&](double sigma) { return kAmplitude * length * phi(sigma); },
-                             0.1 * std::sqrt(length / kG));
-  const Chain<2>& chain = model->chain();
-  // Weights of the modal projection on the free nodes (state order: node 1..n-1).
-  Eigen::VectorXd w(chain.num_nodes() - 1);
-  for (int i = 1; i < chain.num_nodes(); ++i) w[i - 1] = chain.mass(i) * phi(length - chain.node_coordinate(i));
-  auto q = [&](const Eigen::VectorXd& y) {
-    double sum = 0;
-    for (int k = 0; k < w.size(); ++k) sum += w[k] * y[2 * k];
-    return sum;
-  };
   IntegratorOptions options;
   options.rtol = kRtol;
   options.atol = 1e-15;
-  const double period = 2 * kPi / omega;
-  const auto crossings = zero_crossings(*model, model->state_from_chain(), options, periods * period, q);
-  REQUIRE(crossings.size() >= 4);
-  return {kPi / mean_spacing(crossings), static_cast<int>(crossings.size())};
+  const ModeMeasurement m = measure_mode(links, mode, periods, options, kAmplitude);
+  REQUIRE(m.crossings >= 4);
+  return {m.omega, m.crossings};
 }
 
 void check_mode(int mode, const std::vector<int>& links, double periods) {

@@ -8,6 +8,8 @@
 #include <string>
 #include <vector>
 
+#include <boost/math/special_functions/bessel.hpp>
+
 #include "mesh/discretize.hpp"
 #include "solver/integrator.hpp"
 #include "solver/string_model.hpp"
@@ -38,9 +40,10 @@ inline std::unique_ptr<StringModel<2>> hanging_chain(int links, double length, c
 }
 
 /// Times at which q(t, y) changes sign over [0, t_end], located on ARKODE's dense output by
-/// bisection to ~1e-13 of the step.
+/// bisection to ~1e-13 of the step. `stats`, if given, receives the integrator's counters.
 inline std::vector<double> zero_crossings(OdeSystem& system, const Eigen::VectorXd& y0, const IntegratorOptions& options,
-                                          double t_end, const std::function<double(const Eigen::VectorXd&)>& q) {
+                                          double t_end, const std::function<double(const Eigen::VectorXd&)>& q,
+                                          IntegratorStats* stats = nullptr) {
   Integrator integrator(system, 0.0, y0, options);
   std::vector<double> crossings;
   double t_prev = 0.0, q_prev = q(y0);
@@ -63,6 +66,7 @@ inline std::vector<double> zero_crossings(OdeSystem& system, const Eigen::Vector
     t_prev = t;
     q_prev = q_now;
   }
+  if (stats) *stats = integrator.stats();
   return crossings;
 }
 
@@ -78,6 +82,45 @@ inline double mean_spacing(const std::vector<double>& t) {
     skt += kk * t[k];
   }
   return (n * skt - sk * st) / (n * skk - sk * sk);
+}
+
+/// A frequency measured on the hanging chain, with the integrator's counters.
+struct ModeMeasurement {
+  double omega = 0;  ///< measured (rad/s)
+  double exact = 0;  ///< ½ j_{0,n} √(g/ℓ)
+  int crossings = 0;
+  IntegratorStats stats;
+  double relative_error() const { return std::abs(omega - exact) / exact; }
+};
+
+/// Mode `mode` of a hanging chain of length 1 with `links` links (τ_b = 0.1 √(ℓ/g)), started at rest
+/// on the mode shape J0(j_{0,n} √(σ/ℓ)) with lateral amplitude `amplitude`, run for `periods` periods:
+/// the frequency from the zero crossings of the modal projection q(t) = Σ_i m_i u_i(t) φ_n(σ_i)
+/// (u: lateral displacement), as the slope of a least-squares fit of the crossing times. 0 crossings
+/// or 1: omega = 0.
+inline ModeMeasurement measure_mode(int links, int mode, double periods, const IntegratorOptions& options,
+                                    double amplitude) {
+  const double length = 1.0;
+  const double j = boost::math::cyl_bessel_j_zero(0.0, mode);
+  ModeMeasurement out;
+  out.exact = 0.5 * j * std::sqrt(kG / length);
+  auto phi = [&](double sigma) { return boost::math::cyl_bessel_j(0, j * std::sqrt(std::max(sigma, 0.0) / length)); };
+  auto model = hanging_chain(links, length, [&](double sigma) { return amplitude * length * phi(sigma); },
+                             0.1 * std::sqrt(length / kG));
+  const Chain<2>& chain = model->chain();
+  // Weights of the modal projection on the free nodes (state order: node 1..n-1).
+  Eigen::VectorXd w(chain.num_nodes() - 1);
+  for (int i = 1; i < chain.num_nodes(); ++i) w[i - 1] = chain.mass(i) * phi(length - chain.node_coordinate(i));
+  auto q = [&](const Eigen::VectorXd& y) {
+    double sum = 0;
+    for (int k = 0; k < w.size(); ++k) sum += w[k] * y[2 * k];
+    return sum;
+  };
+  const double period = 2 * kPi / out.exact;
+  const auto crossings = zero_crossings(*model, model->state_from_chain(), options, periods * period, q, &out.stats);
+  out.crossings = static_cast<int>(crossings.size());
+  if (crossings.size() >= 2) out.omega = kPi / mean_spacing(crossings);
+  return out;
 }
 
 /// Observed orders log2(e_k / e_{k+1}) for halved mesh sizes, printed as a table.

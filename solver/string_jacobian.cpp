@@ -1,0 +1,271 @@
+// The exact linearisation of the string and its Newton systems: see string_jacobian.hpp.
+#include "string_jacobian.hpp"
+
+#include <cmath>
+#include <vector>
+
+#include <Eigen/SparseLU>
+#include <fmt/format.h>
+#ifdef CHAINSIM_WITH_KLU
+#include <Eigen/KLUSupport>
+#endif
+
+#include "mesh/errors.hpp"
+#include "forces.hpp"
+#include "string_model.hpp"
+
+namespace chainsim {
+
+template <int dim>
+struct StringJacobian<dim>::Factor {
+#ifdef CHAINSIM_WITH_KLU
+  Eigen::KLU<SpMat> lu;
+#else
+  Eigen::SparseLU<SpMat> lu;
+#endif
+  SpMat M;
+  // The pattern the symbolic analysis was done for.
+  std::vector<int> outer, inner;
+  bool analyzed = false;
+  /// Factors `matrix` (compressed), redoing the symbolic analysis only when the pattern changed.
+  void factorize(const SpMat& matrix);
+  bool same_pattern() const {
+    const auto no = static_cast<std::size_t>(M.outerSize()) + 1;
+    const auto ni = static_cast<std::size_t>(M.nonZeros());
+    return analyzed && outer.size() == no && inner.size() == ni &&
+           std::equal(outer.begin(), outer.end(), M.outerIndexPtr()) &&
+           std::equal(inner.begin(), inner.end(), M.innerIndexPtr());
+  }
+};
+
+template <int dim>
+StringJacobian<dim>::StringJacobian(StringModel<dim>& model)
+    : model_(model), factor_(std::make_unique<Factor>()), a_factor_(std::make_unique<Factor>()) {}
+
+template <int dim>
+StringJacobian<dim>::~StringJacobian() = default;
+
+template <int dim>
+void StringJacobian<dim>::linearize(double t, const Eigen::Ref<const Eigen::VectorXd>& y) {
+  using Mat = Eigen::Matrix<double, dim, dim>;
+  using V = Vec<dim>;
+  StringModel<dim>& m = model_;
+  CHAINSIM_VERIFY(m.system_ != nullptr, "the linearisation needs a tension system");
+  m.unpack_state(t, y);
+  m.evaluate_current(t);  // e, l, Δx, Δv, b and the tensions at (t, y)
+  const Chain<dim>& chain = m.chain_;
+  nv_ = dim * m.num_free_;
+  nt_ = m.system_->size();
+  const Eigen::VectorXd& T = m.system_->solution();
+  const int L = chain.num_links();
+  std::vector<int> prev(static_cast<std::size_t>(L), -1);
+  m.for_each_link([&](int j, int, int next) {
+    if (next >= 0) prev[static_cast<std::size_t>(next)] = j;
+  });
+
+  std::vector<Eigen::Triplet<double>> p, qx, qv, wg;
+  p.reserve(static_cast<std::size_t>(4 * dim * dim * L));
+  qx.reserve(static_cast<std::size_t>(6 * dim * L));
+  qv.reserve(static_cast<std::size_t>(2 * dim * L));
+  wg.reserve(static_cast<std::size_t>(2 * dim * L));
+  // Adds the block `value` at (row node, column node) when both are free.
+  auto add_block = [&](std::vector<Eigen::Triplet<double>>& out, int row_node, int col_node, const Mat& value) {
+    const int r = m.slot_[static_cast<std::size_t>(row_node)], c = m.slot_[static_cast<std::size_t>(col_node)];
+    if (r < 0 || c < 0) return;
+    for (int q = 0; q < dim; ++q)
+      for (int s = 0; s < dim; ++s) out.emplace_back(dim * r + q, dim * c + s, value(q, s));
+  };
+  // Adds g·δΔx_k (g a row) to row u: +g at the end node of link k, −g at its start node.
+  auto add_link_gradient = [&](std::vector<Eigen::Triplet<double>>& out, int u, int k, const V& g) {
+    const int ka = m.slot_[static_cast<std::size_t>(chain.link_start(k))];
+    const int kb = m.slot_[static_cast<std::size_t>(chain.link_end(k))];
+    for (int s = 0; s < dim; ++s) {
+      if (kb >= 0) out.emplace_back(u, dim * kb + s, g[s]);
+      if (ka >= 0) out.emplace_back(u, dim * ka + s, -g[s]);
+    }
+  };
+  auto tension_of = [&](int link) { return T[m.link_unknown_[static_cast<std::size_t>(link)]]; };
+  auto projector = [&](int link) -> Mat {
+    const V e = m.e_.col(link);
+    return Mat::Identity() - e * e.transpose();
+  };
+  const double alpha = m.alpha_, beta2 = m.beta_ * m.beta_;
+
+  m.for_each_link([&](int j, int u, int next) {
+    const int a = chain.link_start(j), b = chain.link_end(j);
+    const double l = m.l_[j], h = chain.link_length(j), wa = m.w_[a], wb = m.w_[b];
+    const V e = m.e_.col(j), dx = m.dx_.col(j), dv = m.dv_.col(j);
+    const Mat Pi = projector(j);
+    // P: the tension force ±T_j e_j with δe_j = Π_j δΔx_j / l_j.
+    const Mat K = (T[u] / l) * Pi;
+    add_block(p, a, b, wa * K);
+    add_block(p, a, a, -wa * K);
+    add_block(p, b, b, -wb * K);
+    add_block(p, b, a, wb * K);
+    // Q_j = δr_j − (δA T)_j.
+    const double s = 2 * alpha * dx.dot(dv) + beta2 * 0.5 * (l * l - h * h);
+    const V db = m.b_.col(b) - m.b_.col(a);
+    V gx = ((dv.squaredNorm() + s) / (l * l)) * e - Pi * db / l - (2 * alpha / l) * dv - (beta2 / l) * dx;
+    const V gv = -(2 / l) * (dv + alpha * dx);
+    if (next >= 0) {
+      const double Tn = tension_of(next);
+      gx -= (wb * Tn / l) * (Pi * m.e_.col(next));
+      add_link_gradient(qx, u, next, -(wb * Tn / m.l_[next]) * (projector(next) * e));
+    }
+    const int pj = prev[static_cast<std::size_t>(j)];
+    if (pj >= 0) {
+      const double Tp = tension_of(pj);
+      gx -= (wa * Tp / l) * (Pi * m.e_.col(pj));
+      add_link_gradient(qx, u, pj, -(wa * Tp / m.l_[pj]) * (projector(pj) * e));
+    }
+    add_link_gradient(qx, u, j, gx);
+    add_link_gradient(qv, u, j, gv);
+    // W Gᵀ: column u holds −w_a e_j at node a and +w_b e_j at node b.
+    const int ka = m.slot_[static_cast<std::size_t>(a)], kb = m.slot_[static_cast<std::size_t>(b)];
+    for (int q = 0; q < dim; ++q) {
+      if (ka >= 0) wg.emplace_back(dim * ka + q, u, -wa * e[q]);
+      if (kb >= 0) wg.emplace_back(dim * kb + q, u, wb * e[q]);
+    }
+  });
+  P_.resize(nv_, nv_);
+  P_.setFromTriplets(p.begin(), p.end());
+  Qx_.resize(nt_, nv_);
+  Qx_.setFromTriplets(qx.begin(), qx.end());
+  Qv_.resize(nt_, nv_);
+  Qv_.setFromTriplets(qv.begin(), qv.end());
+  WGt_.resize(nv_, nt_);
+  WGt_.setFromTriplets(wg.begin(), wg.end());
+  // A: the tension matrix as assembled by the model (compressed columns).
+  const SparsePattern& pattern = m.system_->pattern();
+  const std::vector<double>& values = m.system_->values();
+  std::vector<Eigen::Triplet<double>> at;
+  at.reserve(values.size());
+  for (int c = 0; c < pattern.n; ++c)
+    for (int k = pattern.col_ptr[static_cast<std::size_t>(c)]; k < pattern.col_ptr[static_cast<std::size_t>(c) + 1]; ++k)
+      at.emplace_back(pattern.row_index[static_cast<std::size_t>(k)], c, values[static_cast<std::size_t>(k)]);
+  A_.resize(nt_, nt_);
+  A_.setFromTriplets(at.begin(), at.end());
+  A_.makeCompressed();
+  a_factor_->factorize(A_);
+  exact_ = !m.module_;
+  for (const auto& force : m.forces_)
+    if (!dynamic_cast<const Gravity<dim>*>(force.get()) && !dynamic_cast<const EndLoad<dim>*>(force.get())) exact_ = false;
+}
+
+template <int dim>
+void StringJacobian<dim>::Factor::factorize(const SpMat& matrix) {
+  M = matrix;
+  if (!same_pattern()) {
+    lu.analyzePattern(M);
+    outer.assign(M.outerIndexPtr(), M.outerIndexPtr() + M.outerSize() + 1);
+    inner.assign(M.innerIndexPtr(), M.innerIndexPtr() + M.nonZeros());
+    analyzed = true;
+  }
+  lu.factorize(M);
+  if (lu.info() != Eigen::Success) {
+    analyzed = false;
+    throw RecoverableError("a Newton matrix of the string is singular");
+  }
+}
+
+template <int dim>
+Eigen::VectorXd StringJacobian<dim>::apply(const Eigen::Ref<const Eigen::VectorXd>& d) const {
+  Eigen::VectorXd out(d.size());
+  apply(d, out);
+  return out;
+}
+
+template <int dim>
+void StringJacobian<dim>::apply(const Eigen::Ref<const Eigen::VectorXd>& d, Eigen::Ref<Eigen::VectorXd> out) const {
+  const auto dx = d.head(nv_), dv = d.segment(nv_, nv_);
+  const Eigen::VectorXd w = a_factor_->lu.solve(Eigen::VectorXd(Qx_ * dx + Qv_ * dv));
+  out.setZero();
+  out.head(nv_) = dv;
+  out.segment(nv_, nv_) = P_ * dx - WGt_ * w;
+}
+
+template <int dim>
+void StringJacobian<dim>::factor(double gamma) {
+  gamma_ = gamma;
+  const int n = nv_ + nt_;
+  std::vector<Eigen::Triplet<double>> tr;
+  tr.reserve(static_cast<std::size_t>(nv_ + P_.nonZeros() + WGt_.nonZeros() + Qx_.nonZeros() + Qv_.nonZeros() +
+                                      A_.nonZeros()));
+  for (int i = 0; i < nv_; ++i) tr.emplace_back(i, i, 1.0);
+  auto add = [&](const SpMat& block, int row0, int col0, double scale) {
+    for (int c = 0; c < block.outerSize(); ++c)
+      for (SpMat::InnerIterator it(block, c); it; ++it)
+        tr.emplace_back(row0 + static_cast<int>(it.row()), col0 + static_cast<int>(it.col()), scale * it.value());
+  };
+  add(P_, 0, 0, -gamma * gamma);
+  add(WGt_, 0, nv_, gamma);
+  add(Qx_, nv_, 0, gamma);
+  add(Qv_, nv_, 0, 1.0);
+  add(A_, nv_, nv_, -1.0);
+  SpMat M(n, n);
+  M.setFromTriplets(tr.begin(), tr.end());
+  M.makeCompressed();
+  factor_->factorize(M);
+}
+
+template <int dim>
+void StringJacobian<dim>::solve(const Eigen::Ref<const Eigen::VectorXd>& r, Eigen::Ref<Eigen::VectorXd> z) const {
+  CHAINSIM_VERIFY(r.size() >= 2 * nv_ && z.size() == r.size(), "the Newton system has the state's size");
+  const auto rx = r.head(nv_), rv = r.segment(nv_, nv_);
+  Eigen::VectorXd rhs(nv_ + nt_);
+  rhs.head(nv_) = rv + gamma_ * (P_ * rx);
+  rhs.tail(nt_) = -(Qx_ * rx);
+  const Eigen::VectorXd sol = factor_->lu.solve(rhs);
+  z.segment(nv_, nv_) = sol.head(nv_);
+  z.head(nv_) = rx + gamma_ * sol.head(nv_);
+  z.tail(r.size() - 2 * nv_) = r.tail(r.size() - 2 * nv_);
+}
+
+// --- the string's Newton solver (OdeSystem) ------------------------------------------------------
+template <int dim>
+void StringModel<dim>::newton_setup(double t, const Eigen::Ref<const Eigen::VectorXd>& y, bool relinearize,
+                                    double gamma) {
+  if (!jacobian_) jacobian_ = std::make_shared<StringJacobian<dim>>(*this);
+  const bool stale = jacobian_->velocity_unknowns() != dim * num_free_ ||
+                     jacobian_->tension_unknowns() != (system_ ? system_->size() : 0);
+  if (relinearize)
+    jacobian_->linearize(t, y);
+  else if (stale)
+    throw RecoverableError("the string's linearisation is from before its layout changed");
+  jacobian_->factor(gamma);
+}
+
+template <int dim>
+void StringModel<dim>::newton_solve(const Eigen::Ref<const Eigen::VectorXd>& r, Eigen::Ref<Eigen::VectorXd> z) {
+  CHAINSIM_VERIFY(jacobian_ && jacobian_->velocity_unknowns() == dim * num_free_,
+                  "newton_setup() comes before newton_solve()");
+  jacobian_->solve(r, z);
+}
+
+template <int dim>
+bool StringModel<dim>::jacobian_times(const Eigen::Ref<const Eigen::VectorXd>& v, Eigen::Ref<Eigen::VectorXd> Jv) {
+  if (!jacobian_ || !jacobian_->exact() || jacobian_->velocity_unknowns() != dim * num_free_) return false;
+  jacobian_->apply(v, Jv);
+  return true;
+}
+
+template <int dim>
+double StringModel<dim>::explicit_stiffness() const {
+  if (!system_) return 0.0;
+  double h_min = INFINITY;
+  for_each_link([&](int j, int, int) { h_min = std::min(h_min, chain_.link_length(j)); });
+  return chain_.length() / h_min;
+}
+
+template class StringJacobian<2>;
+template class StringJacobian<3>;
+template void StringModel<2>::newton_setup(double, const Eigen::Ref<const Eigen::VectorXd>&, bool, double);
+template void StringModel<3>::newton_setup(double, const Eigen::Ref<const Eigen::VectorXd>&, bool, double);
+template void StringModel<2>::newton_solve(const Eigen::Ref<const Eigen::VectorXd>&, Eigen::Ref<Eigen::VectorXd>);
+template void StringModel<3>::newton_solve(const Eigen::Ref<const Eigen::VectorXd>&, Eigen::Ref<Eigen::VectorXd>);
+template bool StringModel<2>::jacobian_times(const Eigen::Ref<const Eigen::VectorXd>&, Eigen::Ref<Eigen::VectorXd>);
+template bool StringModel<3>::jacobian_times(const Eigen::Ref<const Eigen::VectorXd>&, Eigen::Ref<Eigen::VectorXd>);
+template double StringModel<2>::explicit_stiffness() const;
+template double StringModel<3>::explicit_stiffness() const;
+
+}  // namespace chainsim

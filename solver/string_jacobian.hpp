@@ -1,0 +1,72 @@
+#pragma once
+/// @file string_jacobian.hpp
+/// The exact linearisation of the string's right-hand side and the Newton systems of implicit
+/// methods, solved at O(N) cost (docs/string_solver.md, "The implicit path").
+///
+/// The accelerations are a = b − W Gᵀ T with the tensions from A(x) T = r(x, v) (tension_system.hpp):
+/// W the inverse masses, G the constraint Jacobian (row j: −e_jᵀ at node a, +e_jᵀ at node b).
+/// A variation (δx, δv) of the free nodes gives
+///
+///     δa = P δx − W Gᵀ w,    A w = Qx δx + Qv δv,
+///
+/// with P = ∂a/∂x at frozen tensions (P_v = 0), and Q = ∂r − (∂A) T. P, Qx, Qv, W Gᵀ and A are
+/// sparse (a link couples its two nodes and its neighbouring links), so J = P + C A⁻¹ Q is the Schur
+/// complement of a sparse matrix and the Newton system (I − γ J) z = r of a DIRK stage, with
+/// z = (zx, zv), zx = rx + γ zv, becomes the sparse augmented system in (zv, w)
+///
+///     [ I − γ² P      γ W Gᵀ ] [zv]   [ rv + γ P rx ]
+///     [ γ Qx + Qv     −A     ] [w ] = [ −Qx rx      ]
+///
+/// factored by KLU (Eigen's SparseLU when built without KLU). The ledgers (W_applied, a module's)
+/// enter no right-hand side: their Newton rows are taken as identity. What the linearisation
+/// leaves out: velocity-dependent forces (drag), the derivative of the applied forces, and a front
+/// module's masses and loads: implicit methods use the linearisation as the preconditioner of GMRES,
+/// whose products J·v come from the right-hand side itself, so those terms are still honoured.
+#include <memory>
+
+#include <Eigen/Core>
+#include <Eigen/SparseCore>
+
+namespace chainsim {
+
+template <int dim>
+class StringModel;
+
+template <int dim>
+class StringJacobian {
+ public:
+  explicit StringJacobian(StringModel<dim>& model);
+  ~StringJacobian();
+  StringJacobian(const StringJacobian&) = delete;
+  StringJacobian& operator=(const StringJacobian&) = delete;
+
+  /// Evaluates the model at (t, y) and builds P, Qx, Qv, W Gᵀ and A there.
+  void linearize(double t, const Eigen::Ref<const Eigen::VectorXd>& y);
+  /// J·d for the position and velocity parts of a state-sized d at the last linearisation (the ledger
+  /// rows are zero). Exact for forces that depend on neither x nor v (gravity, drivers).
+  Eigen::VectorXd apply(const Eigen::Ref<const Eigen::VectorXd>& d) const;
+  /// The same into `out` (state-sized), with the factorisation of A made by linearize().
+  void apply(const Eigen::Ref<const Eigen::VectorXd>& d, Eigen::Ref<Eigen::VectorXd> out) const;
+  /// True if the model's applied forces are all state-independent (gravity, loads, drivers) and it
+  /// has no module: J is then exact.
+  bool exact() const { return exact_; }
+  /// Factors the augmented system of I − γ J. Throws RecoverableError if it is singular.
+  void factor(double gamma);
+  /// z = (I − γ J)⁻¹ r (ledger components: z = r) with the γ of the last factor().
+  void solve(const Eigen::Ref<const Eigen::VectorXd>& r, Eigen::Ref<Eigen::VectorXd> z) const;
+
+  int velocity_unknowns() const { return nv_; }
+  int tension_unknowns() const { return nt_; }
+
+ private:
+  using SpMat = Eigen::SparseMatrix<double>;
+  StringModel<dim>& model_;
+  int nv_ = 0, nt_ = 0;  // dim · free nodes; tension unknowns
+  SpMat P_, Qx_, Qv_, WGt_, A_;
+  double gamma_ = 0;
+  bool exact_ = false;
+  struct Factor;
+  std::unique_ptr<Factor> factor_, a_factor_;  // the augmented system; A alone (for apply)
+};
+
+}  // namespace chainsim
