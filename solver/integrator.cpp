@@ -91,13 +91,16 @@ std::string flag_name(int flag) {
 std::string valid_methods() {
   std::string list;
   for (const auto& [alias, entry] : aliases()) list += (list.empty() ? "" : ", ") + alias;
-  return list + ", or an ARKODE_* Butcher table name";
+  return "auto, " + list + ", or an ARKODE_* Butcher table name";
 }
 
 }  // namespace
 
 std::vector<std::pair<std::string, std::string>> method_aliases() {
   std::vector<std::pair<std::string, std::string>> out;
+  out.emplace_back("auto", fmt::format("{} for a system as stiff as a string of {:g} links or more and without "
+                                       "root functions, else {}",
+                                       kAutoImplicit, Integrator::kAutoImplicitStiffness, kAutoExplicit));
   for (const auto& [alias, entry] : aliases())
     out.emplace_back(alias, fmt::format("{} ({})", entry.description, entry.table));
   return out;

@@ -174,7 +174,7 @@ TEST_CASE("bad scenes are refused with the location, the key, the value and what
        "s.toml:18:1: [effects.drag] needs coefficient (1/s, >= 0: the force -coefficient m v on every node)"},
       {"an unknown integration method",
        kBase + std::string("[solver]\nmethod = \"rk99\"\n"),
-       "s.toml:19:10: solver.method = \"rk99\" is not a known integration method: allowed dirk2, dirk3, dirk4, "
+       "s.toml:19:10: solver.method = \"rk99\" is not a known integration method: allowed auto, dirk2, dirk3, dirk4, "
        "dirk5, erk3, erk4, erk5, erk6, erk8, or an ARKODE_* Butcher table name"},
       {"a relative tolerance of one",
        kBase + std::string("[solver]\nrtol = 1.0\n"),
