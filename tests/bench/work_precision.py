@@ -350,19 +350,21 @@ class Study:
                "atol": rtol / 100, "nodes": nodes, "error": float("nan"), "error_eta": float("nan"),
                "error_P": float("nan"), "wall_s": float("nan"), "walls": ";".join(f"{w:.6g}" for w in walls),
                "steps": stats.get("steps", ""), "rhs_evals": stats.get("rhs_evals", ""),
-               "status": "ok" if rc == 0 else (f"exit {rc}" if rc != "timeout" else "timeout"), "command": command_line(args)}
+               "status": "ok" if rc == 0 else (f"exit {rc}" if rc != "timeout" else "timeout"),
+               "why": "" if rc == 0 else str(summary.get("error", ""))[:160], "command": command_line(args)}
         if rc == 0:
             e1, e2 = errors
             row.update(error_eta=e1, error_P=e2, error=max(e for e in (e1, e2) if not math.isnan(e)),
                        wall_s=statistics.median(walls))
         self.rows.append(row)
         self.log(f"  {case:8s} {model:7s} {method:6s} rtol {rtol:7.0e} N {nodes:4d}  error {row['error']:9.3e}"
-                 f"  wall {row['wall_s']:9.4f} s  {row['status']}")
+                 f"  wall {row['wall_s']:9.4f} s  {row['status']} {row['why'][:70]}")
         return row
 
     def sweep(self, case, methods, rtols, meshes, extra=None):
-        """Every method x mesh x tolerance; a method whose run fails (e.g. over its wall budget) skips the
-        tighter tolerances of that mesh, and the finer meshes at that tolerance."""
+        """Every method x mesh x tolerance; a method whose run uses up its wall budget skips the tighter
+        tolerances of that mesh and the finer meshes at that tolerance (they would cost more); any other
+        failure (e.g. a false slack at a loose tolerance) is recorded, and the sweep goes on."""
         for method, desc in methods:
             failed_at = {}
             for nodes in meshes:
@@ -379,7 +381,7 @@ class Study:
                     summary, walls, out, rc = self.runner.run(args, tag)
                     errors = case.measure(out, summary) if rc == 0 else None
                     row = self.record(case.name, method, is_explicit(desc), rtol, nodes, args, summary, walls, rc, errors)
-                    if rc != 0:
+                    if rc == "timeout" or "wall-clock budget" in row["why"]:
                         failed_at[nodes] = rtol
 
     def reduced_floor(self, case, methods, rtols):
@@ -476,24 +478,33 @@ def plot(study, cases, info, path, title, command):
     fig, axes = plt.subplots(1, len(cases), figsize=(5.2 * len(cases), 4.8), squeeze=False)
     for ax, case in zip(axes[0], cases):
         rows = [r for r in study.rows if r["case"] == case.name and r["status"] == "ok" and r["error"] > 0]
-        meshes = sorted({r["nodes"] for r in rows if r["model"] == "string"})
+        string = [r for r in rows if r["model"] == "string"]
+        # One line per method: a tolerance sweep (loosest first) on one mesh; with several meshes, one line
+        # per method and tolerance, the mesh refined along it (coarsest first).
+        refined = len({r["nodes"] for r in string}) > 1
+        rtols = sorted({r["rtol"] for r in string}, reverse=True)
         styles = ["-", "--", ":", "-."]
         for m in methods:
-            for i, n in enumerate(meshes):
-                pts = sorted([(r["wall_s"], r["error"]) for r in rows
-                              if r["method"] == m and r["nodes"] == n and r["model"] == "string"])
+            explicit = any(r["explicit"] for r in rows if r["method"] == m)
+            groups = [(f"{m}, rtol {t:.0e}", styles[i % 4], [r for r in string if r["method"] == m and r["rtol"] == t])
+                      for i, t in enumerate(rtols)] if refined else [(m, "-", [r for r in string if r["method"] == m])]
+            for label, style, group in groups:
+                pts = [(r["wall_s"], r["error"]) for r in sorted(group, key=lambda r: (r["nodes"], -r["rtol"]))]
                 if pts:
                     x, y = zip(*pts)
-                    explicit = any(r["explicit"] for r in rows if r["method"] == m)
-                    ax.loglog(x, y, styles[i % 4], marker="o" if explicit else "s", ms=4, color=color[m],
-                              mfc=color[m] if explicit else "none",
-                              label=f"{m}" + (f", N={n}" if len(meshes) > 1 else ""))
-            pts = sorted([(r["wall_s"], r["error"]) for r in rows if r["method"] == m and r["model"] == "reduced"])
+                    ax.loglog(x, y, style, marker="o" if explicit else "s", ms=4, color=color[m],
+                              mfc=color[m] if explicit else "none", label=label)
+            pts = [(r["wall_s"], r["error"]) for r in sorted(rows, key=lambda r: -r["rtol"])
+                   if r["method"] == m and r["model"] == "reduced"]
             if pts:
                 x, y = zip(*pts)
                 ax.loglog(x, y, "-", color=color[m], lw=0.8, alpha=0.5, marker=".", ms=3)
         if any(r["model"] == "reduced" for r in rows):
             ax.plot([], [], "-", color="gray", marker=".", lw=0.8, label="reduced ODE (floor)")
+        if refined:
+            nodes = sorted({r["nodes"] for r in string})
+            ax.text(0.99, 0.01, f"meshes: {', '.join(map(str, nodes))} nodes", transform=ax.transAxes,
+                    ha="right", va="bottom", fontsize=7)
         ax.set_title(case.title, fontsize=9)
         ax.set_xlabel("wall time of the solve (s, median)")
         ax.set_ylabel("error" + (" (max |Δη|, max rel. |ΔP|)" if case.name in ("falling", "folded", "sliding")
@@ -594,11 +605,11 @@ def main():
         (opts.out / "curved_reference.json").write_text(json.dumps(reference, indent=1))
         study.sweep(curved, methods, [1e-4, 1e-8], [21, 41, 81, 161])
         study.log(f"hanging: {hanging.title}")
-        study.sweep(hanging, methods, [1e-5, 1e-9], [11, 21, 41, 81], hanging.overrides())
+        study.sweep(hanging, methods, [1e-5, 1e-9], [11, 21, 41, 81, 161, 321], hanging.overrides())
         cases = canonical + [tilted, curved, hanging]
 
     fields = ["case", "model", "method", "explicit", "rtol", "atol", "nodes", "error", "error_eta", "error_P",
-              "wall_s", "walls", "steps", "rhs_evals", "status", "command"]
+              "wall_s", "walls", "steps", "rhs_evals", "status", "why", "command"]
     csv_path = opts.out / "work_precision.csv"
     with open(csv_path, "w", newline="") as fh:
         w = csv.DictWriter(fh, fieldnames=fields)
