@@ -134,7 +134,7 @@ class Runner:
             cmd = [str(self.chainsim)] + args + ["--out", str(out), "--json"]
             self.count += 1
             try:
-                p = subprocess.run(cmd, capture_output=True, text=True, timeout=self.budget * 3 + 60)
+                p = subprocess.run(cmd, capture_output=True, text=True, timeout=self.budget * 3 + 60, cwd=ROOT)
             except subprocess.TimeoutExpired:
                 rc = "timeout"
                 break
@@ -154,7 +154,7 @@ def command_line(args):
 
 
 def scene_run_args(scene, overrides, budget):
-    args = ["run", str(scene.relative_to(ROOT)), "--quiet", "--max-wall", str(budget)]
+    args = ["run", os.path.relpath(scene, ROOT), "--quiet", "--max-wall", str(budget)]
     for k, v in overrides.items():
         args += ["--set", f"{k}={v}"]
     return args
@@ -274,12 +274,25 @@ class HangingModeCase:
     def phi(self, sigma):
         return np.array([self.J0(self.j01 * math.sqrt(max(s, 0.0) / self.ell)) for s in np.atleast_1d(sigma)])
 
-    def overrides(self):
+    def write_scene(self, out):
+        """OUT/hanging_chain_mode1.toml: the scene with its straight tilted line replaced by the first mode
+        shape (a polyline through 201 points of it); the runs' commands name this file."""
         s = np.linspace(0.0, self.ell, 201)
         x = self.amplitude * self.ell * self.phi(self.ell - s)
-        points = "[" + ",".join(f"[{xi:.17g},{-si:.17g}]" for xi, si in zip(x, s)) + "]"
-        return {"shape.kind": '"polyline"', "shape.points": points, "stop.t_end": repr(self.t_end),
-                "output.interval": "0.02", "output.fields": '["nodes","stats"]', "output.formats": '["csv"]'}
+        points = "points = [" + ", ".join(f"[{xi:.17g}, {-si:.17g}]" for xi, si in zip(x, s)) + "]"
+        text, n = re.subn(r"^points = \[\[.*\]\].*$", lambda m: points, self.scene.read_text(), count=1,
+                          flags=re.M)
+        if n != 1:
+            raise RuntimeError(f"{self.scene}: no 'points = [[...]]' line to replace by the mode shape")
+        path = out / "hanging_chain_mode1.toml"
+        path.write_text(f"# Written by tests/bench/work_precision.py: {self.scene.name} started on its first mode,\n"
+                        f"# amplitude {self.amplitude:g} l (phi1(sigma) = J0(j01 sqrt(sigma / l)), sigma from the free end).\n"
+                        + text)
+        self.scene = path
+
+    def overrides(self):
+        return {"stop.t_end": repr(self.t_end), "output.interval": "0.02", "output.fields": '["nodes","stats"]',
+                "output.formats": '["csv"]'}
 
     def measure(self, run_dir, summary):
         data = np.genfromtxt(run_dir / "nodes.csv", delimiter=",", names=True)
@@ -431,12 +444,6 @@ def best_settings(rows, case, target):
     return min(ok, key=lambda r: r["wall_s"]) if ok else None
 
 
-def short_command(command):
-    """The command with values longer than 60 characters (the mode shape's points) elided: the CSV has it whole."""
-    return re.sub(r"(--set '?[\w.\[\]]+=)([^ ]{60,})",
-                  lambda m: m.group(1) + "<...: see the CSV>" + ("'" if m.group(2).endswith("'") else ""), command)
-
-
 def write_table(study, cases, info, path):
     rows = study.rows
     lines = ["| case | target error | best wall time (s) | settings | error reached | best explicit (s) | "
@@ -453,7 +460,7 @@ def write_table(study, cases, info, path):
             ex_text = f"{ex['wall_s']:.3g} ({ex['method']})" if ex else "–"
             im_text = f"{im['wall_s']:.3g} ({im['method']})" if im else "–"
             lines.append(f"| {case.name} | {target:.0e} | {best['wall_s']:.3g} | {settings} | {best['error']:.1e} | "
-                         f"{ex_text} | {im_text} | `{short_command(best['command'])}` |")
+                         f"{ex_text} | {im_text} | `{best['command']}` |")
     # where implicit beats explicit: every (case, target) with both reached
     cross = []
     for case in cases:
@@ -535,6 +542,8 @@ def main():
         sys.exit(f"work_precision.py: {opts.chainsim} not found: build it first (cmake --build build --target chainsim)")
     if opts.repeats < 1 or opts.budget <= 0:
         sys.exit("work_precision.py: --repeats must be >= 1 and --budget > 0")
+    opts.out = opts.out.resolve()
+    opts.chainsim = opts.chainsim.resolve()
     opts.out.mkdir(parents=True, exist_ok=True)
     figures = opts.figures or opts.out
     figures.mkdir(parents=True, exist_ok=True)
@@ -561,6 +570,7 @@ def main():
     tilted = TiltedCase(SCENES / "tilted_falling_chain.toml")
     curved = CurvedCase(SCENES / "curved_falling_chain.toml")
     hanging = HangingModeCase(SCENES / "hanging_chain.toml")
+    hanging.write_scene(opts.out)
     smoke_failures = []
 
     if opts.smoke:
