@@ -51,38 +51,41 @@ std::unique_ptr<StringModel<2>> swinging_chain(int links, const std::string& bac
   return model;
 }
 
-/// The model, or nullptr after marking the benchmark skipped when the backend is not built.
-std::unique_ptr<StringModel<2>> model_or_skip(benchmark::State& state) {
+/// The swinging chain of state.range(1) links with backend state.range(0), at (t, y) a little after the
+/// release (20 steps of erk5), so that the velocity terms of the tension equation are not zero. No model
+/// (the benchmark marked skipped) when the backend is not built.
+struct MovingChain {
+  std::unique_ptr<StringModel<2>> model;
+  double t = 0;
+  Eigen::VectorXd y;
+};
+
+MovingChain moving_chain_or_skip(benchmark::State& state) {
   const std::string backend = kBackends[state.range(0)];
+  MovingChain c;
   try {
-    return swinging_chain(static_cast<int>(state.range(1)), backend);
+    c.model = swinging_chain(static_cast<int>(state.range(1)), backend);
   } catch (const InputError& e) {
     state.SkipWithError(("backend " + backend + " not built: " + e.what()).c_str());
-    return nullptr;
+    return c;
   }
-}
-
-/// The state a little after the release, so that the velocity terms of the tension equation are
-/// not zero: 20 steps of erk5.
-Eigen::VectorXd moving_state(StringModel<2>& model, double& t) {
   IntegratorOptions io;
   io.method = "erk5";
   io.rtol = 1e-8;
   io.atol = 1e-10;
-  Integrator integrator(model, 0.0, model.state_from_chain(), io);
+  Integrator integrator(*c.model, 0.0, c.model->state_from_chain(), io);
   for (int k = 0; k < 20; ++k) integrator.advance(10.0, true);
-  t = integrator.time();
-  return integrator.state();
+  c.t = integrator.time();
+  c.y = integrator.state();
+  return c;
 }
 
 void BM_StringRhs(benchmark::State& state) {
-  auto model = model_or_skip(state);
-  if (!model) return;
-  double t = 0;
-  const Eigen::VectorXd y = moving_state(*model, t);
-  Eigen::VectorXd ydot(y.size());
+  MovingChain c = moving_chain_or_skip(state);
+  if (!c.model) return;
+  Eigen::VectorXd ydot(c.y.size());
   for (auto _ : state) {
-    model->rhs(t, y, ydot);
+    c.model->rhs(c.t, c.y, ydot);
     benchmark::DoNotOptimize(ydot.data());
     benchmark::ClobberMemory();
   }
@@ -93,13 +96,12 @@ void BM_StringRhs(benchmark::State& state) {
 }
 
 void BM_TensionSolve(benchmark::State& state) {
-  auto model = model_or_skip(state);
-  if (!model) return;
-  double t = 0;
-  const Eigen::VectorXd y = moving_state(*model, t);
-  Eigen::VectorXd ydot(y.size());
-  model->rhs(t, y, ydot);  // assembles the system of this state
-  TensionSystem& system = model->tension_system();
+  MovingChain c = moving_chain_or_skip(state);
+  if (!c.model) return;
+  Eigen::VectorXd ydot(c.y.size());
+  c.model->rhs(c.t, c.y, ydot);  // assembles the system of this state
+  const double t = c.t;
+  TensionSystem& system = c.model->tension_system();
   const Eigen::VectorXd rhs = system.rhs_vector();
   for (auto _ : state) {
     for (int u = 0; u < system.size(); ++u) system.rhs(u) = rhs[u];  // the solve overwrites it
