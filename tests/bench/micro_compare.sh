@@ -3,7 +3,8 @@
 # revision against the current build. If the earlier revision has no tests/bench/bench_micro.cpp, the
 # current benchmark source is built against the earlier revision's libraries (same API needed). The two
 # binaries then run alternately (old, new, old, new, …), so that drifts of a shared machine hit both
-# alike; printed: the median real time per iteration of each benchmark, and the ratio new/old.
+# alike; printed: the median CPU and real time per iteration of each benchmark, and the ratios new/old
+# (on a loaded machine the CPU time is the steadier of the two).
 #
 # Usage: bash tests/bench/micro_compare.sh OLD_REV [ROUNDS] [FILTER]   (from the repository root, after
 #        `cmake --build build --target chainsim_bench_micro`; ROUNDS default 5; FILTER a
@@ -34,9 +35,9 @@ for ((r = 0; r < rounds; ++r)); do
   done
 done
 /usr/bin/python3 - "$out" "$rounds" "$old_rev" "$(git rev-parse --short HEAD)" <<'PY'
-import json, statistics, sys, collections, glob
+import json, statistics, sys, collections
 out, rounds, old_rev, new_rev = sys.argv[1], int(sys.argv[2]), sys.argv[3], sys.argv[4]
-t = collections.defaultdict(list)
+t = collections.defaultdict(list)  # (which, name, "cpu" | "real") -> microseconds per iteration
 order = []
 for which in ("old", "new"):
     for r in range(rounds):
@@ -44,18 +45,21 @@ for which in ("old", "new"):
             if b.get("error_occurred"):
                 continue
             scale = {"ns": 1e-3, "us": 1.0, "ms": 1e3, "s": 1e6}[b["time_unit"]]
-            t[(which, b["name"])].append(b["real_time"] * scale)
+            for kind in ("cpu", "real"):
+                t[(which, b["name"], kind)].append(b[kind + "_time"] * scale)
             if b["name"] not in order:
                 order.append(b["name"])
-print(f"{'benchmark':34s} {'old (us)':>12s} {'new (us)':>12s} {'new/old':>8s}   "
-      f"old = {old_rev}, new = {new_rev}; medians of {rounds} alternating rounds")
+print(f"old = {old_rev}, new = {new_rev}; medians of {rounds} alternating rounds, microseconds per iteration")
+print(f"{'benchmark':28s} {'old cpu':>10s} {'new cpu':>10s} {'new/old':>8s}   {'old real':>10s} {'new real':>10s} {'new/old':>8s}")
 for name in order:
-    o, n = t[("old", name)], t[("new", name)]
-    if not o or not n:
-        print(f"{name:34s} {'–' if not o else f'{statistics.median(o):12.3f}':>12s} "
-              f"{'–' if not n else f'{statistics.median(n):12.3f}':>12s}")
-        continue
-    mo, mn = statistics.median(o), statistics.median(n)
-    print(f"{name:34s} {mo:12.3f} {mn:12.3f} {mn / mo:8.3f}")
+    cells = []
+    for kind in ("cpu", "real"):
+        o, n = t[("old", name, kind)], t[("new", name, kind)]
+        if o and n:
+            mo, mn = statistics.median(o), statistics.median(n)
+            cells.append(f"{mo:10.3f} {mn:10.3f} {mn / mo:8.3f}")
+        else:
+            cells.append(f"{'–' if not o else f'{statistics.median(o):.3f}':>10s} {'–' if not n else f'{statistics.median(n):.3f}':>10s} {'':>8s}")
+    print(f"{name:28s} {cells[0]}   {cells[1]}")
 PY
 rm -rf "$out"
