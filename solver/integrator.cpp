@@ -111,7 +111,9 @@ void IntegratorOptions::validate() const {
     throw InputError(fmt::format("method = \"{}\" is not a known integration method: allowed {}", method,
                                  valid_methods()));
   require_in_range("rtol", rtol, 1e-14, 1e-2);
-  require_positive("atol", atol);
+  // atol is relative to the state scale: above 1e-2 a component may err by more than 1% of its natural
+  // size (a tension of -1e13 N went unnoticed for a while with atol = 1e6).
+  require_in_range("atol", atol, 0.0, 1e-2, Bound::kOpen);
   require_in_range("max_step", max_step, 0.0, INFINITY);
   require_in_range("initial_step", initial_step, 0.0, INFINITY);
   if (max_steps < 1)

@@ -3,6 +3,7 @@
 #include <cerrno>
 #include <cmath>
 #include <cstring>
+#include <iterator>
 #include <system_error>
 
 #include <fmt/format.h>
@@ -67,21 +68,36 @@ std::vector<double> CsvTable::column(const std::string& name) const {
 }
 
 void CsvTable::write(const std::filesystem::path& path, int significant_digits) const {
-  AtomicFile file(path);
-  auto& out = file.stream();
-  const bool labelled = !label_column_.empty();
-  if (labelled) out << label_column_ << ',';
-  for (std::size_t j = 0; j < columns_.size(); ++j) out << (j ? "," : "") << columns_[j];
-  out << '\n';
-  for (std::size_t i = 0; i < data_.size(); ++i) {
-    if (labelled) out << labels_[i] << ',';
-    for (std::size_t j = 0; j < data_[i].size(); ++j)
-      out << (j ? "," : "")
-          << (significant_digits > 0 ? fmt::format("{:.{}g}", data_[i][j], significant_digits)
-                                     : fmt::format("{}", data_[i][j]));
-    out << '\n';
-  }
+  CsvWriter file(path, columns_, label_column_, significant_digits);
+  for (std::size_t i = 0; i < data_.size(); ++i)
+    file.row(data_[i].data(), data_[i].size(), label_column_.empty() ? nullptr : &labels_[i]);
   file.commit();
+}
+
+CsvWriter::CsvWriter(const std::filesystem::path& path, const std::vector<std::string>& columns,
+                     const std::string& label_column, int significant_digits)
+    : file_(path), columns_(columns.size()), labelled_(!label_column.empty()), digits_(significant_digits) {
+  auto& out = file_.stream();
+  if (labelled_) out << label_column << ',';
+  for (std::size_t j = 0; j < columns.size(); ++j) out << (j ? "," : "") << columns[j];
+  out << '\n';
+}
+
+void CsvWriter::row(const double* values, std::size_t count, const std::string* label) {
+  CHAINSIM_VERIFY(count == columns_, "CSV row length differs from the header");
+  CHAINSIM_VERIFY(labelled_ == (label != nullptr), "a CSV row has a label exactly when its file has a label column");
+  line_.clear();
+  auto it = std::back_inserter(line_);
+  if (label) fmt::format_to(it, "{},", *label);
+  for (std::size_t j = 0; j < count; ++j) {
+    if (j) line_.push_back(',');
+    if (digits_ > 0)
+      fmt::format_to(it, "{:.{}g}", values[j], digits_);
+    else
+      fmt::format_to(it, "{}", values[j]);
+  }
+  line_.push_back('\n');
+  file_.stream().write(line_.data(), static_cast<std::streamsize>(line_.size()));
 }
 
 void write_json(const std::filesystem::path& path, const nlohmann::json& doc) {

@@ -34,6 +34,26 @@ class AtomicFile {
   bool committed_ = false;
 };
 
+/// A CSV file written row by row through an AtomicFile (nothing held in memory): the header at
+/// construction, then rows of numbers, each optionally led by a text label; commit() publishes it.
+/// significant_digits = 0: the shortest text that reads back to the same double.
+class CsvWriter {
+ public:
+  CsvWriter(const std::filesystem::path& path, const std::vector<std::string>& columns,
+            const std::string& label_column = "", int significant_digits = 0);
+  /// Appends a row; it must have one value per column.
+  void row(const double* values, std::size_t count, const std::string* label = nullptr);
+  void row(const std::vector<double>& values) { row(values.data(), values.size()); }
+  void commit() { file_.commit(); }
+
+ private:
+  AtomicFile file_;
+  std::size_t columns_;
+  bool labelled_;
+  int digits_;
+  std::string line_;
+};
+
 /// A CSV table built in memory and written atomically: one header row, then numeric rows, each
 /// optionally led by a text label (e.g. the problem's name) when a label column is named.
 class CsvTable {

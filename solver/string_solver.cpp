@@ -20,21 +20,73 @@ void StringSolverOptions::validate() const {
   require_in_range("output.interval", output_interval, 0.0, INFINITY, Bound::kOpen);
 }
 
-void StringSolverOptions::check_frame_budget(int nodes) const {
-  // About 40 bytes per node and frame, so the limit is under 1 GB: a typo must not exhaust the machine.
-  constexpr double kMaxNodeFrames = 2e7;
-  const double frames = std::floor(t_end / output_interval) + 2;
-  const double node_frames = frames * nodes;
-  if (node_frames > kMaxNodeFrames)
-    throw InputError(fmt::format("output.interval = {:g} s with stop.t_end = {:g} s asks for {:.3g} frames of "
-                                 "{} nodes ({:.3g} node-frames): allowed at most {:.0e}; raise output.interval",
-                                 output_interval, t_end, frames, nodes, node_frames, kMaxNodeFrames));
+namespace {
+// Bytes per node-frame of each output, measured on `chainsim run cases/scenes/hanging_chain.toml
+// --set string.nodes=1001 --set output.interval=0.01 --set stop.t_end=1` (docs/scenes.md):
+// nodes.csv 95 B for 6 values, tension.csv 49 B for 4, frames/ 85 B binary and 203 B ascii. A value
+// of a moving string prints longer than one at rest (up to 17 digits, sign, exponent, comma): the
+// estimate takes 20 B a value, so it bounds the CSV from above.
+constexpr double kCsvBytesPerValue = 20;
+// ParaView, per node: coordinates and velocity (3 doubles each), mass, s and the link's tension
+// (1 double each), the link's two point indices (int32): 84 B raw; as text, the measured 203 B.
+constexpr double kVtkBinaryBytes = 84, kVtkAsciiBytes = 210;
+// Per frame: in memory, the Frame's own fields and vectors' bookkeeping; on disk, the ParaView files'
+// headers, the .pvd entry, the energy and forces rows.
+constexpr double kMemoryPerFrame = 512, kDiskPerFrame = 4096;
+}  // namespace
+
+OutputEstimate StringSolverOptions::estimate_outputs(int nodes, int dim, bool fronts,
+                                                     const OutputSelection& select) const {
+  OutputEstimate e;
+  e.frames = std::floor(t_end / output_interval) + 2;
+  e.node_frames = e.frames * nodes;
+  // A Frame holds every node's position and velocity, a tension per link and the index of each
+  // moving node.
+  e.memory_bytes = e.node_frames * ((2.0 * dim + 1) * sizeof(double) + sizeof(int)) + e.frames * kMemoryPerFrame;
+  double per_node_frame = 0;
+  if (select.csv && select.nodes) per_node_frame += (2.0 + (fronts ? 1 : 0) + 2 * dim) * kCsvBytesPerValue;
+  if (select.csv && select.tension) per_node_frame += 4 * kCsvBytesPerValue;
+  if (select.vtk && select.nodes) per_node_frame += select.vtk_ascii ? kVtkAsciiBytes : kVtkBinaryBytes;
+  e.disk_bytes = e.node_frames * per_node_frame + e.frames * kDiskPerFrame;
+  return e;
+}
+
+void StringSolverOptions::check_output_budget(int nodes, int dim, bool fronts, const OutputSelection& select) const {
+  const OutputEstimate e = estimate_outputs(nodes, dim, fronts, select);
+  const std::string asks = fmt::format("output.interval = {:g} s with stop.t_end = {:g} s asks for {:.3g} frames of {} "
+                                       "nodes ({:.3g} node-frames)",
+                                       output_interval, t_end, e.frames, nodes, e.node_frames);
+  if (e.memory_bytes > kMaxFrameMemory)
+    throw InputError(fmt::format("{}: they would take {:.3g} GB of memory until written, allowed at most {:.3g} GB; "
+                                 "raise output.interval",
+                                 asks, e.memory_bytes / 1e9, kMaxFrameMemory / 1e9));
+  if (e.disk_bytes > select.max_megabytes * 1e6)
+    throw InputError(fmt::format("{}: the selected outputs would take about {:.3g} MB on disk, more than "
+                                 "output.max_megabytes = {:g}; raise output.interval, select fewer fields or formats, "
+                                 "or raise output.max_megabytes",
+                                 asks, e.disk_bytes / 1e6, select.max_megabytes));
 }
 
 const std::vector<std::string>& run_output_files() {
   static const std::vector<std::string> files = {"stats.json", "nodes.csv",  "tension.csv", "energy.csv",
                                                  "forces.csv", "series.csv", "string.pvd"};
   return files;
+}
+
+void clear_run_outputs(const std::filesystem::path& dir) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  auto refuse = [&](const fs::path& path, const char* is, const char* wanted) {
+    throw InputError(fmt::format("--out = '{}': '{}' is {}, where a run writes {}; remove or rename it, or choose "
+                                 "another --out",
+                                 dir.string(), path.string(), is, wanted));
+  };
+  for (const std::string& name : run_output_files())
+    if (fs::is_directory(dir / name, ec)) refuse(dir / name, "a directory", "a file");
+  if (fs::exists(dir / "frames", ec) && !fs::is_directory(dir / "frames", ec))
+    refuse(dir / "frames", "a file", "a directory of ParaView frames");
+  for (const std::string& name : run_output_files()) fs::remove(dir / name, ec);
+  fs::remove_all(dir / "frames", ec);
 }
 
 nlohmann::json to_json(const RunSummary& s) {
@@ -120,7 +172,10 @@ template <int dim>
 StringSolver<dim>::StringSolver(StringModel<dim>& model, const StringSolverOptions& options)
     : model_(model), options_(options) {
   options_.validate();
-  options_.check_frame_budget(model_.chain().num_nodes());
+  // The frames' memory (the scene checks its outputs' disk budget with its own selection).
+  OutputSelection memory_only;
+  memory_only.csv = memory_only.vtk = false;
+  options_.check_output_budget(model_.chain().num_nodes(), dim, model_.module() != nullptr, memory_only);
   describe_model();
 }
 
@@ -348,51 +403,60 @@ void StringSolver<dim>::write_outputs(const std::filesystem::path& dir, const Ou
   ensure_directory(dir);
   // 1. Remove every output of an earlier run first: the directory then holds this run's files or
   //    none, never a mix; stats.json, written last, marks a complete set.
-  std::error_code ec;
-  for (const std::string& name : run_output_files()) std::filesystem::remove(dir / name, ec);
-  std::filesystem::remove_all(dir / "frames", ec);
+  clear_run_outputs(dir);
   const auto& chain = model_.chain();
   const int L = chain.num_links();
   const bool fronts = model_.module() != nullptr;
-  // 2. CSV tables.
+  // 2. CSV files, streamed from the frames (a row at a time: nothing but the frames in memory).
   if (select.csv) {
     const char* axes[] = {"x", "y", "z"};
     std::vector<std::string> columns = {"t", "node"};
     if (fronts) columns.emplace_back("s");
     for (int d = 0; d < dim; ++d) columns.emplace_back(axes[d]);
     for (int d = 0; d < dim; ++d) columns.push_back(std::string("v") + axes[d]);
-    CsvTable nodes(columns);
-    CsvTable tension({"t", "link", "s_mid", "T"});
-    std::vector<std::string> energy_columns = {"t", "K", "V", "W_applied", "drift"};
-    if (fronts) energy_columns.insert(energy_columns.end(), {"W_shocks", "W_heaps", "W_remesh"});
-    CsvTable energy(energy_columns);
-    std::vector<std::string> force_columns = {"t"};
-    force_columns.insert(force_columns.end(), summary_.force_columns.begin(), summary_.force_columns.end());
-    CsvTable forces(force_columns);
     std::vector<double> row;
-    for (const auto& f : frames_) {
-      for (int i : f.moving) {
-        if (!select.nodes) break;
-        row = {f.t, static_cast<double>(i)};
-        if (fronts) row.push_back(chain.node_coordinate(i));
-        for (int d = 0; d < dim; ++d) row.push_back(f.x(d, i));
-        for (int d = 0; d < dim; ++d) row.push_back(f.v(d, i));
-        nodes.add_row(row);
-      }
-      for (int j = 0; select.tension && j < L; ++j)
-        if (!std::isnan(f.tension[j])) tension.add_row({f.t, static_cast<double>(j), chain.link_midpoint(j), f.tension[j]});
-      row = {f.t, f.kinetic, f.potential, f.work, f.drift};
-      if (fronts) row.insert(row.end(), {f.w_shocks, f.w_heaps, f.w_remesh});
-      energy.add_row(row);
-      row = {f.t};
-      row.insert(row.end(), f.forces.begin(), f.forces.end());
-      forces.add_row(row);
+    if (select.nodes) {
+      CsvWriter nodes(dir / "nodes.csv", columns);
+      for (const auto& f : frames_)
+        for (int i : f.moving) {
+          row = {f.t, static_cast<double>(i)};
+          if (fronts) row.push_back(chain.node_coordinate(i));
+          for (int d = 0; d < dim; ++d) row.push_back(f.x(d, i));
+          for (int d = 0; d < dim; ++d) row.push_back(f.v(d, i));
+          nodes.row(row);
+        }
+      nodes.commit();
     }
-    if (select.nodes) nodes.write(dir / "nodes.csv");
-    if (select.tension) tension.write(dir / "tension.csv");
-    if (select.energy) energy.write(dir / "energy.csv");
-    if (select.forces && force_columns.size() > 1) forces.write(dir / "forces.csv");
-    if (select.energy && !summary_.samples.empty()) samples_table(summary_).write(dir / "series.csv");
+    if (select.tension) {
+      CsvWriter tension(dir / "tension.csv", {"t", "link", "s_mid", "T"});
+      for (const auto& f : frames_)
+        for (int j = 0; j < L; ++j)
+          if (!std::isnan(f.tension[j])) tension.row({f.t, static_cast<double>(j), chain.link_midpoint(j), f.tension[j]});
+      tension.commit();
+    }
+    if (select.energy) {
+      std::vector<std::string> energy_columns = {"t", "K", "V", "W_applied", "drift"};
+      if (fronts) energy_columns.insert(energy_columns.end(), {"W_shocks", "W_heaps", "W_remesh"});
+      CsvWriter energy(dir / "energy.csv", energy_columns);
+      for (const auto& f : frames_) {
+        row = {f.t, f.kinetic, f.potential, f.work, f.drift};
+        if (fronts) row.insert(row.end(), {f.w_shocks, f.w_heaps, f.w_remesh});
+        energy.row(row);
+      }
+      energy.commit();
+      if (!summary_.samples.empty()) samples_table(summary_).write(dir / "series.csv");
+    }
+    if (select.forces && !summary_.force_columns.empty()) {
+      std::vector<std::string> force_columns = {"t"};
+      force_columns.insert(force_columns.end(), summary_.force_columns.begin(), summary_.force_columns.end());
+      CsvWriter forces(dir / "forces.csv", force_columns);
+      for (const auto& f : frames_) {
+        row = {f.t};
+        row.insert(row.end(), f.forces.begin(), f.forces.end());
+        forces.row(row);
+      }
+      forces.commit();
+    }
   }
   // 3. ParaView frames (the moving nodes, a line cell per link of an arc), then their index.
   if (select.vtk) {

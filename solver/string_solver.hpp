@@ -32,17 +32,6 @@
 
 namespace chainsim {
 
-struct StringSolverOptions {
-  IntegratorOptions integrator;
-  double t_end = 1.0;            ///< end time (s), > 0 ([stop] t_end)
-  double output_interval = 0.1;  ///< time between frames (s); frames at 0, Δ, 2Δ, …, t_end, and at a stop
-  bool record_steps = false;     ///< a StepSample after every accepted step (series.csv)
-  void validate() const;
-  /// Frames are kept in memory until the outputs are written: throws InputError if t_end and
-  /// output_interval ask for more than 2·10⁷ node-frames of a string with `nodes` nodes.
-  void check_frame_budget(int nodes) const;
-};
-
 /// Which outputs write_outputs() produces: fields × formats. A CSV file per field (nodes, tension,
 /// energy: energy.csv and, when steps are recorded, series.csv; forces: forces.csv when the run has
 /// supports, drivers or fronts), the ParaView frames (geometry and
@@ -52,6 +41,32 @@ struct OutputSelection {
   bool nodes = true, tension = true, energy = true, forces = true, stats = true;  ///< fields
   bool csv = true, vtk = true;                                     ///< formats
   bool vtk_ascii = false;  ///< ParaView files as text instead of raw binary ([output] vtk_encoding)
+  double max_megabytes = 4000;  ///< disk budget of the outputs (MB, [output] max_megabytes)
+};
+
+/// What a run's frames cost, estimated before the run from the real sizes: bytes per node and frame
+/// held in memory until the outputs are written, and written to disk by the selected outputs
+/// (measured, see docs/scenes.md "Output budget").
+struct OutputEstimate {
+  double frames = 0, node_frames = 0;
+  double memory_bytes = 0, disk_bytes = 0;
+};
+
+
+struct StringSolverOptions {
+  IntegratorOptions integrator;
+  double t_end = 1.0;            ///< end time (s), > 0 ([stop] t_end)
+  double output_interval = 0.1;  ///< time between frames (s); frames at 0, Δ, 2Δ, …, t_end, and at a stop
+  bool record_steps = false;     ///< a StepSample after every accepted step (series.csv)
+  void validate() const;
+  /// Largest memory the frames may take until the outputs are written (bytes).
+  static constexpr double kMaxFrameMemory = 2.0 * (1u << 30);
+  /// The frames' memory and the selected outputs' size on disk for a string of `nodes` nodes in `dim`
+  /// dimensions (`fronts`: with front tracking, whose nodes.csv has the s column).
+  OutputEstimate estimate_outputs(int nodes, int dim, bool fronts, const OutputSelection& select) const;
+  /// Throws InputError, before the run, if the frames would take more than kMaxFrameMemory or the
+  /// outputs more than select.max_megabytes on disk (the message names both, and what to change).
+  void check_output_budget(int nodes, int dim, bool fronts, const OutputSelection& select) const;
 };
 
 /// One recorded output time.
@@ -182,5 +197,12 @@ class StringSolver {
 
 /// Every file write_outputs() may write (to clear a directory before a run of any model).
 const std::vector<std::string>& run_output_files();
+
+/// Removes the outputs of an earlier run from `dir` (run_output_files() and frames/), so that the
+/// directory never mixes two runs: call it before integrating, so that a run killed on the way
+/// leaves no earlier stats.json that would pass for its own. Throws InputError, before anything is
+/// removed, if one of those names is taken by something chainsim would not write there (a directory
+/// named like an output file, or a file named frames).
+void clear_run_outputs(const std::filesystem::path& dir);
 
 }  // namespace chainsim

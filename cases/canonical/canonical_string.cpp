@@ -134,7 +134,13 @@ StringCaseRun solve_string_case(const StringCaseSetup& setup) {
                                              std::move(heaps), fold, options, string_options);
   StringSolverOptions run_options;
   run_options.integrator = setup.integrator;
-  run_options.t_end = setup.t_max_over_t0 * t0;
+  // The safety stop on the reduced model's clock, on which the string starts at t_offset (sliding
+  // from η0 = 0): both models then end at the same instant.
+  run_options.t_end = setup.t_max_over_t0 * t0 - out.t_offset;
+  if (!(run_options.t_end > 0))
+    throw InputError(fmt::format("--t-max = {:g} ends before the string starts (t/t0 = {:.6g} on the reduced "
+                                 "solution, sliding from eta0 = 0): raise it",
+                                 setup.t_max_over_t0, out.t_offset / t0));
   // The samples after every step are what is compared; frames only when asked for.
   run_options.output_interval = setup.frame_interval > 0 ? setup.frame_interval : run_options.t_end;
   run_options.record_steps = true;

@@ -17,7 +17,7 @@
 //   stop       the heap_end front reached s0 = 0.01 m at t = 0.38232 s
 //
 // Steps: 1. parse the scene, 2. build and check the model (before any run), 3. check that the output
-// directory is writable, 4. integrate, 5. write the outputs (also after a numerical failure, up to
+// directory is writable and remove an earlier run's outputs from it, 4. integrate, 5. write the outputs (also after a numerical failure, up to
 // the failure, before the error is reported; stats.json last), 6. print the summary. With --json
 // every outcome, failures included, prints one JSON object on stdout.
 #include "cases/cli/run_command.hpp"
@@ -66,13 +66,6 @@ std::string output_files(const OutputSelection& o, bool fronts) {
   return files.empty() ? "(none)" : files;
 }
 
-/// Removes every file a run of any model writes, so that a directory never mixes two runs.
-void clear_outputs(const std::filesystem::path& dir) {
-  std::error_code ec;
-  for (const std::string& name : run_output_files()) std::filesystem::remove(dir / name, ec);
-  std::filesystem::remove_all(dir / "frames", ec);
-}
-
 void print_json(std::ostream& out, nlohmann::json j, const SceneSpec& spec, const std::filesystem::path& dir) {
   j["scene"] = spec.source;
   j["scene_effective"] = scene_to_json(spec);
@@ -112,9 +105,10 @@ Built<dim> build(const SceneSpec& spec) {
 template <int dim>
 int run_string_scene(const SceneSpec& spec, const std::filesystem::path& dir, bool json, bool quiet,
                      std::ostream& out) {
-  // 2.-3. Model, checked; the output directory, before integrating.
+  // 2.-3. Model, checked; the output directory, before integrating (an earlier run's outputs removed).
   Built<dim> scene = build<dim>(spec);
   ensure_writable_directory(dir);
+  clear_run_outputs(dir);
   StringSolver<dim> solver(*scene.model, scene.solver);
   const bool fronts = scene.fronts.has_value();
   auto summary_json = [&] {
@@ -139,7 +133,6 @@ int run_string_scene(const SceneSpec& spec, const std::filesystem::path& dir, bo
   }
   const bool interrupted = solver.summary().status == "interrupted";
   nlohmann::json summary = summary_json();
-  clear_outputs(dir);
   solver.write_outputs(dir, scene.output, &summary);
   if (failure && json) summary["exit_code"] = 3;
   if (interrupted && json) summary["exit_code"] = kInterruptedExit;
@@ -193,6 +186,7 @@ int run_reduced_scene(const SceneSpec& spec, const std::filesystem::path& dir, b
   // 2.-3. The canonical problem the scene is (or the reason it is none); the output directory.
   const ReducedSetup setup = match_canonical_problem(spec);
   ensure_writable_directory(dir);
+  clear_run_outputs(dir);
   // 4.-5. Integrate, write the series and the summary (last).
   ReducedRun run{CsvTable(series_columns()), {}};
   try {
@@ -203,7 +197,6 @@ int run_reduced_scene(const SceneSpec& spec, const std::filesystem::path& dir, b
     throw;
   }
   run.summary["t_end"] = spec.stop.t_end;
-  clear_outputs(dir);
   run.series.write(dir / "series.csv");
   write_json(dir / "stats.json", run.summary);
   // 6. Summary.

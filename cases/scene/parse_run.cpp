@@ -60,8 +60,9 @@ void parse_solver(const Section& top, Context& ctx) {
 
 void parse_output(const Section& top, Context& ctx) {
   auto& out = ctx.spec.output;
-  Section s(subtable(top, "output"), "output", ctx, {"interval", "fields", "formats", "vtk_encoding"});
+  Section s(subtable(top, "output"), "output", ctx, {"interval", "fields", "formats", "vtk_encoding", "max_megabytes"});
   out.interval = s.positive("interval").value_or(out.interval);
+  out.select.max_megabytes = s.positive("max_megabytes").value_or(out.select.max_megabytes);
   if (s.has("fields")) {
     const auto fields = s.string_list("fields", {"nodes", "tension", "energy", "forces", "stats"});
     auto has = [&](const char* f) { return std::find(fields.begin(), fields.end(), f) != fields.end(); };

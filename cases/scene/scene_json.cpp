@@ -96,7 +96,8 @@ json output_json(const SceneSpec& spec) {
   return {{"interval", out.interval},
           {"fields", fields},
           {"formats", formats},
-          {"vtk_encoding", o.vtk_ascii ? "ascii" : "binary"}};
+          {"vtk_encoding", o.vtk_ascii ? "ascii" : "binary"},
+          {"max_megabytes", o.max_megabytes}};
 }
 
 }  // namespace

@@ -89,6 +89,31 @@ int link_count(const SceneSpec& spec, double length, bool closed) {
   return links;
 }
 
+/// The scales of a run must leave its scaled problem well inside the double range: the solver forms
+/// squares and products of them (energies λ v² ℓ, tensions λ (|g| ℓ + v²) + |F|, the reach
+/// ℓ + v t_end + |g| t_end²), so each nonzero input scale lies in [kMinScale, kMaxScale] and each
+/// derived one in [kMinScale², kMaxScale²]. A scene outside is refused at its key before the run,
+/// rather than ending in a non-finite value at its first step.
+constexpr double kMinScale = 1e-100, kMaxScale = 1e100;
+
+struct Scale {
+  std::string key;   ///< the scene key that sets it
+  std::string what;  ///< what it is, with its unit
+  double value;
+};
+
+void check_scales(const SceneSpec& spec, const std::vector<Scale>& inputs, const std::vector<Scale>& derived) {
+  auto check = [&](const Scale& s, double lo, double hi) {
+    if (s.value == 0 || (s.value >= lo && s.value <= hi)) return;
+    fail_at(spec, s.key,
+            fmt::format("{} = {}: {} is {:.3g}, out of the range the solver can represent: allowed {:g} to {:g} "
+                        "(or 0); the scaled problem would overflow or underflow",
+                        s.key, text_of(spec, s.key), s.what, s.value, lo, hi));
+  };
+  for (const Scale& s : inputs) check(s, kMinScale, kMaxScale);
+  for (const Scale& s : derived) check(s, kMinScale * kMinScale, kMaxScale * kMaxScale);
+}
+
 /// Two prescribed ends may never be pulled as far apart as the string is long (it would have to
 /// stretch); sampled over [0, t_end].
 template <int dim>
@@ -151,6 +176,8 @@ SceneParts<dim> build_scene_parts(const SceneSpec& spec) {
   if (spec.effects.drag) forces.push_back(std::make_unique<Drag<dim>>(*spec.effects.drag));
   double forcing_period = INFINITY;
   double driven_speed = 0;  // of ends driven along a line (m/s)
+  double force = 0;         // the largest end load, |F0| + |F1| (N)
+  std::string force_key = "ends";
   auto add_end = [&](const EndSpec& end, int node, const std::string& key) {
     if (end.kind == "free") return;
     if (closed)
@@ -171,6 +198,10 @@ SceneParts<dim> build_scene_parts(const SceneSpec& spec) {
       const Vec<dim> f0 = end.force.empty() ? Vec<dim>::Zero() : as_vec<dim>(spec, end.force, key + ".force");
       const Vec<dim> amp = end.amplitude.empty() ? Vec<dim>::Zero() : as_vec<dim>(spec, end.amplitude, key + ".amplitude");
       if (!end.amplitude.empty()) forcing_period = std::min(forcing_period, 2 * kPi / end.omega);
+      if (f0.norm() + amp.norm() > force) {
+        force = f0.norm() + amp.norm();
+        force_key = key + (end.force.empty() ? ".amplitude" : ".force");
+      }
       forces.push_back(std::make_unique<EndLoad<dim>>(node, f0, amp, end.omega));
     }
   };
@@ -194,6 +225,26 @@ SceneParts<dim> build_scene_parts(const SceneSpec& spec) {
   const double v_max = std::max(chain.velocities().colwise().norm().maxCoeff(), driven_speed);
   if (v_max > 0) t_char = std::min(t_char, length / v_max);
   if (!std::isfinite(t_char)) t_char = spec.stop.t_end;
+  // 5. The scales, judged before the run (see check_scales).
+  {
+    const std::string velocity_key = vel.kind == "uniform"      ? "velocity.value"
+                                     : vel.kind == "tangential" ? "velocity.speed"
+                                     : vel.kind == "nodes"      ? "velocity.values"
+                                                                : "ends";
+    const double t_end = spec.stop.t_end, gn = g.stableNorm();
+    const double tension = spec.density * (gn * length + v_max * v_max) + force;
+    check_scales(spec,
+                 {{spec.length ? "string.length" : "shape", "the string's length (m)", length},
+                  {"string.density", "the line density (kg/m)", spec.density},
+                  {"effects.gravity.g", "|g| (m/s^2)", gn},
+                  {velocity_key, "the fastest initial or driven speed (m/s)", v_max},
+                  {"stop.t_end", "the run's length (s)", t_end},
+                  {force_key, "the largest end load (N)", force}},
+                 {{"effects.gravity.g", "the tension scale density (|g| length + v^2) + |F| (N)", tension},
+                  {"stop.t_end", "the reach length + v t_end + |g| t_end^2 (m)",
+                   length + v_max * t_end + gn * t_end * t_end},
+                  {"effects.gravity.g", "the energy scale (tension scale x length, J)", tension * length}});
+  }
   IntegratorOptions io;
   io.method = so.method;
   io.rtol = so.rtol;
@@ -213,7 +264,8 @@ SceneParts<dim> build_scene_parts(const SceneSpec& spec) {
   run.t_end = spec.stop.t_end;
   run.output_interval = spec.output.interval;
   at_key(spec, "solver", [&] { run.validate(); });
-  at_key(spec, "output.interval", [&] { run.check_frame_budget(chain.num_nodes()); });
+  at_key(spec, "output.interval",
+         [&] { run.check_output_budget(chain.num_nodes(), dim, spec.has_fronts(), spec.output.select); });
   return SceneParts<dim>{std::move(curve), std::move(chain), length, g, std::move(forces), std::move(prescribed),
                          t_char, mo, run};
 }

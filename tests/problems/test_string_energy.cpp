@@ -257,5 +257,5 @@ TEST_CASE("an output request too large for memory is refused before the run", "[
   so.output_interval = 1e-9;
   CHECK_THROWS_WITH(StringSolver<2>(*model, so),
                     Contains("output.interval = 1e-09 s with stop.t_end = 1e+06 s") &&
-                        Contains("allowed at most 2e+07"));
+                        Contains("of memory until written, allowed at most 2.15 GB"));
 }

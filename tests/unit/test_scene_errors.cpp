@@ -179,6 +179,9 @@ TEST_CASE("bad scenes are refused with the location, the key, the value and what
       {"a relative tolerance of one",
        kBase + std::string("[solver]\nrtol = 1.0\n"),
        "s.toml:19:8: solver.rtol = 1 is out of range: allowed 1e-14 <= rtol <= 0.01"},
+      {"an absolute tolerance of a million",
+       kBase + std::string("[solver]\natol = 1e6\n"),
+       "s.toml:19:8: solver.atol = 1e+06 is out of range: allowed 0 < atol <= 0.01"},
       {"an unknown tension backend",
        kBase + std::string("[solver]\nbackend = \"lu\"\n"),
        "s.toml:19:11: solver.backend = \"lu\" is not a tension solver: allowed auto, " + backends},
@@ -211,7 +214,20 @@ TEST_CASE("bad scenes are refused with the location, the key, the value and what
        "s.toml:12:9: Error while parsing key-value pair: cannot redefine existing string 'start'"},
       {"too many frames",
        kBase + std::string("[output]\ninterval = 1e-9\n"),
-       "s.toml:19:12: output.interval = 1e-09 s with stop.t_end = 0.2 s asks for 2e+08 frames of 11 nodes (2.2e+09 node-frames): allowed at most 2e+07; raise output.interval"},
+       "s.toml:19:12: output.interval = 1e-09 s with stop.t_end = 0.2 s asks for 2e+08 frames of 11 nodes (2.2e+09 node-frames): they would take 199 GB of memory until written, allowed at most 2.15 GB; raise output.interval"},
+      {"outputs over the disk budget",
+       kBase + std::string("[output]\ninterval = 1e-3\nmax_megabytes = 0.01\n"),
+       "s.toml:19:12: output.interval = 0.001 s with stop.t_end = 0.2 s asks for 202 frames of 11 nodes (2.22e+03 "
+       "node-frames): the selected outputs would take about 1.46 MB on disk, more than output.max_megabytes = 0.01; "
+       "raise output.interval, select fewer fields or formats, or raise output.max_megabytes"},
+      {"gravity out of the double range",
+       edit(kBase, "g = [0.0, -9.81]", "g = [5.0, -1e300]"),
+       "s.toml:14:5: effects.gravity.g = [5.0, -1e300]: |g| (m/s^2) is 1e+300, out of the range the solver can "
+       "represent: allowed 1e-100 to 1e+100 (or 0); the scaled problem would overflow or underflow"},
+      {"a run long enough for its reach to overflow",
+       edit(edit(kBase, "t_end = 0.2", "t_end = 1e99"), "g = [0.0, -9.81]", "g = [0.0, -1e5]"),
+       "s.toml:17:9: stop.t_end = 1e99: the reach length + v t_end + |g| t_end^2 (m) is 1e+203, out of the range the "
+       "solver can represent: allowed 1e-200 to 1e+200 (or 0); the scaled problem would overflow or underflow"},
       {"a shape shorter than the string",
        edit(kBase, "length = 1.0", "length = 1.5"),
        "s.toml:2:10: string.length = 1.5 m but the shape (polyline through 2 points) is 1 m long: they differ by "
