@@ -176,8 +176,24 @@ def methods_from_help(chainsim):
     return out
 
 
+def methods_allowed(chainsim):
+    """Every method name the binary accepts, from its message for an unknown one ("allowed erk3, ..., auto, or an
+    ARKODE_* Butcher table name"): names accepted but not listed with a description (e.g. an automatic choice)."""
+    text = subprocess.run([str(chainsim), "reduced", "falling", "--method", "not-a-method"], capture_output=True,
+                          text=True).stderr
+    m = re.search(r"allowed (.*)", text)
+    if not m:
+        return []
+    names = [n.strip() for n in re.split(r",|\bor\b", m.group(1))]
+    return [n for n in names if re.fullmatch(r"[A-Za-z0-9_]+", n)]
+
+
 def is_explicit(description):
     return description.lower().startswith("explicit")
+
+
+def is_implicit(description):
+    return description.lower().startswith("implicit")
 
 
 # ------------------------------------------------------------------------------------------------
@@ -353,13 +369,15 @@ class Study:
         self.opts = opts
         self.runner = Runner(opts.chainsim, opts.out, opts.repeats, opts.budget, print)
         self.rows = []
+        self.kinds = {}  # method -> explicit, implicit or other (e.g. an automatic choice)
 
     def log(self, *a):
         print(*a, flush=True)
 
     def record(self, case, method, explicit, rtol, nodes, args, summary, walls, rc, errors, model="string"):
         stats = summary.get("stats", summary.get("integrator", {}))
-        row = {"case": case, "model": model, "method": method, "explicit": int(explicit), "rtol": rtol,
+        row = {"case": case, "model": model, "method": method, "explicit": int(explicit),
+               "kind": self.kinds.get(method, "explicit" if explicit else "other"), "rtol": rtol,
                "atol": rtol / 100, "nodes": nodes, "error": float("nan"), "error_eta": float("nan"),
                "error_P": float("nan"), "wall_s": float("nan"), "walls": ";".join(f"{w:.6g}" for w in walls),
                "steps": stats.get("steps", ""), "rhs_evals": stats.get("rhs_evals", ""),
@@ -451,8 +469,8 @@ def write_table(study, cases, info, path):
     for case in cases:
         for target in (1e-2, 1e-4, 1e-6):
             best = best_settings(rows, case.name, target)
-            ex = best_settings([r for r in rows if r["explicit"]], case.name, target)
-            im = best_settings([r for r in rows if not r["explicit"]], case.name, target)
+            ex = best_settings([r for r in rows if r["kind"] == "explicit"], case.name, target)
+            im = best_settings([r for r in rows if r["kind"] == "implicit"], case.name, target)
             if best is None:
                 lines.append(f"| {case.name} | {target:.0e} | not reached in this grid | | | | | |")
                 continue
@@ -465,8 +483,8 @@ def write_table(study, cases, info, path):
     cross = []
     for case in cases:
         for target in (1e-2, 1e-3, 1e-4, 1e-5, 1e-6, 1e-7, 1e-8):
-            ex = best_settings([r for r in rows if r["explicit"]], case.name, target)
-            im = best_settings([r for r in rows if not r["explicit"]], case.name, target)
+            ex = best_settings([r for r in rows if r["kind"] == "explicit"], case.name, target)
+            im = best_settings([r for r in rows if r["kind"] == "implicit"], case.name, target)
             if ex and im:
                 cross.append(f"{case.name} {target:.0e}: implicit/explicit = {im['wall_s'] / ex['wall_s']:.2f}")
     text = "\n".join(lines) + "\n\nBest implicit over best explicit wall time (< 1: implicit faster):\n\n" + \
@@ -550,6 +568,9 @@ def main():
     command = "/usr/bin/python3 tests/bench/work_precision.py " + " ".join(shlex.quote(a) for a in sys.argv[1:])
     info = machine_info(opts.chainsim)
     all_methods = methods_from_help(opts.chainsim)
+    listed = {m for m, _ in all_methods}
+    all_methods += [(m, "accepted by chainsim, no description") for m in methods_allowed(opts.chainsim)
+                    if m not in listed]
     if not all_methods:
         sys.exit("work_precision.py: no methods found in `chainsim compare --help`")
     known = dict(all_methods)
@@ -563,6 +584,8 @@ def main():
         methods = [m for m in all_methods if m[0] not in DEFAULT_SKIP]
     start = time.time()
     study = Study(opts)
+    study.kinds = {m: "explicit" if is_explicit(d) else "implicit" if is_implicit(d) else "other"
+                   for m, d in all_methods}
     study.log(f"chainsim {info['git']} ({info['build_type']}), SUNDIALS {info['sundials']}, {info['cpu']}, "
               f"{info['cores']} cores, load {info['load']:.1f}; methods {', '.join(m for m, _ in methods)}")
 
@@ -618,7 +641,7 @@ def main():
         study.sweep(hanging, methods, [1e-5, 1e-9], [11, 21, 41, 81, 161, 321], hanging.overrides())
         cases = canonical + [tilted, curved, hanging]
 
-    fields = ["case", "model", "method", "explicit", "rtol", "atol", "nodes", "error", "error_eta", "error_P",
+    fields = ["case", "model", "method", "explicit", "kind", "rtol", "atol", "nodes", "error", "error_eta", "error_P",
               "wall_s", "walls", "steps", "rhs_evals", "status", "why", "command"]
     csv_path = opts.out / "work_precision.csv"
     with open(csv_path, "w", newline="") as fh:
