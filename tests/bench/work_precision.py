@@ -526,11 +526,8 @@ def plot(study, cases, info, path, title, command):
                 ax.loglog(x, y, "-", color=color[m], lw=0.8, alpha=0.5, marker=".", ms=3)
         if any(r["model"] == "reduced" for r in rows):
             ax.plot([], [], "-", color="gray", marker=".", lw=0.8, label="reduced ODE (floor)")
-        if refined:
-            nodes = sorted({r["nodes"] for r in string})
-            ax.text(0.99, 0.01, f"meshes: {', '.join(map(str, nodes))} nodes", transform=ax.transAxes,
-                    ha="right", va="bottom", fontsize=7)
-        ax.set_title(case.title, fontsize=9)
+        meshes = f"\nmeshes: {', '.join(map(str, sorted({r['nodes'] for r in string})))} nodes" if refined else ""
+        ax.set_title(case.title + meshes, fontsize=9)
         ax.set_xlabel("wall time of the solve (s, median)")
         ax.set_ylabel("error" + (" (max |Δη|, max rel. |ΔP|)" if case.name in ("falling", "folded", "sliding")
                                  else " (relative)"))
