@@ -451,8 +451,12 @@ class Study:
                  + ", ".join(f"{v:.9f}" for v in values))
         self.log(f"  {case.name}: observed orders {', '.join(f'{o:.2f}' for o in orders)}; Richardson reference "
                  f"t_stop = {ref:.9f} s (previous triple: {alt:.9f}, difference {abs(ref - alt) / ref:.1e} relative)")
+        # The extrapolation assumes the asymptotic range: the observed orders must agree.
+        asymptotic = len(orders) > 1 and abs(orders[-1] - orders[-2]) < 0.2 and orders[-1] > 0.5
+        self.log(f"  {case.name}: the observed orders " + ("agree (within 0.2): the meshes are in the asymptotic "
+                 "range" if asymptotic else "DISAGREE (or fewer than four meshes): the reference is not reliable"))
         case.reference = ref
-        return {"meshes": meshes, "t_stop": values, "orders": orders, "reference": ref,
+        return {"meshes": meshes, "t_stop": values, "orders": orders, "asymptotic": asymptotic, "reference": ref,
                 "reference_previous_triple": alt, "method": method, "rtol": rtol}
 
 
