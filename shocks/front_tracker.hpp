@@ -9,11 +9,12 @@
 ///
 ///   heap   a quiescent heap, either fed through a fixed point x0 (a pile under a hole, an edge:
 ///          *pinned*) or lying on a plane (the table under a falling chain). The arc ends in a
-///          straight *partial link* of material length l from its end node k to the contact
-///          (s0 = s_k ± l), in direction e (from the arc into the heap):
-///              pinned     the contact is x0, l = |x0 − x_k|, e = (x0 − x_k)/l
-///              on a plane the arc's last full link continued to the plane (point p, normal n):
-///                         l = n·(p − x_k)/(n·e); the contact x_k + l e slides along the plane
+///          *partial link* of material length l from its end node k to the contact (s0 = s_k ± l):
+///          the string there is the quadratic interpolant x(s) (docs/shocks.md, "Second order at a
+///          moving front"), e its unit tangent at the contact (from the arc into the heap):
+///              pinned     through x_{k∓1}, x_k and the contact x0; l = |x0 − x_k|
+///              on a plane through the last three nodes (point p, normal n), s0 its root of
+///                         n·(x(s0) − p) = 0; the contact x(s0) slides along the plane
 ///          w = dl/dt is the rate at which the arc gains material (w < 0: it runs into the heap).
 ///          Jump conditions (the internal shock of dissipation f at the contact plus the external
 ///          shock at the heap, docs/shocks.md):
@@ -40,23 +41,25 @@
 /// exact: it reproduces the reduced ODE for every N.
 ///
 /// Front crossings are ARKODE root events (two per front): a heap takes the end node in when the
-/// partial link shrinks to h/2 and gives out a new node when it grows to 3h/2; a fold moves the node
-/// it reaches from one arc to the other. Material moves with its momentum (mass parcels carry their
-/// velocity), so mass and momentum are conserved at every crossing; the kinetic energy a crossing
-/// removes is booked as W_remesh (zero for straight motions). Then the string rebuilds its arcs,
-/// projects positions and velocities onto the link constraints (StringModel::project) and the
-/// integration continues with the new state size.
+/// partial link shrinks to h/2 (every other node keeps its state) and gives out a new node when it
+/// grows to 3h/2 (at the interpolant's position and velocity there); a fold moves the node it reaches
+/// from one arc to the other, its material moving with its momentum (mass parcels). What a crossing
+/// changes in the lumped momentum and energy is booked (heap impulse, W_remesh; zero for straight
+/// motions). Then the string rebuilds its arcs, projects positions and velocities onto the link
+/// constraints (StringModel::project) and the integration continues with the new state size.
 ///
 /// The tracker's ledgers follow the string's state [ x | v | W_applied ]:
 ///              [ W_shocks | W_heaps | impulse (dim) | heap moment (dim) ]
 ///   W_shocks   Σ over internal shocks of W_s = −D (dissipation, ≤ 0)
 ///   W_heaps    Σ over heaps of W* (external shocks)
 ///   impulse    ∫ (all external forces on the string and heaps) dt: gravity, drag, loads, the
-///              reactions of fixed/driven nodes and of the planes under the heaps
+///              reactions of fixed/driven nodes and of the planes under the heaps, plus what the
+///              crossings change in Σ m_i v_i (the re-lumped end's momentum, taken by the heap's support)
 ///   heap moment  change of Σ over heaps of ∫ x dm (kg m): material laid on a plane stays where the
 ///              contact was when it arrived, so the heaps' potential energy needs their first moment
 /// Ledgers: K + V − (K0 + V0) − W_applied − W_shocks − W_heaps − W_remesh → 0 and
 ///          p − p0 − impulse → 0 (p = Σ m_i v_i; heaps are at rest), to the discretization error.
+#include <cmath>
 #include <optional>
 #include <string>
 #include <vector>
@@ -110,6 +113,8 @@ class FrontTracker final : public StringModule<dim> {
     Vec<dim> normal = Vec<dim>::Zero();  ///< unit normal of the plane, towards the string's side
     Vec<dim> last_direction = Vec<dim>::Zero();  ///< on a plane, once the arc has no full link left:
                                                  ///< the direction its partial link keeps
+    Vec<dim> last_curvature = Vec<dim>::Zero();  ///< on a plane, once the arc has one full link left:
+                                                 ///< the second derivative x'' its end keeps
     int arc_minus = -1, arc_plus = -1;  ///< arcs on either side (−1: the heap's side)
   };
 
@@ -122,6 +127,12 @@ class FrontTracker final : public StringModule<dim> {
   /// dissipative kink nowhere else (docs/shocks.md), so a run stops when the arms open wider than
   /// this angle from antiparallel (and a fold that starts wider is refused).
   static constexpr double kMaxFoldOpeningDeg = 20;
+  /// The folded link's material (length h) must span its chord |x_b − x_a|. The fold crosses a node
+  /// when the chord's component along the fold direction (the bisector of the arms) reaches h: with
+  /// arms on one line the chord is then h, with arms within kMaxFoldOpeningDeg of antiparallel at
+  /// most h / cos(kMaxFoldOpeningDeg / 2). The run stops when the chord passes that (the fold has come
+  /// apart, docs/shocks.md "A fold whose arms turn apart").
+  static double max_fold_chord() { return 1 / std::cos(0.5 * kMaxFoldOpeningDeg * kPi / 180); }
 
   // --- StringModule ------------------------------------------------------------------------------
   std::vector<ArcRange> initial_arcs(const Chain<dim>& chain) override;
@@ -133,7 +144,8 @@ class FrontTracker final : public StringModule<dim> {
   double potential_correction(const StringModel<dim>& model, const Eigen::Ref<const Eigen::VectorXd>& ledger) const override;
   void fill(const StringModel<dim>& model, const Eigen::Ref<const Eigen::VectorXd>& ledger,
             ModuleLedger<dim>& out) const override;
-  /// Two per front (crossings), one per stop condition, one per fold (it opens past kMaxFoldOpeningDeg).
+  /// Two per front (crossings), one per stop condition, one per fold (it opens past kMaxFoldOpeningDeg
+  /// or comes apart: its chord passes max_fold_chord() h).
   int num_events() const override {
     return 2 * static_cast<int>(fronts_.size()) + static_cast<int>(options_.stop_at.size()) + num_folds();
   }
@@ -155,8 +167,9 @@ class FrontTracker final : public StringModule<dim> {
   HeapEnd heap_end(const StringModel<dim>& model, const Front& front) const;
   double heap_mass(std::size_t front) const;  // needs the front states
   std::string fold_opened_message(std::size_t front) const;  // needs the front states
+  std::string fold_apart_message(const StringModel<dim>& model, std::size_t front, double t) const;
   /// Moves the node a front reached across it (heap: in or out; fold: from one arc to the other).
-  EventAction transfer(StringModel<dim>& model, std::size_t front, int e0, Eigen::Ref<Eigen::VectorXd> ledger);
+  EventAction transfer(StringModel<dim>& model, std::size_t front, int e0);
 
   std::vector<HeapSpec<dim>> heap_specs_;
   std::optional<FoldSpec> fold_spec_;
@@ -166,6 +179,8 @@ class FrontTracker final : public StringModule<dim> {
   std::vector<Front> fronts_;
   std::vector<double> expected_s0_;  // where each front is meant to start (m)
   std::vector<FrontState<dim>> fs_;
+  std::vector<double> fold_chord_;  // per front: a fold's |x_b − x_a| / h (0 for a heap)
+  std::vector<Vec<dim>> partial_mid_;  // per heap front: the midpoint of the string from the end node to it
   long transfers_ = 0;
   double w_remesh_ = 0;
   Vec<dim> heap_moment0_ = Vec<dim>::Zero();  // Σ heap mass × point at t = 0

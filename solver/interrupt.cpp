@@ -25,4 +25,17 @@ bool interrupt_requested() { return g_interrupt.load(); }
 void clear_interrupt() { g_interrupt.store(false); }
 void install_sigint_handler() { std::signal(SIGINT, on_sigint); }
 
+ScopedSigintHandler::ScopedSigintHandler(bool active) : active_(active) {
+  if (!active_) return;
+  struct sigaction action {};
+  action.sa_handler = on_sigint;
+  sigemptyset(&action.sa_mask);
+  sigaction(SIGINT, &action, &previous_);
+}
+
+ScopedSigintHandler::~ScopedSigintHandler() {
+  if (!active_) return;
+  sigaction(SIGINT, &previous_, nullptr);
+}
+
 }  // namespace chainsim

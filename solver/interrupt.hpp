@@ -6,6 +6,8 @@
 /// The flag is process-wide and async-signal-safe (a lock-free atomic). `install_sigint_handler()`
 /// makes SIGINT set it (the command-line tool does this); a second SIGINT while the flag is still set
 /// restores the default action and re-raises, so a run that does not stop can still be killed.
+#include <signal.h>
+
 namespace chainsim {
 
 /// Asks every running StringSolver to stop at its next accepted step.
@@ -15,5 +17,21 @@ bool interrupt_requested();
 void clear_interrupt();
 /// SIGINT -> request_interrupt() (the second one kills the process).
 void install_sigint_handler();
+
+/// install_sigint_handler() for the scope's lifetime, then the previous handler back (with its
+/// flags): for a host program, such as the Python interpreter, whose own handler cannot act while a
+/// run holds the thread (the Python module installs it around a run that released the GIL).
+/// `active` = false does nothing (a run outside the host's main thread).
+class ScopedSigintHandler {
+ public:
+  explicit ScopedSigintHandler(bool active = true);
+  ~ScopedSigintHandler();
+  ScopedSigintHandler(const ScopedSigintHandler&) = delete;
+  ScopedSigintHandler& operator=(const ScopedSigintHandler&) = delete;
+
+ private:
+  bool active_;
+  struct sigaction previous_ {};
+};
 
 }  // namespace chainsim

@@ -3,7 +3,9 @@
 /// The chainsim subcommands as plain functions (cases/cli/main.cpp only parses the command line).
 /// Each returns the process exit code and throws InputError / NumericalError on failure.
 #include <iosfwd>
+#include <optional>
 #include <string>
+#include <vector>
 
 #include "cases/canonical/canonical_string.hpp"
 #include "cases/reduced/reduced_models.hpp"
@@ -55,5 +57,19 @@ struct PlotCommandOptions {
 /// Runs /usr/bin/python3 (else python3 on PATH) -m chainsim_plot with PYTHONPATH set to the source
 /// tree's python/; returns its exit code (1 if it cannot be started).
 int run_plot_command(const PlotCommandOptions& options);
+
+/// `chainsim sweep SCENE --grid KEY=V1,V2,... --out DIR`: the scene at every point of the grid, on
+/// `jobs` threads, one row per point in DIR/sweep.csv (cases/scene/scene_sweep.hpp; docs/python.md).
+/// Defined in sweep_command.cpp.
+struct SweepCommandOptions {
+  std::string scene;
+  std::vector<std::string> grid;       ///< "KEY=V1,V2,..." per axis
+  std::vector<std::string> overrides;  ///< --set KEY=VALUE for every point
+  std::optional<double> t_end;         ///< replaces [stop] t_end (s)
+  int jobs = 0;                        ///< threads; 0 = every core
+  std::string out;                     ///< "" = results/sweep/<scene stem>
+  bool json = false;
+};
+int run_sweep_command(const SweepCommandOptions& options, std::ostream& out);
 
 }  // namespace chainsim

@@ -189,6 +189,26 @@ int main(int argc, char** argv) {
   cmd_plot->add_option("--times", plot.times, "times of the snapshots and tension profiles (s), e.g. 0,0.1,0.2");
   cmd_plot->add_option("--format", plot.format, "animation format: mp4 | gif (default mp4 if ffmpeg is installed)");
 
+  // --- chainsim sweep --------------------------------------------------------------------------
+  chainsim::SweepCommandOptions sweep;
+  auto* cmd_sweep = app.add_subcommand(
+      "sweep", "Run a scene at every point of a grid of scene keys (one row per point in OUT/sweep.csv; a failed "
+               "point is a row with its error) on local cores");
+  cmd_sweep->add_option("scene", sweep.scene, "scene file")->required();
+  cmd_sweep->add_option("--grid", sweep.grid,
+                        "KEY=V1,V2,...: an axis of the grid (repeatable; the points are all combinations); KEY as for "
+                        "run --set, or f (the dissipation of the scene's only front), e.g. --grid f=0,0.5,1 --grid "
+                        "string.nodes=51,101")
+      ->required()
+      ->allow_extra_args(false);
+  cmd_sweep->add_option("--set", sweep.overrides, "KEY=VALUE: sets a scene key for every point (as run --set)")
+      ->allow_extra_args(false);
+  double sweep_t_end = 0;
+  auto* opt_sweep_t_end = cmd_sweep->add_option("--t-end", sweep_t_end, "end time (s), > 0: replaces [stop] t_end");
+  cmd_sweep->add_option("--jobs", sweep.jobs, "threads, >= 1 (default: every core)");
+  cmd_sweep->add_option("--out", sweep.out, "output directory (default results/sweep/<scene name>)");
+  cmd_sweep->add_flag("--json", sweep.json, "print the sweep's counts as one JSON object on stdout");
+
   // With --json, every failure also prints one JSON object on stdout: the command's own (run, and
   // compare after a numerical failure, print their summary), else {"status": "failed", "error", ...}.
   const bool json = [&] {
@@ -233,6 +253,10 @@ int main(int argc, char** argv) {
       if (opt_t_end->count() > 0) run.t_end = run_t_end;
       if (opt_max_wall->count() > 0) run.max_wall = run_max_wall;
       code = chainsim::run_scene_command(run, out);
+    }
+    if (*cmd_sweep) {
+      if (opt_sweep_t_end->count() > 0) sweep.t_end = sweep_t_end;
+      code = chainsim::run_sweep_command(sweep, out);
     }
     std::cout << buffered.str();
     return code;

@@ -43,11 +43,30 @@ std::vector<std::string> plot_arguments(const PlotCommandOptions& options) {
 
 }  // namespace
 
+namespace {
+
+/// The directory holding chainsim_plot: beside an installed executable (PREFIX/bin/chainsim ->
+/// PREFIX/CHAINSIM_PYTHON_INSTALL_DIR), else the source tree the executable was built from.
+std::string python_dir() {
+#ifdef CHAINSIM_PYTHON_INSTALL_DIR
+  std::error_code ec;
+  const std::filesystem::path exe = std::filesystem::read_symlink("/proc/self/exe", ec);
+  if (!ec) {
+    const std::filesystem::path installed = exe.parent_path().parent_path() / CHAINSIM_PYTHON_INSTALL_DIR;
+    if (std::filesystem::exists(installed / "chainsim_plot" / "__main__.py", ec)) return installed.string();
+  }
+#endif
+  return CHAINSIM_PYTHON_DIR;
+}
+
+}  // namespace
+
 int run_plot_command(const PlotCommandOptions& options) {
-  const std::filesystem::path package = std::filesystem::path(CHAINSIM_PYTHON_DIR) / "chainsim_plot";
+  const std::string python_path = python_dir();
+  const std::filesystem::path package = std::filesystem::path(python_path) / "chainsim_plot";
   if (!std::filesystem::exists(package / "__main__.py")) {
     std::cerr << fmt::format("chainsim: error: plot: the plotting package is not at {} (chainsim plot runs it from "
-                             "the source tree it was built from)\n",
+                             "the installed tree or the source tree it was built from)\n",
                              package.string());
     return 1;
   }
@@ -66,7 +85,7 @@ int run_plot_command(const PlotCommandOptions& options) {
   }
   if (pid == 0) {
     const char* old = std::getenv("PYTHONPATH");
-    const std::string path = std::string(CHAINSIM_PYTHON_DIR) + (old && *old ? std::string(":") + old : "");
+    const std::string path = python_path + (old && *old ? std::string(":") + old : "");
     setenv("PYTHONPATH", path.c_str(), 1);
     execvp(argv[0], argv.data());
     std::cerr << fmt::format("chainsim: error: plot needs Python 3 with numpy and matplotlib: cannot run {}: {} "

@@ -34,6 +34,7 @@
 #include "cases/scene/reduced_scene.hpp"
 #include "cases/scene/scene_json.hpp"
 #include "cases/scene/scene.hpp"
+#include "cases/scene/scene_run.hpp"
 #include "cases/cli/progress.hpp"
 #include "solver/interrupt.hpp"
 #include "mesh/errors.hpp"
@@ -73,67 +74,25 @@ void print_json(std::ostream& out, nlohmann::json j, const SceneSpec& spec, cons
   out << j.dump() << '\n';
 }
 
-/// A string scene, with or without fronts, built and ready to run.
-template <int dim>
-struct Built {
-  std::unique_ptr<StringModel<dim>> model;
-  StringSolverOptions solver;
-  OutputSelection output;
-  nlohmann::json description;  ///< with fronts: front_scene's description (fronts, stop events)
-  std::optional<FrontScene<dim>> fronts;
-};
-
-template <int dim>
-Built<dim> build(const SceneSpec& spec) {
-  Built<dim> b;
-  if (spec.has_fronts()) {
-    FrontScene<dim> scene = build_front_scene<dim>(spec);
-    b.model = std::move(scene.model);
-    b.solver = scene.solver;
-    b.output = scene.output;
-    b.description = scene.description;
-    b.fronts = std::move(scene);
-  } else {
-    StringScene<dim> scene = build_string_scene<dim>(spec);
-    b.model = std::move(scene.model);
-    b.solver = scene.solver;
-    b.output = scene.output;
-  }
-  return b;
-}
-
 template <int dim>
 int run_string_scene(const SceneSpec& spec, const std::filesystem::path& dir, bool json, bool quiet,
                      std::ostream& out) {
   // 2.-3. Model, checked; the output directory, before integrating (an earlier run's outputs removed).
-  Built<dim> scene = build<dim>(spec);
+  SceneRun<dim> scene(spec);
   ensure_writable_directory(dir);
   clear_run_outputs(dir);
-  StringSolver<dim> solver(*scene.model, scene.solver);
-  const bool fronts = scene.fronts.has_value();
-  auto summary_json = [&] {
-    if (fronts) return front_summary(*scene.fronts, solver.summary());
-    nlohmann::json j = to_json(solver.summary());
-    j["model"] = "string";
-    j["fronts"] = nlohmann::json::array();  // none built: no fronts, no root functions
-    j["num_fronts"] = 0;
-    return j;
-  };
+  const StringSolver<dim>& solver = scene.solver();
+  const bool fronts = scene.has_fronts();
   // 4.-5. Integrate (a numerical failure, or Ctrl-C, still writes what was done), write, summary last.
   std::optional<NumericalError> failure;
   {
-    ProgressLine progress(scene.solver.t_end, progress_wanted(quiet));
-    solver.on_step = [&](double t, const Eigen::VectorXd&) { progress.update(t); };
+    ProgressLine progress(scene.solver_options().t_end, progress_wanted(quiet));
     install_sigint_handler();
-    try {
-      solver.run();
-    } catch (const NumericalError& e) {
-      failure = e;
-    }
+    failure = scene.run([&](double t) { progress.update(t); });
   }
   const bool interrupted = solver.summary().status == "interrupted";
-  nlohmann::json summary = summary_json();
-  solver.write_outputs(dir, scene.output, &summary);
+  nlohmann::json summary = scene.summary();
+  scene.write(dir, summary);
   if (failure && json) summary["exit_code"] = 3;
   if (interrupted && json) summary["exit_code"] = kInterruptedExit;
   // 6. Summary.
@@ -142,16 +101,16 @@ int run_string_scene(const SceneSpec& spec, const std::filesystem::path& dir, bo
     print_json(out, summary, spec, dir);
   } else if (!failure) {  // a failure is reported by its message (outputs written up to it)
     out << fmt::format("scene      {} ({}D, {} nodes, {})\n", spec.source, s.dimension, s.nodes,
-                       scene.model->chain().closed() ? "closed" : "open");
+                       scene.model().chain().closed() ? "closed" : "open");
     if (fronts) {
       std::vector<std::string> names;
-      for (const nlohmann::json& f : scene.description["fronts"]) {
+      for (const nlohmann::json& f : scene.description()["fronts"]) {
         std::string where;
         if (f.contains("on_plane")) where = f["on_plane"].get<bool>() ? ", on a plane" : ", pinned";
         names.push_back(fmt::format("{} (f = {:g}, s0 = {:g} m{})", f["name"].get<std::string>(),
                                     f["f"].get<double>(), f["s0"].get<double>(), where));
       }
-      const int stops = static_cast<int>(scene.description["stop_events"].size());
+      const int stops = static_cast<int>(scene.description()["stop_events"].size());
       out << fmt::format("fronts     {}; {} root functions (2 per front + {} stop event{})\n", join_words(names),
                          s.root_functions, stops, stops == 1 ? "" : "s");
     }
@@ -160,7 +119,8 @@ int run_string_scene(const SceneSpec& spec, const std::filesystem::path& dir, bo
                        s.prescribed.empty() ? "" : "prescribed " + join_words(s.prescribed) + "; ", s.root_functions,
                        s.junction_unknowns);
     out << fmt::format("method     {} (order {}), rtol {:g}, atol {:g}, tension backend {}\n", s.stats.method,
-                       s.stats.order, scene.solver.integrator.rtol, scene.solver.integrator.atol, s.tension_backend);
+                       s.stats.order, scene.solver_options().integrator.rtol,
+                       scene.solver_options().integrator.atol, s.tension_backend);
     out << fmt::format("run        {} at t = {:.6g} s (t_end = {:g} s) in {:.3f} s wall: {} steps, {} rhs "
                        "evaluations, {} tension solves{}\n",
                        s.status, s.t_stop, s.t_end, s.wall_s, s.stats.steps, s.stats.rhs_evals, s.tension_solves,
@@ -176,7 +136,7 @@ int run_string_scene(const SceneSpec& spec, const std::filesystem::path& dir, bo
                        s.slack ? s.slack->message()
                                : s.slack_policy == SlackPolicy::kIgnore ? "not checked" : "none at any accepted step",
                        to_string(s.slack_policy));
-    out << fmt::format("outputs    {}: {}\n", dir.string(), output_files(scene.output, fronts));
+    out << fmt::format("outputs    {}: {}\n", dir.string(), output_files(scene.output(), fronts));
   }
   if (failure) throw *failure;
   return interrupted ? kInterruptedExit : 0;
@@ -229,7 +189,7 @@ void check_in(const SceneSpec& spec) {
   if (spec.model == "reduced")
     match_canonical_problem(spec);
   else
-    build<dim>(spec);
+    SceneRun<dim>{spec};
 }
 
 }  // namespace

@@ -75,7 +75,7 @@ SceneSpec parse_scene_text(std::string_view text, const std::string& source, con
 
 SceneSpec parse_scene(const std::filesystem::path& file) { return parse_scene(file, {}); }
 
-SceneSpec parse_scene(const std::filesystem::path& file, const std::vector<std::string>& overrides) {
+std::string read_scene_file(const std::filesystem::path& file) {
   const std::string name = file.string();
   auto too_large = [&] {
     return InputError(fmt::format("{}:1:1: the scene file is larger than {} MiB ({} bytes), the most a scene may have",
@@ -98,7 +98,11 @@ SceneSpec parse_scene(const std::filesystem::path& file, const std::vector<std::
     text.append(chunk.data(), n);
   }
   if (in.bad()) throw InputError(fmt::format("cannot read the scene file '{}'", name));
-  return parse_scene_text(text, name, overrides);
+  return text;
+}
+
+SceneSpec parse_scene(const std::filesystem::path& file, const std::vector<std::string>& overrides) {
+  return parse_scene_text(read_scene_file(file), file.string(), overrides);
 }
 
 }  // namespace chainsim

@@ -174,6 +174,8 @@ SceneSpec parse_scene(const std::filesystem::path& file);
 /// has none, before any check, so that a bad value or unknown key is refused as in the file, located
 /// at "--set KEY=VALUE".
 SceneSpec parse_scene(const std::filesystem::path& file, const std::vector<std::string>& overrides);
+/// The text of a scene file (read up to the size limit of a scene; InputError if it cannot be read).
+std::string read_scene_file(const std::filesystem::path& file);
 /// The same from text; `source` names it in messages.
 SceneSpec parse_scene_text(std::string_view text, const std::string& source);
 SceneSpec parse_scene_text(std::string_view text, const std::string& source, const std::vector<std::string>& overrides);

@@ -18,3 +18,13 @@ namespace chainsim {
 nlohmann::json scene_to_json(const SceneSpec& spec);
 
 }  // namespace chainsim
+
+namespace chainsim {
+
+/// The TOML text of a scene given as a JSON object (sections as objects, [[arrays of tables]] as
+/// arrays of objects; the Python module's Scene.from_dict), to be read by parse_scene_text, which
+/// checks it like a file. Throws InputError for a value TOML cannot hold (null, an array that mixes
+/// tables and values, a top-level value that is not an object).
+std::string scene_toml_text(const nlohmann::json& scene);
+
+}  // namespace chainsim

@@ -1,0 +1,61 @@
+#pragma once
+/// @file scene_run.hpp
+/// One run of a string scene (with or without fronts), exactly as `chainsim run` does it: the model
+/// built and checked (build_string_scene, or build_front_scene when the scene has a heap or a fold),
+/// the one runner (StringSolver), the summary that becomes stats.json, and the run directory
+/// (StringSolver::write_outputs). `chainsim run`, `chainsim sweep` and the Python module
+/// (python/chainsim) all run scenes through this class, so they give the same numbers.
+#include <filesystem>
+#include <functional>
+#include <memory>
+#include <optional>
+
+#include <nlohmann/json.hpp>
+
+#include "cases/scene/scene.hpp"
+#include "mesh/errors.hpp"
+#include "solver/string_solver.hpp"
+
+namespace chainsim {
+
+template <int dim>
+struct FrontScene;
+
+template <int dim>
+class SceneRun {
+ public:
+  /// Builds the model of `spec` (spec.model = "string", dim = spec.dimension) and checks it.
+  /// Throws InputError located at the key at fault.
+  explicit SceneRun(const SceneSpec& spec);
+  ~SceneRun();
+  SceneRun(SceneRun&&) noexcept;
+  SceneRun& operator=(SceneRun&&) noexcept;
+
+  /// Integrates from t = 0 (StringSolver::run), calling `on_step(t)` after every accepted step.
+  /// A numerical failure does not throw: it is returned, and the solver keeps the frames, samples
+  /// and summary up to it (status "failed"); Ctrl-C (solver/interrupt.hpp) ends with "interrupted".
+  std::optional<NumericalError> run(const std::function<void(double)>& on_step = {});
+
+  const StringSolver<dim>& solver() const { return *solver_; }
+  const StringModel<dim>& model() const { return *model_; }
+  const StringSolverOptions& solver_options() const { return options_; }
+  const OutputSelection& output() const { return output_; }
+  bool has_fronts() const { return fronts_ != nullptr; }
+  /// With fronts: what was built (front_scene.hpp's description: fronts, stop events); else null.
+  nlohmann::json description() const;
+
+  /// The run's summary as stats.json holds it: to_json(summary) with "model": "string" and no fronts,
+  /// or front_summary() for a scene with fronts.
+  nlohmann::json summary() const;
+  /// Writes the run directory (the scene's [output] selection; stats.json = `summary`, last).
+  void write(const std::filesystem::path& dir, const nlohmann::json& summary) const;
+
+ private:
+  std::unique_ptr<StringModel<dim>> model_;
+  StringSolverOptions options_;
+  OutputSelection output_;
+  std::unique_ptr<FrontScene<dim>> fronts_;  ///< the front scene's description (its model moved out)
+  std::unique_ptr<StringSolver<dim>> solver_;
+};
+
+}  // namespace chainsim

@@ -1,0 +1,182 @@
+// Sweeps of a scene: see scene_sweep.hpp.
+#include "cases/scene/scene_sweep.hpp"
+
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <set>
+#include <thread>
+
+#include <fmt/format.h>
+
+#include "cases/scene/reduced_scene.hpp"
+#include "cases/scene/scene.hpp"
+#include "cases/scene/scene_run.hpp"
+#include "mesh/errors.hpp"
+#include "solver/interrupt.hpp"
+
+namespace chainsim {
+
+namespace {
+
+/// `f` -> the dotted key of the scene's only front's dissipation.
+std::string front_f_key(const SceneSpec& spec) {
+  const std::size_t fronts = spec.effects.heaps.size() + (spec.effects.fold ? 1 : 0);
+  if (fronts != 1)
+    throw InputError(fmt::format("{}: the sweep key f names the dissipation of the scene's only front, but the "
+                                 "scene has {} fronts: write effects.heap[K].f or effects.fold.f",
+                                 spec.source, fronts));
+  return spec.effects.fold ? "effects.fold.f" : "effects.heap[0].f";
+}
+
+/// The point's overrides with `f=` replaced by the key it stands for.
+std::vector<std::string> resolve_keys(const SweepScene& scene, const std::vector<std::string>& point) {
+  std::vector<std::string> out;
+  std::optional<std::string> f_key;
+  for (const std::string& o : point) {
+    if (o.rfind("f=", 0) == 0) {
+      if (!f_key) f_key = front_f_key(parse_scene_text(scene.text, scene.source, scene.overrides));
+      out.push_back(*f_key + o.substr(1));
+    } else {
+      out.push_back(o);
+    }
+  }
+  return out;
+}
+
+template <int dim>
+nlohmann::json run_string_point(const SceneSpec& spec) {
+  SceneRun<dim> run(spec);
+  const std::optional<NumericalError> failure = run.run();
+  nlohmann::json summary = run.summary();
+  if (failure) summary["error"] = failure->what();
+  return summary;
+}
+
+nlohmann::json run_point(const SceneSpec& spec) {
+  if (spec.model == "reduced") {
+    ReducedRun run = solve_reduced(match_canonical_problem(spec));
+    run.summary["t_end"] = spec.stop.t_end;
+    run.summary["status"] = "completed";
+    return run.summary;
+  }
+  return spec.dimension == 3 ? run_string_point<3>(spec) : run_string_point<2>(spec);
+}
+
+void flatten_into(nlohmann::json& row, const std::string& prefix, const nlohmann::json& value) {
+  if (value.is_object()) {
+    for (const auto& [key, item] : value.items()) flatten_into(row, prefix.empty() ? key : prefix + "." + key, item);
+  } else if (value.is_array()) {
+    bool numbers = true;
+    for (const auto& item : value) numbers = numbers && item.is_number();
+    if (!numbers) return;
+    for (std::size_t k = 0; k < value.size(); ++k) row[fmt::format("{}[{}]", prefix, k)] = value[k];
+  } else if (!value.is_null()) {
+    row[prefix] = value;
+  }
+}
+
+}  // namespace
+
+SweepAxis parse_grid_axis(const std::string& argument) {
+  const auto eq = argument.find('=');
+  if (eq == std::string::npos || eq == 0)
+    throw InputError(fmt::format("--grid {}: expected KEY=V1,V2,..., e.g. --grid string.nodes=51,101", argument));
+  SweepAxis axis{argument.substr(0, eq), {}};
+  std::string value;
+  int depth = 0;
+  bool quoted = false;
+  for (char c : argument.substr(eq + 1) + ",") {
+    if (c == '"') quoted = !quoted;
+    if (!quoted && (c == '[' || c == '{')) ++depth;
+    if (!quoted && (c == ']' || c == '}')) --depth;
+    if (c == ',' && depth == 0 && !quoted) {
+      if (value.empty())
+        throw InputError(fmt::format("--grid {}: an empty value (two commas, or a comma at an end)", argument));
+      axis.values.push_back(value);
+      value.clear();
+    } else {
+      value += c;
+    }
+  }
+  return axis;
+}
+
+std::vector<std::vector<std::string>> sweep_points(const std::vector<SweepAxis>& grid) {
+  if (grid.empty()) throw InputError("a sweep needs at least one grid axis KEY=V1,V2,...");
+  std::set<std::string> keys;
+  std::vector<std::vector<std::string>> points = {{}};
+  for (const SweepAxis& axis : grid) {
+    if (axis.values.empty()) throw InputError(fmt::format("the grid axis {} has no values", axis.key));
+    if (!keys.insert(axis.key).second) throw InputError(fmt::format("the grid key {} is given twice", axis.key));
+    std::vector<std::vector<std::string>> next;
+    for (const auto& point : points)
+      for (const std::string& value : axis.values) {
+        next.push_back(point);
+        next.back().push_back(axis.key + "=" + value);
+      }
+    points = std::move(next);
+  }
+  return points;
+}
+
+nlohmann::json run_sweep_point(const SweepScene& scene, const std::vector<std::string>& point) {
+  const auto start = std::chrono::steady_clock::now();
+  nlohmann::json row = nlohmann::json::object();
+  nlohmann::json summary;
+  std::string status, error;
+  try {
+    std::vector<std::string> overrides = scene.overrides;
+    for (const std::string& o : resolve_keys(scene, point)) overrides.push_back(o);
+    SceneSpec spec = parse_scene_text(scene.text, scene.source, overrides);
+    if (scene.t_end) {
+      if (!(*scene.t_end > 0 && std::isfinite(*scene.t_end)))
+        throw InputError(fmt::format("t_end = {:g} is out of range: allowed t_end > 0", *scene.t_end));
+      spec.stop.t_end = *scene.t_end;
+    }
+    summary = run_point(spec);
+    status = summary.value("status", "completed");
+    error = summary.value("error", "");
+  } catch (const InputError& e) {
+    status = "error";
+    error = e.what();
+  } catch (const NumericalError& e) {  // the reduced model's failure
+    status = "failed";
+    error = e.what();
+  } catch (const std::exception& e) {
+    status = "error";
+    error = e.what();
+  }
+  if (!summary.is_null()) row = flatten_summary(summary);
+  row["status"] = status;
+  row["error"] = error;
+  row["wall_time_s"] = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return row;
+}
+
+std::vector<nlohmann::json> run_sweep(const SweepScene& scene, const std::vector<std::vector<std::string>>& points,
+                                      int workers) {
+  std::vector<nlohmann::json> rows(points.size());
+  std::atomic<std::size_t> next{0};
+  auto work = [&] {
+    for (std::size_t k; (k = next.fetch_add(1)) < points.size();)
+      rows[k] = interrupt_requested()
+                    ? nlohmann::json{{"status", "interrupted"}, {"error", "not run: interrupted by the user"},
+                                     {"wall_time_s", 0.0}}
+                    : run_sweep_point(scene, points[k]);
+  };
+  const int n = std::max(1, std::min<int>(workers, static_cast<int>(points.size())));
+  std::vector<std::thread> threads;
+  for (int w = 1; w < n; ++w) threads.emplace_back(work);
+  work();
+  for (auto& t : threads) t.join();
+  return rows;
+}
+
+nlohmann::json flatten_summary(const nlohmann::json& summary) {
+  nlohmann::json row = nlohmann::json::object();
+  flatten_into(row, "", summary);
+  return row;
+}
+
+}  // namespace chainsim

@@ -1,0 +1,63 @@
+#pragma once
+/// @file scene_sweep.hpp
+/// Sweeps: many short runs of one scene, each with some of its keys set (`chainsim sweep`, and
+/// chainsim.sweep in Python, which sends the same points to a Dask cluster).
+///
+/// A grid is a list of axes KEY = [values]; its points are the Cartesian product (the last axis
+/// varies fastest). A point is a list of "KEY=VALUE" overrides applied to the scene exactly as
+/// `chainsim run --set KEY=VALUE` applies them (cases/scene/scene_overrides.hpp): the same keys,
+/// the same checks, the same located messages. One key more: `f`, the dissipation of the scene's
+/// only front (effects.heap[0].f, or effects.fold.f).
+///
+/// Each point is one SceneRun (or, for model = "reduced", one reduced run): it never throws; it
+/// gives a row (JSON object) with
+///   status        "completed" | "stopped" | "interrupted" (Ctrl-C) | "failed" (numerical failure)
+///                 | "error" (the point's scene was refused: bad key or value, inconsistent scene)
+///   error         the message ("" when none)
+///   wall_time_s   wall-clock time of the whole point: parsing, building, running (s)
+///   and the run's summary (stats.json) flattened: top-level numbers, strings and booleans as they
+///   are, nested objects as "parent.child", arrays of numbers as "name[k]" (other arrays left out).
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+namespace chainsim {
+
+/// The scene a sweep varies: its TOML text (a file's content, with `source` naming the file in
+/// messages), overrides applied to every point first, and an optional end time for every run.
+struct SweepScene {
+  std::string text;
+  std::string source;
+  std::vector<std::string> overrides;  ///< "KEY=VALUE", before each point's own
+  std::optional<double> t_end;         ///< replaces [stop] t_end (s), > 0
+};
+
+/// One axis of a grid: a key (dotted, as for --set, or `f`) and its values as TOML values ("0.5", "101").
+struct SweepAxis {
+  std::string key;
+  std::vector<std::string> values;
+};
+
+/// Parses "KEY=V1,V2,..." (`chainsim sweep --grid`); a value may be a TOML array or inline table
+/// ("shape.end=[1,0],[0,1]": commas inside brackets and braces do not split). Throws InputError.
+SweepAxis parse_grid_axis(const std::string& argument);
+
+/// The grid's points, each a list of "KEY=VALUE" (KEY as written in the grid). Throws InputError for
+/// an empty grid, an axis without values, or a key given twice.
+std::vector<std::vector<std::string>> sweep_points(const std::vector<SweepAxis>& grid);
+
+/// Runs one point (see the file comment for the row). Never throws for a bad point.
+nlohmann::json run_sweep_point(const SweepScene& scene, const std::vector<std::string>& point);
+
+/// Runs every point on `workers` threads (the runs share nothing but the interrupt flag); the rows are
+/// in the order of the points. After Ctrl-C (solver/interrupt.hpp) the running points end
+/// "interrupted" and the points not started yet are rows with status "interrupted".
+std::vector<nlohmann::json> run_sweep(const SweepScene& scene, const std::vector<std::vector<std::string>>& points,
+                                      int workers);
+
+/// The summary flattened into a row's columns (see the file comment).
+nlohmann::json flatten_summary(const nlohmann::json& summary);
+
+}  // namespace chainsim

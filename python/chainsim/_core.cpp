@@ -1,0 +1,404 @@
+// chainsim._core: the compiled half of the Python module (python/chainsim/__init__.py is the other).
+// Only bindings: every number comes from the C++ library, through the code the command-line tool runs
+// (SceneRun = `chainsim run`, solve_reduced = `chainsim reduced`, compare_with_reduced = `chainsim
+// compare`, run_sweep / run_sweep_point = `chainsim sweep`). JSON documents cross as text (json.loads
+// on the Python side: doubles round-trip exactly); arrays as numpy arrays (copies).
+#include <cmath>
+#include <limits>
+#include <memory>
+#include <optional>
+#include <string>
+#include <variant>
+#include <vector>
+
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+#include <pybind11/stl/filesystem.h>
+
+#include <nlohmann/json.hpp>
+
+#include "cases/canonical/canonical_string.hpp"
+#include "cases/reduced/reduced_models.hpp"
+#include "cases/scene/reduced_scene.hpp"
+#include "cases/scene/scene.hpp"
+#include "cases/scene/scene_json.hpp"
+#include "cases/scene/scene_run.hpp"
+#include "cases/scene/scene_sweep.hpp"
+#include "mesh/errors.hpp"
+#include "solver/interrupt.hpp"
+#include "solver/output.hpp"
+
+namespace py = pybind11;
+using namespace chainsim;
+
+namespace {
+
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+py::array_t<double> array1(const std::vector<double>& v) {
+  py::array_t<double> a(static_cast<py::ssize_t>(v.size()));
+  std::copy(v.begin(), v.end(), a.mutable_data());
+  return a;
+}
+
+/// Every column of a table, by its CSV name.
+py::dict table_dict(const CsvTable& table) {
+  py::dict d;
+  for (const std::string& c : table.columns()) d[py::str(c)] = array1(table.column(c));
+  return d;
+}
+
+/// Builds an array of shape `shape` filled with NaN.
+py::array_t<double> nan_array(const std::vector<py::ssize_t>& shape) {
+  py::array_t<double> a(shape);
+  std::fill(a.mutable_data(), a.mutable_data() + a.size(), kNaN);
+  return a;
+}
+
+/// A run's frames as arrays (frame index first), named as in the CSV files.
+template <int dim>
+py::dict frames_dict(const SceneRun<dim>& run) {
+  const auto& frames = run.solver().frames();
+  const auto& chain = run.model().chain();
+  const auto F = static_cast<py::ssize_t>(frames.size());
+  const py::ssize_t N = chain.num_nodes(), L = chain.num_links();
+  const char* axes[] = {"x", "y", "z"};
+  py::dict nodes, tension, energy, forces, fronts;
+  std::vector<double> t, s(static_cast<std::size_t>(N)), s_mid(static_cast<std::size_t>(L));
+  for (const auto& f : frames) t.push_back(f.t);
+  for (int i = 0; i < N; ++i) s[static_cast<std::size_t>(i)] = chain.node_coordinate(i);
+  for (int j = 0; j < L; ++j) s_mid[static_cast<std::size_t>(j)] = chain.link_midpoint(j);
+  // nodes: x, y[, z], vx, vy[, vz] of shape (frames, nodes); NaN for a node in no arc (in a heap).
+  std::vector<py::array_t<double>> x, v;
+  for (int d = 0; d < dim; ++d) {
+    x.push_back(nan_array({F, N}));
+    v.push_back(nan_array({F, N}));
+  }
+  auto moving = py::array_t<bool>({F, N});
+  std::fill(moving.mutable_data(), moving.mutable_data() + moving.size(), false);
+  auto T = nan_array({F, L});
+  for (py::ssize_t k = 0; k < F; ++k) {
+    const auto& f = frames[static_cast<std::size_t>(k)];
+    for (int i : f.moving) {
+      moving.mutable_at(k, i) = true;
+      for (int d = 0; d < dim; ++d) {
+        x[d].mutable_at(k, i) = f.x(d, i);
+        v[d].mutable_at(k, i) = f.v(d, i);
+      }
+    }
+    for (py::ssize_t j = 0; j < L; ++j) T.mutable_at(k, j) = f.tension[j];
+  }
+  nodes["t"] = array1(t);
+  {
+    auto idx = py::array_t<long>(N);
+    for (py::ssize_t i = 0; i < N; ++i) idx.mutable_at(i) = i;
+    nodes["node"] = idx;
+  }
+  nodes["s"] = array1(s);
+  for (int d = 0; d < dim; ++d) {
+    nodes[py::str(axes[d])] = x[d];
+    nodes[py::str(std::string("v") + axes[d])] = v[d];
+  }
+  nodes["moving"] = moving;
+  tension["t"] = array1(t);
+  {
+    auto idx = py::array_t<long>(L);
+    for (py::ssize_t j = 0; j < L; ++j) idx.mutable_at(j) = j;
+    tension["link"] = idx;
+  }
+  tension["s_mid"] = array1(s_mid);
+  tension["T"] = T;
+  // energy: the ledger terms of energy.csv.
+  std::vector<double> K, V, W, drift, ws, wh, wr;
+  for (const auto& f : frames) {
+    K.push_back(f.kinetic);
+    V.push_back(f.potential);
+    W.push_back(f.work);
+    drift.push_back(f.drift);
+    ws.push_back(f.w_shocks);
+    wh.push_back(f.w_heaps);
+    wr.push_back(f.w_remesh);
+  }
+  energy["t"] = array1(t);
+  energy["K"] = array1(K);
+  energy["V"] = array1(V);
+  energy["W_applied"] = array1(W);
+  energy["drift"] = array1(drift);
+  if (run.has_fronts()) {
+    energy["W_shocks"] = array1(ws);
+    energy["W_heaps"] = array1(wh);
+    energy["W_remesh"] = array1(wr);
+  }
+  // forces: the columns of forces.csv.
+  const auto& names = run.solver().summary().force_columns;
+  forces["t"] = array1(t);
+  for (std::size_t c = 0; c < names.size(); ++c) {
+    std::vector<double> col;
+    for (const auto& f : frames) col.push_back(c < f.forces.size() ? f.forces[c] : kNaN);
+    forces[py::str(names[c])] = array1(col);
+  }
+  // fronts at the frames: s0, s0_dot (frames, fronts), position and reaction (frames, fronts, dim).
+  const py::ssize_t nf = frames.empty() ? 0 : static_cast<py::ssize_t>(frames.front().fronts.size());
+  auto s0 = nan_array({F, nf}), s0_dot = nan_array({F, nf});
+  auto position = nan_array({F, nf, dim}), reaction = nan_array({F, nf, dim});
+  for (py::ssize_t k = 0; k < F; ++k) {
+    const auto& fs = frames[static_cast<std::size_t>(k)].fronts;
+    for (py::ssize_t q = 0; q < nf && q < static_cast<py::ssize_t>(fs.size()); ++q) {
+      const auto& fr = fs[static_cast<std::size_t>(q)];
+      s0.mutable_at(k, q) = fr.s0;
+      s0_dot.mutable_at(k, q) = fr.s0_dot;
+      for (int d = 0; d < dim; ++d) {
+        position.mutable_at(k, q, d) = fr.position(d);
+        reaction.mutable_at(k, q, d) = fr.reaction(d);
+      }
+    }
+  }
+  fronts["t"] = array1(t);
+  fronts["s0"] = s0;
+  fronts["s0_dot"] = s0_dot;
+  fronts["position"] = position;
+  fronts["reaction"] = reaction;
+  py::dict out;
+  out["nodes"] = nodes;
+  out["tension"] = tension;
+  out["energy"] = energy;
+  out["forces"] = forces;
+  out["fronts"] = fronts;
+  out["series"] = run.solver().summary().samples.empty() ? py::dict() : table_dict(samples_table(run.solver().summary()));
+  return out;
+}
+
+/// A finished run of a scene: the string solver's (2D or 3D) or the reduced model's.
+class Run {
+ public:
+  using Variant = std::variant<std::unique_ptr<SceneRun<2>>, std::unique_ptr<SceneRun<3>>, ReducedRun>;
+  explicit Run(Variant run) : run_(std::move(run)) {}
+
+  std::string summary() const {
+    return std::visit(
+        [](const auto& r) -> std::string {
+          if constexpr (std::is_same_v<std::decay_t<decltype(r)>, ReducedRun>)
+            return r.summary.dump();
+          else
+            return r->summary().dump();
+        },
+        run_);
+  }
+
+  py::dict arrays() const {
+    return std::visit(
+        [](const auto& r) -> py::dict {
+          if constexpr (std::is_same_v<std::decay_t<decltype(r)>, ReducedRun>) {
+            py::dict d;
+            d["series"] = table_dict(r.series);
+            return d;
+          } else {
+            return frames_dict(*r);
+          }
+        },
+        run_);
+  }
+
+  /// The run directory, as `chainsim run --out DIR` writes it (string runs; a reduced run's arrays and
+  /// summary are all it has).
+  void write(const std::filesystem::path& dir) const {
+    std::visit(
+        [&](const auto& r) {
+          if constexpr (std::is_same_v<std::decay_t<decltype(r)>, ReducedRun>)
+            throw InputError("write(): a reduced run has no run directory here (chainsim run writes one)");
+          else
+            r->write(dir, r->summary());
+        },
+        run_);
+  }
+
+  std::string error;  ///< a numerical failure's message ("" if none)
+
+ private:
+  Variant run_;
+};
+
+template <int dim>
+std::unique_ptr<Run> run_string(const SceneSpec& spec, bool handle_sigint) {
+  auto run = std::make_unique<SceneRun<dim>>(spec);
+  std::optional<NumericalError> failure;
+  {
+    clear_interrupt();
+    ScopedSigintHandler sigint(handle_sigint);
+    py::gil_scoped_release release;
+    failure = run->run();
+  }
+  auto out = std::make_unique<Run>(Run::Variant(std::move(run)));
+  if (failure) out->error = failure->what();
+  return out;
+}
+
+SceneSpec parse(const std::string& text, const std::string& source, const std::vector<std::string>& overrides,
+                std::optional<double> t_end) {
+  SceneSpec spec = parse_scene_text(text, source, overrides);
+  if (t_end) {
+    if (!(*t_end > 0 && std::isfinite(*t_end)))
+      throw InputError(fmt::format("t_end = {:g} is out of range: allowed t_end > 0 (s)", *t_end));
+    spec.stop.t_end = *t_end;
+  }
+  return spec;
+}
+
+std::unique_ptr<Run> run_scene(const std::string& text, const std::string& source,
+                               const std::vector<std::string>& overrides, std::optional<double> t_end,
+                               bool handle_sigint) {
+  const SceneSpec spec = parse(text, source, overrides, t_end);
+  if (spec.model == "reduced") {
+    const ReducedSetup setup = match_canonical_problem(spec);
+    ReducedRun r{CsvTable(series_columns()), {}};
+    {
+      py::gil_scoped_release release;
+      r = solve_reduced(setup);
+    }
+    r.summary["t_end"] = spec.stop.t_end;
+    return std::make_unique<Run>(Run::Variant(std::move(r)));
+  }
+  return spec.dimension == 3 ? run_string<3>(spec, handle_sigint) : run_string<2>(spec, handle_sigint);
+}
+
+/// The chain's and the integrator's settings shared by reduced() and compare(): keyword -> field.
+template <class Setup>
+void set_common(Setup& s, const py::dict& kw) {
+  for (const auto& [key, value] : kw) {
+    const std::string k = py::str(key);
+    if (k == "f") s.chain.dissipation = py::cast<double>(value);
+    else if (k == "eta0") { if (!value.is_none()) s.eta0 = py::cast<double>(value); }
+    else if (k == "eps") s.eps = py::cast<double>(value);
+    else if (k == "force") s.force = py::cast<double>(value);
+    else if (k == "length") s.chain.length = py::cast<double>(value);
+    else if (k == "density") s.chain.density = py::cast<double>(value);
+    else if (k == "gravity") s.chain.gravity = py::cast<double>(value);
+    else if (k == "t_max") s.t_max_over_t0 = py::cast<double>(value);
+    else if (k == "method") s.integrator.method = py::cast<std::string>(value);
+    else if (k == "rtol") s.integrator.rtol = py::cast<double>(value);
+    else if (k == "atol") s.integrator.atol = py::cast<double>(value);
+    else if (k == "max_step") s.integrator.max_step = py::cast<double>(value);
+    else if (k == "max_steps") s.integrator.max_steps = py::cast<long>(value);
+    else if constexpr (std::is_same_v<Setup, StringCaseSetup>) {
+      if (k == "nodes") s.nodes = py::cast<int>(value);
+      else if (k == "tilt_deg") s.tilt_deg = py::cast<double>(value);
+      else if (k == "bend_deg") s.bend_deg = py::cast<double>(value);
+      else if (k == "frame_interval") s.frame_interval = py::cast<double>(value);
+      else throw InputError(fmt::format("compare() got an unknown keyword {}", k));
+    } else {
+      throw InputError(fmt::format("reduced() got an unknown keyword {}", k));
+    }
+  }
+}
+
+py::tuple reduced(const std::string& problem, const py::dict& kw) {
+  ReducedSetup setup;
+  setup.problem = parse_problem(problem);
+  set_common(setup, kw);
+  ReducedRun r{CsvTable(series_columns()), {}};
+  {
+    py::gil_scoped_release release;
+    r = solve_reduced(setup);
+  }
+  return py::make_tuple(table_dict(r.series), r.summary.dump());
+}
+
+py::tuple compare(const std::string& problem, const py::dict& kw) {
+  StringCaseSetup setup;
+  setup.problem = parse_problem(problem);
+  set_common(setup, kw);
+  setup.validate();
+  std::optional<Comparison> c;
+  {
+    py::gil_scoped_release release;
+    c = compare_with_reduced(setup);
+  }
+  return py::make_tuple(table_dict(samples_table(c->string.run)), table_dict(c->reduced.series), c->summary.dump(),
+                        c->string.run.status == "failed" ? c->string.run.error : std::string());
+}
+
+SweepScene sweep_scene(const std::string& text, const std::string& source, const std::vector<std::string>& overrides,
+                       std::optional<double> t_end) {
+  return SweepScene{text, source, overrides, t_end};
+}
+
+}  // namespace
+
+PYBIND11_MODULE(_core, m) {
+  m.doc() = "chainsim's C++ library (see the package chainsim and docs/python.md)";
+  static py::exception<InputError> input_error(m, "ChainsimInputError", PyExc_ValueError);
+  static py::exception<NumericalError> numerical_error(m, "NumericalError", PyExc_RuntimeError);
+  py::register_exception_translator([](std::exception_ptr p) {
+    try {
+      if (p) std::rethrow_exception(p);
+    } catch (const InputError& e) {
+      PyErr_SetString(input_error.ptr(), e.what());
+    } catch (const NumericalError& e) {
+      PyErr_SetString(numerical_error.ptr(), e.what());
+    }
+  });
+
+  py::class_<Run>(m, "Run", "a finished run (use chainsim.Result)")
+      .def("summary", &Run::summary, "the summary (stats.json) as JSON text")
+      .def("arrays", &Run::arrays, "the recorded frames and samples as numpy arrays, by CSV file and column")
+      .def("write", &Run::write, py::arg("dir"), "the run directory, as `chainsim run --out DIR` writes it")
+      .def_readonly("error", &Run::error);
+
+  m.def("check_scene",
+        [](const std::string& text, const std::string& source, const std::vector<std::string>& overrides,
+           std::optional<double> t_end) { return scene_to_json(parse(text, source, overrides, t_end)).dump(); },
+        py::arg("text"), py::arg("source"), py::arg("overrides"), py::arg("t_end") = py::none(),
+        "parses and checks a scene (as `chainsim run` reads it); returns the effective scene as JSON text");
+  m.def("read_scene_file", [](const std::filesystem::path& path) { return read_scene_file(path); }, py::arg("path"),
+        "the text of a scene file, read as `chainsim run` reads it");
+  m.def("scene_toml_text", [](const std::string& json) { return scene_toml_text(nlohmann::json::parse(json)); },
+        py::arg("json"), "a scene given as JSON text, written as TOML");
+  m.def("run_scene", &run_scene, py::arg("text"), py::arg("source"), py::arg("overrides"),
+        py::arg("t_end") = py::none(), py::arg("handle_sigint") = false,
+        "builds and runs a scene as `chainsim run` does (the GIL released; with handle_sigint, Ctrl-C stops the run "
+        "at its next accepted step: status \"interrupted\")");
+  m.def("reduced", &reduced, py::arg("problem"), py::arg("kwargs"),
+        "`chainsim reduced`: returns (series columns, summary JSON text)");
+  m.def("compare", &compare, py::arg("problem"), py::arg("kwargs"),
+        "`chainsim compare`: returns (string series, reduced series, summary JSON text, the string run's error)");
+  m.def("sweep_points",
+        [](const std::vector<std::pair<std::string, std::vector<std::string>>>& grid) {
+          std::vector<SweepAxis> axes;
+          for (const auto& [key, values] : grid) axes.push_back({key, values});
+          return sweep_points(axes);
+        },
+        py::arg("grid"), "the grid's points as lists of KEY=VALUE overrides");
+  m.def("run_sweep_point",
+        [](const std::string& text, const std::string& source, const std::vector<std::string>& overrides,
+           std::optional<double> t_end, const std::vector<std::string>& point) {
+          const SweepScene scene = sweep_scene(text, source, overrides, t_end);
+          py::gil_scoped_release release;
+          return run_sweep_point(scene, point).dump();
+        },
+        py::arg("text"), py::arg("source"), py::arg("overrides"), py::arg("t_end"), py::arg("point"),
+        "one sweep point as `chainsim sweep` runs it: the row as JSON text");
+  m.def("run_sweep",
+        [](const std::string& text, const std::string& source, const std::vector<std::string>& overrides,
+           std::optional<double> t_end, const std::vector<std::vector<std::string>>& points, int workers,
+           bool handle_sigint) {
+          const SweepScene scene = sweep_scene(text, source, overrides, t_end);
+          std::vector<nlohmann::json> rows;
+          {
+            clear_interrupt();
+            ScopedSigintHandler sigint(handle_sigint);
+            py::gil_scoped_release release;
+            rows = run_sweep(scene, points, workers);
+          }
+          std::vector<std::string> out;
+          for (const auto& r : rows) out.push_back(r.dump());
+          return out;
+        },
+        py::arg("text"), py::arg("source"), py::arg("overrides"), py::arg("t_end"), py::arg("points"),
+        py::arg("workers"), py::arg("handle_sigint") = false,
+        "the points on `workers` threads, as `chainsim sweep` runs them: rows as JSON text");
+  m.def("flatten_summary", [](const std::string& json) { return flatten_summary(nlohmann::json::parse(json)).dump(); },
+        py::arg("json"), "a summary flattened into a sweep row's columns");
+  m.def("interrupt_requested", &interrupt_requested);
+  m.def("clear_interrupt", &clear_interrupt);
+}

@@ -1,0 +1,88 @@
+// Sweeps (cases/scene/scene_sweep.hpp) and scenes given as JSON (scene_json.hpp: scene_toml_text).
+// The sweep's threads run here under the sanitizers too (the Python tests do not).
+#include <cmath>
+
+#include <catch2/catch.hpp>
+#include <nlohmann/json.hpp>
+
+#include "cases/reduced/reduced_models.hpp"
+#include "cases/scene/scene_json.hpp"
+#include "cases/scene/scene_sweep.hpp"
+#include "mesh/errors.hpp"
+#include "test_scene_support.hpp"
+
+using namespace chainsim;
+using chainsim::test::kFallingBase;
+using chainsim::test::kSceneBase;
+
+TEST_CASE("sweep grids: axes, points in order, refused grids", "[unit][sweep]") {
+  const SweepAxis a = parse_grid_axis("shape.points=[[0,0],[0,-1]],[[0,0],[1,0]]");
+  CHECK(a.key == "shape.points");
+  CHECK(a.values == std::vector<std::string>{"[[0,0],[0,-1]]", "[[0,0],[1,0]]"});
+  const auto points = sweep_points({parse_grid_axis("f=0,1"), parse_grid_axis("string.nodes=11,21,31")});
+  REQUIRE(points.size() == 6);
+  CHECK(points[1] == std::vector<std::string>{"f=0", "string.nodes=21"});   // the last axis fastest
+  CHECK(points[3] == std::vector<std::string>{"f=1", "string.nodes=11"});
+  CHECK_THROWS_AS(parse_grid_axis("f"), InputError);
+  CHECK_THROWS_WITH(parse_grid_axis("f=0,,1"), Catch::Contains("empty value"));
+  CHECK_THROWS_WITH(sweep_points({parse_grid_axis("f=0"), parse_grid_axis("f=1")}), Catch::Contains("twice"));
+  CHECK_THROWS_AS(sweep_points({}), InputError);
+}
+
+TEST_CASE("a sweep on two threads gives the rows of one, a bad point is an error row, f names the front",
+          "[unit][sweep]") {
+  const SweepScene falling{kFallingBase, "falling.toml", {}, std::nullopt};
+  const auto points = sweep_points({parse_grid_axis("f=0,1,1.5"), parse_grid_axis("string.nodes=6,11")});
+  const std::vector<nlohmann::json> one = run_sweep(falling, points, 1), two = run_sweep(falling, points, 2);
+  REQUIRE(one.size() == 6);
+  for (std::size_t k = 0; k < one.size(); ++k) {
+    nlohmann::json a = one[k], b = two[k];
+    for (auto* row : {&a, &b}) {
+      row->erase("wall_time_s");
+      row->erase("wall_s");
+    }
+    CHECK(a == b);
+  }
+  // f = 1.5: refused, located at the override the key f stands for; the sweep went on.
+  for (std::size_t k : {4, 5}) {
+    CHECK(one[k]["status"] == "error");
+    CHECK_THAT(one[k]["error"].get<std::string>(),
+               Catch::Contains("--set effects.heap[0].f=1.5") && Catch::Contains("allowed 0 <= f <= 1"));
+  }
+  // The straight falling chain is exact on any mesh: the stop time is the quadrature's, t0 ξ(ε; f).
+  const double t0 = std::sqrt(2 * 1.0 / 9.81);
+  for (std::size_t k = 0; k < 4; ++k) {
+    const double f = k < 2 ? 0.0 : 1.0;
+    CHECK(one[k]["status"] == "stopped");
+    CHECK(one[k]["nodes"] == (k % 2 == 0 ? 6 : 11));
+    CHECK(one[k]["t_stop"].get<double>() == Approx(t0 * exact::xi(Problem::kFalling, f, 0.01, 1.0)).epsilon(1e-6));
+  }
+}
+
+TEST_CASE("a sweep point that fails numerically is a row with its error", "[unit][sweep]") {
+  const SweepScene hanging{kSceneBase, "hanging.toml", {"solver.max_steps=3"}, 1.0};
+  const nlohmann::json row = run_sweep_point(hanging, {"string.nodes=6"});
+  CHECK(row["status"] == "failed");
+  CHECK_THAT(row["error"].get<std::string>(), Catch::Contains("steps"));
+  CHECK(row["t_end"] == 1.0);
+  const nlohmann::json bad = run_sweep_point(hanging, {"f=0.5"});  // no front: f names nothing
+  CHECK(bad["status"] == "error");
+  CHECK_THAT(bad["error"].get<std::string>(), Catch::Contains("has 0 fronts"));
+}
+
+TEST_CASE("a scene given as JSON is the scene of the same TOML", "[unit][sweep]") {
+  const nlohmann::json scene = {
+      {"string", {{"length", 1.0}, {"density", 0.1}, {"nodes", 11}}},
+      {"shape", {{"kind", "polyline"}, {"points", {{0.0, 0.0}, {0.0, -1.0}}}}},
+      {"ends", {{"start", "fixed"}}},
+      {"effects", {{"gravity", {{"g", {0.0, -9.81}}}}}},
+      {"stop", {{"t_end", 0.2}}}};
+  const SceneSpec from_json = parse_scene_text(scene_toml_text(scene), "<dict>");
+  CHECK(scene_to_json(from_json) == scene_to_json(parse_scene_text(kSceneBase, "<dict>")));
+  // arrays of tables, and a value TOML cannot hold
+  nlohmann::json falling = scene;
+  falling["effects"]["heap"] = {{{"side", "end"}, {"s0", 1.0}, {"f", 0.1}, {"point", {0.0, -1.0}}}};
+  CHECK_THAT(scene_toml_text(falling), Catch::Contains("[[effects.heap]]"));
+  CHECK_THROWS_WITH(scene_toml_text({{"string", {{"length", nullptr}}}}), Catch::Contains("string.length = null"));
+  CHECK_THROWS_AS(scene_toml_text(nlohmann::json::array()), InputError);
+}
