@@ -18,7 +18,7 @@ esac
 # clang and libclang-rt-14-dev: the sanitizer build and the scene fuzzer of .ci/run (libFuzzer).
 # python3-dev, pybind11-dev: the Python module chainsim; pandas, dask, distributed: its sweeps (docs/python.md).
 packages=(cmake make g++ libeigen3-dev libsuitesparse-dev libsundials-dev catch2 libcli11-dev
-          libtomlplusplus-dev nlohmann-json3-dev libfmt-dev libboost-dev python3-matplotlib python3-numpy
+          libtomlplusplus-dev nlohmann-json3-dev libfmt-dev libboost-dev libbenchmark-dev python3-matplotlib python3-numpy
           python3-pil python3-pytest python3-vtk9 ffmpeg clang libclang-rt-14-dev
           python3-dev pybind11-dev python3-pandas python3-dask python3-distributed)
 missing=()

@@ -11,12 +11,10 @@ old_rev=${1:?usage: compare_revisions.sh OLD_REV [ROUNDS]}
 rounds=${2:-7}
 new_bin=build/tests/chainsim_bench_scene
 [ -x "$new_bin" ] || { echo "build $new_bin first" >&2; exit 2; }
-work=$(mktemp -d)
-trap 'git worktree remove --force "$work/src" >/dev/null 2>&1 || true; rm -rf "$work"' EXIT
-git worktree add -q --detach "$work/src" "$old_rev"
-cmake -S "$work/src" -B "$work/build" -DCMAKE_BUILD_TYPE=Release >/dev/null
-cmake --build "$work/build" -j "$(nproc)" --target chainsim_bench_scene >/dev/null
-old_bin="$work/build/tests/chainsim_bench_scene"
+source "$(dirname "$0")/old_revision.sh"
+old_revision_checkout "$old_rev"
+old_revision_build chainsim_bench_scene
+old_bin="$old_build/tests/chainsim_bench_scene"
 # One line per run and kind: "<old|new> <kind> <run ms>".
 for ((r = 0; r < rounds; ++r)); do
   for which in old new; do
