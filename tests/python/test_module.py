@@ -202,7 +202,7 @@ def test_sweep_on_a_local_dask_cluster_with_a_bad_point():
     from dask.distributed import Client, LocalCluster
     scene = chainsim.Scene.from_file(os.path.join(SCENES, "hanging_chain.toml"))
     grid = {"string.nodes": [11, 21, 31, 1], "solver.method": ["erk5", "erk8"]}   # nodes = 1: refused
-    with LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None) as cluster, \
+    with LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=":0") as cluster, \
             Client(cluster) as client:
         df = chainsim.sweep(scene, grid, t_end=0.2, client=client)
     assert len(df) == 8
