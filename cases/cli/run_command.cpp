@@ -103,14 +103,17 @@ int run_string_scene(const SceneSpec& spec, const std::filesystem::path& dir, bo
     out << fmt::format("scene      {} ({}D, {} nodes, {})\n", spec.source, s.dimension, s.nodes,
                        scene.model().chain().closed() ? "closed" : "open");
     if (fronts) {
+      // description() returns a copy: keep it alive for the loop (a range over a member of the
+      // temporary would dangle).
+      const nlohmann::json description = scene.description();
       std::vector<std::string> names;
-      for (const nlohmann::json& f : scene.description()["fronts"]) {
+      for (const nlohmann::json& f : description["fronts"]) {
         std::string where;
         if (f.contains("on_plane")) where = f["on_plane"].get<bool>() ? ", on a plane" : ", pinned";
         names.push_back(fmt::format("{} (f = {:g}, s0 = {:g} m{})", f["name"].get<std::string>(),
                                     f["f"].get<double>(), f["s0"].get<double>(), where));
       }
-      const int stops = static_cast<int>(scene.description()["stop_events"].size());
+      const int stops = static_cast<int>(description["stop_events"].size());
       out << fmt::format("fronts     {}; {} root functions (2 per front + {} stop event{})\n", join_words(names),
                          s.root_functions, stops, stops == 1 ? "" : "s");
     }
