@@ -4,7 +4,8 @@
 ///
 /// The reduced chain models and the string solver both describe themselves as an OdeSystem; the
 /// Integrator advances it with an adaptive Runge–Kutta method (explicit ERK by default, or a
-/// diagonally implicit DIRK with a dense difference-quotient Jacobian), finds the zeros of the
+/// diagonally implicit DIRK whose Newton systems the system solves itself, as the string does with
+/// its sparse linearisation, or else with a dense difference-quotient Jacobian), finds the zeros of the
 /// system's event functions with ARKODE's rootfinding, and reports ARKODE's run statistics.
 ///
 /// integrator.cpp is the only file that includes <arkode/...>: moving to SUNDIALS 7 touches one file.
