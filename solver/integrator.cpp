@@ -20,6 +20,7 @@
 #include <sunmatrix/sunmatrix_dense.h>
 
 #include "mesh/errors.hpp"
+#include "nvector_kernels.hpp"
 
 namespace chainsim {
 
@@ -281,12 +282,13 @@ struct Integrator::Impl {
     });
   }
 
-  /// A new state vector: fused vector operations on (ARKODE's stage sums become one pass over
-  /// the data instead of one per term).
+  /// A new state vector: fused vector operations on (ARKODE's stage sums become one call instead
+  /// of one per term), and the hot ones computed by Eigen kernels (nvector_kernels.hpp).
   N_Vector new_vector(sunindextype n) const {
     N_Vector v = N_VNew_Serial(n, ctx);
     if (!v) throw Error("N_VNew_Serial failed");
     N_VEnableFusedOps_Serial(v, SUNTRUE);
+    use_eigen_kernels(v);
     return v;
   }
 
