@@ -656,9 +656,12 @@ def main():
         study.log(f"tilted: {tilted.title}")
         study.sweep(tilted, methods, rtols, [41])
         study.log(f"curved: {curved.title}")
-        reference = study.richardson(curved, [41, 81, 161, 321], "erk5", 1e-10)
+        # Meshes with a node on the cutoff (1 cm = 1/100 of the chain: the number of links a multiple of 100): where
+        # the cutoff falls inside a link, the error has a part that depends on that fraction, and the orders
+        # observed on 161, 321, 641, 1281 nodes wander (2.44, 1.67); on these they are 1.96, 2.03, 1.96.
+        reference = study.richardson(curved, [101, 201, 401, 801, 1601], "erk8", 1e-12)
         (opts.out / "curved_reference.json").write_text(json.dumps(reference, indent=1))
-        study.sweep(curved, methods, [1e-4, 1e-8], [21, 41, 81, 161])
+        study.sweep(curved, methods, [1e-4, 1e-8], [21, 41, 81, 161, 321])
         study.log(f"hanging: {hanging.title}")
         study.sweep(hanging, methods, [1e-5, 1e-9], [11, 21, 41, 81, 161, 321], hanging.overrides())
         cases = canonical + [tilted, curved, hanging]
