@@ -56,6 +56,9 @@ class OdeSystem {
                             double /*gamma*/) {}
   /// z ≈ (I − γ J)⁻¹ r with the γ of the last newton_setup().
   virtual void newton_solve(const Eigen::Ref<const Eigen::VectorXd>& r, Eigen::Ref<Eigen::VectorXd> z) { z = r; }
+  /// True if newton_solve() inverts I − γ J for the very J of jacobian_times() (the linearisation
+  /// leaves nothing out): the Newton corrections are then newton_solve(r) itself, without GMRES.
+  virtual bool newton_solver_exact() const { return false; }
   /// Jv = J v at the last linearisation, if the system has it analytically (true); false: GMRES
   /// takes J v from a difference quotient of rhs().
   virtual bool jacobian_times(const Eigen::Ref<const Eigen::VectorXd>& /*v*/, Eigen::Ref<Eigen::VectorXd> /*Jv*/) {
