@@ -190,25 +190,40 @@ struct Integrator::Impl {
   static constexpr int kKrylovDimension = 10;
   /// Newton iterations per stage before ARKODE calls it a convergence failure (its default is 3).
   static constexpr int kNewtonIterations = 8;
+  /// ARKODE's crdown: the Newton convergence rate it assumes at least, crate = max(crdown · crate,
+  /// ‖δ_m‖/‖δ_{m−1}‖), is reset to 1 at every linearisation, so with its default 0.3 the first
+  /// stage after it converges only if its second correction is below nlscoef/0.3 = 0.33 in the
+  /// error norm. With a fresh exact linearisation the measured rate is ~1e-5, but on a fine string the
+  /// second correction is the round-off of the residual (the vertical velocities, weighted by atol
+  /// alone, carry the round-off of accelerations of order g·N per node): 0.3–1.3 at 10,000 links,
+  /// and Newton "failed" at every fourth step or so (docs/string_solver.md, "The implicit path").
+  /// 0.05 lets the measured rate count; the remaining-error estimate crate·‖δ‖ ≤ nlscoef is kept.
+  static constexpr double kNewtonRateFloor = 0.05;
 
-  /// The linear solver of an implicit method (after creation and after every resize): GMRES
-  /// (SUNDIALS SPGMR) preconditioned by the system's Newton solver when it has one, with products
-  /// J·v from jac_times(); else a dense difference-quotient Jacobian.
+  /// The linear solver of an implicit method (after creation and after every resize). With the
+  /// system's Newton solver: the solver itself (direct_newton_solver()) when it is exact, else GMRES
+  /// (SUNDIALS SPGMR) preconditioned by it, with products J·v from jac_times(). Without one: a
+  /// dense difference-quotient Jacobian.
   void attach_linear_solver() {
     free_linear_solver();
     if (system.has_newton_solver()) {
-      ls = SUNLinSol_SPGMR(y, SUN_PREC_LEFT, kKrylovDimension, ctx);
-      if (!ls) throw Error("SUNLinSol_SPGMR failed");
-      jv_work = N_VClone(y);
       newton_ready = false;
+      if (system.newton_solver_exact()) {
+        ls = direct_newton_solver(ctx);
+      } else {
+        ls = SUNLinSol_SPGMR(y, SUN_PREC_LEFT, kKrylovDimension, ctx);
+        if (!ls) throw Error("SUNLinSol_SPGMR failed");
+        jv_work = N_VClone(y);
+      }
       check(ARKStepSetLinearSolver(mem, ls, nullptr), "ARKStepSetLinearSolver");
       check(ARKStepSetPreconditioner(mem, Impl::newton_linearize, Impl::newton_solve), "ARKStepSetPreconditioner");
-      check(ARKStepSetJacTimes(mem, nullptr, Impl::jac_times), "ARKStepSetJacTimes");
+      if (jv_work) check(ARKStepSetJacTimes(mem, nullptr, Impl::jac_times), "ARKStepSetJacTimes");
       // A fresh linearisation at every step: it costs a few right-hand sides, and a stale one is far
       // off on the fast modes of a fine string (γ ω² ≫ 1), where Newton then fails and cuts the step.
       check(ARKStepSetLSetupFrequency(mem, 1), "ARKStepSetLSetupFrequency");
       check(ARKStepSetJacEvalFrequency(mem, 1), "ARKStepSetJacEvalFrequency");
       check(ARKStepSetMaxNonlinIters(mem, kNewtonIterations), "ARKStepSetMaxNonlinIters");
+      check(ARKStepSetNonlinCRDown(mem, kNewtonRateFloor), "ARKStepSetNonlinCRDown");
       return;
     }
     const sunindextype n = N_VGetLength(y);
@@ -224,6 +239,60 @@ struct Integrator::Impl {
     ls = nullptr;
     jac = nullptr;
     jv_work = nullptr;
+  }
+
+  /// A SUNDIALS linear solver whose solve is the system's exact Newton solver (ARKODE's
+  /// preconditioner set-up and solve, registered by ARKStepSetPreconditioner): GMRES with it as
+  /// preconditioner converges in one iteration, which costs a second solve, a product J·v and the
+  /// Gram–Schmidt and norm passes of SPGMR per Newton iteration; this takes the first solve as the
+  /// correction. It reports itself as iterative (matrix-free) so that ARKODE calls the set-up.
+  struct DirectNewton {
+    void* data = nullptr;
+    SUNPSetupFn setup = nullptr;
+    SUNPSolveFn solve = nullptr;
+    int last_flag = SUNLS_SUCCESS;
+  };
+  static SUNLinearSolver direct_newton_solver(SUNContext context) {
+    SUNLinearSolver s = SUNLinSolNewEmpty(context);
+    if (!s) throw Error("SUNLinSolNewEmpty failed");
+    s->content = new DirectNewton;
+    s->ops->gettype = [](SUNLinearSolver) { return SUNLINEARSOLVER_ITERATIVE; };
+    s->ops->getid = [](SUNLinearSolver) { return SUNLINEARSOLVER_CUSTOM; };
+    s->ops->setatimes = [](SUNLinearSolver, void*, SUNATimesFn) { return int{SUNLS_SUCCESS}; };
+    s->ops->setpreconditioner = [](SUNLinearSolver S, void* data, SUNPSetupFn setup, SUNPSolveFn solve) {
+      auto* c = static_cast<DirectNewton*>(S->content);
+      c->data = data;
+      c->setup = setup;
+      c->solve = solve;
+      return int{SUNLS_SUCCESS};
+    };
+    // Scaling vectors accepted and unused (the solve is exact): ARKODE then skips the tolerance
+    // rescaling it does for iterative solvers without them (a norm per Newton iteration).
+    s->ops->setscalingvectors = [](SUNLinearSolver, N_Vector, N_Vector) { return int{SUNLS_SUCCESS}; };
+    s->ops->initialize = [](SUNLinearSolver) { return int{SUNLS_SUCCESS}; };
+    s->ops->setup = [](SUNLinearSolver S, SUNMatrix) {
+      auto* c = static_cast<DirectNewton*>(S->content);
+      const int flag = c->setup ? c->setup(c->data) : 0;
+      c->last_flag = flag == 0 ? SUNLS_SUCCESS : flag > 0 ? SUNLS_PSET_FAIL_REC : SUNLS_PSET_FAIL_UNREC;
+      return c->last_flag;
+    };
+    s->ops->solve = [](SUNLinearSolver S, SUNMatrix, N_Vector x, N_Vector b, sunrealtype tol) {
+      auto* c = static_cast<DirectNewton*>(S->content);
+      if (!c->solve) return c->last_flag = SUNLS_ILL_INPUT;
+      const int flag = c->solve(c->data, b, x, tol, SUN_PREC_LEFT);
+      c->last_flag = flag == 0 ? SUNLS_SUCCESS : flag > 0 ? SUNLS_PSOLVE_FAIL_REC : SUNLS_PSOLVE_FAIL_UNREC;
+      return c->last_flag;
+    };
+    s->ops->numiters = [](SUNLinearSolver) { return 0; };  // no Krylov iterations
+    s->ops->resnorm = [](SUNLinearSolver) { return sunrealtype{0}; };
+    s->ops->lastflag = [](SUNLinearSolver S) { return static_cast<sunindextype>(static_cast<DirectNewton*>(S->content)->last_flag); };
+    s->ops->free = [](SUNLinearSolver S) {
+      delete static_cast<DirectNewton*>(S->content);
+      S->content = nullptr;
+      SUNLinSolFreeEmpty(S);
+      return int{SUNLS_SUCCESS};
+    };
+    return s;
   }
 
   // J·v from the system's linearisation if it has one (OdeSystem::jacobian_times), else by a

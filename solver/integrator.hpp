@@ -45,9 +45,9 @@ class OdeSystem {
 
   // --- Newton systems of implicit methods (optional) -----------------------------------------
   /// True if the system solves its own Newton systems (I − γ J) z = r, J = ∂F/∂y: implicit methods
-  /// then solve their Newton systems with GMRES preconditioned by newton_solve(), with products J·v
-  /// from jacobian_times() or difference quotients of rhs(); otherwise with a dense
-  /// difference-quotient Jacobian.
+  /// then take the Newton corrections from newton_solve() directly when newton_solver_exact(), else
+  /// from GMRES preconditioned by newton_solve(), with products J·v from jacobian_times() or
+  /// difference quotients of rhs(); otherwise they use a dense difference-quotient Jacobian.
   virtual bool has_newton_solver() const { return false; }
   /// Prepares newton_solve() for γ at (t, y). `relinearize` false: keep the linearisation of the last
   /// call and only change γ (y is then not used). Throw RecoverableError if (t, y) cannot be
@@ -56,6 +56,9 @@ class OdeSystem {
                             double /*gamma*/) {}
   /// z ≈ (I − γ J)⁻¹ r with the γ of the last newton_setup().
   virtual void newton_solve(const Eigen::Ref<const Eigen::VectorXd>& r, Eigen::Ref<Eigen::VectorXd> z) { z = r; }
+  /// True if newton_solve() inverts I − γ J for the very J of jacobian_times() (the linearisation
+  /// leaves nothing out): the Newton corrections are then newton_solve(r) itself, without GMRES.
+  virtual bool newton_solver_exact() const { return false; }
   /// Jv = J v at the last linearisation, if the system has it analytically (true); false: GMRES
   /// takes J v from a difference quotient of rhs().
   virtual bool jacobian_times(const Eigen::Ref<const Eigen::VectorXd>& /*v*/, Eigen::Ref<Eigen::VectorXd> /*Jv*/) {
@@ -137,8 +140,8 @@ class Integrator {
   static constexpr double kStepFloor = 1e-14;
   static constexpr int kStallSteps = 5;
   /// "auto" picks an implicit method from this OdeSystem::explicit_stiffness() on (measured
-  /// crossover: docs/string_solver.md, "The implicit path").
-  static constexpr double kAutoImplicitStiffness = 200;
+  /// crossover at equal accuracy, 35 links: docs/string_solver.md, "The implicit path").
+  static constexpr double kAutoImplicitStiffness = 50;
   /// The method "auto" resolves to for `system` (any other name is returned unchanged).
   static std::string resolve_method(const std::string& method, const OdeSystem& system);
 

@@ -4,39 +4,72 @@
 #include <cmath>
 #include <vector>
 
-#include <Eigen/SparseLU>
 #include <fmt/format.h>
-#ifdef CHAINSIM_WITH_KLU
-#include <Eigen/KLUSupport>
-#endif
 
 #include "mesh/errors.hpp"
 #include "forces.hpp"
 #include "string_model.hpp"
+#include "tension_system.hpp"
 
 namespace chainsim {
 
 template <int dim>
 struct StringJacobian<dim>::Factor {
-#ifdef CHAINSIM_WITH_KLU
-  Eigen::KLU<SpMat> lu;
-#else
-  Eigen::SparseLU<SpMat> lu;
-#endif
-  SpMat M;
-  // The pattern the symbolic analysis was done for.
-  std::vector<int> outer, inner;
-  bool analyzed = false;
-  /// Factors `matrix` (compressed), redoing the symbolic analysis only when the pattern changed.
-  void factorize(const SpMat& matrix);
-  bool same_pattern() const {
-    const auto no = static_cast<std::size_t>(M.outerSize()) + 1;
-    const auto ni = static_cast<std::size_t>(M.nonZeros());
-    return analyzed && outer.size() == no && inner.size() == ni &&
-           std::equal(outer.begin(), outer.end(), M.outerIndexPtr()) &&
-           std::equal(inner.begin(), inner.end(), M.innerIndexPtr());
-  }
+  SparsePattern pattern;
+  /// (row, column) of each entry of the assembly sequence and its slot in `pattern`: the sequence is
+  /// the same at every call for one layout, so only the values are summed into their slots.
+  std::vector<int> rows, cols, slot;
+  std::vector<double> values;
+  SparseFactorization lu;
+  /// Factors the matrix of `entries` (duplicates summed), redoing the pattern and its symbolic
+  /// analysis only when the sequence of (row, column) changed. Throws RecoverableError if singular.
+  void factorize(int n, const std::vector<Eigen::Triplet<double>>& entries);
+  /// Factors A with its pattern and values as the tension system holds them.
+  void factorize(const SparsePattern& a_pattern, const std::vector<double>& a_values);
 };
+
+template <int dim>
+void StringJacobian<dim>::Factor::factorize(int n, const std::vector<Eigen::Triplet<double>>& entries) {
+  bool same = lu.analyzed() && pattern.n == n && rows.size() == entries.size();
+  for (std::size_t k = 0; same && k < entries.size(); ++k)
+    same = entries[k].row() == rows[k] && entries[k].col() == cols[k];
+  if (!same) {
+    SpMat m(n, n);
+    m.setFromTriplets(entries.begin(), entries.end());
+    m.makeCompressed();
+    pattern.n = n;
+    pattern.col_ptr.assign(m.outerIndexPtr(), m.outerIndexPtr() + n + 1);
+    pattern.row_index.assign(m.innerIndexPtr(), m.innerIndexPtr() + m.nonZeros());
+    rows.resize(entries.size());
+    cols.resize(entries.size());
+    slot.resize(entries.size());
+    for (std::size_t k = 0; k < entries.size(); ++k) {
+      rows[k] = entries[k].row();
+      cols[k] = entries[k].col();
+      slot[k] = pattern.find(rows[k], cols[k]);
+    }
+    lu.analyze(pattern);
+  }
+  values.assign(pattern.row_index.size(), 0.0);
+  for (std::size_t k = 0; k < entries.size(); ++k) values[static_cast<std::size_t>(slot[k])] += entries[k].value();
+  if (!lu.factor(values.data()).ok) {
+    rows.clear();  // analyse afresh next time
+    throw RecoverableError("a Newton matrix of the string is singular");
+  }
+}
+
+template <int dim>
+void StringJacobian<dim>::Factor::factorize(const SparsePattern& a_pattern, const std::vector<double>& a_values) {
+  if (!lu.analyzed() || pattern.n != a_pattern.n || pattern.col_ptr != a_pattern.col_ptr ||
+      pattern.row_index != a_pattern.row_index) {
+    pattern = a_pattern;
+    lu.analyze(pattern);
+  }
+  if (!lu.factor(a_values.data()).ok) {
+    pattern.n = -1;  // analyse afresh next time
+    throw RecoverableError("a Newton matrix of the string is singular");
+  }
+}
 
 template <int dim>
 StringJacobian<dim>::StringJacobian(StringModel<dim>& model)
@@ -136,36 +169,9 @@ void StringJacobian<dim>::linearize(double t, const Eigen::Ref<const Eigen::Vect
   WGt_.resize(nv_, nt_);
   WGt_.setFromTriplets(wg.begin(), wg.end());
   // A: the tension matrix as assembled by the model (compressed columns).
-  const SparsePattern& pattern = m.system_->pattern();
-  const std::vector<double>& values = m.system_->values();
-  std::vector<Eigen::Triplet<double>> at;
-  at.reserve(values.size());
-  for (int c = 0; c < pattern.n; ++c)
-    for (int k = pattern.col_ptr[static_cast<std::size_t>(c)]; k < pattern.col_ptr[static_cast<std::size_t>(c) + 1]; ++k)
-      at.emplace_back(pattern.row_index[static_cast<std::size_t>(k)], c, values[static_cast<std::size_t>(k)]);
-  A_.resize(nt_, nt_);
-  A_.setFromTriplets(at.begin(), at.end());
-  A_.makeCompressed();
-  a_factor_->factorize(A_);
-  exact_ = !m.module_;
-  for (const auto& force : m.forces_)
-    if (!dynamic_cast<const Gravity<dim>*>(force.get()) && !dynamic_cast<const EndLoad<dim>*>(force.get())) exact_ = false;
-}
-
-template <int dim>
-void StringJacobian<dim>::Factor::factorize(const SpMat& matrix) {
-  M = matrix;
-  if (!same_pattern()) {
-    lu.analyzePattern(M);
-    outer.assign(M.outerIndexPtr(), M.outerIndexPtr() + M.outerSize() + 1);
-    inner.assign(M.innerIndexPtr(), M.innerIndexPtr() + M.nonZeros());
-    analyzed = true;
-  }
-  lu.factorize(M);
-  if (lu.info() != Eigen::Success) {
-    analyzed = false;
-    throw RecoverableError("a Newton matrix of the string is singular");
-  }
+  a_values_ = m.system_->values();
+  a_factor_->factorize(m.system_->pattern(), a_values_);
+  exact_ = m.newton_solver_exact();
 }
 
 template <int dim>
@@ -178,7 +184,8 @@ Eigen::VectorXd StringJacobian<dim>::apply(const Eigen::Ref<const Eigen::VectorX
 template <int dim>
 void StringJacobian<dim>::apply(const Eigen::Ref<const Eigen::VectorXd>& d, Eigen::Ref<Eigen::VectorXd> out) const {
   const auto dx = d.head(nv_), dv = d.segment(nv_, nv_);
-  const Eigen::VectorXd w = a_factor_->lu.solve(Eigen::VectorXd(Qx_ * dx + Qv_ * dv));
+  Eigen::VectorXd w = Qx_ * dx + Qv_ * dv;
+  a_factor_->lu.solve(w.data());
   out.setZero();
   out.head(nv_) = dv;
   out.segment(nv_, nv_) = P_ * dx - WGt_ * w;
@@ -188,9 +195,10 @@ template <int dim>
 void StringJacobian<dim>::factor(double gamma) {
   gamma_ = gamma;
   const int n = nv_ + nt_;
-  std::vector<Eigen::Triplet<double>> tr;
-  tr.reserve(static_cast<std::size_t>(nv_ + P_.nonZeros() + WGt_.nonZeros() + Qx_.nonZeros() + Qv_.nonZeros() +
-                                      A_.nonZeros()));
+  std::vector<Eigen::Triplet<double>>& tr = entries_;
+  tr.clear();
+  tr.reserve(static_cast<std::size_t>(nv_ + P_.nonZeros() + WGt_.nonZeros() + Qx_.nonZeros() + Qv_.nonZeros()) +
+             a_values_.size());
   for (int i = 0; i < nv_; ++i) tr.emplace_back(i, i, 1.0);
   auto add = [&](const SpMat& block, int row0, int col0, double scale) {
     for (int c = 0; c < block.outerSize(); ++c)
@@ -201,21 +209,22 @@ void StringJacobian<dim>::factor(double gamma) {
   add(WGt_, 0, nv_, gamma);
   add(Qx_, nv_, 0, gamma);
   add(Qv_, nv_, 0, 1.0);
-  add(A_, nv_, nv_, -1.0);
-  SpMat M(n, n);
-  M.setFromTriplets(tr.begin(), tr.end());
-  M.makeCompressed();
-  factor_->factorize(M);
+  const SparsePattern& a = a_factor_->pattern;  // −A
+  for (int c = 0; c < a.n; ++c)
+    for (int k = a.col_ptr[static_cast<std::size_t>(c)]; k < a.col_ptr[static_cast<std::size_t>(c) + 1]; ++k)
+      tr.emplace_back(nv_ + a.row_index[static_cast<std::size_t>(k)], nv_ + c, -a_values_[static_cast<std::size_t>(k)]);
+  factor_->factorize(n, tr);
 }
 
 template <int dim>
 void StringJacobian<dim>::solve(const Eigen::Ref<const Eigen::VectorXd>& r, Eigen::Ref<Eigen::VectorXd> z) const {
   CHAINSIM_VERIFY(r.size() >= 2 * nv_ && z.size() == r.size(), "the Newton system has the state's size");
   const auto rx = r.head(nv_), rv = r.segment(nv_, nv_);
-  Eigen::VectorXd rhs(nv_ + nt_);
-  rhs.head(nv_) = rv + gamma_ * (P_ * rx);
-  rhs.tail(nt_) = -(Qx_ * rx);
-  const Eigen::VectorXd sol = factor_->lu.solve(rhs);
+  Eigen::VectorXd& sol = work_;
+  sol.resize(nv_ + nt_);
+  sol.head(nv_) = rv + gamma_ * (P_ * rx);
+  sol.tail(nt_) = -(Qx_ * rx);
+  factor_->lu.solve(sol.data());
   z.segment(nv_, nv_) = sol.head(nv_);
   z.head(nv_) = rx + gamma_ * sol.head(nv_);
   z.tail(r.size() - 2 * nv_) = r.tail(r.size() - 2 * nv_);
@@ -250,6 +259,14 @@ bool StringModel<dim>::jacobian_times(const Eigen::Ref<const Eigen::VectorXd>& v
 }
 
 template <int dim>
+bool StringModel<dim>::newton_solver_exact() const {
+  if (module_ || !system_) return false;
+  for (const auto& force : forces_)
+    if (!dynamic_cast<const Gravity<dim>*>(force.get()) && !dynamic_cast<const EndLoad<dim>*>(force.get())) return false;
+  return true;
+}
+
+template <int dim>
 double StringModel<dim>::explicit_stiffness() const {
   if (!system_) return 0.0;
   double h_min = INFINITY;
@@ -265,6 +282,8 @@ template void StringModel<2>::newton_solve(const Eigen::Ref<const Eigen::VectorX
 template void StringModel<3>::newton_solve(const Eigen::Ref<const Eigen::VectorXd>&, Eigen::Ref<Eigen::VectorXd>);
 template bool StringModel<2>::jacobian_times(const Eigen::Ref<const Eigen::VectorXd>&, Eigen::Ref<Eigen::VectorXd>);
 template bool StringModel<3>::jacobian_times(const Eigen::Ref<const Eigen::VectorXd>&, Eigen::Ref<Eigen::VectorXd>);
+template bool StringModel<2>::newton_solver_exact() const;
+template bool StringModel<3>::newton_solver_exact() const;
 template double StringModel<2>::explicit_stiffness() const;
 template double StringModel<3>::explicit_stiffness() const;
 

@@ -17,12 +17,13 @@
 ///     [ I − γ² P      γ W Gᵀ ] [zv]   [ rv + γ P rx ]
 ///     [ γ Qx + Qv     −A     ] [w ] = [ −Qx rx      ]
 ///
-/// factored by KLU (Eigen's SparseLU when built without KLU). The ledgers (W_applied, a module's)
+/// factored by KLU (klu_refactor between steps; Eigen's SparseLU when built without KLU). The ledgers (W_applied, a module's)
 /// enter no right-hand side: their Newton rows are taken as identity. What the linearisation
 /// leaves out: velocity-dependent forces (drag), the derivative of the applied forces, and a front
 /// module's masses and loads: implicit methods use the linearisation as the preconditioner of GMRES,
 /// whose products J·v come from the right-hand side itself, so those terms are still honoured.
 #include <memory>
+#include <vector>
 
 #include <Eigen/Core>
 #include <Eigen/SparseCore>
@@ -62,11 +63,14 @@ class StringJacobian {
   using SpMat = Eigen::SparseMatrix<double>;
   StringModel<dim>& model_;
   int nv_ = 0, nt_ = 0;  // dim · free nodes; tension unknowns
-  SpMat P_, Qx_, Qv_, WGt_, A_;
+  SpMat P_, Qx_, Qv_, WGt_;
+  std::vector<double> a_values_;  // A, in the tension system's pattern (a_factor_->pattern)
   double gamma_ = 0;
   bool exact_ = false;
   struct Factor;
   std::unique_ptr<Factor> factor_, a_factor_;  // the augmented system; A alone (for apply)
+  std::vector<Eigen::Triplet<double>> entries_;  // the augmented system's assembly (kept: no reallocation)
+  mutable Eigen::VectorXd work_;                 // the augmented right-hand side and solution of solve()
 };
 
 }  // namespace chainsim

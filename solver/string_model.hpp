@@ -106,6 +106,9 @@ class StringModel final : public OdeSystem {
   bool has_newton_solver() const override { return system_ != nullptr; }
   void newton_setup(double t, const Eigen::Ref<const Eigen::VectorXd>& y, bool relinearize, double gamma) override;
   void newton_solve(const Eigen::Ref<const Eigen::VectorXd>& r, Eigen::Ref<Eigen::VectorXd> z) override;
+  /// No module and only state-independent applied forces (gravity, end loads): the linearisation
+  /// is exact (string_jacobian.hpp).
+  bool newton_solver_exact() const override;
   /// J v of the last linearisation; only without a module (whose loads it leaves out).
   bool jacobian_times(const Eigen::Ref<const Eigen::VectorXd>& v, Eigen::Ref<Eigen::VectorXd> Jv) override;
   /// ℓ / h_min: the fastest transverse wave crosses a link in ~h/c, the motion the string in ~ℓ/c.

@@ -178,81 +178,140 @@ class EigenBackend final : public TensionBackend {
 
 #ifdef CHAINSIM_WITH_KLU
 // ----------------------------------------------------------------------------------------------
-// SuiteSparse KLU: klu_analyze once (BTF + AMD), klu_factor on the first call, then klu_refactor
-// (same pivot sequence, numeric only). A refactorization whose reciprocal pivot growth looks bad is
-// redone with a fresh klu_factor (new pivoting) before the matrix is declared singular.
+// SuiteSparse KLU through SparseFactorization (klu_refactor between calls).
 class KluBackend final : public TensionBackend {
  public:
-  KluBackend() { klu_defaults(&common_); }
-  ~KluBackend() override { release(); }
   std::string name() const override { return "klu"; }
-
-  void analyze(const SparsePattern& pattern, const std::vector<ArcBlock>&) override {
-    release();
-    n_ = pattern.n;
-    ap_ = pattern.col_ptr;
-    ai_ = pattern.row_index;
-    symbolic_ = klu_analyze(n_, ap_.data(), ai_.data(), &common_);
-    if (!symbolic_) throw Error(fmt::format("internal error: klu_analyze failed (status {})", common_.status));
-  }
-
+  void analyze(const SparsePattern& pattern, const std::vector<ArcBlock>&) override { lu_.analyze(pattern); }
   SolveStatus factor_solve(const double* values, double* rhs) override {
-    auto* ax = const_cast<double*>(values);  // KLU's C interface is not const-correct; it does not write Ax
-    bool ok = false;
-    if (numeric_) {
-      ok = klu_refactor(ap_.data(), ai_.data(), ax, symbolic_, numeric_, &common_) && well_conditioned();
-      if (!ok) klu_free_numeric(&numeric_, &common_);
-    }
-    if (!numeric_) {
-      numeric_ = klu_factor(ap_.data(), ai_.data(), ax, symbolic_, &common_);
-      ok = numeric_ != nullptr && well_conditioned();
-    }
-    if (!ok) return singular_status();
-    if (!klu_solve(symbolic_, numeric_, n_, 1, rhs, &common_))
-      return {false, -1, 0.0, fmt::format("klu_solve failed (status {})", common_.status)};
-    return {};
-  }
-
- private:
-  bool well_conditioned() {
-    if (common_.status != KLU_OK) return false;
-    if (!klu_rcond(symbolic_, numeric_, &common_)) return false;
-    return common_.rcond > kSingularPivot;
-  }
-
-  SolveStatus singular_status() {
-    SolveStatus s{false, -1, 0.0, fmt::format("KLU (status {}, rcond {:.3g})", common_.status, common_.rcond)};
-    if (numeric_ && numeric_->Udiag) {
-      // Smallest |U(k,k)|; column k of the permuted matrix is column Q[k] of A.
-      const auto* udiag = static_cast<const double*>(numeric_->Udiag);
-      int worst = 0;
-      for (int k = 1; k < n_; ++k)
-        if (std::abs(udiag[k]) < std::abs(udiag[worst])) worst = k;
-      s.unknown = symbolic_->Q ? symbolic_->Q[worst] : worst;
-      s.pivot = udiag[worst];
-    } else if (common_.singular_col >= 0 && common_.singular_col < n_) {
-      s.unknown = common_.singular_col;
-    }
-    if (numeric_) klu_free_numeric(&numeric_, &common_);
+    SolveStatus s = lu_.factor(values);
+    if (s.ok) lu_.solve(rhs);
     return s;
   }
 
-  void release() {
-    if (numeric_) klu_free_numeric(&numeric_, &common_);
-    if (symbolic_) klu_free_symbolic(&symbolic_, &common_);
-  }
-
-  klu_common common_{};
-  klu_symbolic* symbolic_ = nullptr;
-  klu_numeric* numeric_ = nullptr;
-  int n_ = 0;
-  std::vector<int> ap_, ai_;
+ private:
+  SparseFactorization lu_;
 };
 #endif
 
 }  // namespace
 
 // ------------------------------------------------------------------------------------------------
+#ifdef CHAINSIM_WITH_KLU
+struct SparseFactorization::Impl {
+  Impl() { klu_defaults(&common); }
+  ~Impl() { release(); }
+  klu_common common{};
+  klu_symbolic* symbolic = nullptr;
+  klu_numeric* numeric = nullptr;
+  int n = 0;
+  std::vector<int> ap, ai;
+
+  bool well_conditioned() {
+    if (common.status != KLU_OK) return false;
+    if (!klu_rcond(symbolic, numeric, &common)) return false;
+    return common.rcond > kSingularPivot;
+  }
+  SolveStatus singular_status() {
+    SolveStatus s{false, -1, 0.0, fmt::format("KLU (status {}, rcond {:.3g})", common.status, common.rcond)};
+    if (numeric && numeric->Udiag) {
+      // Smallest |U(k,k)|; column k of the permuted matrix is column Q[k] of A.
+      const auto* udiag = static_cast<const double*>(numeric->Udiag);
+      int worst = 0;
+      for (int k = 1; k < n; ++k)
+        if (std::abs(udiag[k]) < std::abs(udiag[worst])) worst = k;
+      s.unknown = symbolic->Q ? symbolic->Q[worst] : worst;
+      s.pivot = udiag[worst];
+    } else if (common.singular_col >= 0 && common.singular_col < n) {
+      s.unknown = static_cast<int>(common.singular_col);
+    }
+    if (numeric) klu_free_numeric(&numeric, &common);
+    return s;
+  }
+  void release() {
+    if (numeric) klu_free_numeric(&numeric, &common);
+    if (symbolic) klu_free_symbolic(&symbolic, &common);
+  }
+};
+
+void SparseFactorization::analyze(const SparsePattern& pattern) {
+  Impl& d = *impl_;
+  d.release();
+  d.n = pattern.n;
+  d.ap = pattern.col_ptr;
+  d.ai = pattern.row_index;
+  d.symbolic = klu_analyze(d.n, d.ap.data(), d.ai.data(), &d.common);
+  if (!d.symbolic) throw Error(fmt::format("internal error: klu_analyze failed (status {})", d.common.status));
+}
+
+bool SparseFactorization::analyzed() const { return impl_->symbolic != nullptr; }
+
+SolveStatus SparseFactorization::factor(const double* values) {
+  Impl& d = *impl_;
+  CHAINSIM_VERIFY(d.symbolic, "analyze() comes before factor()");
+  auto* ax = const_cast<double*>(values);  // KLU's C interface is not const-correct; it does not write Ax
+  bool ok = false;
+  if (d.numeric) {
+    ok = klu_refactor(d.ap.data(), d.ai.data(), ax, d.symbolic, d.numeric, &d.common) && d.well_conditioned();
+    if (!ok) klu_free_numeric(&d.numeric, &d.common);
+  }
+  if (!d.numeric) {
+    d.numeric = klu_factor(d.ap.data(), d.ai.data(), ax, d.symbolic, &d.common);
+    ok = d.numeric != nullptr && d.well_conditioned();
+  }
+  return ok ? SolveStatus{} : d.singular_status();
+}
+
+void SparseFactorization::solve(double* rhs) {
+  Impl& d = *impl_;
+  CHAINSIM_VERIFY(d.numeric, "factor() comes before solve()");
+  if (!klu_solve(d.symbolic, d.numeric, d.n, 1, rhs, &d.common))
+    throw Error(fmt::format("internal error: klu_solve failed (status {})", d.common.status));
+}
+#else
+struct SparseFactorization::Impl {
+  Eigen::SparseMatrix<double> matrix;
+  Eigen::SparseLU<Eigen::SparseMatrix<double>, Eigen::COLAMDOrdering<int>> lu;
+  Eigen::VectorXd x;
+  bool analyzed = false, factored = false;
+};
+
+void SparseFactorization::analyze(const SparsePattern& pattern) {
+  Impl& d = *impl_;
+  std::vector<Eigen::Triplet<double>> triplets;
+  for (int c = 0; c < pattern.n; ++c)
+    for (int k = pattern.col_ptr[c]; k < pattern.col_ptr[c + 1]; ++k) triplets.emplace_back(pattern.row_index[k], c, 1.0);
+  d.matrix.resize(pattern.n, pattern.n);
+  d.matrix.setFromTriplets(triplets.begin(), triplets.end());
+  d.matrix.makeCompressed();
+  d.lu.analyzePattern(d.matrix);
+  d.analyzed = true;
+  d.factored = false;
+}
+
+bool SparseFactorization::analyzed() const { return impl_->analyzed; }
+
+SolveStatus SparseFactorization::factor(const double* values) {
+  Impl& d = *impl_;
+  CHAINSIM_VERIFY(d.analyzed, "analyze() comes before factor()");
+  std::copy(values, values + d.matrix.nonZeros(), d.matrix.valuePtr());
+  d.lu.factorize(d.matrix);
+  d.factored = d.lu.info() == Eigen::Success;
+  return d.factored ? SolveStatus{} : SolveStatus{false, -1, 0.0, "Eigen SparseLU: " + d.lu.lastErrorMessage()};
+}
+
+void SparseFactorization::solve(double* rhs) {
+  Impl& d = *impl_;
+  CHAINSIM_VERIFY(d.factored, "factor() comes before solve()");
+  Eigen::Map<Eigen::VectorXd> b(rhs, d.matrix.rows());
+  d.x = d.lu.solve(b);
+  b = d.x;
+}
+#endif
+
+SparseFactorization::SparseFactorization() : impl_(std::make_unique<Impl>()) {}
+SparseFactorization::~SparseFactorization() = default;
+
 int SparsePattern::find(int row, int col) const {
   if (col < 0 || col >= n) return -1;
   auto begin = row_index.begin() + col_ptr[col], end = row_index.begin() + col_ptr[col + 1];

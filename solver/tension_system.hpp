@@ -72,6 +72,31 @@ class TensionBackend {
   virtual SolveStatus factor_solve(const double* values, double* rhs) = 0;
 };
 
+/// A sparse LU factorisation of one pattern that keeps its symbolic analysis, and with KLU its pivot
+/// sequence, between numeric factorisations: SuiteSparse KLU (klu_analyze once, klu_factor, then
+/// klu_refactor; a refactorisation whose reciprocal condition estimate looks bad is redone with a
+/// fresh klu_factor before the matrix is declared singular), or Eigen's SparseLU when chainsim is
+/// built without KLU. Used by the "klu" backend and by the Newton matrices of implicit methods
+/// (string_jacobian.hpp), which factor once and solve many times.
+class SparseFactorization {
+ public:
+  SparseFactorization();
+  ~SparseFactorization();
+  SparseFactorization(const SparseFactorization&) = delete;
+  SparseFactorization& operator=(const SparseFactorization&) = delete;
+  /// Symbolic phase for `pattern`; factor() then takes values in its order.
+  void analyze(const SparsePattern& pattern);
+  bool analyzed() const;
+  /// Numeric factorisation. Reports a singular (or numerically singular) matrix instead of throwing.
+  SolveStatus factor(const double* values);
+  /// x = A⁻¹ b in place, with the last successful factor().
+  void solve(double* rhs);
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
 /// Backends compiled into this build ("tridiagonal", "eigen", and "klu" when CHAINSIM_WITH_KLU).
 std::vector<std::string> tension_backend_names();
 /// A backend by name; throws InputError (listing the valid names) for an unknown one.
