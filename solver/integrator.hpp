@@ -9,6 +9,7 @@
 /// system's event functions with ARKODE's rootfinding, and reports ARKODE's run statistics.
 ///
 /// integrator.cpp is the only file that includes <arkode/...>: moving to SUNDIALS 7 touches one file.
+#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
@@ -148,11 +149,16 @@ class Integrator {
     kStep,           ///< one internal step taken (one_step mode), t < t_target
   };
 
+  /// Called by advance() at a root return before the event is polished, with the step that holds
+  /// the root: its start and the root ARKODE located on it. interpolate() covers [t_start, t_root]
+  /// during the call (it no longer does once the polish has recomputed the step).
+  using RootStepHook = std::function<void(double t_start, double t_root)>;
+
   /// Advance towards t_target (never past it). In one_step mode return after each internal step,
   /// which lets a caller record the adaptive steps. Throws NumericalError when ARKODE fails (the
   /// message carries ARKODE's flag name and the time reached), or when the watchdog (see the class
   /// comment) stops the run.
-  Outcome advance(double t_target, bool one_step = false);
+  Outcome advance(double t_target, bool one_step = false, const RootStepHook& before_polish = {});
 
   /// Current time and state of the integrator.
   double time() const { return t_; }
@@ -160,7 +166,9 @@ class Integrator {
 
   /// After Outcome::kEvent: for each event function, +1/-1 if it crossed zero increasing/decreasing, else 0.
   /// The event's time and state are polished to the method's accuracy (not the interpolant's):
-  /// the step holding the root is recomputed up to the root, found by Newton iteration on g.
+  /// the step holding the root is recomputed up to the root, found by Newton iteration on g, each
+  /// iterate one step of the method from the step's start. The next restart() or resize() resumes
+  /// with the step size ARKODE had reached before the event rather than a fresh estimate.
   const std::vector<int>& events_found() const { return events_found_; }
 
   /// Interpolated state (k = 0) or its k-th derivative at time t inside the last step (dense output).
