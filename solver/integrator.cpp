@@ -529,12 +529,19 @@ Integrator::Outcome Integrator::advance(double t_target, bool one_step, const Ro
 // ARKODE locates a root on its interpolant, whose error (degree <= 5, often cubic) is far larger
 // than the step's own error for high-order methods. Polish: integrate again from the start of the
 // step that holds the root, with rootfinding off, to the root's time, and correct that time with
-// Newton steps on g(t) along the flow, dg/dt = ∇g · F, until g vanishes to rounding. Each
-// integration is one step of the method from the step's start straight to the iterate (ARKODE
+// Newton steps on g(t) along the flow, dg/dt = ∇g · F, until g vanishes to rounding. The first
+// integration is one step of the method from the step's start straight to ARKODE's root (ARKODE
 // accepted a longer step from there, so a shorter one meets the tolerance; if it does not, ARKODE
-// shortens it and takes more): typically two steps per event. ARKODE's own estimate of a first step
-// instead began far below the step (down to 1e-13 s on the falling chain) and needed several.
+// shortens it and takes more); ARKODE's own estimate of a first step instead began far below the
+// step (down to 1e-13 s on the falling chain) and needed several. A Newton correction dt of that
+// time is then a step of Heun's method from the integrated state, y + dt (F(y) + F(y + dt F(y))) / 2,
+// whose second-order term is checked to be below kHeunShare of the error tolerance (its error,
+// O(dt³), is smaller still by dt over the time scale of the motion); a larger correction integrates
+// again from the step's start.
 void Integrator::polish_event(double t_step_start, const Eigen::VectorXd& y_step_start) {
+  // The largest share of the error tolerance (weighted RMS norm) the second-order term of a Heun
+  // correction may have.
+  constexpr double kHeunShare = 1e-3;
   Impl& d = *impl_;
   int k = 0;
   while (k < static_cast<int>(events_found_.size()) && events_found_[k] == 0) ++k;
@@ -546,13 +553,40 @@ void Integrator::polish_event(double t_step_start, const Eigen::VectorXd& y_step
   d.check(ARKStepRootInit(d.mem, 0, nullptr), "ARKStepRootInit");
 
   Eigen::VectorXd g(nev), g_ahead(nev), ydot(y_.size());
+  // The last integrated state, F there, and the error weights of the tolerance (ARKStepGetErrWeights).
+  double t_base = t_step_start;
+  Eigen::VectorXd y_base, f_base, f_euler(y_.size()), weights;
   double t_event = t_;
   for (int iteration = 0; iteration < 4; ++iteration) {
-    restart(t_step_start, y_step_start);
-    if (t_event > t_step_start) d.check(ARKStepSetInitStep(d.mem, t_event - t_step_start), "ARKStepSetInitStep");
-    while (t_ < t_event) evolve(t_event, /*one_step=*/false);
+    bool corrected = false;
+    if (y_base.size() > 0) {
+      const double dt = t_event - t_base;
+      const Eigen::VectorXd y_euler = y_base + dt * f_base;
+      d.system.rhs(t_event, y_euler, f_euler);
+      const Eigen::VectorXd second = 0.5 * dt * (f_euler - f_base);
+      if (std::sqrt((second.array() * weights.array()).square().mean()) <= kHeunShare) {
+        t_ = t_event;
+        y_ = y_euler + second;
+        corrected = true;
+      }
+    }
+    if (!corrected) {
+      restart(t_step_start, y_step_start);
+      if (t_event > t_step_start) d.check(ARKStepSetInitStep(d.mem, t_event - t_step_start), "ARKStepSetInitStep");
+      while (t_ < t_event) evolve(t_event, /*one_step=*/false);
+    }
     d.system.events(t_, y_, g);
     d.system.rhs(t_, y_, ydot);
+    if (!corrected) {
+      t_base = t_;
+      y_base = y_;
+      f_base = ydot;
+      N_Vector w = N_VClone(d.y);
+      const int flag = ARKStepGetErrWeights(d.mem, w);
+      weights = Eigen::Map<Eigen::VectorXd>(N_VGetArrayPointer(w), N_VGetLength(w));
+      N_VDestroy(w);
+      d.check(flag, "ARKStepGetErrWeights");
+    }
     const double dt_probe = 1e-6 * std::max(t_event - t_step_start, 1e-300);
     d.system.events(t_ + dt_probe, y_ + dt_probe * ydot, g_ahead);
     const double slope = (g_ahead[k] - g[k]) / dt_probe;
