@@ -166,9 +166,10 @@ class Integrator {
 
   /// After Outcome::kEvent: for each event function, +1/-1 if it crossed zero increasing/decreasing, else 0.
   /// The event's time and state are polished to the method's accuracy (not the interpolant's):
-  /// the step holding the root is recomputed up to the root, found by Newton iteration on g, each
-  /// iterate one step of the method from the step's start. The next restart() or resize() resumes
-  /// with the step size ARKODE had reached before the event rather than a fresh estimate.
+  /// the step holding the root is recomputed up to ARKODE's root in one step of the method, and the
+  /// root's time corrected by Newton iteration on g (small corrections by a Heun step along the flow,
+  /// larger ones by recomputing the step). The next restart() or resize() resumes with the step size
+  /// ARKODE had reached before the event rather than a fresh estimate.
   const std::vector<int>& events_found() const { return events_found_; }
 
   /// Interpolated state (k = 0) or its k-th derivative at time t inside the last step (dense output).

@@ -40,9 +40,9 @@ const double kT0 = std::sqrt(2.0 / kG);  // t0 = sqrt(2 l / g) for l = 1 m
 constexpr double kStopTolerance = 1e-10;
 constexpr double kEtaTolerance = 3e-10;
 /// Frames interpolated inside the steps carry the error of ARKODE's Hermite interpolant (degree 4 for
-/// erk5), not the step's: measured max |η − η*| 4.2e-9 (folded chain, 8 ms before its stop, where
-/// η' grows without bound), 8.0e-10 (falling), 3.0e-11 (sliding), and |η'| to 1.2e-7, 2.0e-8 and
-/// 1.2e-10. Bounds about five times above.
+/// erk5), not the step's: measured max |η − η*| 6.4e-9 (folded chain, near its stop, where η'
+/// grows without bound), 8.0e-10 (falling), 3.0e-11 (sliding), and |η'| to 1.2e-7, 2.0e-8 and
+/// 1.2e-10. Bounds three to four times above.
 constexpr double kFrameEtaTolerance = 2e-8;
 constexpr double kFrameRateTolerance = 5e-7;
 /// The reduced ODE (rtol 1e-13) against its quadrature: ~1e-12 (docs/reduced.md).
@@ -261,12 +261,13 @@ TEST_CASE("frames of a front run far denser than its steps cost few steps and fo
     const auto [sparse_scene, sparse] = run("1");
     const auto [dense_scene, dense] = run("2e-4");
     CHECK(sparse->frames().size() == 2);
-    // The output times inside a step are interpolated, not stopped at: a frame every 2e-4 s, 5 to 8
-    // frames per step, costs a few per cent of steps (the frames still stop the first steps, shorter
-    // than the interval, which starts a slightly different step sequence: measured 393, 366 and 313
-    // steps against 402, 341 and 294). Stopping at every frame took at least one step per frame.
+    // The output times inside a step are interpolated, not stopped at: a frame every 2e-4 s, 6 to 12
+    // frames per step, costs at most a few per cent of steps (the frames still stop the first steps
+    // and any step shorter than the interval, which starts a slightly different step sequence:
+    // measured 293, 248 and 232 steps against 304, 242 and 213, falling, folded and sliding chain).
+    // Stopping at every frame took at least one step per frame.
     const long steps_sparse = sparse->summary().stats.steps, steps_dense = dense->summary().stats.steps;
-    CHECK(steps_dense <= 1.1 * steps_sparse);
+    CHECK(steps_dense <= 1.2 * steps_sparse);
     CHECK(4 * steps_dense < static_cast<long>(dense->frames().size()));
     // Every multiple of the interval below the stop, then the stop; η and |η'| at each frame against
     // the quadrature (η'² from the first integral).
