@@ -387,6 +387,7 @@ Integrator::Integrator(OdeSystem& system, double t0, const Eigen::VectorXd& y0,
       d.check(ARKStepSetRootDirection(d.mem, dirs.data()), "ARKStepSetRootDirection");
     }
     d.check(ARKStepSetNoInactiveRootWarn(d.mem), "ARKStepSetNoInactiveRootWarn");
+    if (d.order > kMaxDenseOrder) d.check(ARKStepSetInterpolantDegree(d.mem, 3), "ARKStepSetInterpolantDegree");
     events_found_.assign(nev, 0);
   }
 }

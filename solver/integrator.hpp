@@ -140,6 +140,12 @@ class Integrator {
   /// "auto" picks an implicit method from this OdeSystem::explicit_stiffness() on (measured
   /// crossover: docs/string_solver.md, "The implicit path").
   static constexpr double kAutoImplicitStiffness = 200;
+  /// Methods up to this order interpolate inside a step with ARKODE's Hermite interpolant of degree
+  /// order − 1 (at most 5): frames can be taken from it. Above it the steps are far more accurate than
+  /// any interpolant, so frames are stop times, and with event functions the interpolant serves only
+  /// ARKODE's rootfinding, whose root the polish recomputes: it is then cubic, whose evaluations need
+  /// no right-hand side (degrees 4 and 5 take one and two per evaluation).
+  static constexpr int kMaxDenseOrder = 5;
   /// The method "auto" resolves to for `system` (any other name is returned unchanged).
   static std::string resolve_method(const std::string& method, const OdeSystem& system);
 

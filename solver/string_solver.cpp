@@ -16,7 +16,7 @@ namespace chainsim {
 
 namespace {
 /// Frames are interpolated for methods up to this order (docs/string_solver.md, "The implicit path").
-constexpr int kMaxDenseOrder = 5;
+constexpr int kMaxDenseOrder = Integrator::kMaxDenseOrder;
 /// A step of this fraction of the output interval or longer counts as longer than the frames: a step
 /// that ARKODE shortened to end at a frame, one interval after the previous one, ends a few rounding
 /// units short of the interval.
