@@ -152,6 +152,8 @@ struct Integrator::Impl {
   long max_steps = 0;
   double max_wall_s = 0;
   long steps_total = 0;        // accepted steps over the Integrator's life
+  // The step the next restart() or resize() starts with (0: ARKODE's estimate); set by an event's polish.
+  double h_resume = 0;
   int short_steps = 0;         // accepted steps in a row below the step-size floor
   std::chrono::steady_clock::time_point wall_start = std::chrono::steady_clock::now();
 
@@ -456,6 +458,7 @@ Integrator::Integrator(OdeSystem& system, double t0, const Eigen::VectorXd& y0,
       d.check(ARKStepSetRootDirection(d.mem, dirs.data()), "ARKStepSetRootDirection");
     }
     d.check(ARKStepSetNoInactiveRootWarn(d.mem), "ARKStepSetNoInactiveRootWarn");
+    if (d.order > kMaxDenseOrder) d.check(ARKStepSetInterpolantDegree(d.mem, 3), "ARKStepSetInterpolantDegree");
     events_found_.assign(nev, 0);
   }
 }
@@ -550,7 +553,7 @@ void Integrator::watchdog(double t_before, int flag) {
       t_);
 }
 
-Integrator::Outcome Integrator::advance(double t_target, bool one_step) {
+Integrator::Outcome Integrator::advance(double t_target, bool one_step, const RootStepHook& before_polish) {
   CHAINSIM_VERIFY(t_target >= t_, "the integrator only moves forward in time");
   // Invariant: on entry (t_, y_) is a state the method computed (the end of a step, a restart,
   // or a polished event), never an interpolated one; it is kept as the start of the next step.
@@ -583,6 +586,7 @@ Integrator::Outcome Integrator::advance(double t_target, bool one_step) {
     watchdog(t_step_start, flag);
     if (flag == ARK_ROOT_RETURN) {
       impl_->check(ARKStepGetRootInfo(impl_->mem, events_found_.data()), "ARKStepGetRootInfo");
+      if (before_polish) before_polish(t_step_start, t_);
       polish_event(t_step_start, y_step_start);
       return Outcome::kEvent;
     }
@@ -597,22 +601,64 @@ Integrator::Outcome Integrator::advance(double t_target, bool one_step) {
 // ARKODE locates a root on its interpolant, whose error (degree <= 5, often cubic) is far larger
 // than the step's own error for high-order methods. Polish: integrate again from the start of the
 // step that holds the root, with rootfinding off, to the root's time, and correct that time with
-// Newton steps on g(t) along the flow, dg/dt = ∇g · F, until g vanishes to rounding.
+// Newton steps on g(t) along the flow, dg/dt = ∇g · F, until g vanishes to rounding. The first
+// integration is one step of the method from the step's start straight to ARKODE's root (ARKODE
+// accepted a longer step from there, so a shorter one meets the tolerance; if it does not, ARKODE
+// shortens it and takes more); ARKODE's own estimate of a first step instead began far below the
+// step (down to 1e-13 s on the falling chain) and needed several. A Newton correction dt of that
+// time is then a step of Heun's method from the integrated state, y + dt (F(y) + F(y + dt F(y))) / 2,
+// whose second-order term is checked to be below kHeunShare of the error tolerance (its error,
+// O(dt³), is smaller still by dt over the time scale of the motion); a larger correction integrates
+// again from the step's start.
 void Integrator::polish_event(double t_step_start, const Eigen::VectorXd& y_step_start) {
+  // The largest share of the error tolerance (weighted RMS norm) the second-order term of a Heun
+  // correction may have.
+  constexpr double kHeunShare = 1e-3;
   Impl& d = *impl_;
   int k = 0;
   while (k < static_cast<int>(events_found_.size()) && events_found_[k] == 0) ++k;
   CHAINSIM_VERIFY(k < static_cast<int>(events_found_.size()), "a root return names an event");
   const int nev = d.system.num_events();
+  // The step ARKODE would have taken next: the run resumes with it after the event (restart/resize).
+  sunrealtype h_next = 0;
+  ARKStepGetCurrentStep(d.mem, &h_next);
   d.check(ARKStepRootInit(d.mem, 0, nullptr), "ARKStepRootInit");
 
   Eigen::VectorXd g(nev), g_ahead(nev), ydot(y_.size());
+  // The last integrated state, F there, and the error weights of the tolerance (ARKStepGetErrWeights).
+  double t_base = t_step_start;
+  Eigen::VectorXd y_base, f_base, f_euler(y_.size()), weights;
   double t_event = t_;
   for (int iteration = 0; iteration < 4; ++iteration) {
-    restart(t_step_start, y_step_start);
-    while (t_ < t_event) evolve(t_event, /*one_step=*/false);
+    bool corrected = false;
+    if (y_base.size() > 0) {
+      const double dt = t_event - t_base;
+      const Eigen::VectorXd y_euler = y_base + dt * f_base;
+      d.system.rhs(t_event, y_euler, f_euler);
+      const Eigen::VectorXd second = 0.5 * dt * (f_euler - f_base);
+      if (std::sqrt((second.array() * weights.array()).square().mean()) <= kHeunShare) {
+        t_ = t_event;
+        y_ = y_euler + second;
+        corrected = true;
+      }
+    }
+    if (!corrected) {
+      restart(t_step_start, y_step_start);
+      if (t_event > t_step_start) d.check(ARKStepSetInitStep(d.mem, t_event - t_step_start), "ARKStepSetInitStep");
+      while (t_ < t_event) evolve(t_event, /*one_step=*/false);
+    }
     d.system.events(t_, y_, g);
     d.system.rhs(t_, y_, ydot);
+    if (!corrected) {
+      t_base = t_;
+      y_base = y_;
+      f_base = ydot;
+      N_Vector w = N_VClone(d.y);
+      const int flag = ARKStepGetErrWeights(d.mem, w);
+      weights = Eigen::Map<Eigen::VectorXd>(N_VGetArrayPointer(w), N_VGetLength(w));
+      N_VDestroy(w);
+      d.check(flag, "ARKStepGetErrWeights");
+    }
     const double dt_probe = 1e-6 * std::max(t_event - t_step_start, 1e-300);
     d.system.events(t_ + dt_probe, y_ + dt_probe * ydot, g_ahead);
     const double slope = (g_ahead[k] - g[k]) / dt_probe;
@@ -624,6 +670,7 @@ void Integrator::polish_event(double t_step_start, const Eigen::VectorXd& y_step
     if (std::abs(t_next - t_event) <= 8 * std::numeric_limits<double>::epsilon() * t_unit) break;
     t_event = t_next;
   }
+  d.h_resume = std::abs(h_next);
 
   d.check(ARKStepRootInit(d.mem, nev, Impl::roots), "ARKStepRootInit");
   std::vector<int> dirs = d.system.event_directions();
@@ -645,6 +692,8 @@ void Integrator::restart(double t, const Eigen::VectorXd& y) {
   CHAINSIM_VERIFY(y.size() == N_VGetLength(d.y), "restart() keeps the state length; use resize()");
   Eigen::Map<Eigen::VectorXd>(N_VGetArrayPointer(d.y), y.size()) = y;
   d.check(ARKStepReset(d.mem, t, d.y), "ARKStepReset");
+  d.check(ARKStepSetInitStep(d.mem, d.h_resume), "ARKStepSetInitStep");  // 0: ARKODE's estimate
+  d.h_resume = 0;
   t_ = t;
   y_ = y;
 }
@@ -658,6 +707,8 @@ void Integrator::resize(double t, const Eigen::VectorXd& y) {
   N_VDestroy(d.y);
   d.y = ynew;
   d.check(flag, "ARKStepResize");
+  d.check(ARKStepSetInitStep(d.mem, d.h_resume), "ARKStepSetInitStep");  // 0: ARKODE's estimate
+  d.h_resume = 0;
   d.apply_tolerances();
   if (d.implicit) d.attach_linear_solver();
   t_ = t;

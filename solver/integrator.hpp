@@ -9,6 +9,7 @@
 /// system's event functions with ARKODE's rootfinding, and reports ARKODE's run statistics.
 ///
 /// integrator.cpp is the only file that includes <arkode/...>: moving to SUNDIALS 7 touches one file.
+#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
@@ -142,6 +143,12 @@ class Integrator {
   /// "auto" picks an implicit method from this OdeSystem::explicit_stiffness() on (measured
   /// crossover at equal accuracy, 35 links: docs/string_solver.md, "The implicit path").
   static constexpr double kAutoImplicitStiffness = 50;
+  /// Methods up to this order interpolate inside a step with ARKODE's Hermite interpolant of degree
+  /// order − 1 (at most 5): frames can be taken from it. Above it the steps are far more accurate than
+  /// any interpolant, so frames are stop times, and with event functions the interpolant serves only
+  /// ARKODE's rootfinding, whose root the polish recomputes: it is then cubic, whose evaluations need
+  /// no right-hand side (degrees 4 and 5 take one and two per evaluation).
+  static constexpr int kMaxDenseOrder = 5;
   /// The method "auto" resolves to for `system` (any other name is returned unchanged).
   static std::string resolve_method(const std::string& method, const OdeSystem& system);
 
@@ -151,11 +158,16 @@ class Integrator {
     kStep,           ///< one internal step taken (one_step mode), t < t_target
   };
 
+  /// Called by advance() at a root return before the event is polished, with the step that holds
+  /// the root: its start and the root ARKODE located on it. interpolate() covers [t_start, t_root]
+  /// during the call (it no longer does once the polish has recomputed the step).
+  using RootStepHook = std::function<void(double t_start, double t_root)>;
+
   /// Advance towards t_target (never past it). In one_step mode return after each internal step,
   /// which lets a caller record the adaptive steps. Throws NumericalError when ARKODE fails (the
   /// message carries ARKODE's flag name and the time reached), or when the watchdog (see the class
   /// comment) stops the run.
-  Outcome advance(double t_target, bool one_step = false);
+  Outcome advance(double t_target, bool one_step = false, const RootStepHook& before_polish = {});
 
   /// Current time and state of the integrator.
   double time() const { return t_; }
@@ -163,7 +175,10 @@ class Integrator {
 
   /// After Outcome::kEvent: for each event function, +1/-1 if it crossed zero increasing/decreasing, else 0.
   /// The event's time and state are polished to the method's accuracy (not the interpolant's):
-  /// the step holding the root is recomputed up to the root, found by Newton iteration on g.
+  /// the step holding the root is recomputed up to ARKODE's root in one step of the method, and the
+  /// root's time corrected by Newton iteration on g (small corrections by a Heun step along the flow,
+  /// larger ones by recomputing the step). The next restart() or resize() resumes with the step size
+  /// ARKODE had reached before the event rather than a fresh estimate.
   const std::vector<int>& events_found() const { return events_found_; }
 
   /// Interpolated state (k = 0) or its k-th derivative at time t inside the last step (dense output).

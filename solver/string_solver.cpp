@@ -16,7 +16,11 @@ namespace chainsim {
 
 namespace {
 /// Frames are interpolated for methods up to this order (docs/string_solver.md, "The implicit path").
-constexpr int kMaxDenseOrder = 5;
+constexpr int kMaxDenseOrder = Integrator::kMaxDenseOrder;
+/// A step of this fraction of the output interval or longer counts as longer than the frames: a step
+/// that ARKODE shortened to end at a frame, one interval after the previous one, ends a few rounding
+/// units short of the interval.
+constexpr double kStepOfFrames = 1 - 1e-9;
 }  // namespace
 
 void StringSolverOptions::validate() const {
@@ -357,42 +361,43 @@ const RunSummary& StringSolver<dim>::run() {
       if (on_step) on_step(t, y);
       if (options_.record_steps) record_sample(t, y);
     };
-    // Without root functions, frames closer together than the integrator's steps come from ARKODE's
-    // dense output and never shorten a step: the integrator runs towards t_end, and every output
-    // time inside an accepted step is interpolated on that step, then projected onto the link
-    // constraints (projected_state). Frames further apart than the steps are stop times (exact
-    // states; at most one shortened step per frame), and so are all frames of methods of order above
-    // kMaxDenseOrder, whose steps are far more accurate than ARKODE's Hermite interpolant (degree <= 5). With root functions the output times stay
-    // stop times: an event's polish recomputes its step, after which the interpolant no longer
-    // covers the frames before it.
-    if (model_.num_events() == 0) {
-      for (long k = 1; k <= n_out;) {
-        const IntegratorStats st = integrator->stats();
-        const bool dense = st.last_step > options_.output_interval && st.order <= kMaxDenseOrder;
-        integrator->advance(dense ? options_.t_end : output_time(k), /*one_step=*/true);
-        const double t = integrator->time();
-        const Eigen::VectorXd& y = integrator->state();
-        after_step(t, y);
-        for (; k <= n_out && output_time(k) <= t; ++k) {
-          const double t_out = output_time(k);
-          if (t_out == t)
-            record_frame(t_out, y);
-          else
-            record_frame(t_out, model_.projected_state(t_out, integrator->interpolate(t_out)));
-        }
-        if (k <= n_out && interrupt_requested()) {  // Ctrl-C: stop at this accepted state, outputs valid
-          record_frame(t, y);
-          finish("interrupted");
-          summary_.stop_reason = fmt::format("interrupted by the user at t = {:.9g} s", t);
-          return summary_;
-        }
-      }
-    }
-    for (long k = 1; k <= n_out && model_.num_events() > 0;) {
-      const double t_out = output_time(k);
-      const Integrator::Outcome outcome = integrator->advance(t_out, /*one_step=*/true);
+    // Frames closer together than the integrator's steps come from ARKODE's dense output and never
+    // shorten a step: the integrator runs towards t_end, and every output time inside an accepted
+    // step is interpolated on that step, then projected onto the link constraints (projected_state).
+    // Frames further apart than the steps are stop times (exact states; at most one shortened step
+    // per frame), and so are all frames of methods of order above kMaxDenseOrder, whose steps are far
+    // more accurate than ARKODE's Hermite interpolant (degree <= 5). With root functions, the frames
+    // inside the step that holds a root are interpolated before the event's polish recomputes that
+    // step (the interpolant no longer covers them afterwards) and kept if they lie before the
+    // polished event; those at or after it are taken after the event, on the steps that follow.
+    // `step` is the last step that ended without an event: the polish's step ends at the event and
+    // says nothing about the step size of the run.
+    // An interpolated frame is also a row of the step record (series.csv), as a frame at a stop time
+    // is: every frame's time is one of its rows.
+    auto record_interpolated = [&](double t_out, const Eigen::VectorXd& y_interpolated) {
+      const Eigen::VectorXd y_out = model_.projected_state(t_out, y_interpolated);
+      record_frame(t_out, y_out);
+      if (options_.record_steps) record_sample(t_out, y_out);
+    };
+    double step = 0;
+    std::vector<std::pair<double, Eigen::VectorXd>> before_event;
+    long k = 1;
+    const Integrator::RootStepHook interpolate_before_event = [&](double, double t_root) {
+      for (long j = k; j <= n_out && output_time(j) < t_root; ++j)
+        before_event.emplace_back(output_time(j), integrator->interpolate(output_time(j)));
+    };
+    while (k <= n_out) {
+      const bool dense = step > kStepOfFrames * options_.output_interval && integrator->stats().order <= kMaxDenseOrder;
+      before_event.clear();
+      const Integrator::Outcome outcome =
+          integrator->advance(dense ? options_.t_end : output_time(k), /*one_step=*/true, interpolate_before_event);
       const double t = integrator->time();
       if (outcome == Integrator::Outcome::kEvent) {
+        for (const auto& [t_out, y_out] : before_event) {
+          if (!(t_out < t)) break;
+          record_interpolated(t_out, y_out);
+          ++k;
+        }
         Eigen::VectorXd state = integrator->state();
         const EventAction action = model_.handle_events(t, state, integrator->events_found());
         if (action.kind == EventAction::Kind::kStop) {
@@ -409,12 +414,12 @@ const RunSummary& StringSolver<dim>::run() {
         if (options_.record_steps) record_sample(t, state);
         continue;
       }
+      step = integrator->stats().last_step;
       const Eigen::VectorXd& y = integrator->state();
+      for (; k <= n_out && output_time(k) < t; ++k) record_interpolated(output_time(k), integrator->interpolate(output_time(k)));
       after_step(t, y);
-      if (outcome == Integrator::Outcome::kReachedTarget) {
-        record_frame(t_out, y);
-        ++k;
-      } else if (interrupt_requested()) {  // Ctrl-C: stop at this accepted state, outputs valid
+      if (k <= n_out && output_time(k) == t) record_frame(output_time(k++), y);
+      if (k <= n_out && interrupt_requested()) {  // Ctrl-C: stop at this accepted state, outputs valid
         record_frame(t, y);
         finish("interrupted");
         summary_.stop_reason = fmt::format("interrupted by the user at t = {:.9g} s", t);
