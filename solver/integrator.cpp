@@ -569,7 +569,7 @@ Integrator::Outcome Integrator::advance(double t_target, bool one_step, const Ro
     const Eigen::VectorXd y_step_start = y_;
     const int flag = evolve(t_target, /*one_step=*/true);
     if (flag == ARK_UNREC_RHSFUNC_ERR) {
-      if (h_retry == 0) ARKStepGetLastStep(impl_->mem, &h_retry);
+      if (h_retry == 0) h_retry = last_step();
       h_retry *= 0.25;
       if (++retries > kMaxRetries || !(h_retry > 0))
         throw NumericalError(fmt::format("time integration stalled at t = {:.12g} s: the model refused every trial "
@@ -715,6 +715,12 @@ void Integrator::resize(double t, const Eigen::VectorXd& y) {
   y_ = y;
 }
 
+double Integrator::last_step() const {
+  sunrealtype h = 0;
+  ARKStepGetLastStep(impl_->mem, &h);
+  return h;
+}
+
 IntegratorStats Integrator::stats() const {
   const Impl& d = *impl_;
   IntegratorStats s;
@@ -739,9 +745,7 @@ IntegratorStats Integrator::stats() const {
       s.lin_solves = d.newton_solves;
     }
   }
-  sunrealtype h = 0;
-  ARKStepGetLastStep(d.mem, &h);
-  s.last_step = h;
+  s.last_step = last_step();
   s.recoverable_failures = d.recoverable_failures;
   s.method = d.table;
   s.order = d.order;

@@ -192,6 +192,8 @@ class Integrator {
   void resize(double t, const Eigen::VectorXd& y);
 
   IntegratorStats stats() const;
+  /// The size of the last accepted step (s): stats().last_step without the other counters.
+  double last_step() const;
 
  private:
   int evolve(double t_target, bool one_step);

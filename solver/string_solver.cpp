@@ -386,8 +386,9 @@ const RunSummary& StringSolver<dim>::run() {
       for (long j = k; j <= n_out && output_time(j) < t_root; ++j)
         before_event.emplace_back(output_time(j), integrator->interpolate(output_time(j)));
     };
+    const bool interpolating_method = integrator->stats().order <= kMaxDenseOrder;  // fixed for the run
     while (k <= n_out) {
-      const bool dense = step > kStepOfFrames * options_.output_interval && integrator->stats().order <= kMaxDenseOrder;
+      const bool dense = interpolating_method && step > kStepOfFrames * options_.output_interval;
       before_event.clear();
       const Integrator::Outcome outcome =
           integrator->advance(dense ? options_.t_end : output_time(k), /*one_step=*/true, interpolate_before_event);
@@ -414,7 +415,7 @@ const RunSummary& StringSolver<dim>::run() {
         if (options_.record_steps) record_sample(t, state);
         continue;
       }
-      step = integrator->stats().last_step;
+      step = integrator->last_step();
       const Eigen::VectorXd& y = integrator->state();
       for (; k <= n_out && output_time(k) < t; ++k) record_interpolated(output_time(k), integrator->interpolate(output_time(k)));
       after_step(t, y);
