@@ -16,11 +16,12 @@ esac
 
 # 1. Packages (all from Debian's archive). dpkg -s is quick, so a ready machine skips apt entirely.
 # clang and libclang-rt-14-dev: the sanitizer build and the scene fuzzer of .ci/run (libFuzzer).
-# python3-dev, pybind11-dev: the Python module chainsim; pandas, dask, distributed: its sweeps (docs/python.md).
+# python3-dev, pybind11-dev: the Python module chainsim; pandas, dask, distributed: its sweeps (docs/python.md);
+# python3-hypothesis: the property tests of its front door (tests/python/).
 packages=(cmake make g++ libeigen3-dev libsuitesparse-dev libsundials-dev catch2 libcli11-dev
           libtomlplusplus-dev nlohmann-json3-dev libfmt-dev libboost-dev libbenchmark-dev python3-matplotlib python3-numpy
           python3-pil python3-pytest python3-vtk9 ffmpeg clang libclang-rt-14-dev
-          python3-dev pybind11-dev python3-pandas python3-dask python3-distributed)
+          python3-dev pybind11-dev python3-pandas python3-dask python3-distributed python3-hypothesis)
 missing=()
 for p in "${packages[@]}"; do dpkg -s "$p" >/dev/null 2>&1 || missing+=("$p"); done
 if [ ${#missing[@]} -gt 0 ]; then

@@ -99,7 +99,7 @@ std::string describe_parse_error(const CLI::App& app, const CLI::ParseError& e, 
 int main(int argc, char** argv) {
   CLI::App app{"chainsim: dynamics of inextensible strings and chains with shocks"};
   app.require_subcommand(1);
-  app.set_version_flag("--version", "chainsim 0.1.0");
+  app.set_version_flag("--version", CHAINSIM_VERSION_TEXT);  // cases/CMakeLists.txt
 
   // --- chainsim reduced ------------------------------------------------------------------------
   chainsim::ReducedCommandOptions reduced;

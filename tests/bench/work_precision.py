@@ -377,14 +377,16 @@ def machine_info(chainsim):
     if cache.exists():
         m = re.search(r"^CMAKE_BUILD_TYPE:STRING=(.*)$", cache.read_text(), re.M)
         build_type = m.group(1) if m else "?"
-    rev = subprocess.run(["git", "-C", str(ROOT), "describe", "--always", "--dirty"], capture_output=True,
-                         text=True).stdout.strip() or "?"
+    # The binary names its version and the revision it was built from (read at configure time): no git here.
+    version = subprocess.run([chainsim, "--version"], capture_output=True, text=True).stdout.strip()
+    m = re.match(r"chainsim (\S+) \((.*)\)$", version)
+    rev = f"{m.group(1)}, {m.group(2)}" if m else (version or "?")
     sundials = "?"
     config = Path("/usr/include/sundials/sundials_config.h")
     if config.exists():
         m = re.search(r'#define SUNDIALS_VERSION "([^"]+)"', config.read_text())
         sundials = m.group(1) if m else "?"
-    return {"cpu": cpu, "cores": os.cpu_count(), "build_type": build_type, "git": rev, "sundials": sundials,
+    return {"cpu": cpu, "cores": os.cpu_count(), "build_type": build_type, "revision": rev, "sundials": sundials,
             "load": os.getloadavg()[0], "python": platform.python_version()}
 
 
@@ -564,7 +566,7 @@ def plot(study, cases, info, path, title, command):
         ax.legend(fontsize=6, ncol=2)
     fig.suptitle(title, fontsize=11)
     footer = (f"{info['cpu']}, {info['cores']} cores (shared: load average {info['load']:.1f} at the start); "
-              f"build {info['build_type']}; chainsim {info['git']}, SUNDIALS {info['sundials']}\n{command}")
+              f"build {info['build_type']}; chainsim {info['revision']}, SUNDIALS {info['sundials']}\n{command}")
     fig.text(0.01, 0.005, footer, fontsize=7, va="bottom", family="monospace")
     fig.tight_layout(rect=(0, 0.07, 1, 0.95))
     fig.savefig(path, dpi=110)
@@ -612,7 +614,7 @@ def main():
     study = Study(opts)
     study.kinds = {m: "explicit" if is_explicit(d) else "implicit" if is_implicit(d) else "other"
                    for m, d in all_methods}
-    study.log(f"chainsim {info['git']} ({info['build_type']}), SUNDIALS {info['sundials']}, {info['cpu']}, "
+    study.log(f"chainsim {info['revision']} ({info['build_type']}), SUNDIALS {info['sundials']}, {info['cpu']}, "
               f"{info['cores']} cores, load {info['load']:.1f}; methods {', '.join(m for m, _ in methods)}")
 
     canonical = [CanonicalCase(p, SCENES / f"{p}_chain.toml") for p in ("falling", "folded", "sliding")]
