@@ -64,7 +64,7 @@ int run_plot_command(const PlotCommandOptions& options);
 struct FitCommandOptions {
   std::string target;                  ///< falling | folded | sliding, or a scene file
   std::vector<std::string> data;       ///< CSV files, each FILE[@KEY=VALUE...]
-  std::string observable, time_column, sigma, profile, jobs, max_nfev, out;
+  std::string observable, column, time_column, sigma, profile, jobs, max_nfev, out;
   std::vector<std::string> free;       ///< NAME=START[:LOWER:UPPER]
   std::vector<std::string> per_run;    ///< names of free parameters fitted once per data file
   std::vector<std::string> overrides;  ///< --set KEY=VALUE

@@ -26,6 +26,9 @@ inline CLI::App* add_fit_command(CLI::App& app, FitCommandOptions& fit) {
   cmd->add_option("--observable", fit.observable,
                   "the column of values, named as the model output it is: y, P, ... (reduced), s0_0, support_y, "
                   "node[K].y, ... (string), t_stop (default: the only column that is neither time nor sigma)");
+  cmd->add_option("--column", fit.column,
+                  "the CSV column of the values, when it is not named as the observable (e.g. --observable s0_0 "
+                  "--column y: the string solver's front coordinate against a column of heights)");
   cmd->add_option("--time-column", fit.time_column, "the time column (s) (default t)");
   cmd->add_option("--sigma", fit.sigma,
                   "the data's standard deviation, > 0 (a number), or the name of a column of them (default: the "

@@ -38,6 +38,8 @@ KNOWN_BOUNDS = {"f": (0.0, 1.0), "eta0": (0.0, 1.0), "t_offset": (-np.inf, np.in
 # Columns whose time derivative is another column of the same series: the model is interpolated between its
 # steps by cubic Hermite polynomials there (error ~ h^4), linearly elsewhere.
 TIME_DERIVATIVE = {"y": "ydot", "ydot": "yddot"}
+UNITS = {"y": "m", "ydot": "m/s", "yddot": "m/s²", "P": "N", "t_stop": "s", "K": "J", "V": "J", "s0_0": "m",
+         "s0dot_0": "m/s", "support_x": "N", "support_y": "N", "front_0_x": "m", "front_0_y": "m"}
 
 
 def _error(message):
@@ -114,11 +116,12 @@ class Data:
                              f"{self.t[i - 1]!r}: allowed strictly increasing times (sort the rows, merge repeats)")
 
     @classmethod
-    def from_csv(cls, path, observable=None, time="t", sigma=None, settings=None, run=None):
+    def from_csv(cls, path, observable=None, time="t", sigma=None, settings=None, run=None, column=None):
         """Reads a CSV file: a header row naming the columns, then one row per point; lines starting with # are
-        comments. `time` names the time column (s); `observable` the column of values (default: the only column
-        that is neither the time nor `sigma`); `sigma` a column of standard deviations, or a number (default:
-        the column "sigma" if there is one, else estimated from the residuals)."""
+        comments. `time` names the time column (s); `observable` the model output the values are, and `column`
+        the column that holds them (default: the observable's name; without either, the only column that is
+        neither the time nor sigma); `sigma` a column of standard deviations, or a number (default: the column
+        "sigma" if there is one, else estimated from the residuals)."""
         path = os.fspath(path)
         try:
             with open(path, newline="") as handle:
@@ -133,21 +136,25 @@ class Data:
         header_line, header = rows[0]
         names = [c.strip() for c in next(csv.reader([header]))]
         sigma_column = sigma if isinstance(sigma, str) else ("sigma" if "sigma" in names and sigma is None else None)
-        if observable is None and time not in names:
+        if column is None and observable is not None:
+            column = observable
+        if column is None and time not in names:
             raise _error(f"{path}:{header_line}: no column '{time}' in the header {names} (the time column is set by "
                          f"--time-column / time=)")
-        if observable is None:
+        if column is None:
             others = [c for c in names if c not in (time, sigma_column)]
             if len(others) != 1:
                 raise _error(f"{path}:{header_line}: cannot tell the observable from the columns {names}: name it "
                              f"(--observable, observable=)")
-            observable = others[0]
-        value_column = observable
+            column = others[0]
+        observable = observable or column
+        value_column = column
         needed = [value_column] + ([time] if observable != "t_stop" else []) + ([sigma_column] if sigma_column else [])
         for column in needed:
             if column not in names:
                 raise _error(f"{path}:{header_line}: no column '{column}' in the header {names} (the time column is "
-                             f"set by --time-column / time=, the values by --observable / observable=)")
+                             f"set by --time-column / time=, the values by --column / column= or --observable / "
+                             f"observable=)")
         index = {c: names.index(c) for c in needed}
         t, values, sig, lines = [], [], [], []
         for line, row_text in rows[1:]:
@@ -769,9 +776,13 @@ def plot_fit(fit_result, directory):
             for sign in (-1, 1):
                 axr.axhline(sign * noise, color="tab:gray", lw=0.8, ls="--", label="noise" if sign > 0 else None)
             axr.set_xlabel("t (s)")
+            if "t_offset" in problem.base and t[0] <= t_offset <= t[-1]:
+                ax.axvline(t_offset, color="tab:gray", lw=0.8, ls=":", label=f"release, t = {t_offset:.4g} s")
         counters[r] = counters.get(r, 0) + 1
-        ax.set_ylabel(s["observable"])
-        axr.set_ylabel("data - model")
+        unit = "m" if s["observable"].startswith("node[") else UNITS.get(s["observable"], "")
+        unit = f" ({unit})" if unit else ""
+        ax.set_ylabel(s["observable"] + unit)
+        axr.set_ylabel("data - model" + unit)
         axr.axhline(0, color="k", lw=0.8)
         ax.set_title(f"{os.path.basename(s['name'])}: {s['n']} points", fontsize=9)
         ax.legend(fontsize=8)
@@ -815,7 +826,7 @@ def _save(fig, directory, name):
 
 
 # ----------------------------------------------------------------------------------------------------------------
-# The command line: `chainsim fit` runs `python3 -m chainsim.fitting`
+# The command line: `chainsim fit` runs `python3 -m chainsim fit` (chainsim/__main__.py), which calls main()
 
 def _parse_value(text):
     try:
@@ -843,6 +854,7 @@ def _parser():
                    "drop2.csv@eta0=0.8); FILE@run=NAME puts files of one drop in one run")
     p.add_argument("--observable", help="the column of values and the model output it is (default: the only column "
                    "that is not the time or sigma)")
+    p.add_argument("--column", help="the CSV column of the values (default: the observable's name)")
     p.add_argument("--time-column", default="t", help="the time column (s) (default t)")
     p.add_argument("--sigma", help="the data's standard deviation (a number), or the name of a column of them "
                    "(default: the column sigma if present, else estimated from the residuals)")
@@ -911,11 +923,15 @@ def main(argv=None):
                 else:
                     settings[key] = _parse_value(value)
             data.append(Data.from_csv(path, observable=args.observable, time=args.time_column, sigma=sigma,
-                                      settings=settings, run=run))
+                                      settings=settings, run=run, column=args.column))
         result = fit(args.target, data, _parse_free(args.free), per_run=args.per_run, fixed=fixed,
                      profile=None if args.profile == "none" else args.profile, absolute_sigma=args.absolute_sigma,
                      workers=args.jobs or None, max_nfev=args.max_nfev)
         paths = result.write(args.out, figures=not args.no_figures)
+    except ImportError as e:
+        sys.stderr.write(f"chainsim: error: fit needs SciPy and matplotlib ({e}): install the Debian packages "
+                         f"python3-scipy python3-matplotlib, or run with /usr/bin/python3\n")
+        return 1
     except (ChainsimInputError, NumericalError) as e:
         code = 3 if isinstance(e, NumericalError) else 2
         if args.json:   # as every chainsim command prints a failure with --json
@@ -929,6 +945,3 @@ def main(argv=None):
         print("outputs    " + " ".join(paths))
     return 0
 
-
-if __name__ == "__main__":
-    sys.exit(main())

@@ -271,6 +271,6 @@ def test_chainsim_fit_on_the_command_line(tmp_path):
 def test_chainsim_fit_help_describes_every_option():
     r = cli("--help")
     assert r.returncode == 0
-    for option in ("--observable", "--time-column", "--sigma", "--free", "--per-run", "--set", "--profile",
+    for option in ("--observable", "--column", "--time-column", "--sigma", "--free", "--per-run", "--set", "--profile",
                    "--absolute-sigma", "--jobs", "--max-nfev", "--out", "--no-figures", "--json"):
         assert option in r.stdout, option
