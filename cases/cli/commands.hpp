@@ -54,8 +54,8 @@ struct PlotCommandOptions {
   bool animate = false;
   std::string speed, fps, times, format;
 };
-/// Runs /usr/bin/python3 (else python3 on PATH) -m chainsim_plot with PYTHONPATH set to the source
-/// tree's python/; returns its exit code (1 if it cannot be started).
+/// Runs /usr/bin/python3 (else python3 on PATH) -m chainsim_plot (run_python_module, python_command.hpp);
+/// returns its exit code (1 if it cannot be started).
 int run_plot_command(const PlotCommandOptions& options);
 
 /// `chainsim fit TARGET DATA.csv... [...]`: fits scene keys (f, ...) to measured series with the Python

@@ -72,6 +72,7 @@ class Data:
         self.columns = columns or {"t": "t", "value": self.observable, "sigma": "sigma"}
         self.settings = dict(settings or {})
         self.run = run
+        self.header_line = None   # the line of a CSV file's header row
         self.sigma_given = sigma is not None
         if sigma is None:
             self.sigma = None
@@ -177,8 +178,10 @@ class Data:
             sigma = sig
         elif isinstance(sigma, str):
             sigma = None
-        return cls(t, values, observable, sigma=sigma, settings=settings, run=run, name=path, lines=lines,
+        data = cls(t, values, observable, sigma=sigma, settings=settings, run=run, name=path, lines=lines,
                    columns={"t": time, "value": value_column, "sigma": sigma_column or "sigma"})
+        data.header_line = header_line
+        return data
 
     def __repr__(self):
         return f"<Data {self.name}: {self.observable}, {len(self.values)} points>"
@@ -630,8 +633,16 @@ def fit(target, data, free=None, *, bounds=None, per_run=(), fixed=None, profile
     if n_points <= n_par:
         raise _error(f"{n_points} data points for {n_par} free parameters ({', '.join(problem.names)}): too few "
                      f"(allowed: more points than parameters)")
-    # The observables are checked at the start values, before the fit.
-    problem.predictions([problem.x0])
+    # The observables are checked at the start values, before the fit; a message names the file that asks.
+    try:
+        problem.predictions([problem.x0])
+    except ChainsimInputError as e:
+        asking = [d for d in data if str(e).startswith(f"observable '{d.observable}'")]
+        if not asking:
+            raise
+        d = asking[0]
+        where = f"{d.name}:{d.header_line}" if d.header_line is not None else d.name
+        raise _error(f"{where}: column {d.columns['value']}: {e}") from None
     warnings = []
     # Weights: the given sigmas; series without them are first weighted by their spread, then by the noise
     # estimated from that fit's residuals (so that series in different units count by their noise).
@@ -799,10 +810,10 @@ def plot_fit(fit_result, directory):
         ax.plot(p["values"], p["delta_chi2"], "o-", ms=3, color="k", label=r"profile $\Delta\chi^2/s^2$")
         ax.axhline(CHI2_95, color="tab:red", lw=1, ls="--", label="95% level (3.84)")
         v, (lo, hi), (clo, chi) = fit_result.value[name], fit_result.profile_interval[name], fit_result.interval[name]
-        ax.axvspan(lo, hi, color="tab:red", alpha=0.12, label=f"profile 95%: [{lo:.4g}, {hi:.4g}]")
+        ax.axvspan(lo, hi, color="tab:red", alpha=0.12, label=f"profile 95%: [{lo:.5g}, {hi:.5g}]")
         values = np.asarray(p["values"])
         ax.plot(values, ((values - v) / fit_result.sd[name]) ** 2, color="tab:blue", lw=1, ls=":",
-                label=f"covariance (quadratic): [{clo:.4g}, {chi:.4g}]")
+                label=f"covariance (quadratic): [{clo:.5g}, {chi:.5g}]")
         ax.axvline(v, color="k", lw=0.8)
         ax.set_ylim(0, max(2 * CHI2_95, float(np.max(p["delta_chi2"])) * 1.05))
         ax.set_xlabel(name)

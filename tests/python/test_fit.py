@@ -264,6 +264,8 @@ def test_chainsim_fit_on_the_command_line(tmp_path):
     r = cli("falling", path, "--free", "f=2", "--json")
     assert r.returncode == 2 and json.loads(r.stdout)["status"] == "failed"
     assert "f = 2.0 is out of range" in r.stderr
+    r = cli("falling", path, "--observable", "height", "--column", "y")
+    assert r.returncode == 2 and f"{path}:2: column y: observable 'height' is not an output of this model" in r.stderr
     r = cli("falling", path, "--jobs", "x")
     assert r.returncode == 2 and "--jobs" in r.stderr
 
