@@ -273,19 +273,23 @@ def _interpolate(t_model, y_model, dy_model, t):
     return h00 * ym[i] + h10 * h * dm[i] + h01 * ym[i + 1] + h11 * h * dm[i + 1]
 
 
-def _predict(task):
+def _predict(task, with_span=False):
     """One model run and its predictions at the data times (a module-level function: it runs on Dask workers).
 
-    task = (target, settings, t_offset, [(observable, times), ...]) -> [predicted values, ...]"""
+    task = (target, settings, t_offset, [(observable, times), ...]) -> [predicted values, ...]
+    with_span: also the last time of each observable's table on the data's clock (None for t_stop)."""
     target, settings, t_offset, wanted = task
     result = _run_model(target, settings)
-    out = []
+    out, ends = [], []
     for observable, t in wanted:
         if observable == "t_stop":
             out.append(np.full(len(t), float(result.summary["t_stop"]) + t_offset))
+            ends.append(None)
         else:
-            out.append(_interpolate(*_table(result, observable), np.asarray(t) - t_offset))
-    return out
+            table = _table(result, observable)
+            out.append(_interpolate(*table, np.asarray(t) - t_offset))
+            ends.append(float(table[0][-1]) + t_offset)
+    return (out, ends) if with_span else out
 
 
 # ----------------------------------------------------------------------------------------------------------------
@@ -473,7 +477,8 @@ class FitResult:
 
     def table(self):
         """The fit as a text table: parameters (value, sd, 95% intervals), then series (points, residuals, noise)."""
-        lines = [f"fit of {self.target}: {self.points} points, {len(self.names)} parameters, chi2 = "
+        plural = "s" if len(self.names) != 1 else ""
+        lines = [f"fit of {self.target}: {self.points} points, {len(self.names)} parameter{plural}, chi2 = "
                  f"{self.chi2:.6g}, s^2 = chi2/(N-p) = {self.s2:.4g}" + (" (sigma taken as given)"
                                                                           if self.absolute_sigma else "")]
         lines.append(f"{'parameter':<18} {'value':>13} {'sd':>11} {'95% (covariance)':>29} {'95% (profile)':>29}")
@@ -708,8 +713,18 @@ def fit(target, data, free=None, *, bounds=None, per_run=(), fixed=None, profile
             profile_curve = {"parameter": profile, "values": values, "delta_chi2": (np.array(chis) - chi2) / s2}
     elif profile is not None and profile != "f":
         raise _error(f"profile = '{profile}' is not a free parameter (free: {', '.join(problem.names)})")
-    # The series at the best fit.
+    # The series at the best fit, and the points past the model's end (held at its final state there).
     pred = problem.predictions([x])[0]
+    ends = {}
+    for rr in range(len(problem.runs)):
+        ends[rr] = iter(_predict(problem.task(x, rr), with_span=True)[1])
+    for d, rr in zip(data, problem.run_of):
+        end = next(ends[rr])
+        late = int(np.sum(d.t > end)) if end is not None else 0
+        if late:
+            warnings.append(f"{d.name}: {late} points after the model's end at t = {end:.6g} s (its stop, on the "
+                            f"data's clock): the model is held at its final state there; cut the data at the stop "
+                            f"(the landing) unless the observable stays put")
     series, counters = [], {}
     for k, (d, rr) in enumerate(zip(data, problem.run_of)):
         j = counters.get(rr, 0)

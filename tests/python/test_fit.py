@@ -159,6 +159,26 @@ def test_a_stop_time_is_an_observable():
     assert fit.interval["f"][0] <= F_TRUE <= fit.interval["f"][1]
 
 
+def test_points_after_the_models_stop_are_reported_and_the_other_problems_fit():
+    """Data past the landing: the model is held at its final state there, and the fit says so. The folded and the
+    sliding chain (their y and the force P) recover f = 0.4 within their intervals."""
+    t, y = truth(n=60, fraction=1.2)
+    fit = chainsim.fit("falling", noisy(t, y, 0.003, seed=1), {"f": 0.5}, fixed=FAST, profile_points=0)
+    assert any("10 points after the model's end" in w for w in fit.warnings), fit.warnings
+    for problem, observable, eta0 in (("folded", "y", None), ("folded", "P", None), ("sliding", "y", 0.25),
+                                      ("sliding", "P", 0.25)):
+        r = chainsim.reduced(problem, f=0.4, eta0=eta0)
+        t = np.linspace(0.0, 0.9 * r.summary["t_stop"], 60)
+        y = _interpolate(*_table(r, observable), t)
+        data = noisy(t, y, 0.003 * np.abs(y).max(), seed=1, observable=observable)
+        # P has no time-derivative column: it is interpolated linearly, so its model keeps the reduced ODE's
+        # default steps (t0/500); FAST's long steps would make the interpolation error larger than the noise
+        fixed = dict(FAST if observable == "y" else {}, **({"eta0": eta0} if eta0 else {}))
+        fit = chainsim.fit(problem, data, {"f": 0.5}, fixed=fixed, profile_points=0)
+        assert fit.interval["f"][0] <= 0.4 <= fit.interval["f"][1], (problem, observable, fit)
+        assert not fit.warnings
+
+
 def test_a_fit_on_a_dask_client_gives_the_local_fit():
     pytest.importorskip("dask.distributed")
     from dask.distributed import Client, LocalCluster
