@@ -351,7 +351,6 @@ class _Problem:
                 self.lo.append(lo)
                 self.hi.append(hi)
         self.x0, self.lo, self.hi = (np.array(a, dtype=float) for a in (self.x0, self.lo, self.hi))
-        self.sigma = [d.sigma if d.sigma is not None else None for d in data]
         self.scale = [np.ones(len(d.values)) for d in data]   # the sigma used in the weights
         self.evaluations = 0
         self._last = (None, None)   # the last full evaluation: least_squares asks for the Jacobian where it was
@@ -607,7 +606,7 @@ def fit(target, data, free=None, *, bounds=None, per_run=(), fixed=None, profile
 
     target          a canonical problem ("falling", "folded", "sliding": the reduced ODE), a Scene, or a scene
                     file's path (a scene with model = "reduced" runs the reduced ODE, any other the string solver)
-    data            a Data or a list of them (joint fit: the shared parameters are fitted to all)
+    data            a Data, a CSV file's path, or a list of them (joint fit: the shared parameters are fitted to all)
     free            {name: start} or {name: (start, lower, upper)}: f, the reduced model's keywords (eta0, eps,
                     force, length, density, gravity) or the scene's dotted keys, and t_offset (the release time on
                     the data's clock). Default {"f": 0.5}. f is bounded to [0, 1], eta0 to [0, 1].
@@ -627,7 +626,10 @@ def fit(target, data, free=None, *, bounds=None, per_run=(), fixed=None, profile
         target = Scene.from_file(target)
     if not isinstance(target, (str, Scene)):
         raise _error(f"fit() fits a Scene, a scene file or a problem ({', '.join(PROBLEMS)}), not {target!r}")
-    data = [data] if isinstance(data, Data) else list(data)
+    data = [data] if isinstance(data, (Data, str, os.PathLike)) else list(data)
+    data = [Data.from_csv(d) if isinstance(d, (str, os.PathLike)) else d for d in data]
+    if not all(isinstance(d, Data) for d in data):
+        raise _error(f"fit() fits chainsim.Data series or CSV files' paths, not {data!r}")
     if not data:
         raise _error("fit() needs at least one data series")
     free = {"f": 0.5} if free is None else dict(free)

@@ -274,6 +274,9 @@ def test_chainsim_fit_on_the_command_line(tmp_path):
     assert result["profile_interval"]["f"][0] <= F_TRUE <= result["profile_interval"]["f"][1]
     assert sorted(os.listdir(out)) == ["fit.json", "fit.png", "fit_series.csv", "fit_table.txt", "profile.png"]
     assert json.loads((out / "fit.json").read_text())["value"] == result["value"]
+    # the same fit from Python, the file given by its path
+    same = chainsim.fit("falling", path, {"f": 0.5, "t_offset": (0, -0.1, 0.1)}, fixed={"max_step": 1}, profile=None)
+    assert same.value == result["value"]
     # the table
     r = cli("falling", path, "--free", "f=0.5", "--free", "t_offset=0:-0.1:0.1", "--out", str(out), "--no-figures")
     assert r.returncode == 0 and "95% (profile)" in r.stdout and "t_offset" in r.stdout
