@@ -480,13 +480,14 @@ class FitResult:
         lines = [f"fit of {self.target}: {self.points} points, {len(self.names)} parameter{plural}, chi2 = "
                  f"{self.chi2:.6g}, s^2 = chi2/(N-p) = {self.s2:.4g}" + (" (sigma taken as given)"
                                                                           if self.absolute_sigma else "")]
-        lines.append(f"{'parameter':<18} {'value':>13} {'sd':>11} {'95% (covariance)':>29} {'95% (profile)':>29}")
+        w = max([18] + [len(n) for n in self.names])
+        lines.append(f"{'parameter':<{w}} {'value':>13} {'sd':>11} {'95% (covariance)':>29} {'95% (profile)':>29}")
         for n in self.names:
             lo, hi = self.interval[n]
             p = self.profile_interval.get(n)
             ptext = f"[{p[0]:.6g}, {p[1]:.6g}]" if p else "-"
             bound = f"  on its {self.on_bound[n]} bound" if n in self.on_bound else ""
-            lines.append(f"{n:<18} {self.value[n]:>13.7g} {self.sd[n]:>11.3g} {f'[{lo:.6g}, {hi:.6g}]':>29} "
+            lines.append(f"{n:<{w}} {self.value[n]:>13.7g} {self.sd[n]:>11.3g} {f'[{lo:.6g}, {hi:.6g}]':>29} "
                          f"{ptext:>29}{bound}")
         lines.append(f"{'series':<30} {'observable':<14} {'points':>6} {'residual norm':>14} {'rms':>11} "
                      f"{'noise':>11}")

@@ -134,6 +134,20 @@ def test_the_reduced_and_the_string_model_fit_the_same_data_alike():
     assert string.sd["f"] == pytest.approx(reduced.sd["f"], rel=1e-2)
 
 
+def test_any_scene_key_fitted_to_a_node_coordinate_on_the_string_solver():
+    """A scene without fronts: the damped catenary released from its V shape, the drag coefficient (3/s) fitted to
+    the height of its middle node (1 mm noise), with its profile."""
+    scene = chainsim.Scene.from_file(os.path.join(SCENES, "damped_catenary.toml")).set(
+        **{"string.nodes": 21, "stop.t_end": 1.0, "output.interval": 0.01})
+    t = np.linspace(0.0, 1.0, 50)
+    y = _interpolate(*_table(scene.set("effects.drag.coefficient", 3.0).run(), "node[10].y"), t)
+    key = "effects.drag.coefficient"
+    fit = chainsim.fit(scene, noisy(t, y, 0.001, seed=0, observable="node[10].y"), {key: (4.0, 0.1, 10.0)},
+                       profile=key, profile_points=0)
+    assert fit.interval[key][0] <= 3.0 <= fit.interval[key][1]
+    assert fit.profile_interval[key][0] <= 3.0 <= fit.profile_interval[key][1]
+
+
 def test_a_joint_fit_of_two_drops_shares_f_and_narrows_its_interval():
     """Two drops, from the full height and from eta0 = 0.6 (the chain held partly on the table), each released at
     its own time on the data's clock (t_offset per run)."""
