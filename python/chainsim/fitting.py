@@ -219,7 +219,10 @@ def _run_model(target, settings):
 
 
 def _table(result, observable):
-    """(t, values, dvalues/dt or None) of an observable of a run, or raises ChainsimInputError naming the columns."""
+    """(t, values, dvalues/dt or None, smooth) of an observable of a run, or raises ChainsimInputError naming the
+    columns; smooth: the run is the reduced ODE (no front crossings)."""
+    from . import ReducedResult
+    smooth = isinstance(result, ReducedResult)
     series = getattr(result, "series", {}) or {}
     forces = getattr(result, "forces", {}) or {}
     nodes = getattr(result, "nodes", {}) or {}
@@ -242,14 +245,14 @@ def _table(result, observable):
         for i, v in enumerate(values):
             last = v if np.isfinite(v) else last
             values[i] = last
-        return np.asarray(nodes["t"], dtype=float), values, None
+        return np.asarray(nodes["t"], dtype=float), values, None, False
     for table in tables:
         if name in table and name != "t":
             d = TIME_DERIVATIVE.get(name)
             if d is None and name.startswith("s0_") and "s0dot_" + name[3:] in table:
                 d = "s0dot_" + name[3:]
             return (np.asarray(table["t"], dtype=float), np.asarray(table[name], dtype=float),
-                    np.asarray(table[d], dtype=float) if d and d in table else None)
+                    np.asarray(table[d], dtype=float) if d and d in table else None, smooth)
     available = sorted({c for c in list(series) + list(forces) if c != "t"})
     if nodes:
         available.append("node[K].x|y")
@@ -257,11 +260,16 @@ def _table(result, observable):
                  f"{', '.join(available)}")
 
 
-def _interpolate(t_model, y_model, dy_model, t):
-    """The model at times t: cubic Hermite between steps where dy/dt is known, else linear; held constant before
-    the first and after the last step (the chain at rest before its release and after its stop)."""
+def _interpolate(t_model, y_model, dy_model, smooth, t):
+    """The model at times t: cubic Hermite between steps where dy/dt is known; else a cubic spline through the steps
+    of a smooth model (the reduced ODE), linear interpolation for the string solver (whose series may have kinks at
+    front crossings); held constant before the first and after the last step (the chain at rest before its
+    release and after its stop)."""
     keep = np.append(np.diff(t_model) > 0, True)  # a crossing may repeat a time: keep the state after it
     tm, ym = t_model[keep], y_model[keep]
+    if dy_model is None and smooth and len(tm) >= 4:
+        from scipy.interpolate import CubicSpline
+        return CubicSpline(tm, ym)(np.clip(t, tm[0], tm[-1]))
     if dy_model is None:
         return np.interp(t, tm, ym)
     dm = dy_model[keep]

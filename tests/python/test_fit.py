@@ -165,6 +165,17 @@ def test_a_joint_fit_of_two_drops_shares_f_and_narrows_its_interval():
     assert joint.sd["f"] < min(s.sd["f"] for s in single)
 
 
+def test_the_finite_differences_do_not_depend_on_their_step():
+    """The derivatives of the force P (no time-derivative column) at steps 1e-4 and 1e-5 agree to 1e-3: the model's
+    interpolation between its steps does not move with the parameters (linear interpolation: 1% apart)."""
+    from chainsim.fitting import _Problem
+    t, p = truth("P", n=200, fraction=0.95)
+    problem = _Problem("falling", [chainsim.Data(t, p, "P")], {"f": F_TRUE, "t_offset": 0.0}, None, [], {}, 1, None)
+    x = np.array([F_TRUE, 0.0])
+    coarse, fine = problem.jacobian(x, 1e-4), problem.jacobian(x, 1e-5)
+    assert np.linalg.norm(fine - coarse) < 1e-3 * np.linalg.norm(coarse)
+
+
 def test_a_stop_time_is_an_observable():
     """Ten measured fall times (to eta = eps) with 2 ms noise: f from t_stop alone."""
     t_stop = chainsim.reduced("falling", f=F_TRUE).summary["t_stop"]
@@ -185,8 +196,8 @@ def test_points_after_the_models_stop_are_reported_and_the_other_problems_fit():
         t = np.linspace(0.0, 0.9 * r.summary["t_stop"], 60)
         y = _interpolate(*_table(r, observable), t)
         data = noisy(t, y, 0.003 * np.abs(y).max(), seed=1, observable=observable)
-        # P has no time-derivative column: it is interpolated linearly, so its model keeps the reduced ODE's
-        # default steps (t0/500); FAST's long steps would make the interpolation error larger than the noise
+        # P has no time-derivative column: its spline through the steps needs the reduced ODE's default steps
+        # (t0/500); with FAST's long steps its derivatives in f are noisy (docs/fit.md)
         fixed = dict(FAST if observable == "y" else {}, **({"eta0": eta0} if eta0 else {}))
         fit = chainsim.fit(problem, data, {"f": 0.5}, fixed=fixed, profile_points=0)
         assert fit.interval["f"][0] <= 0.4 <= fit.interval["f"][1], (problem, observable, fit)
