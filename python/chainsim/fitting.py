@@ -589,7 +589,8 @@ def _profile_bound(problem, x_best, j, chi2_min, s2, sd, direction, diff_step, m
     limit = problem.hi[j] if direction > 0 else problem.lo[j]
 
     def g(v):
-        return (_profile_chi2(problem, x_best, j, v, diff_step, max_nfev)[0] - chi2_min) / s2 - CHI2_95
+        with np.errstate(over="ignore"):   # data without noise: s2 is the smallest double
+            return (_profile_chi2(problem, x_best, j, v, diff_step, max_nfev)[0] - chi2_min) / s2 - CHI2_95
 
     step = 2.0 * sd if sd > 0 and math.isfinite(sd) else 0.1 * max(abs(f0), 1.0)
     inner, outer = f0, f0 + direction * step
@@ -674,14 +675,16 @@ def fit(target, data, free=None, *, bounds=None, per_run=(), fixed=None, profile
         for k in estimated:
             share = n_par * len(data[k].values) / n_points
             noise = math.sqrt(float(raw[k] @ raw[k]) / max(len(data[k].values) - share, 1.0))
-            problem.scale[k] = np.full(len(data[k].values), max(noise, 1e-300))
+            # data without noise (the model's own values): a floor at the round-off of the values
+            floor = 1e-15 * max(float(np.abs(data[k].values).max()), 1e-300)
+            problem.scale[k] = np.full(len(data[k].values), max(noise, floor))
         if len(data) > 1:
             result, x = _least_squares(problem, x, diff_step, max_nfev)
             raw = problem.raw_residuals(x)
     r = problem.residuals(x)
     chi2 = float(r @ r)
     dof = n_points - n_par
-    s2 = 1.0 if absolute_sigma else chi2 / dof
+    s2 = 1.0 if absolute_sigma else max(chi2 / dof, np.finfo(float).tiny)   # > 0 for data without noise
     J = problem.jacobian(x, diff_step)
     on_bound = {}
     span = problem.hi - problem.lo
@@ -721,7 +724,9 @@ def fit(target, data, free=None, *, bounds=None, per_run=(), fixed=None, profile
                                  profile_points)
             values = np.union1d(values, [x[j]])
             chis = _map_profile(problem, x, j, values, diff_step, max_nfev)
-            profile_curve = {"parameter": profile, "values": values, "delta_chi2": (np.array(chis) - chi2) / s2}
+            with np.errstate(over="ignore"):
+                delta = (np.array(chis) - chi2) / s2
+            profile_curve = {"parameter": profile, "values": values, "delta_chi2": delta}
     elif profile is not None and profile != "f":
         raise _error(f"profile = '{profile}' is not a free parameter (free: {', '.join(problem.names)})")
     # The series at the best fit, and the points past the model's end (held at its final state there).

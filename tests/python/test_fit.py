@@ -176,6 +176,17 @@ def test_the_finite_differences_do_not_depend_on_their_step():
     assert np.linalg.norm(fine - coarse) < 1e-3 * np.linalg.norm(coarse)
 
 
+def test_data_without_noise_are_fitted_exactly():
+    """The model's own values (chi2 = 0): f exactly, a zero sd, no division by zero, JSON without NaN."""
+    r = chainsim.reduced("falling", f=F_TRUE, **FAST)
+    t = np.linspace(0.0, 0.35, 30)
+    fit = chainsim.fit("falling", chainsim.Data(t, _interpolate(*_table(r, "y"), t), "y"), {"f": F_TRUE}, fixed=FAST,
+                       profile_points=5)
+    assert fit.value["f"] == F_TRUE and fit.chi2 == 0.0 and fit.sd["f"] == 0.0
+    assert fit.interval["f"] == (F_TRUE, F_TRUE) and fit.profile_interval["f"] == (F_TRUE, F_TRUE)
+    assert "NaN" not in json.dumps(fit.to_dict())
+
+
 def test_a_stop_time_is_an_observable():
     """Ten measured fall times (to eta = eps) with 2 ms noise: f from t_stop alone."""
     t_stop = chainsim.reduced("falling", f=F_TRUE).summary["t_stop"]
