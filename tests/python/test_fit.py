@@ -221,7 +221,7 @@ def test_a_fit_on_a_dask_client_gives_the_local_fit():
     t, y = truth(n=30)
     data = noisy(t, y, 0.005, seed=2)
     local = chainsim.fit("falling", data, {"f": 0.5}, fixed=FAST, profile=None)
-    with LocalCluster(n_workers=1, threads_per_worker=2, processes=False, dashboard_address=":0") as cluster, \
+    with LocalCluster(n_workers=1, threads_per_worker=2, processes=True, dashboard_address=":0") as cluster, \
             Client(cluster) as client:
         remote = chainsim.fit("falling", data, {"f": 0.5}, fixed=FAST, profile=None, client=client)
     assert remote.value["f"] == local.value["f"]
