@@ -21,7 +21,8 @@ esac
 packages=(cmake make g++ libeigen3-dev libsuitesparse-dev libsundials-dev catch2 libcli11-dev
           libtomlplusplus-dev nlohmann-json3-dev libfmt-dev libboost-dev libbenchmark-dev python3-matplotlib python3-numpy
           python3-pil python3-pytest python3-vtk9 ffmpeg clang libclang-rt-14-dev
-          python3-dev pybind11-dev python3-pandas python3-dask python3-distributed python3-hypothesis)
+          python3-dev pybind11-dev python3-pandas python3-dask python3-distributed python3-hypothesis
+          python3-scipy)   # chainsim fit / chainsim.fit: scipy.optimize.least_squares (docs/fit.md)
 missing=()
 for p in "${packages[@]}"; do dpkg -s "$p" >/dev/null 2>&1 || missing+=("$p"); done
 if [ ${#missing[@]} -gt 0 ]; then

@@ -54,9 +54,23 @@ struct PlotCommandOptions {
   bool animate = false;
   std::string speed, fps, times, format;
 };
-/// Runs /usr/bin/python3 (else python3 on PATH) -m chainsim_plot with PYTHONPATH set to the source
-/// tree's python/; returns its exit code (1 if it cannot be started).
+/// Runs /usr/bin/python3 (else python3 on PATH) -m chainsim_plot (run_python_module, python_command.hpp);
+/// returns its exit code (1 if it cannot be started).
 int run_plot_command(const PlotCommandOptions& options);
+
+/// `chainsim fit TARGET DATA.csv... [...]`: fits scene keys (f, ...) to measured series with the Python
+/// module chainsim.fitting (docs/fit.md). The option values are passed on as written (the module checks
+/// them); "" = not given. Defined in fit_command.cpp; returns the module's exit code.
+struct FitCommandOptions {
+  std::string target;                  ///< falling | folded | sliding, or a scene file
+  std::vector<std::string> data;       ///< CSV files, each FILE[@KEY=VALUE...]
+  std::string observable, column, time_column, sigma, profile, jobs, max_nfev, out;
+  std::vector<std::string> free;       ///< NAME=START[:LOWER:UPPER]
+  std::vector<std::string> per_run;    ///< names of free parameters fitted once per data file
+  std::vector<std::string> overrides;  ///< --set KEY=VALUE
+  bool absolute_sigma = false, no_figures = false, json = false;
+};
+int run_fit_command(const FitCommandOptions& options);
 
 /// `chainsim sweep SCENE --grid KEY=V1,V2,... --out DIR`: the scene at every point of the grid, on
 /// `jobs` threads, one row per point in DIR/sweep.csv (cases/scene/scene_sweep.hpp; docs/python.md).

@@ -10,6 +10,7 @@
 #include <nlohmann/json.hpp>
 
 #include "cases/cli/commands.hpp"
+#include "cases/cli/fit_options.hpp"
 #include "cases/cli/run_command.hpp"
 #include "mesh/errors.hpp"
 
@@ -189,6 +190,9 @@ int main(int argc, char** argv) {
   cmd_plot->add_option("--times", plot.times, "times of the snapshots and tension profiles (s), e.g. 0,0.1,0.2");
   cmd_plot->add_option("--format", plot.format, "animation format: mp4 | gif (default mp4 if ffmpeg is installed)");
 
+  chainsim::FitCommandOptions fit;  // chainsim fit (cases/cli/fit_options.hpp)
+  auto* cmd_fit = chainsim::add_fit_command(app, fit);
+
   // --- chainsim sweep --------------------------------------------------------------------------
   chainsim::SweepCommandOptions sweep;
   auto* cmd_sweep = app.add_subcommand(
@@ -235,6 +239,7 @@ int main(int argc, char** argv) {
     return fail(sub ? sub->get_name() : "", describe_parse_error(app, e, argc > 1 ? argv[1] : ""), 2);
   }
   if (*cmd_plot) return chainsim::run_plot_command(plot);
+  if (*cmd_fit) return chainsim::run_fit_command(fit);
 
   const CLI::App* sub = entered_subcommand(app);
   const std::string command = sub ? sub->get_name() : "";

@@ -317,3 +317,11 @@ def plot(directory, times=None, animate=False, speed=1.0, fps=25, fmt=None):
     """Draws a run directory into DIR/figures/ as `chainsim plot DIR` does; returns the paths written."""
     from chainsim_plot.cli import plot_run
     return plot_run(os.fspath(directory), times=times, animate=animate, speed=speed, fps=fps, fmt=fmt)
+
+
+# ------------------------------------------------------------------------------------------------------------------
+# Fits to measured series (python/chainsim/fitting.py, docs/fit.md)
+
+from .fitting import Data, FitResult, fit  # noqa: E402
+
+__all__ += ["Data", "FitResult", "fit"]

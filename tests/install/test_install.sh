@@ -23,6 +23,13 @@ r = chainsim.reduced("falling", f=0.5)
 assert abs(r.summary["t_stop_over_t0"] - r.summary["t_stop_over_t0_exact"]) < 1e-9
 import chainsim_plot
 print("import chainsim from", os.path.dirname(chainsim.__file__))' "$prefix")
+  # the installed `chainsim fit` runs the installed package (cases/cli/python_command.cpp), with SciPy
+  if "$python" -c "import scipy" 2>/dev/null; then
+    (cd "$tmp" && env -u PYTHONPATH "$prefix/bin/chainsim" fit falling "$here/../../examples/data/falling_chain_height.csv" \
+       --free f=0.5 --free t_offset=0:-0.1:0.1 --set length=1 --set density=0.1 --profile none --no-figures \
+       --out "$tmp/fit" >/dev/null)
+    test -f "$tmp/fit/fit.json"
+  fi
 fi
 cmake -S "$here" -B "$tmp/consumer" -DCMAKE_PREFIX_PATH="$prefix" -DCMAKE_BUILD_TYPE=Release >/dev/null
 cmake --build "$tmp/consumer" >/dev/null
