@@ -266,6 +266,13 @@ def load_run(path):
     check_directory(path)
     j = lambda name: os.path.join(path, name)  # noqa: E731
     files = sorted(os.listdir(path))
+    # Every chainsim command clears what the others wrote before writing; a directory holding both
+    # `chainsim run`'s summary and another command's was mixed by an older chainsim, or by hand.
+    others = [f for f in ("summary.json", "string_series.csv", "reduced_series.csv") if f in files]
+    if "stats.json" in files and others:
+        raise RunError(f"RUN_DIR '{path}' mixes the outputs of two commands: stats.json of `chainsim run` beside "
+                       f"{', '.join(others)} of `chainsim compare` or `chainsim reduced`; run the command again "
+                       f"(it removes the other's files first)")
     summary = read_json(j("stats.json"))
     if summary is None:
         summary = read_json(j("summary.json"))
