@@ -12,7 +12,9 @@ A run directory is recognised by the files in it (see `load_run`):
 Every table is read by its header and every column is optional: a string run with fronts may carry
 energy.csv and tension.csv as well, nodes.csv may or may not have the columns s and vx, vy[, vz].
 """
+import contextlib
 import csv
+import fcntl
 import json
 import os
 
@@ -240,6 +242,49 @@ def _fronts(series, info):
     ks = sorted(int(c[3:]) for c in series.columns if c.startswith("s0_") and c[3:].isdigit())
     info = info if isinstance(info, list) else []
     return [Front(k, info[k] if k < len(info) else None, series) for k in ks]
+
+
+LOCK_NAME = ".chainsim.lock"
+
+
+@contextlib.contextmanager
+def holding(path):
+    """Holds the run directory `path` as every chainsim command that writes one does (RunDirectory in
+    solver/output.hpp): an exclusive flock on path/.chainsim.lock holding this process's pid, released
+    (and the file removed) on leaving, or by the kernel if the process dies. A directory another chainsim
+    process holds (a run still writing it) raises RunError naming its pid; meanwhile, a run into it is
+    refused the same way."""
+    check_directory(path)
+    lock = os.path.join(path, LOCK_NAME)
+    while True:
+        try:
+            fd = os.open(lock, os.O_RDWR | os.O_CREAT | os.O_CLOEXEC, 0o644)
+        except OSError as e:
+            raise RunError(f"RUN_DIR '{path}' is not writable: cannot create '{lock}': {e.strerror}") from e
+        try:
+            fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except OSError as e:
+            holder = os.pread(fd, 32, 0).decode(errors="replace").strip()
+            os.close(fd)
+            raise RunError(f"RUN_DIR '{path}' is in use by another chainsim process (pid "
+                           f"{holder or 'not yet recorded'}), which holds '{lock}': wait for that run to end") from e
+        try:
+            same = os.path.samestat(os.fstat(fd), os.stat(lock))
+        except OSError:
+            same = False
+        if same:
+            break
+        os.close(fd)  # the holder before us removed the name meanwhile: lock the current one
+    try:
+        os.ftruncate(fd, 0)
+        os.pwrite(fd, f"{os.getpid()}\n".encode(), 0)
+        yield
+    finally:
+        try:
+            os.unlink(lock)
+        except OSError:
+            pass
+        os.close(fd)
 
 
 def check_directory(path):

@@ -10,9 +10,11 @@ import math
 import os
 import re
 import shutil
+import signal
 import subprocess
 import sys
 import tempfile
+import time
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 SOURCE = os.path.abspath(os.path.join(HERE, "..", ".."))
@@ -288,6 +290,33 @@ def test_error_mixed_directory_exits_2():
     code, err = plot_here(out)
     assert code == 2
     assert "mixes the outputs of two commands: stats.json of `chainsim run` beside summary.json" in err
+
+
+def test_error_directory_in_use_exits_2_and_plot_holds_it_as_runs_do():
+    # plot takes the lock every command that writes a run takes: refused while a run writes the directory,
+    # and a run is refused while plot draws.
+    from chainsim_plot.readers import holding
+    out = os.path.join(ROOT, "in_use")
+    run = subprocess.Popen([BINARY, "run", scene("hanging_chain", 21), "--out", out, "--quiet", "--t-end", "1000",
+                            "--max-wall", "60"], stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    try:
+        lock = os.path.join(out, ".chainsim.lock")
+        for _ in range(1000):
+            if os.path.exists(lock) and open(lock).read() == f"{run.pid}\n":
+                break
+            time.sleep(0.01)
+        code, err = plot_here(out)
+        assert code == 2
+        assert f"RUN_DIR '{out}' is in use by another chainsim process (pid {run.pid})" in err
+    finally:
+        run.send_signal(signal.SIGINT)
+        assert run.wait(timeout=60) == 130
+    with holding(out):
+        r = chainsim("run", scene("hanging_chain", 21), "--out", out)
+        assert r.returncode == 2
+        assert f"is in use by another chainsim process (pid {os.getpid()})" in r.stderr
+    assert not os.path.exists(os.path.join(out, ".chainsim.lock"))
+    assert plot_here(out)[0] == 0
 
 
 def test_error_bad_options_exit_2():
