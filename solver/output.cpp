@@ -279,8 +279,23 @@ void clear_run_outputs(const fs::path& dir) {
 std::vector<std::string> outputs_present(const fs::path& dir) {
   std::vector<std::string> out;
   std::error_code ec;
-  for (const OutputName& n : run_output_names())
-    if (fs::exists(dir / n.name, ec)) out.push_back(n.kind == OutputName::kFile ? n.name : n.name + "/");
+  for (const OutputName& n : run_output_names()) {
+    const fs::path path = dir / n.name;
+    if (n.kind == OutputName::kFile) {
+      if (fs::is_regular_file(path, ec)) out.push_back(n.name);
+      continue;
+    }
+    // A directory counts when it holds an output (not only a user's files).
+    bool holds = false;
+    if (!fs::is_directory(path, ec)) continue;
+    if (n.kind == OutputName::kRunDirectory) {
+      holds = !outputs_present(path).empty();
+    } else {
+      for (fs::directory_iterator it(path, ec), end; !ec && it != end && !holds; it.increment(ec))
+        for (const std::string& pattern : n.patterns) holds = holds || matches(pattern, it->path().filename().string());
+    }
+    if (holds) out.push_back(n.name + "/");
+  }
   return out;
 }
 

@@ -130,8 +130,8 @@ const std::vector<std::string>& run_output_files();
 /// directories).
 void clear_run_outputs(const std::filesystem::path& dir);
 
-/// The names of run_output_names() present in `dir` (a directory with a trailing '/'), in that
-/// list's order: after a clean-up and a run, exactly what the run wrote.
+/// The names of run_output_names() present in `dir` (a directory with a trailing '/', when it holds
+/// one of its outputs), in that list's order: after a clean-up and a run, exactly what the run wrote.
 std::vector<std::string> outputs_present(const std::filesystem::path& dir);
 
 /// A run directory held by this process: created if needed, locked, and checked for writing.

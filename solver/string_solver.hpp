@@ -195,5 +195,4 @@ class StringSolver {
   Vec<dim> p0_ = Vec<dim>::Zero();
 };
 
-
 }  // namespace chainsim
