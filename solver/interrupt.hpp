@@ -1,11 +1,13 @@
 #pragma once
 /// @file interrupt.hpp
-/// A run stopped by the user (Ctrl-C) ends cleanly: the runner checks this flag after every accepted
-/// step and stops with status "interrupted", so the outputs written so far stay valid.
+/// A run stopped by the user (Ctrl-C) or by a batch scheduler (SIGTERM) ends cleanly: the runner
+/// checks this flag after every accepted step and stops with status "interrupted", so the outputs
+/// written so far stay valid.
 ///
 /// The flag is process-wide and async-signal-safe (a lock-free atomic). `install_sigint_handler()`
-/// makes SIGINT set it (the command-line tool does this); a second SIGINT while the flag is still set
-/// restores the default action and re-raises, so a run that does not stop can still be killed.
+/// makes SIGINT and SIGTERM set it (the command-line tool does this); a second signal while the flag
+/// is still set restores the default action and re-raises, so a run that does not stop can still be
+/// killed.
 #include <signal.h>
 
 namespace chainsim {
@@ -15,10 +17,12 @@ void request_interrupt();
 /// True once an interrupt was requested (until clear_interrupt()).
 bool interrupt_requested();
 void clear_interrupt();
-/// SIGINT -> request_interrupt() (the second one kills the process).
+/// Who asked: "SIGTERM", or "the user" (SIGINT, request_interrupt()), for "interrupted by ...".
+const char* interrupt_cause();
+/// SIGINT and SIGTERM -> the interrupt flag (the second signal kills the process).
 void install_sigint_handler();
 
-/// install_sigint_handler() for the scope's lifetime, then the previous handler back (with its
+/// SIGINT -> the interrupt flag for the scope's lifetime, then the previous handler back (with its
 /// flags): for a host program, such as the Python interpreter, whose own handler cannot act while a
 /// run holds the thread (the Python module installs it around a run that released the GIL).
 /// `active` = false does nothing (a run outside the host's main thread).

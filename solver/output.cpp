@@ -1,10 +1,16 @@
 #include "output.hpp"
 
+#include <atomic>
 #include <cerrno>
 #include <cmath>
 #include <cstring>
 #include <iterator>
 #include <system_error>
+
+#include <fcntl.h>
+#include <sys/file.h>
+#include <sys/stat.h>
+#include <unistd.h>
 
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
@@ -13,9 +19,15 @@
 
 namespace chainsim {
 
+namespace {
+/// Temporary files written by this process so far: with the pid, a name no other writer uses.
+std::atomic<unsigned long> g_temp_files{0};
+}  // namespace
+
 AtomicFile::AtomicFile(std::filesystem::path target) : target_(std::move(target)) {
   temp_ = target_;
-  temp_.replace_filename("." + target_.filename().string() + ".tmp");
+  temp_.replace_filename(fmt::format(".{}.{}.{}.tmp", target_.filename().string(), static_cast<long>(::getpid()),
+                                     g_temp_files.fetch_add(1)));
   errno = 0;
   out_.open(temp_, std::ios::out | std::ios::trunc);
   if (!out_)
@@ -102,8 +114,12 @@ void CsvWriter::row(const double* values, std::size_t count, const std::string* 
 
 void write_json(const std::filesystem::path& path, const nlohmann::json& doc) {
   AtomicFile file(path);
-  file.stream() << doc.dump(2) << '\n';
+  file.stream() << json_text(doc, 2) << '\n';
   file.commit();
+}
+
+std::string json_text(const nlohmann::json& doc, int indent) {
+  return doc.dump(indent, ' ', false, nlohmann::json::error_handler_t::replace);
 }
 
 void ensure_directory(const std::filesystem::path& dir) {
@@ -126,6 +142,216 @@ void ensure_writable_directory(const std::filesystem::path& dir) {
   }
   std::error_code ec;
   std::filesystem::remove(probe, ec);
+}
+
+namespace {
+
+namespace fs = std::filesystem;
+
+/// `text` matches `pattern`, where '*' matches any run of characters (none included).
+bool matches(const std::string& pattern, const std::string& text) {
+  std::size_t p = 0, t = 0, star = std::string::npos, resume = 0;
+  while (t < text.size()) {
+    if (p < pattern.size() && pattern[p] == '*') {
+      star = p++;
+      resume = t;
+    } else if (p < pattern.size() && pattern[p] == text[t]) {
+      ++p;
+      ++t;
+    } else if (star != std::string::npos) {
+      p = star + 1;
+      t = ++resume;
+    } else {
+      return false;
+    }
+  }
+  while (p < pattern.size() && pattern[p] == '*') ++p;
+  return p == pattern.size();
+}
+
+/// The target of an AtomicFile temporary name (".NAME.PID.N.tmp", or ".NAME.tmp" as earlier versions
+/// wrote it), or "" if `file` is no such name.
+std::string temp_target(const std::string& file) {
+  const std::string suffix = ".tmp";
+  if (file.size() <= 1 + suffix.size() || file[0] != '.' || file.compare(file.size() - suffix.size(), suffix.size(), suffix))
+    return "";
+  std::string name = file.substr(1, file.size() - 1 - suffix.size());
+  // Strip ".PID.N" when present.
+  auto strip_number = [](std::string& s) {
+    const std::size_t dot = s.rfind('.');
+    if (dot == std::string::npos || dot + 1 == s.size()) return false;
+    for (std::size_t k = dot + 1; k < s.size(); ++k)
+      if (s[k] < '0' || s[k] > '9') return false;
+    s.erase(dot);
+    return true;
+  };
+  std::string stripped = name;
+  if (strip_number(stripped) && strip_number(stripped)) return stripped;
+  return name;
+}
+
+/// Removes from `dir` the files named by `patterns` and the temporary files of AtomicFile for them.
+void remove_matching(const fs::path& dir, const std::vector<std::string>& patterns) {
+  std::error_code ec;
+  std::vector<fs::path> doomed;
+  for (fs::directory_iterator it(dir, ec), end; !ec && it != end; it.increment(ec)) {
+    if (it->is_directory(ec)) continue;
+    const std::string file = it->path().filename().string(), target = temp_target(file);
+    for (const std::string& pattern : patterns)
+      if (matches(pattern, file) || (!target.empty() && matches(pattern, target))) {
+        doomed.push_back(it->path());
+        break;
+      }
+  }
+  for (const fs::path& path : doomed) fs::remove(path, ec);
+}
+
+std::string read_holder(int fd) {
+  char buffer[32] = {};
+  const ssize_t n = ::pread(fd, buffer, sizeof buffer - 1, 0);
+  std::string pid = n > 0 ? std::string(buffer, static_cast<std::size_t>(n)) : std::string();
+  while (!pid.empty() && (pid.back() == '\n' || pid.back() == ' ')) pid.pop_back();
+  return pid;
+}
+
+}  // namespace
+
+const std::vector<OutputName>& run_output_names() {
+  using N = OutputName;
+  static const std::vector<OutputName> names = {
+      // chainsim run (string and reduced models), in the order its summary lists them
+      {"nodes.csv"}, {"tension.csv"}, {"energy.csv"}, {"series.csv"}, {"forces.csv"}, {"string.pvd"},
+      {"frames", N::kDirectory, {"frame_*.vtp", "fronts_*.vtp"}, "a directory of ParaView frames"}, {"stats.json"},
+      // chainsim compare, reduced, canonical, sweep
+      {"string_series.csv"}, {"reduced_series.csv"}, {"summary.csv"}, {"summary.json"}, {"sweep.csv"},
+      {"figure_data", N::kDirectory, {"*.csv"}, "a directory of figure data"},
+      {"falling", N::kRunDirectory, {}, "a run directory"},
+      {"folded", N::kRunDirectory, {}, "a run directory"},
+      {"sliding", N::kRunDirectory, {}, "a run directory"},
+      // chainsim plot
+      {"figures", N::kDirectory, {"*.png", "animation.mp4", "animation.gif"}, "a directory of figures"},
+      // the write probe of ensure_writable_directory()
+      {"chainsim_write_probe"}};
+  return names;
+}
+
+const std::vector<std::string>& run_output_files() {
+  static const std::vector<std::string> files = [] {
+    std::vector<std::string> out;
+    for (const OutputName& n : run_output_names())
+      if (n.kind == OutputName::kFile) out.push_back(n.name);
+    return out;
+  }();
+  return files;
+}
+
+void clear_run_outputs(const fs::path& dir) {
+  std::error_code ec;
+  // 1. Refuse, before removing anything, a name taken by something chainsim would not write there.
+  for (const OutputName& n : run_output_names()) {
+    const fs::path path = dir / n.name;
+    if (!fs::exists(path, ec)) continue;
+    const bool is_dir = fs::is_directory(path, ec);
+    if (is_dir == (n.kind == OutputName::kFile))
+      throw InputError(fmt::format("--out = '{}': '{}' is {}, where a run writes {}; remove or rename it, or "
+                                   "choose another --out",
+                                   dir.string(), path.string(), is_dir ? "a directory" : "a file", n.what));
+  }
+  // 2. The files (and their stray temporary files), then the directories' files, each directory
+  //    removed when nothing else is left in it.
+  std::vector<std::string> top;
+  for (const OutputName& n : run_output_names())
+    if (n.kind == OutputName::kFile) top.push_back(n.name);
+  remove_matching(dir, top);
+  for (const OutputName& n : run_output_names()) {
+    const fs::path path = dir / n.name;
+    if (n.kind == OutputName::kFile || !fs::is_directory(path, ec)) continue;
+    if (n.kind == OutputName::kRunDirectory) {
+      RunDirectory nested(path);  // refused if a run is writing there
+      nested.clear();
+    } else {
+      remove_matching(path, n.patterns);
+    }
+    fs::remove(path, ec);  // only if empty: a user's own file keeps it
+  }
+}
+
+std::vector<std::string> outputs_present(const fs::path& dir) {
+  std::vector<std::string> out;
+  std::error_code ec;
+  for (const OutputName& n : run_output_names()) {
+    const fs::path path = dir / n.name;
+    if (n.kind == OutputName::kFile) {
+      if (fs::is_regular_file(path, ec)) out.push_back(n.name);
+      continue;
+    }
+    // A directory counts when it holds an output (not only a user's files).
+    bool holds = false;
+    if (!fs::is_directory(path, ec)) continue;
+    if (n.kind == OutputName::kRunDirectory) {
+      holds = !outputs_present(path).empty();
+    } else {
+      for (fs::directory_iterator it(path, ec), end; !ec && it != end && !holds; it.increment(ec))
+        for (const std::string& pattern : n.patterns) holds = holds || matches(pattern, it->path().filename().string());
+    }
+    if (holds) out.push_back(n.name + "/");
+  }
+  return out;
+}
+
+RunDirectory::RunDirectory(fs::path dir) : dir_(std::move(dir)) {
+  ensure_directory(dir_);
+  const fs::path lock = dir_ / kLockName;
+  // Open, lock and check that the file locked is still the one the name points to: the holder
+  // before us removes the name after its run, and a lock on the removed file would guard nothing.
+  for (;;) {
+    fd_ = ::open(lock.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
+    if (fd_ < 0)
+      throw InputError(fmt::format("--out = '{}' is not writable: cannot create '{}': {}", dir_.string(),
+                                   lock.string(), std::strerror(errno)));
+    if (::flock(fd_, LOCK_EX | LOCK_NB) != 0) {
+      const int error = errno;
+      const std::string holder = read_holder(fd_);
+      ::close(fd_);
+      fd_ = -1;
+      if (error != EWOULDBLOCK)
+        throw InputError(fmt::format("--out = '{}': cannot lock '{}': {}", dir_.string(), lock.string(),
+                                     std::strerror(error)));
+      const bool self = holder == std::to_string(static_cast<long>(::getpid()));
+      throw InputError(fmt::format(
+          "--out = '{}' is in use by {} (pid {}), which holds '{}': a directory holds one run at a time; wait "
+          "for that run to end or choose another --out",
+          dir_.string(), self ? "another run in this process" : "another chainsim process",
+          holder.empty() ? "not yet recorded" : holder, lock.string()));
+    }
+    struct stat held {}, named {};
+    if (::fstat(fd_, &held) == 0 && ::stat(lock.c_str(), &named) == 0 && held.st_dev == named.st_dev &&
+        held.st_ino == named.st_ino)
+      break;
+    ::close(fd_);  // the name was removed or replaced meanwhile: lock the current one
+    fd_ = -1;
+  }
+  const std::string pid = std::to_string(static_cast<long>(::getpid())) + "\n";
+  if (::ftruncate(fd_, 0) != 0 || ::pwrite(fd_, pid.data(), pid.size(), 0) != static_cast<ssize_t>(pid.size())) {
+    const int error = errno;
+    ::unlink(lock.c_str());
+    ::close(fd_);
+    throw InputError(fmt::format("--out = '{}' is not writable: cannot write '{}': {}", dir_.string(), lock.string(),
+                                 std::strerror(error)));
+  }
+  try {
+    ensure_writable_directory(dir_);
+  } catch (...) {
+    ::unlink(lock.c_str());
+    ::close(fd_);
+    throw;
+  }
+}
+
+RunDirectory::~RunDirectory() {
+  if (fd_ < 0) return;
+  ::unlink((dir_ / kLockName).c_str());  // while still held: see the constructor
+  ::close(fd_);
 }
 
 nlohmann::json to_json(const IntegratorStats& s) {

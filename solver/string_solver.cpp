@@ -76,28 +76,6 @@ void StringSolverOptions::check_output_budget(int nodes, int dim, bool fronts, c
                                  asks, e.disk_bytes / 1e6, select.max_megabytes));
 }
 
-const std::vector<std::string>& run_output_files() {
-  static const std::vector<std::string> files = {"stats.json", "nodes.csv",  "tension.csv", "energy.csv",
-                                                 "forces.csv", "series.csv", "string.pvd"};
-  return files;
-}
-
-void clear_run_outputs(const std::filesystem::path& dir) {
-  namespace fs = std::filesystem;
-  std::error_code ec;
-  auto refuse = [&](const fs::path& path, const char* is, const char* wanted) {
-    throw InputError(fmt::format("--out = '{}': '{}' is {}, where a run writes {}; remove or rename it, or choose "
-                                 "another --out",
-                                 dir.string(), path.string(), is, wanted));
-  };
-  for (const std::string& name : run_output_files())
-    if (fs::is_directory(dir / name, ec)) refuse(dir / name, "a directory", "a file");
-  if (fs::exists(dir / "frames", ec) && !fs::is_directory(dir / "frames", ec))
-    refuse(dir / "frames", "a file", "a directory of ParaView frames");
-  for (const std::string& name : run_output_files()) fs::remove(dir / name, ec);
-  fs::remove_all(dir / "frames", ec);
-}
-
 nlohmann::json to_json(const RunSummary& s) {
   nlohmann::json j = {{"status", s.status},
                       {"stop_reason", s.stop_reason},
@@ -423,7 +401,7 @@ const RunSummary& StringSolver<dim>::run() {
       if (k <= n_out && interrupt_requested()) {  // Ctrl-C: stop at this accepted state, outputs valid
         record_frame(t, y);
         finish("interrupted");
-        summary_.stop_reason = fmt::format("interrupted by the user at t = {:.9g} s", t);
+        summary_.stop_reason = fmt::format("interrupted by {} at t = {:.9g} s", interrupt_cause(), t);
         return summary_;
       }
     }

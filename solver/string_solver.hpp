@@ -195,14 +195,4 @@ class StringSolver {
   Vec<dim> p0_ = Vec<dim>::Zero();
 };
 
-/// Every file write_outputs() may write (to clear a directory before a run of any model).
-const std::vector<std::string>& run_output_files();
-
-/// Removes the outputs of an earlier run from `dir` (run_output_files() and frames/), so that the
-/// directory never mixes two runs: call it before integrating, so that a run killed on the way
-/// leaves no earlier stats.json that would pass for its own. Throws InputError, before anything is
-/// removed, if one of those names is taken by something chainsim would not write there (a directory
-/// named like an output file, or a file named frames).
-void clear_run_outputs(const std::filesystem::path& dir);
-
 }  // namespace chainsim

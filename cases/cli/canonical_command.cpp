@@ -288,7 +288,8 @@ int run_canonical_command(const CanonicalCommandOptions& options, std::ostream& 
     check.validate();
   }
   const fs::path root(options.out);
-  ensure_writable_directory(root);
+  const RunDirectory run_dir(root);  // held until summary.json is written
+  run_dir.clear();
   const fs::path fig = root / "figure_data";
   ensure_directory(fig);
 
@@ -298,7 +299,7 @@ int run_canonical_command(const CanonicalCommandOptions& options, std::ostream& 
     ReducedSetup setup;
     setup.problem = p;
     const ReducedRun run = solve_reduced(setup);
-    ensure_directory(root / to_string(p));
+    const RunDirectory problem_dir(root / to_string(p));  // a run directory of its own (cleared above)
     run.series.write(root / to_string(p) / "series.csv");
     write_json(root / to_string(p) / "summary.json", run.summary);
   }
@@ -328,7 +329,7 @@ int run_canonical_command(const CanonicalCommandOptions& options, std::ostream& 
   table.write(root / "summary.csv");
   write_json(root / "summary.json", rows);  // written last
   if (options.json) {
-    out << rows.dump() << '\n';
+    out << json_text(rows) << '\n';
     return 0;
   }
   fmt::print(out, "The paper's three chain problems, each three ways: the string solver with front tracking ({} nodes),\n"

@@ -17,7 +17,8 @@ int run_compare_command(CompareCommandOptions options, std::ostream& out) {
   const std::filesystem::path dir =
       options.out.empty() ? std::filesystem::path("results") / "compare" / options.problem
                           : std::filesystem::path(options.out);
-  ensure_directory(dir);
+  const RunDirectory run_dir(dir);  // held until the outputs are written
+  run_dir.clear();
   const Comparison c = compare_with_reduced(options.setup);
   samples_table(c.string.run).write(dir / "string_series.csv");
   c.reduced.series.write(dir / "reduced_series.csv");
@@ -30,7 +31,7 @@ int run_compare_command(CompareCommandOptions options, std::ostream& out) {
       j["error"] = error;
       j["exit_code"] = 3;
     }
-    out << j.dump() << '\n';
+    out << json_text(j) << '\n';
   } else {
     const auto& s = c.summary;
     out << fmt::format("{} chain, f = {}, {} nodes: string solver vs reduced ODE\n", options.problem,

@@ -13,6 +13,7 @@
 #include "cases/cli/fit_options.hpp"
 #include "cases/cli/run_command.hpp"
 #include "mesh/errors.hpp"
+#include "solver/output.hpp"
 
 namespace {
 
@@ -226,7 +227,7 @@ int main(int argc, char** argv) {
     if (json && !printed) {
       nlohmann::json j = {{"status", "failed"}, {"error", message}, {"exit_code", code}};
       if (!command.empty()) j["command"] = command;
-      std::cout << j.dump() << '\n';
+      std::cout << chainsim::json_text(j) << '\n';
     }
     return code;
   };

@@ -7,6 +7,7 @@
 
 #include "cases/cli/commands.hpp"
 #include "mesh/errors.hpp"
+#include "solver/output.hpp"
 
 namespace chainsim {
 
@@ -15,7 +16,6 @@ namespace fs = std::filesystem;
 namespace {
 
 void write_run(const ReducedRun& run, const fs::path& dir) {
-  ensure_directory(dir);
   run.series.write(dir / "series.csv");
   write_json(dir / "summary.json", run.summary);
 }
@@ -45,10 +45,12 @@ void print_human(const nlohmann::json& s, std::ostream& out) {
 int run_reduced_command(ReducedCommandOptions options, std::ostream& out) {
   options.setup.problem = parse_problem(options.problem);
   const fs::path dir = options.out.empty() ? fs::path("results") / "reduced" / options.problem : fs::path(options.out);
+  const RunDirectory run_dir(dir);  // held until the outputs are written
+  run_dir.clear();
   const ReducedRun run = solve_reduced(options.setup);
   write_run(run, dir);
   if (options.json) {
-    out << run.summary.dump() << '\n';
+    out << json_text(run.summary) << '\n';
   } else {
     print_human(run.summary, out);
     fmt::print(out, "  wrote {} and {}\n", (dir / "series.csv").string(), (dir / "summary.json").string());

@@ -16,8 +16,9 @@
 //   ...
 //   stop       the heap_end front reached s0 = 0.01 m at t = 0.38232 s
 //
-// Steps: 1. parse the scene, 2. build and check the model (before any run), 3. check that the output
-// directory is writable and remove an earlier run's outputs from it, 4. integrate, 5. write the outputs (also after a numerical failure, up to
+// Steps: 1. parse the scene, 2. build and check the model (before any run), 3. lock the output
+// directory (refused if another run holds it), check that it is writable and remove what any chainsim
+// command wrote there before, 4. integrate (SIGINT or SIGTERM: stop at the next accepted step), 5. write the outputs (also after a numerical failure, up to
 // the failure, before the error is reported; stats.json last), 6. print the summary. With --json
 // every outcome, failures included, prints one JSON object on stdout.
 #include "cases/cli/run_command.hpp"
@@ -53,17 +54,10 @@ std::string join_words(const std::vector<std::string>& words) {
   return out;
 }
 
-std::string output_files(const OutputSelection& o, bool fronts) {
+/// What the run wrote: the outputs present in its directory (cleared before the run and locked).
+std::string output_files(const std::filesystem::path& dir) {
   std::string files;
-  auto add = [&](bool on, const char* name) {
-    if (on) files += std::string(files.empty() ? "" : " ") + name;
-  };
-  add(o.csv && o.nodes, "nodes.csv");
-  add(o.csv && o.tension, "tension.csv");
-  add(o.csv && o.energy, fronts ? "energy.csv series.csv" : "energy.csv");
-  add(o.csv && o.forces, "forces.csv");
-  add(o.vtk && o.nodes, "string.pvd frames/");
-  add(o.stats, "stats.json");
+  for (const std::string& name : outputs_present(dir)) files += (files.empty() ? "" : " ") + name;
   return files.empty() ? "(none)" : files;
 }
 
@@ -71,28 +65,30 @@ void print_json(std::ostream& out, nlohmann::json j, const SceneSpec& spec, cons
   j["scene"] = spec.source;
   j["scene_effective"] = scene_to_json(spec);
   j["out"] = dir.string();
-  out << j.dump() << '\n';
+  out << json_text(j) << '\n';
 }
 
 template <int dim>
 int run_string_scene(const SceneSpec& spec, const std::filesystem::path& dir, bool json, bool quiet,
                      std::ostream& out) {
-  // 2.-3. Model, checked; the output directory, before integrating (an earlier run's outputs removed).
+  // Ctrl-C and SIGTERM from here on stop the run at its next accepted step (none taken yet: at t = 0).
+  install_sigint_handler();
+  // 2.-3. Model, checked; the output directory, locked for the whole run, before integrating (what
+  //       any chainsim command wrote there before removed).
   SceneRun<dim> scene(spec);
-  ensure_writable_directory(dir);
-  clear_run_outputs(dir);
+  const RunDirectory run_dir(dir);
+  run_dir.clear();
   const StringSolver<dim>& solver = scene.solver();
   const bool fronts = scene.has_fronts();
-  // 4.-5. Integrate (a numerical failure, or Ctrl-C, still writes what was done), write, summary last.
+  // 4.-5. Integrate (a numerical failure, or a signal, still writes what was done), write, summary last.
   std::optional<NumericalError> failure;
   {
     ProgressLine progress(scene.solver_options().t_end, progress_wanted(quiet));
-    install_sigint_handler();
     failure = scene.run([&](double t) { progress.update(t); });
   }
   const bool interrupted = solver.summary().status == "interrupted";
   nlohmann::json summary = scene.summary();
-  scene.write(dir, summary);
+  scene.write(run_dir, summary);
   if (failure && json) summary["exit_code"] = 3;
   if (interrupted && json) summary["exit_code"] = kInterruptedExit;
   // 6. Summary.
@@ -139,7 +135,7 @@ int run_string_scene(const SceneSpec& spec, const std::filesystem::path& dir, bo
                        s.slack ? s.slack->message()
                                : s.slack_policy == SlackPolicy::kIgnore ? "not checked" : "none at any accepted step",
                        to_string(s.slack_policy));
-    out << fmt::format("outputs    {}: {}\n", dir.string(), output_files(scene.output(), fronts));
+    out << fmt::format("outputs    {}: {}\n", dir.string(), output_files(dir));
   }
   if (failure) throw *failure;
   return interrupted ? kInterruptedExit : 0;
@@ -148,8 +144,8 @@ int run_string_scene(const SceneSpec& spec, const std::filesystem::path& dir, bo
 int run_reduced_scene(const SceneSpec& spec, const std::filesystem::path& dir, bool json, std::ostream& out) {
   // 2.-3. The canonical problem the scene is (or the reason it is none); the output directory.
   const ReducedSetup setup = match_canonical_problem(spec);
-  ensure_writable_directory(dir);
-  clear_run_outputs(dir);
+  const RunDirectory run_dir(dir);
+  run_dir.clear();
   // 4.-5. Integrate, write the series and the summary (last).
   ReducedRun run{CsvTable(series_columns()), {}};
   try {
@@ -177,7 +173,7 @@ int run_reduced_scene(const SceneSpec& spec, const std::filesystem::path& dir, b
                      p["f"].get<double>(), p["eta0"].get<double>(), p["eps"].get<double>(), p["force"].get<double>());
   out << fmt::format("stop       {} at t = {:.12g} s (t/t0 = {:.12g}, exact {})\n", s["stop_reason"].get<std::string>(),
                      s["t_stop"].get<double>(), s["t_stop_over_t0"].get<double>(), exact(s["t_stop_over_t0_exact"]));
-  out << fmt::format("outputs    {}: series.csv stats.json\n", dir.string());
+  out << fmt::format("outputs    {}: {}\n", dir.string(), output_files(dir));
   return 0;
 }
 
@@ -228,9 +224,8 @@ int run_scene_command(const RunCommandOptions& options, std::ostream& out) {
   } catch (const std::exception& e) {
     if (options.json) {
       const bool input = dynamic_cast<const InputError*>(&e) != nullptr;
-      out << nlohmann::json{{"status", "failed"}, {"error", e.what()}, {"scene", options.scene},
-                            {"exit_code", input ? 2 : 1}}
-                 .dump()
+      out << json_text({{"status", "failed"}, {"error", e.what()}, {"scene", options.scene},
+                        {"exit_code", input ? 2 : 1}})
           << '\n';
     }
     throw;

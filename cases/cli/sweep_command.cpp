@@ -58,9 +58,10 @@ int run_sweep_command(const SweepCommandOptions& options, std::ostream& out) {
                                         ? std::filesystem::path("results") / "sweep" /
                                               std::filesystem::path(options.scene).stem()
                                         : std::filesystem::path(options.out);
-  ensure_writable_directory(dir);
+  install_sigint_handler();  // SIGINT, SIGTERM: the running points stop, the rows are written
+  const RunDirectory run_dir(dir);  // held until sweep.csv is written
+  run_dir.clear();
 
-  install_sigint_handler();
   const auto start = std::chrono::steady_clock::now();
   const std::vector<nlohmann::json> rows = run_sweep(scene, points, jobs);
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
@@ -95,9 +96,8 @@ int run_sweep_command(const SweepCommandOptions& options, std::ostream& out) {
   std::string counts;
   for (const auto& [status, n] : statuses) counts += fmt::format("{}{} {}", counts.empty() ? "" : ", ", n, status);
   if (options.json) {
-    out << nlohmann::json{{"points", rows.size()}, {"jobs", jobs}, {"wall_s", wall}, {"statuses", statuses},
-                          {"out", (dir / "sweep.csv").string()}}
-               .dump()
+    out << json_text({{"points", rows.size()}, {"jobs", jobs}, {"wall_s", wall}, {"statuses", statuses},
+                      {"out", (dir / "sweep.csv").string()}})
         << '\n';
   } else {
     out << fmt::format("sweep      {}: {} points on {} thread{} in {:.3g} s\n", options.scene, rows.size(), jobs,

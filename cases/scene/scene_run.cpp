@@ -61,7 +61,12 @@ nlohmann::json SceneRun<dim>::summary() const {
 
 template <int dim>
 void SceneRun<dim>::write(const std::filesystem::path& dir, const nlohmann::json& summary) const {
-  solver_->write_outputs(dir, output_, &summary);
+  write(RunDirectory(dir), summary);
+}
+
+template <int dim>
+void SceneRun<dim>::write(const RunDirectory& dir, const nlohmann::json& summary) const {
+  solver_->write_outputs(dir.path(), output_, &summary);
 }
 
 template class SceneRun<2>;

@@ -47,8 +47,12 @@ class SceneRun {
   /// The run's summary as stats.json holds it: to_json(summary) with "model": "string" and no fronts,
   /// or front_summary() for a scene with fronts.
   nlohmann::json summary() const;
-  /// Writes the run directory (the scene's [output] selection; stats.json = `summary`, last).
+  /// Writes the run directory (the scene's [output] selection; stats.json = `summary`, last), after
+  /// removing what any chainsim command wrote there before, holding its lock meanwhile (RunDirectory:
+  /// InputError if another run holds it).
   void write(const std::filesystem::path& dir, const nlohmann::json& summary) const;
+  /// The same into a directory this process already holds (`chainsim run` locks it for the whole run).
+  void write(const RunDirectory& dir, const nlohmann::json& summary) const;
 
  private:
   std::unique_ptr<StringModel<dim>> model_;

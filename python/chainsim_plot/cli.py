@@ -70,6 +70,13 @@ def parser():
 
 def plot_run(run_dir, times=None, animate=False, speed=1.0, fps=25, fmt=None, out_dir=None):
     """Draws one run; returns the paths written. Raises RunError for what cannot be drawn."""
+    from .readers import holding
+
+    with holding(run_dir):  # no chainsim command writes the directory meanwhile
+        return _plot_held(run_dir, times, animate, speed, fps, fmt, out_dir)
+
+
+def _plot_held(run_dir, times, animate, speed, fps, fmt, out_dir):
     from . import figures
     from .readers import RunError, is_canonical, load_run
 

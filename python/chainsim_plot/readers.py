@@ -12,7 +12,9 @@ A run directory is recognised by the files in it (see `load_run`):
 Every table is read by its header and every column is optional: a string run with fronts may carry
 energy.csv and tension.csv as well, nodes.csv may or may not have the columns s and vx, vy[, vz].
 """
+import contextlib
 import csv
+import fcntl
 import json
 import os
 
@@ -242,6 +244,49 @@ def _fronts(series, info):
     return [Front(k, info[k] if k < len(info) else None, series) for k in ks]
 
 
+LOCK_NAME = ".chainsim.lock"
+
+
+@contextlib.contextmanager
+def holding(path):
+    """Holds the run directory `path` as every chainsim command that writes one does (RunDirectory in
+    solver/output.hpp): an exclusive flock on path/.chainsim.lock holding this process's pid, released
+    (and the file removed) on leaving, or by the kernel if the process dies. A directory another chainsim
+    process holds (a run still writing it) raises RunError naming its pid; meanwhile, a run into it is
+    refused the same way."""
+    check_directory(path)
+    lock = os.path.join(path, LOCK_NAME)
+    while True:
+        try:
+            fd = os.open(lock, os.O_RDWR | os.O_CREAT | os.O_CLOEXEC, 0o644)
+        except OSError as e:
+            raise RunError(f"RUN_DIR '{path}' is not writable: cannot create '{lock}': {e.strerror}") from e
+        try:
+            fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except OSError as e:
+            holder = os.pread(fd, 32, 0).decode(errors="replace").strip()
+            os.close(fd)
+            raise RunError(f"RUN_DIR '{path}' is in use by another chainsim process (pid "
+                           f"{holder or 'not yet recorded'}), which holds '{lock}': wait for that run to end") from e
+        try:
+            same = os.path.samestat(os.fstat(fd), os.stat(lock))
+        except OSError:
+            same = False
+        if same:
+            break
+        os.close(fd)  # the holder before us removed the name meanwhile: lock the current one
+    try:
+        os.ftruncate(fd, 0)
+        os.pwrite(fd, f"{os.getpid()}\n".encode(), 0)
+        yield
+    finally:
+        try:
+            os.unlink(lock)
+        except OSError:
+            pass
+        os.close(fd)
+
+
 def check_directory(path):
     """Raises RunError unless `path` is a readable directory."""
     if not os.path.exists(path):
@@ -266,6 +311,13 @@ def load_run(path):
     check_directory(path)
     j = lambda name: os.path.join(path, name)  # noqa: E731
     files = sorted(os.listdir(path))
+    # Every chainsim command clears what the others wrote before writing; a directory holding both
+    # `chainsim run`'s summary and another command's was mixed by an older chainsim, or by hand.
+    others = [f for f in ("summary.json", "string_series.csv", "reduced_series.csv") if f in files]
+    if "stats.json" in files and others:
+        raise RunError(f"RUN_DIR '{path}' mixes the outputs of two commands: stats.json of `chainsim run` beside "
+                       f"{', '.join(others)} of `chainsim compare` or `chainsim reduced`; run the command again "
+                       f"(it removes the other's files first)")
     summary = read_json(j("stats.json"))
     if summary is None:
         summary = read_json(j("summary.json"))

@@ -235,3 +235,32 @@ def test_read_run_reads_a_cli_directory(tmp_path):
     cli("run", os.path.join(SCENES, "hanging_chain.toml"), "--out", str(tmp_path), "--t-end", "0.1", "--quiet")
     run = chainsim.read_run(tmp_path)
     assert run.kind == "string" and run.summary["t_stop"] == 0.1
+
+
+# ------------------------------------------------------------------------------------------------------------------
+# A run directory belongs to one run: Result.write takes the lock `chainsim run` takes (the same C++ code)
+
+def test_write_is_refused_while_a_run_holds_the_directory_and_clears_other_commands_outputs(tmp_path):
+    scene_file = os.path.join(SCENES, "hanging_chain.toml")
+    result = chainsim.Scene.from_file(scene_file).set("string.nodes", 11).run(t_end=0.05)
+    out = tmp_path / "d"
+    # A run of 1000 s (ended below) holds the directory.
+    run = subprocess.Popen([BINARY, "run", scene_file, "--out", str(out), "--quiet", "--t-end", "1000",
+                            "--max-wall", "60"], stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    try:
+        lock = out / ".chainsim.lock"
+        for _ in range(1000):
+            if lock.exists() and lock.read_text() == f"{run.pid}\n":
+                break
+            time.sleep(0.01)
+        with pytest.raises(chainsim.ChainsimInputError, match=rf"is in use by another chainsim process \(pid {run.pid}\)"):
+            result.write(out)
+    finally:
+        run.send_signal(signal.SIGINT)
+        assert run.wait(timeout=60) == 130
+    # Free again: write() replaces the run's set and removes what compare wrote there.
+    cli("compare", "falling", "--nodes", "11", "--out", str(tmp_path / "c"))
+    (tmp_path / "c" / "notes.txt").write_text("mine\n")
+    result.write(tmp_path / "c")
+    assert sorted(os.listdir(tmp_path / "c")) == ["energy.csv", "forces.csv", "frames", "nodes.csv", "notes.txt",
+                                                 "stats.json", "string.pvd", "tension.csv"]

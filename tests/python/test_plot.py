@@ -10,9 +10,11 @@ import math
 import os
 import re
 import shutil
+import signal
 import subprocess
 import sys
 import tempfile
+import time
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 SOURCE = os.path.abspath(os.path.join(HERE, "..", ".."))
@@ -116,10 +118,11 @@ def plot_here(directory, *options, stdout=False):
     return code, (out if stdout else err).getvalue()
 
 
-def check_plot(kind, expected, *options, here=False):
+def check_plot(kind, expected, *options, here=False, directory=None):
     """chainsim plot exits 0, prints exactly the expected files of RUN_DIR/figures, and each is a PNG.
-    here=True: the package's entry point in this process instead of the binary (quicker)."""
-    directory = run_dir(kind)
+    here=True: the package's entry point in this process instead of the binary (quicker). RUN_DIR is
+    the run of `kind`, or `directory`."""
+    directory = directory or run_dir(kind)
     if here:
         code, out = plot_here(directory, *options, stdout=True)
         assert code == 0
@@ -179,6 +182,23 @@ def test_kind_canonical_run():
     for problem in ("falling", "folded", "sliding"):
         names += [f"{problem}_chain.png", f"{problem}_snapshots.png"]
     check_plot("canonical", names, here=True)
+
+
+def test_kind_run_after_compare_draws_only_the_run():
+    # Before: compare's summary.json and series stayed beside the run's files, and plot drew compare.png and
+    # fronts.png for a hanging chain. Now the run removes them (and the figures drawn of them), and plot
+    # writes only under figures/.
+    out = os.path.join(ROOT, "compare_then_run")
+    assert chainsim("compare", "falling", "--nodes", "21", "--out", out).returncode == 0
+    code, printed = plot_here(out, stdout=True)
+    assert code == 0 and "compare.png" in printed
+    r = chainsim("run", scene("hanging_chain", 21), "--out", out)
+    assert r.returncode == 0, r.stderr
+    before = sorted(os.listdir(out))
+    assert "figures" not in before and "summary.json" not in before and "string_series.csv" not in before
+    listed = check_plot(None, ["snapshots.png", "energy.png", "tension.png"], here=True, directory=out)
+    assert sorted(os.listdir(os.path.join(out, "figures"))) == sorted(os.path.basename(p) for p in listed)
+    assert sorted(f for f in os.listdir(out) if f != "figures") == before
 
 
 # --- the animation --------------------------------------------------------------------------------
@@ -260,6 +280,43 @@ def test_error_canonical_directory_missing_a_file_exits_2():
     assert not os.path.exists(os.path.join(fake, "figures"))
     code, err = plot_here(fake, "--animate")
     assert code == 2 and "--animate needs node frames" in err
+
+
+def test_error_mixed_directory_exits_2():
+    # A directory an older chainsim left mixed: a run's stats.json beside compare's summary.json.
+    out = os.path.join(ROOT, "mixed")
+    shutil.copytree(run_dir("compare"), out)
+    shutil.copy(os.path.join(run_dir("string"), "stats.json"), out)
+    code, err = plot_here(out)
+    assert code == 2
+    assert "mixes the outputs of two commands: stats.json of `chainsim run` beside summary.json" in err
+
+
+def test_error_directory_in_use_exits_2_and_plot_holds_it_as_runs_do():
+    # plot takes the lock every command that writes a run takes: refused while a run writes the directory,
+    # and a run is refused while plot draws.
+    from chainsim_plot.readers import holding
+    out = os.path.join(ROOT, "in_use")
+    run = subprocess.Popen([BINARY, "run", scene("hanging_chain", 21), "--out", out, "--quiet", "--t-end", "1000",
+                            "--max-wall", "60"], stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    try:
+        lock = os.path.join(out, ".chainsim.lock")
+        for _ in range(1000):
+            if os.path.exists(lock) and open(lock).read() == f"{run.pid}\n":
+                break
+            time.sleep(0.01)
+        code, err = plot_here(out)
+        assert code == 2
+        assert f"RUN_DIR '{out}' is in use by another chainsim process (pid {run.pid})" in err
+    finally:
+        run.send_signal(signal.SIGINT)
+        assert run.wait(timeout=60) == 130
+    with holding(out):
+        r = chainsim("run", scene("hanging_chain", 21), "--out", out)
+        assert r.returncode == 2
+        assert f"is in use by another chainsim process (pid {os.getpid()})" in r.stderr
+    assert not os.path.exists(os.path.join(out, ".chainsim.lock"))
+    assert plot_here(out)[0] == 0
 
 
 def test_error_bad_options_exit_2():

@@ -5,8 +5,21 @@
 #include <fstream>
 #include <string>
 
+#include <chrono>
+#include <set>
+#include <sstream>
+#include <thread>
+
+#include <fcntl.h>
+#include <signal.h>
+#include <spawn.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
 #include <catch2/catch.hpp>
 #include <nlohmann/json.hpp>
+
+extern char** environ;
 
 namespace {
 
@@ -195,4 +208,217 @@ TEST_CASE("chainsim plot and compare have --help and plot refuses a missing run 
   const Result r = run("plot " + missing);
   CHECK(r.status == 2);
   CHECK_THAT(r.output, Catch::Matchers::StartsWith("chainsim: error: RUN_DIR '" + missing + "' does not exist"));
+}
+
+// --- a run directory belongs to one run -------------------------------------------------------------
+
+namespace {
+
+/// Starts `chainsim ARGS...` in the background, its stdout and stderr into `log`; returns its pid.
+pid_t spawn(const std::vector<std::string>& args, const std::string& log) {
+  posix_spawn_file_actions_t actions;
+  posix_spawn_file_actions_init(&actions);
+  posix_spawn_file_actions_addopen(&actions, STDOUT_FILENO, log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+  posix_spawn_file_actions_adddup2(&actions, STDOUT_FILENO, STDERR_FILENO);
+  std::vector<std::string> words = {"chainsim"};
+  words.insert(words.end(), args.begin(), args.end());
+  std::vector<char*> argv;
+  for (auto& w : words) argv.push_back(w.data());
+  argv.push_back(nullptr);
+  pid_t pid = 0;
+  REQUIRE(posix_spawn(&pid, CHAINSIM_BINARY, &actions, nullptr, argv.data(), environ) == 0);
+  posix_spawn_file_actions_destroy(&actions);
+  return pid;
+}
+
+int wait_exit(pid_t pid) {
+  int status = 0;
+  REQUIRE(waitpid(pid, &status, 0) == pid);
+  REQUIRE(WIFEXITED(status));
+  return WEXITSTATUS(status);
+}
+
+std::string slurp(const std::filesystem::path& file) {
+  std::ifstream in(file);
+  std::stringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+
+std::set<std::string> listing(const std::filesystem::path& dir) {
+  std::set<std::string> names;
+  for (const auto& e : std::filesystem::directory_iterator(dir)) names.insert(e.path().filename().string());
+  return names;
+}
+
+/// A hanging chain of `nodes` nodes swinging for `t_end` s (taut throughout), frames every 0.05 s.
+std::string swinging_chain(int nodes, double t_end) {
+  return "[string]\nlength = 1.0\nnodes = " + std::to_string(nodes) +
+         "\n[shape]\nkind = \"polyline\"\npoints = [[0.0, 0.0], [0.1, -0.994987437107]]\n[ends]\nstart = "
+         "\"fixed\"\n[effects.gravity]\ng = [0.0, -9.81]\n[output]\ninterval = 0.05\n[stop]\nt_end = " +
+         std::to_string(t_end) + "\n";
+}
+
+/// The run in `dir` is one complete set: nodes.csv's last time is stats.json's t_stop and, without
+/// fronts (which hide the nodes in a heap), its rows are stats.json's frames times `nodes`; the files
+/// are those of that run (no series.csv of a run with fronts beside a string run's, nothing of
+/// another command).
+void check_one_run(const std::filesystem::path& dir, int nodes, const std::set<std::string>& files) {
+  CHECK(listing(dir) == files);
+  const auto stats = nlohmann::json::parse(slurp(dir / "stats.json"));
+  CHECK(stats["nodes"] == nodes);
+  std::ifstream csv(dir / "nodes.csv");
+  std::string line;
+  std::getline(csv, line);
+  long rows = 0;
+  double last = -1;
+  while (std::getline(csv, line)) {
+    ++rows;
+    last = std::stod(line.substr(0, line.find(',')));
+  }
+  if (stats["num_fronts"] == 0) CHECK(rows == stats["frames"].get<long>() * nodes);
+  CHECK(last == stats["t_stop"].get<double>());
+}
+
+const std::set<std::string> kStringRunFiles = {"energy.csv", "forces.csv", "frames", "nodes.csv",
+                                               "stats.json", "string.pvd", "tension.csv"};
+
+}  // namespace
+
+TEST_CASE("a second run into a directory in use is refused at once, naming the directory and the holder's pid",
+          "[unit][cli][output]") {
+  const std::filesystem::path dir = temp_dir("cli_lock");
+  std::filesystem::create_directories(dir);
+  std::ofstream(dir / "long.toml") << swinging_chain(101, 1000.0);
+  std::ofstream(dir / "short.toml") << swinging_chain(11, 0.1);
+  const auto out = dir / "d";
+  const pid_t first = spawn({"run", (dir / "long.toml").string(), "--out", out.string(), "--quiet", "--max-wall", "60"},
+                            (dir / "first.log").string());
+  // Wait until the first run holds the directory (its pid in the lock file).
+  const std::string pid = std::to_string(first);
+  bool held = false;
+  for (int k = 0; k < 1000 && !held; ++k) {
+    held = slurp(out / ".chainsim.lock") == pid + "\n";
+    if (!held) std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+  if (!held) kill(first, SIGKILL);
+  REQUIRE(held);
+  // Every command that writes a run is refused, with exit 2, before touching anything.
+  for (const std::string& cmd : {"run " + (dir / "short.toml").string(), std::string("compare falling --nodes 11"),
+                                 std::string("reduced falling"), "sweep " + (dir / "short.toml").string() +
+                                                                      " --grid string.nodes=11"}) {
+    CAPTURE(cmd);
+    const Result second = run(cmd + " --out " + out.string());
+    CHECK(second.status == 2);
+    CHECK_THAT(second.output, Catch::Matchers::StartsWith("chainsim: error: --out = '" + out.string() +
+                                                          "' is in use by another chainsim process (pid " + pid + ")"));
+  }
+  REQUIRE(kill(first, SIGINT) == 0);
+  CHECK(wait_exit(first) == 130);
+  // The first run's set alone, complete; the lock released.
+  check_one_run(out, 101, kStringRunFiles);
+  CHECK(nlohmann::json::parse(slurp(out / "stats.json"))["status"] == "interrupted");
+  // Free again: the short run now runs there and replaces the set.
+  CHECK(run("run " + (dir / "short.toml").string() + " --out " + out.string()).status == 0);
+  check_one_run(out, 11, kStringRunFiles);
+}
+
+TEST_CASE("two runs started together into one directory never mix: one is refused or they run one after the other",
+          "[unit][cli][output]") {
+  // A: a falling chain with a heap (writes series.csv); D: a hanging chain (does not). Before the lock
+  // they both exited 0 leaving D's stats.json beside A's files, or failed on a shared write probe.
+  const std::filesystem::path dir = temp_dir("cli_race");
+  std::filesystem::create_directories(dir);
+  const std::string source = CHAINSIM_SOURCE_DIR;
+  const std::string a = source + "/cases/scenes/falling_chain.toml", d = source + "/cases/scenes/hanging_chain.toml";
+  int refused = 0;
+  for (int attempt = 0; attempt < 6; ++attempt) {
+    CAPTURE(attempt);
+    const auto out = dir / ("d" + std::to_string(attempt));
+    const pid_t pa = spawn({"run", a, "--out", out.string(), "--quiet"}, (dir / "a.log").string());
+    std::this_thread::sleep_for(std::chrono::milliseconds(5 * attempt));
+    const pid_t pd = spawn({"run", d, "--out", out.string(), "--quiet"}, (dir / "d.log").string());
+    const int code_a = wait_exit(pa), code_d = wait_exit(pd);
+    for (const auto& [code, log] : {std::pair{code_a, "a.log"}, std::pair{code_d, "d.log"}}) {
+      CHECK((code == 0 || code == 2));
+      if (code == 2) {
+        ++refused;
+        CHECK_THAT(slurp(dir / log), Catch::Matchers::Contains("' is in use by another chainsim process (pid "));
+      }
+    }
+    CHECK((code_a == 0 || code_d == 0));
+    // The directory holds the set of the run that wrote last, whole.
+    const auto stats = nlohmann::json::parse(slurp(out / "stats.json"));
+    std::set<std::string> files = kStringRunFiles;
+    if (stats["num_fronts"] == 1) files.insert("series.csv");
+    check_one_run(out, stats["nodes"].get<int>(), files);
+  }
+  CHECK(refused > 0);  // the runs did overlap
+}
+
+TEST_CASE("every command that writes a run removes what any of them wrote there before, and nothing else",
+          "[unit][cli][output]") {
+  const std::filesystem::path dir = temp_dir("cli_clean");
+  std::filesystem::create_directories(dir / "d" / "frames");
+  const auto out = dir / "d";
+  std::ofstream(out / "notes.txt") << "mine\n";
+  std::ofstream(out / "frames" / "mine.txt") << "mine\n";
+  std::ofstream(dir / "short.toml") << swinging_chain(11, 0.1);
+  const std::string to = " --out " + out.string();
+  const std::set<std::string> mine = {"notes.txt", "frames"};
+  auto with_mine = [&](std::set<std::string> files) {
+    files.insert(mine.begin(), mine.end());
+    return files;
+  };
+  REQUIRE(run("compare falling --nodes 11" + to).status == 0);
+  CHECK(listing(out) == with_mine({"reduced_series.csv", "string_series.csv", "summary.json"}));
+  REQUIRE(run("run " + (dir / "short.toml").string() + to).status == 0);
+  CHECK(listing(out) == with_mine(kStringRunFiles));  // frames/ holds both the run's and the user's
+  CHECK(std::filesystem::exists(out / "frames" / "mine.txt"));
+  REQUIRE(run("reduced falling" + to).status == 0);
+  CHECK(listing(out) == with_mine({"series.csv", "summary.json"}));
+  REQUIRE(run("sweep " + (dir / "short.toml").string() + " --grid string.nodes=11,12" + to).status == 0);
+  CHECK(listing(out) == with_mine({"sweep.csv"}));
+  REQUIRE(run("run " + (dir / "short.toml").string() + to).status == 0);
+  REQUIRE(run("canonical --quick --nodes 11" + to).status == 0);
+  CHECK(listing(out) ==
+        with_mine({"falling", "figure_data", "folded", "sliding", "summary.csv", "summary.json"}));
+  REQUIRE(run("compare folded --nodes 11" + to).status == 0);
+  CHECK(listing(out) == with_mine({"reduced_series.csv", "string_series.csv", "summary.json"}));
+  CHECK(slurp(out / "notes.txt") == "mine\n");
+  CHECK(slurp(out / "frames" / "mine.txt") == "mine\n");
+}
+
+TEST_CASE("the summary lists the outputs the run wrote: no forces.csv where none was written", "[unit][cli][output]") {
+  // A loop travelling along its own shape: no gravity, no end loads, so no force columns.
+  const std::filesystem::path dir = temp_dir("cli_outputs_line");
+  const std::string scene = std::string(CHAINSIM_SOURCE_DIR) + "/cases/scenes/travelling_loop.toml";
+  const Result r = run("run " + scene + " --t-end 0.01 --quiet --out " + (dir / "d").string());
+  REQUIRE(r.status == 0);
+  CHECK_THAT(r.output, Catch::Matchers::Contains("outputs    " + (dir / "d").string() +
+                                                 ": nodes.csv tension.csv energy.csv string.pvd frames/ stats.json\n"));
+  CHECK(listing(dir / "d") == std::set<std::string>{"energy.csv", "frames", "nodes.csv", "stats.json", "string.pvd",
+                                                    "tension.csv"});
+}
+
+TEST_CASE("paths and --set keys that are not UTF-8 give JSON with U+FFFD and the run's own exit code",
+          "[unit][cli]") {
+  const std::filesystem::path dir = temp_dir("cli_not_utf8");
+  std::filesystem::create_directories(dir);
+  const std::string scene = (dir / "s\xff.toml").string(), out = (dir / "o\xff").string();
+  std::ofstream(scene) << swinging_chain(11, 0.1);
+  // A run that completes exits 0 and prints its summary (it printed a JSON type_error with exit 1).
+  const Result ok = run("run '" + scene + "' --json --out '" + out + "'", true);
+  CHECK(ok.status == 0);
+  const auto summary = nlohmann::json::parse(ok.output);
+  CHECK(summary["status"] == "completed");
+  CHECK(summary["out"] == (dir / "o\xef\xbf\xbd").string());
+  CHECK(summary["scene"] == (dir / "s\xef\xbf\xbd.toml").string());
+  CHECK(std::filesystem::exists(std::filesystem::path(out) / "stats.json"));
+  // A bad key is bad input: exit 2 and the error object.
+  const Result bad = run("run '" + scene + "' --json --set 'string.\xff=1' --out '" + out + "'", true);
+  CHECK(bad.status == 2);
+  const auto error = nlohmann::json::parse(bad.output);
+  CHECK(error["exit_code"] == 2);
+  CHECK_THAT(error["error"].get<std::string>(), Catch::Matchers::Contains("'string.\xef\xbf\xbd' is not a scene key"));
 }

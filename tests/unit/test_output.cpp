@@ -1,0 +1,151 @@
+// A run directory belongs to one run (solver/output.hpp): RunDirectory locks it (a second holder, in
+// this process or another, is refused at once naming the pid; the lock dies with the process),
+// temporary files have names no other writer uses, and the clean-up removes what any chainsim
+// command may have written there, stray temporary files included, and never another file.
+#include <filesystem>
+#include <fstream>
+#include <set>
+#include <string>
+
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <catch2/catch.hpp>
+
+#include "mesh/errors.hpp"
+#include "solver/output.hpp"
+#include "test_scene_support.hpp"
+
+using namespace chainsim;
+using Catch::Matchers::Contains;
+using test::temp_dir;
+
+namespace {
+
+std::set<std::string> entries(const std::filesystem::path& dir) {
+  std::set<std::string> names;
+  for (const auto& e : std::filesystem::directory_iterator(dir)) names.insert(e.path().filename().string());
+  return names;
+}
+
+std::string refusal(const std::filesystem::path& dir) {
+  try {
+    RunDirectory second(dir);
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+}  // namespace
+
+TEST_CASE("a run directory is held by one RunDirectory at a time, and the lock dies with its holder",
+          "[unit][output]") {
+  const auto dir = temp_dir("run_directory_lock") / "out";
+  const std::string pid = std::to_string(static_cast<long>(::getpid()));
+  {
+    const RunDirectory first(dir);
+    CHECK(std::filesystem::is_directory(dir));
+    CHECK(test::read(dir / RunDirectory::kLockName) == pid + "\n");
+    // A second holder in this process is refused at once, naming the directory and the pid.
+    const std::string message = refusal(dir);
+    CHECK_THAT(message, Contains("--out = '" + dir.string() + "' is in use by another run in this process (pid " +
+                                 pid + ")"));
+    // ... and so is one in another process (a child: its own open file, its own pid).
+    const pid_t child = ::fork();
+    REQUIRE(child >= 0);
+    if (child == 0) {
+      const std::string m = refusal(dir);
+      ::_exit(m.find("is in use by another chainsim process (pid " + pid + ")") != std::string::npos ? 0 : 1);
+    }
+    int status = 0;
+    REQUIRE(::waitpid(child, &status, 0) == child);
+    CHECK((WIFEXITED(status) && WEXITSTATUS(status) == 0));
+  }
+  // Released: the lock file is gone and the directory can be held again.
+  CHECK_FALSE(std::filesystem::exists(dir / RunDirectory::kLockName));
+  CHECK_NOTHROW(RunDirectory(dir));
+  // A holder that dies without releasing (no destructor: _exit) leaves a lock file that blocks nothing.
+  const pid_t child = ::fork();
+  REQUIRE(child >= 0);
+  if (child == 0) {
+    new RunDirectory(dir);  // never destroyed
+    ::_exit(0);
+  }
+  int status = 0;
+  REQUIRE(::waitpid(child, &status, 0) == child);
+  CHECK(std::filesystem::exists(dir / RunDirectory::kLockName));
+  CHECK(test::read(dir / RunDirectory::kLockName) == std::to_string(child) + "\n");
+  CHECK_NOTHROW(RunDirectory(dir));
+}
+
+TEST_CASE("temporary files are named for the process and the file, so no two writers share one",
+          "[unit][output]") {
+  const auto dir = temp_dir("atomic_names");
+  AtomicFile a(dir / "nodes.csv"), b(dir / "nodes.csv");
+  a.stream() << "a\n";
+  b.stream() << "b\n";
+  const std::set<std::string> names = entries(dir);
+  REQUIRE(names.size() == 2);  // two temporary files, not one shared
+  const std::string prefix = ".nodes.csv." + std::to_string(static_cast<long>(::getpid())) + ".";
+  for (const std::string& name : names) {
+    CHECK(name.rfind(prefix, 0) == 0);
+    CHECK(name.substr(name.size() - 4) == ".tmp");
+  }
+  a.commit();
+  CHECK(test::read(dir / "nodes.csv") == "a\n");
+}
+
+TEST_CASE("the clean-up removes what any chainsim command writes, stray temporary files included, and nothing else",
+          "[unit][output]") {
+  const auto dir = temp_dir("clean_up");
+  auto touch = [&](const std::string& name) {
+    std::filesystem::create_directories((dir / name).parent_path());
+    std::ofstream(dir / name) << "x\n";
+  };
+  // What run, compare, reduced, canonical, sweep and plot write, and temporary files of killed writers.
+  const std::vector<std::string> chainsim_files = {
+      "stats.json", "nodes.csv", "tension.csv", "energy.csv", "forces.csv", "series.csv", "string.pvd",
+      "frames/frame_0000.vtp", "frames/fronts_0000.vtp", "string_series.csv", "reduced_series.csv", "summary.json",
+      "summary.csv", "sweep.csv", "figure_data/falling_f0_ode.csv", "falling/series.csv", "folded/summary.json",
+      "sliding/series.csv", "figures/compare.png", "figures/animation.mp4", ".nodes.csv.123.4.tmp",
+      ".nodes.csv.tmp", ".stats.json.99.0.tmp", "frames/.frame_0003.vtp.77.12.tmp",
+      "falling/.series.csv.5.6.tmp", ".chainsim_write_probe.8.9.tmp"};
+  // A user's own files, some inside chainsim's directories, some looking like temporary files.
+  const std::vector<std::string> user_files = {"notes.txt", "my.csv", ".my.csv.1.2.tmp", "frames/readme.txt",
+                                               "figures/sketch.svg", "falling/nodes.txt", ".tmp", "stats.json.bak"};
+  for (const auto& name : chainsim_files) touch(name);
+  for (const auto& name : user_files) touch(name);
+  clear_run_outputs(dir);
+  for (const auto& name : chainsim_files) CHECK_FALSE(std::filesystem::exists(dir / name));
+  for (const auto& name : user_files) CHECK(std::filesystem::exists(dir / name));
+  // chainsim's directories stay only where a user's file is left in them.
+  CHECK(entries(dir) == std::set<std::string>{"notes.txt", "my.csv", ".my.csv.1.2.tmp", "frames", "figures",
+                                              "falling", ".tmp", "stats.json.bak"});
+  // What is left is no output (the summary's list of a run's outputs names none of it).
+  CHECK(outputs_present(dir).empty());
+  touch("frames/frame_0000.vtp");
+  touch("falling/summary.json");
+  touch("stats.json");
+  CHECK(outputs_present(dir) == std::vector<std::string>{"frames/", "stats.json", "falling/"});
+}
+
+TEST_CASE("the clean-up refuses a directory whose problem subdirectory another run holds", "[unit][output]") {
+  const auto dir = temp_dir("clean_up_nested");
+  std::filesystem::create_directories(dir / "folded");
+  std::ofstream(dir / "folded" / "series.csv") << "x\n";
+  {
+    const RunDirectory held(dir / "folded");
+    CHECK_THROWS_WITH(clear_run_outputs(dir), Contains("is in use by"));
+    CHECK(std::filesystem::exists(dir / "folded" / "series.csv"));
+  }
+  clear_run_outputs(dir);
+  CHECK_FALSE(std::filesystem::exists(dir / "folded"));
+}
+
+TEST_CASE("JSON text replaces bytes that are not UTF-8 instead of failing", "[unit][output]") {
+  const nlohmann::json j = {{"out", std::string("d\xff")}, {"ok", "caf\xc3\xa9"}};
+  const std::string text = json_text(j);
+  CHECK(text == "{\"ok\":\"caf\xc3\xa9\",\"out\":\"d\xef\xbf\xbd\"}");
+  CHECK(nlohmann::json::parse(text)["out"] == "d\xef\xbf\xbd");
+}
