@@ -3,6 +3,7 @@
 
 #include <chrono>
 #include <cmath>
+#include <limits>
 #include <string>
 
 #include <fmt/format.h>
@@ -153,6 +154,10 @@ void ReducedSetup::validate() const {
                                  "allowed force = 0",
                                  force, to_string(problem)));
   require_positive("--t-max", t_max_over_t0);
+  if (!std::isfinite(t_max_over_t0 * chain.t0()))
+    throw InputError(fmt::format("--t-max = {} is out of range: t_max t0 = {} x {} s overflows; allowed t_max <= {}",
+                                 t_max_over_t0, t_max_over_t0, chain.t0(),
+                                 std::numeric_limits<double>::max() / chain.t0()));
   integrator.validate();
 }
 
@@ -171,8 +176,10 @@ struct Snapshot {
 /// The ODE for one problem: state (y, ẏ, E_shock, E_heap, E_force), where E_k = ∫ W_k dt.
 class ReducedOde : public OdeSystem {
  public:
-  explicit ReducedOde(const ReducedSetup& s)
-      : s_(s), l_(s.chain.length), lam_(s.chain.density), g_(s.chain.gravity), f_(s.chain.dissipation) {}
+  /// `t_max`: the run's end (s), which bounds its time scale.
+  ReducedOde(const ReducedSetup& s, double t_max)
+      : s_(s), l_(s.chain.length), lam_(s.chain.density), g_(s.chain.gravity), f_(s.chain.dissipation),
+        t_max_(t_max) {}
 
   int size() const override { return 5; }
 
@@ -261,11 +268,13 @@ class ReducedOde : public OdeSystem {
     return scale;
   }
 
-  double time_scale() const override { return s_.chain.t0(); }
+  /// t0, or the run's length if shorter: the integrator's step-size floor is a fraction of this, so
+  /// it stays below the steps a run of any length takes (a run of 1e-7 t0 has steps far below 1e-14 t0).
+  double time_scale() const override { return std::min(s_.chain.t0(), t_max_); }
 
  private:
   const ReducedSetup& s_;
-  double l_, lam_, g_, f_;
+  double l_, lam_, g_, f_, t_max_;
 };
 
 /// The recorded series, bounded before the run: rows of accepted steps 0, k, 2k, … (stride k), the
@@ -322,21 +331,25 @@ ReducedRun solve_reduced(const ReducedSetup& setup) {
   const double eta0 = setup.initial_eta();
 
   // 1. Initial state: at rest, except the sliding chain from η0 = 0, which starts on its
-  //    non-trivial branch y = a t²/2 at η = kSlidingStartEta (see reduced_models.hpp).
+  //    non-trivial branch y = a t²/2 at η = kSlidingStartEta (see reduced_models.hpp), or at the
+  //    safety stop if that comes first: the branch is the exact solution up to there.
+  //    Every time is on the clock of the release (t = 0): the run ends at t_max = t_max/t0 · t0
+  //    exactly, whatever its size relative to t0 and to t_start.
+  const double t_max = setup.t_max_over_t0 * t0;
   double t_start = 0.0;
   Eigen::VectorXd u0 = Eigen::VectorXd::Zero(5);
   u0[0] = eta0 * l;
   const bool sliding_branch = setup.problem == Problem::kSliding && eta0 == 0.0;
   if (sliding_branch) {
     const double a = g / (3.0 + 2.0 * f);
-    u0[0] = kSlidingStartEta * l;
-    t_start = std::sqrt(2.0 * u0[0] / a);
+    t_start = std::min(std::sqrt(2.0 * kSlidingStartEta * l / a), t_max);
+    u0[0] = 0.5 * a * t_start * t_start;
     u0[1] = a * t_start;
   }
 
   // 2. Integrator: record the accepted steps (thinned to max_rows), with steps no longer than t0/500
   //    by default.
-  ReducedOde ode(setup);
+  ReducedOde ode(setup, t_max);
   IntegratorOptions opts = setup.integrator;
   if (opts.max_step == 0) opts.max_step = t0 / 500.0;
   Integrator integrator(ode, t_start, u0, opts);
@@ -360,12 +373,11 @@ ReducedRun solve_reduced(const ReducedSetup& setup) {
   record(t_start, u0);
 
   // 3. Advance step by step until a stop event (or the safety time).
-  const double t_max = t_start + setup.t_max_over_t0 * t0;
   std::string stop_reason = "t_max";
-  std::string stop_detail = fmt::format("the safety stop t_max = {:g} t0 was reached before a stop event",
+  std::string stop_detail = fmt::format("the safety stop t_max = {} t0 was reached before a stop event",
                                         setup.t_max_over_t0);
   int turning_points = 0;
-  for (;;) {
+  while (integrator.time() < t_max) {
     const auto outcome = integrator.advance(t_max, /*one_step=*/true);
     record(integrator.time(), integrator.state());
     if (outcome == Integrator::Outcome::kReachedTarget) break;
@@ -426,7 +438,7 @@ ReducedRun solve_reduced(const ReducedSetup& setup) {
       {"stop_detail", stop_detail},
       {"t_start", t_start},
       {"t_stop", t_stop},
-      {"t_stop_over_t0", t_stop / t0},
+      {"t_stop_over_t0", stop_reason == "t_max" ? setup.t_max_over_t0 : t_stop / t0},  // t_max as given
       {"eta_stop", eta_stop},
       {"P_stop", q.P},
       {"P_stop_over_P0", q.P / P0},

@@ -96,10 +96,10 @@ FrontScene<dim> build_front_scene(const SceneSpec& spec) {
   if (fx.plane) {
     plane_point = as_vec<dim>(spec, fx.plane->point, "effects.plane.point");
     const Vec<dim> n = as_vec<dim>(spec, fx.plane->normal, "effects.plane.normal");
-    if (!(n.norm() > 0))
+    if (n.isZero(0.0))
       fail_at(spec, "effects.plane.normal",
               fmt::format("effects.plane.normal = {} is zero: a plane needs a normal", text_of(spec, "effects.plane.normal")));
-    plane_normal = n.normalized();
+    plane_normal = n.stableNormalized();  // [0, 1e300] too: its norm overflows, its direction does not
   }
   for (std::size_t k = 0; k < fx.heaps.size(); ++k) {
     const HeapEntry& heap = fx.heaps[k];

@@ -106,7 +106,7 @@ void check_scales(const SceneSpec& spec, const std::vector<Scale>& inputs, const
   auto check = [&](const Scale& s, double lo, double hi) {
     if (s.value == 0 || (s.value >= lo && s.value <= hi)) return;
     fail_at(spec, s.key,
-            fmt::format("{} = {}: {} is {:.3g}, out of the range the solver can represent: allowed {:g} to {:g} "
+            fmt::format("{} = {}: {} is {}, out of the range the solver can represent: allowed {} to {} "
                         "(or 0); the scaled problem would overflow or underflow",
                         s.key, text_of(spec, s.key), s.what, s.value, lo, hi));
   };
@@ -239,7 +239,8 @@ SceneParts<dim> build_scene_parts(const SceneSpec& spec) {
                   {"effects.gravity.g", "|g| (m/s^2)", gn},
                   {velocity_key, "the fastest initial or driven speed (m/s)", v_max},
                   {"stop.t_end", "the run's length (s)", t_end},
-                  {force_key, "the largest end load (N)", force}},
+                  {force_key, "the largest end load (N)", force},
+                  {"solver.stabilization_time", "the Baumgarte time (s)", so.stabilization_time.value_or(0.0)}},
                  {{"effects.gravity.g", "the tension scale density (|g| length + v^2) + |F| (N)", tension},
                   {"stop.t_end", "the reach length + v t_end + |g| t_end^2 (m)",
                    length + v_max * t_end + gn * t_end * t_end},

@@ -237,11 +237,7 @@ std::unique_ptr<Run> run_string(const SceneSpec& spec, bool handle_sigint) {
 SceneSpec parse(const std::string& text, const std::string& source, const std::vector<std::string>& overrides,
                 std::optional<double> t_end) {
   SceneSpec spec = parse_scene_text(text, source, overrides);
-  if (t_end) {
-    if (!(*t_end > 0 && std::isfinite(*t_end)))
-      throw InputError(fmt::format("t_end = {:g} is out of range: allowed t_end > 0 (s)", *t_end));
-    spec.stop.t_end = *t_end;
-  }
+  if (t_end) replace_t_end(spec, *t_end, "t_end");
   return spec;
 }
 
@@ -320,7 +316,7 @@ py::tuple compare(const std::string& problem, const py::dict& kw) {
 
 SweepScene sweep_scene(const std::string& text, const std::string& source, const std::vector<std::string>& overrides,
                        std::optional<double> t_end) {
-  return SweepScene{text, source, overrides, t_end};
+  return SweepScene{text, source, overrides, t_end, "t_end"};
 }
 
 }  // namespace
@@ -369,6 +365,13 @@ PYBIND11_MODULE(_core, m) {
           return sweep_points(axes);
         },
         py::arg("grid"), "the grid's points as lists of KEY=VALUE overrides");
+  m.def("check_sweep_points",
+        [](const std::string& text, const std::string& source, const std::vector<std::string>& overrides,
+           std::optional<double> t_end, const std::vector<std::vector<std::string>>& points) {
+          check_sweep_points(sweep_scene(text, source, overrides, t_end), points);
+        },
+        py::arg("text"), py::arg("source"), py::arg("overrides"), py::arg("t_end"), py::arg("points"),
+        "refuses (ChainsimInputError) points that set one scene key twice, before any runs");
   m.def("run_sweep_point",
         [](const std::string& text, const std::string& source, const std::vector<std::string>& overrides,
            std::optional<double> t_end, const std::vector<std::string>& point) {
