@@ -87,6 +87,16 @@ TEST_CASE("bad scenes are refused with the location, the key, the value and what
       {"one node",
        edit(kBase, "nodes = 11", "nodes = 1"),
        "s.toml:4:9: string.nodes = 1 is out of range: allowed 2 <= nodes <= 10000000"},
+      {"one node too many (issue #21: it printed 'nodes = 1e+07 ... nodes <= 1e+07')",
+       edit(kBase, "nodes = 11", "nodes = 10000001"),
+       "s.toml:4:9: string.nodes = 10000001 is out of range: allowed 2 <= nodes <= 10000000"},
+      {"a node count beyond every integer type but int64's",
+       edit(kBase, "nodes = 11", "nodes = 9223372036854775807"),
+       "s.toml:4:9: string.nodes = 9223372036854775807 is out of range: allowed 2 <= nodes <= 10000000"},
+      {"a Baumgarte time below the solver's range (issue #21: exit 3 'non-finite' at t = 0)",
+       kBase + std::string("[solver]\nstabilization_time = 1e-300\n"),
+       "s.toml:19:22: solver.stabilization_time = 1e-300: the Baumgarte time (s) is 1e-300, out of the range the "
+       "solver can represent: allowed 1e-100 to 1e+100 (or 0); the scaled problem would overflow or underflow"},
       {"a fourth dimension",
        edit(kBase, "nodes = 11", "nodes = 11\ndimension = 4"),
        "s.toml:5:13: string.dimension = 4 is not allowed; valid values: 2, 3"},
@@ -390,4 +400,30 @@ TEST_CASE("solver.slack and solver.max_wall_s are parsed and checked, and check_
     INFO(c.what);
     CHECK(error_of(c.text) == c.message);
   }
+}
+
+TEST_CASE("--t-end is located at the option in every message about stop.t_end (issue #21)", "[unit][scene]") {
+  // `chainsim run --t-end 1e-300` blamed "file:30:9: stop.t_end = 10.0".
+  SceneSpec spec = parse_scene_text(kBase, "s.toml");
+  replace_t_end(spec, 1e-300, "--t-end");
+  CHECK(spec.stop.t_end == 1e-300);
+  try {
+    check_scene(spec);
+    FAIL("a run of 1e-300 s was not refused");
+  } catch (const InputError& e) {
+    CHECK(std::string(e.what()) ==
+          "--t-end: stop.t_end = 1e-300: the run's length (s) is 1e-300, out of the range the solver can represent: "
+          "allowed 1e-100 to 1e+100 (or 0); the scaled problem would overflow or underflow");
+  }
+  CHECK_THROWS_WITH(replace_t_end(spec, -1, "--t-end"), "--t-end = -1 is out of range: allowed t_end > 0 (s)");
+  CHECK_THROWS_WITH(replace_t_end(spec, NAN, "t_end"), "t_end = nan is out of range: allowed t_end > 0 (s)");
+}
+
+TEST_CASE("a plane's normal of any representable size is a direction (issue #21)", "[unit][scene]") {
+  // normal = [0, 1e300] said "must be a nonzero vector": its norm overflows, its direction does not.
+  const std::string huge = edit(test::kFallingBase, "normal = [0.0, 1.0]", "normal = [0.0, 1e300]");
+  CHECK(error_of(huge).empty());
+  CHECK(error_of(edit(huge, "model = \"string\"", "model = \"reduced\"")).empty());
+  CHECK_THAT(error_of(edit(test::kFallingBase, "normal = [0.0, 1.0]", "normal = [0.0, 0.0]")),
+             Catch::Contains("effects.plane.normal = [0.0, 0.0] is zero"));
 }
