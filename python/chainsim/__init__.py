@@ -58,6 +58,8 @@ def _text_key(key):
         key.encode("utf-8")
     except UnicodeEncodeError:
         raise ChainsimInputError(f"{key!r} is not a scene key: it holds a lone surrogate") from None
+    if any(ord(c) < 0x20 for c in key):
+        raise ChainsimInputError(f"{key!r} is not a scene key: it holds a control character")
     return key
 
 

@@ -3,7 +3,9 @@
 // (SceneRun = `chainsim run`, solve_reduced = `chainsim reduced`, compare_with_reduced = `chainsim
 // compare`, run_sweep / run_sweep_point = `chainsim sweep`). JSON documents cross as text (json.loads
 // on the Python side: doubles round-trip exactly); arrays as numpy arrays (copies).
+#include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <limits>
 #include <memory>
 #include <optional>
@@ -167,6 +169,15 @@ py::dict frames_dict(const SceneRun<dim>& run) {
   out["fronts"] = fronts;
   out["series"] = run.solver().summary().samples.empty() ? py::dict() : table_dict(samples_table(run.solver().summary()));
   return out;
+}
+
+/// Raises `type` with the message `what`. Messages quote what the user wrote, which need not be valid
+/// UTF-8 (the bytes of a scene file): decoded with backslash escapes, so that the error raised is always
+/// the one thrown, never a UnicodeDecodeError.
+void set_error(PyObject* type, const char* what) {
+  const py::object message = py::reinterpret_steal<py::object>(
+      PyUnicode_DecodeUTF8(what, static_cast<Py_ssize_t>(std::strlen(what)), "backslashreplace"));
+  if (message) PyErr_SetObject(type, message.ptr());
 }
 
 /// A finished run of a scene: the string solver's (2D or 3D) or the reduced model's.
@@ -364,6 +375,8 @@ nlohmann::json scene_value(py::handle value, const std::string& at, int depth = 
                                      shown(key)));
       }
       const std::string name = utf8(key, where);
+      if (std::any_of(name.begin(), name.end(), [](char c) { return static_cast<unsigned char>(c) < 0x20; }))
+        throw InputError(fmt::format("{} has the key {}: no scene key holds a control character", where, shown(key)));
       object[name] = scene_value(item, at.empty() ? name : at + "." + name, depth + 1);
     }
     return object;
@@ -459,9 +472,9 @@ PYBIND11_MODULE(_core, m) {
     try {
       if (p) std::rethrow_exception(p);
     } catch (const InputError& e) {
-      PyErr_SetString(input_error.ptr(), e.what());
+      set_error(input_error.ptr(), e.what());
     } catch (const NumericalError& e) {
-      PyErr_SetString(numerical_error.ptr(), e.what());
+      set_error(numerical_error.ptr(), e.what());
     }
   });
 
