@@ -56,10 +56,18 @@ std::string to_string(Problem problem) {
 }
 
 void ChainParameters::validate() const {
-  require_positive("--length", length);
-  require_positive("--density", density);
-  require_positive("--gravity", gravity);
+  // Each scale, and the energy scale λ g ℓ² the ledger and the tolerances use, in the range the
+  // solvers accept (mesh/errors.hpp): ℓ = 5e-324 made the energy scale 0 (an internal error).
+  for (const auto& [name, value] : {std::pair{"--length", length}, {"--density", density}, {"--gravity", gravity}}) {
+    require_positive(name, value);
+    require_in_range(name, value, kMinScale, kMaxScale);
+  }
   require_in_range("--f", dissipation, 0.0, 1.0);
+  const double energy = density * gravity * length * length;
+  if (!(energy >= kMinScale * kMinScale && energy <= kMaxScale * kMaxScale))
+    throw InputError(fmt::format("--length = {}, --density = {}, --gravity = {}: the energy scale lambda g l^2 = {} J "
+                                 "is out of the range the solver can represent: allowed {} to {}",
+                                 length, density, gravity, energy, kMinScale * kMinScale, kMaxScale * kMaxScale));
 }
 
 double ChainParameters::t0() const { return std::sqrt(2.0 * length / gravity); }

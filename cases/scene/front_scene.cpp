@@ -79,6 +79,12 @@ FrontScene<dim> build_front_scene(const SceneSpec& spec) {
     fail_at(spec, first_front,
             fmt::format("{} on a closed string: fronts are tracked on open strings only (string.closed = true)",
                         fx.heaps.empty() ? "[effects.fold]" : "[[effects.heap]]"));
+  if (chain.num_links() < 2) {
+    const std::string key = spec.link_length ? "string.link_length" : "string.nodes";
+    fail_at(spec, key,
+            fmt::format("{} = {} gives {} link: a string with fronts needs at least 2 links (allowed nodes >= 3)", key,
+                        text_of(spec, key), chain.num_links()));
+  }
   for (std::size_t k = 0; k < fx.heaps.size(); ++k) {
     const HeapEntry& heap = fx.heaps[k];
     const EndSpec& end = heap.side == "start" ? spec.start : spec.end;
@@ -213,13 +219,17 @@ FrontScene<dim> build_front_scene(const SceneSpec& spec) {
   for (const auto& p : parts.prescribed) d["prescribed"].push_back(fmt::format("node {}: {}", p.node, p.path->description()));
   const StringModelOptions mo = parts.model;
   const std::string fit_key = fold && heaps.empty() ? "effects.fold.s0" : first_front;
+  // Located at the front and naming it: the tracker's messages speak of "the heap's plane", "the fold".
   scene.model = at_key(spec, fit_key, [&] {
     try {
       return std::make_unique<StringModel<dim>>(make_front_model<dim>(std::move(parts.chain), std::move(parts.forces),
                                                                       std::move(parts.prescribed), heaps, fold,
                                                                       options, mo));
     } catch (const RecoverableError& e) {  // a degenerate front geometry found while placing the fronts
-      throw InputError(e.what());
+      throw InputError(fmt::format("{}: {}", fit_key, e.what()));
+    } catch (const InputError& e) {
+      if (spec.located(e.what())) throw;
+      throw InputError(fmt::format("{}: {}", fit_key, e.what()));
     }
   });
   const FrontTracker<dim>& tracker = *front_tracker(*scene.model);

@@ -92,9 +92,8 @@ int link_count(const SceneSpec& spec, double length, bool closed) {
 /// The scales of a run must leave its scaled problem well inside the double range: the solver forms
 /// squares and products of them (energies λ v² ℓ, tensions λ (|g| ℓ + v²) + |F|, the reach
 /// ℓ + v t_end + |g| t_end²), so each nonzero input scale lies in [kMinScale, kMaxScale] and each
-/// derived one in [kMinScale², kMaxScale²]. A scene outside is refused at its key before the run,
-/// rather than ending in a non-finite value at its first step.
-constexpr double kMinScale = 1e-100, kMaxScale = 1e100;
+/// derived one in [kMinScale², kMaxScale²] (mesh/errors.hpp). A scene outside is refused at its key
+/// before the run, rather than ending in a non-finite value at its first step.
 
 struct Scale {
   std::string key;   ///< the scene key that sets it

@@ -37,6 +37,8 @@ def _toml_value(value, key):
     if isinstance(value, (bool, np.bool_)):
         return "true" if value else "false"
     if isinstance(value, (int, np.integer)):
+        if not -2**63 <= int(value) < 2**63:
+            raise ChainsimInputError(f"{key} = {value} is out of range: allowed integers from {-2**63} to {2**63 - 1}")
         return str(int(value))
     if isinstance(value, (float, np.floating)):
         return repr(float(value))

@@ -356,7 +356,14 @@ TEST_CASE("a reduced run at g = 1e-100 or l = 1e90 stops at its t_max, a tiny fr
   }
   // A t_max whose time t_max t0 overflows is refused with the allowed range.
   ReducedSetup huge = make(Problem::kFalling, 0.5, 0.01, 1.0);
-  huge.chain.gravity = 1e-300;
+  huge.chain.gravity = 1e-100;
+  huge.chain.length = 1e100;  // t0 = 1.4e100 s
   huge.t_max_over_t0 = 1e300;
   CHECK_THROWS_WITH(solve_reduced(huge), Contains("--t-max = 1e+300 is out of range") && Contains("allowed t_max <="));
+  // Scales beyond the solver's range are refused with it (l = 5e-324 made the energy scale 0: an internal error).
+  ReducedSetup tiny = make(Problem::kFalling, 0.5, 0.01, 1.0);
+  tiny.chain.length = 5e-324;
+  CHECK_THROWS_WITH(solve_reduced(tiny), "--length = 5e-324 is out of range: allowed 1e-100 <= length <= 1e+100");
+  tiny.chain.length = 1e-60;  // each scale in range, but lambda g l^2 = 9.81e-120 J is not
+  CHECK_THROWS_WITH(solve_reduced(tiny), Contains("the energy scale lambda g l^2 = 9.81e-120 J is out of the range"));
 }

@@ -20,7 +20,7 @@ import numpy as np
 import pytest
 
 hypothesis = pytest.importorskip("hypothesis")
-from hypothesis import HealthCheck, given, settings, strategies as st  # noqa: E402
+from hypothesis import HealthCheck, example, given, settings, strategies as st  # noqa: E402
 
 import chainsim  # noqa: E402
 
@@ -98,6 +98,8 @@ def shown(key):
         names.append(".".join(parts[:-1]))
     if len(parts) > 1:
         names.append(re.sub(r"\[\d+\]$", "", parts[-1]))
+    if key.startswith("effects.plane."):  # the plane's keys may be refused at the heap that lies on it
+        names.append("effects.heap[0]")
     return names
 
 
@@ -146,6 +148,19 @@ def with_value(scene, key, value):
 
 @fuzz_settings(400)
 @given(key=st.sampled_from(SCENE_KEYS), value=values)
+# The reproducers of issue #21, and what the random draws found (each failed before its fix).
+@example(key="string.nodes", value=np.int64(11))
+@example(key="string.length", value=np.float32(1.0))
+@example(key="shape.points", value=np.array([[0.0, 1.0], [0.0, 0.0]]))
+@example(key="string.closed", value=np.bool_(False))
+@example(key="string.length", value=math.nan)
+@example(key="string.length", value=math.inf)
+@example(key="string.nodes", value=10**400)
+@example(key="solver.method", value="\ud800")
+@example(key="string.nodes", value=10000001)
+@example(key="effects.plane.normal", value=[0.0, 1e300])
+@example(key="effects.plane.normal", value=np.array([1.0, 0.0]))
+@example(key="solver.stabilization_time", value=1e-300)
 def test_scene_from_dict_with_any_value(key, value):
     scene = ends_well(lambda: chainsim.Scene.from_dict(with_value(BASE, key, value)), shown(key))
     if scene is not None:
@@ -167,6 +182,10 @@ def test_scene_from_dict_of_anything(scene):
 
 @fuzz_settings(300)
 @given(key=keys, value=values)
+@example(key="\x00", value=10000001)
+@example(key="\ud800", value=1)
+@example(key="string.nodes", value=2)
+@example(key="string.nodes", value=np.int64(21))
 def test_scene_set_with_any_key_and_value(key, value):
     scene = chainsim.Scene.from_dict(BASE)
     changed = ends_well(lambda: scene.set(key, value), shown(key) if isinstance(key, str) else [repr(key)])
@@ -194,6 +213,11 @@ def keyword_names(kwargs):
 @fuzz_settings(300)
 @given(problem=st.one_of(st.sampled_from(["falling", "folded", "sliding"]), text, numbers),
        kwargs=st.dictionaries(st.sampled_from(REDUCED_KEYWORDS), st.one_of(numbers, text, st.none()), max_size=3))
+@example(problem="falling", kwargs={"f": "0.5"})
+@example(problem="sliding", kwargs={"t_max": 1e-6})
+@example(problem="falling", kwargs={"t_max": 1e-7})
+@example(problem="falling", kwargs={"gravity": 1e-100, "t_max": 1e-49})
+@example(problem="falling", kwargs={"length": 5e-324})
 def test_reduced_with_any_keywords(problem, kwargs):
     kwargs.setdefault("max_steps", 20000)
     ends_well(lambda: chainsim.reduced(problem, **kwargs), keyword_names(kwargs) + ["problem"])
@@ -202,6 +226,7 @@ def test_reduced_with_any_keywords(problem, kwargs):
 @fuzz_settings(60)
 @given(problem=st.sampled_from(["falling", "folded", "sliding"]),
        kwargs=st.dictionaries(st.sampled_from(COMPARE_KEYWORDS), st.one_of(numbers, text, st.none()), max_size=3))
+@example(problem="falling", kwargs={"nodes": 10**20})
 def test_compare_with_any_keywords(problem, kwargs):
     if "nodes" in kwargs and isinstance(kwargs["nodes"], (int, np.integer)) and 13 <= kwargs["nodes"] <= 200001:
         kwargs["nodes"] = 13  # a valid but large mesh: keep the run cheap
@@ -215,6 +240,9 @@ def test_compare_with_any_keywords(problem, kwargs):
 @given(grid=st.dictionaries(st.one_of(st.sampled_from(SCENE_KEYS + ["f"]), keys),
                             st.one_of(st.lists(values, max_size=2), values), min_size=0, max_size=2),
        t_end=st.one_of(st.none(), floats, text))
+@example(grid={"f": [0.1], "effects.heap[0].f": [0.9]}, t_end=None)
+@example(grid={"stop.t_end": [0.01]}, t_end=0.02)
+@example(grid={"model": [10**400]}, t_end=None)
 def test_scene_sweep_with_any_grid(grid, t_end):
     scene = chainsim.Scene.from_dict(BASE)
     names = [n for k in grid for n in (shown(k) if isinstance(k, str) else [repr(k)])]
@@ -231,6 +259,8 @@ def test_scene_sweep_with_any_grid(grid, t_end):
        grid=st.dictionaries(st.one_of(st.sampled_from(REDUCED_KEYWORDS), text),
                             st.one_of(st.lists(st.one_of(numbers, text), max_size=2), numbers), min_size=0,
                             max_size=2))
+@example(problem="falling", grid={"f": ["x", 0.5]})
+@example(problem="falling", grid={"length": [5e-324]})
 def test_reduced_sweep_with_any_grid(problem, grid):
     table = ends_well(lambda: chainsim.sweep(problem, {**grid, "max_steps": [20000]}, workers=1),
                       [n for k in grid for n in shown(k)] + ["problem", "grid"])
