@@ -172,7 +172,7 @@ def test_dict_scenes_take_numpy_values_and_refuse_at_the_key_what_no_scene_holds
             chainsim.Scene.from_dict({**d, **change})
 
 
-def test_reduced_and_compare_keywords_of_the_wrong_type_are_input_errors():
+def test_reduced_and_compare_keywords_of_the_wrong_type_are_refused_as_input():
     """Issue #21: reduced(f="0.5") and compare(nodes=10**20) raised RuntimeError "Unable to cast"; inside a sweep
     that aborted the whole sweep instead of giving an error row."""
     with pytest.raises(chainsim.ChainsimInputError, match=r"reduced\(\): f = '0.5' must be a number"):
