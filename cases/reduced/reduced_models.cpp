@@ -142,7 +142,7 @@ void ReducedSetup::validate() const {
   if (problem != Problem::kSliding && eps < min_cutoff()) {
     const double f = chain.dissipation;
     throw InputError(fmt::format(
-        "--eps = {:g} is out of range for the {} chain with f = {:g}, eta0 = {:g}: allowed {:g} <= eps < {:g}. The "
+        "--eps = {} is out of range for the {} chain with f = {}, eta0 = {}: allowed {} <= eps < {}. The "
         "exact time left between that cutoff and the singular end of the fall is {:.2g} t0, less than {:g} t0 "
         "(about 10^3 round-off units of t): the run cannot resolve the cutoff",
         eps, to_string(problem), f, e0, min_cutoff(), problem == Problem::kFalling ? e0 : 1.0 - e0,
@@ -153,12 +153,12 @@ void ReducedSetup::validate() const {
     const double weight = chain.density * chain.gravity * chain.length;
     if (e0 == 0.0 && force > weight)
       throw InputError(fmt::format(
-          "--force = {:g} N exceeds the chain's weight lambda g l = {:g} N: released at eta0 = 0, the free end would "
-          "rise above its start at once, out of the model's domain eta >= 0; allowed 0 <= force <= {:g} N at "
+          "--force = {} N exceeds the chain's weight lambda g l = {} N: released at eta0 = 0, the free end would "
+          "rise above its start at once, out of the model's domain eta >= 0; allowed 0 <= force <= {} N at "
           "eta0 = 0 (from eta0 > 0 a larger force lifts the fold to the fixed end, where the run stops)",
           force, weight, weight));
   } else if (force != 0.0)
-    throw InputError(fmt::format("--force = {:g} applies to the folded chain only (the {} chain has no loaded end): "
+    throw InputError(fmt::format("--force = {} applies to the folded chain only (the {} chain has no loaded end): "
                                  "allowed force = 0",
                                  force, to_string(problem)));
   require_positive("--t-max", t_max_over_t0);

@@ -114,9 +114,9 @@ FrontScene<dim> build_front_scene(const SceneSpec& spec) {
     const bool inside = start ? (heap.s0 >= 0 && heap.s0 < ell) : (heap.s0 > 0 && heap.s0 <= ell * (1 + 1e-12));
     if (!inside)
       fail_at(spec, key + ".s0",
-              fmt::format("{}.s0 = {} is outside the string: allowed {} for side = \"{}\" (the string is {:g} m long)",
+              fmt::format("{}.s0 = {} is outside the string: allowed {} for side = \"{}\" (the string is {} m long)",
                           key, text_of(spec, key + ".s0"),
-                          start ? fmt::format("0 <= s0 < {:g}", ell) : fmt::format("0 < s0 <= {:g}", ell), heap.side,
+                          start ? fmt::format("0 <= s0 < {}", ell) : fmt::format("0 < s0 <= {}", ell), heap.side,
                           ell));
     const Vec<dim> point = as_vec<dim>(spec, heap.point, key + ".point");
     const Vec<dim> on_shape = parts.curve->point(heap.s0);
@@ -168,7 +168,7 @@ FrontScene<dim> build_front_scene(const SceneSpec& spec) {
     const bool end_heap = std::any_of(fx.heaps.begin(), fx.heaps.end(), [](const HeapEntry& e) { return e.side == "end"; });
     if (!((start_heap ? s0 > s_lo : s0 >= 0) && s0 < s_hi))
       fail_at(spec, key,
-              fmt::format("effects.fold.s0 = {} is {}: allowed {:g} {} s0 < {:g}", text_of(spec, key),
+              fmt::format("effects.fold.s0 = {} is {}: allowed {} {} s0 < {}", text_of(spec, key),
                           start_heap || end_heap ? "not between the heaps" : "outside the string", s_lo,
                           start_heap ? "<" : "<=", s_hi));
     const double d = kTangentStep * ell;
@@ -194,7 +194,7 @@ FrontScene<dim> build_front_scene(const SceneSpec& spec) {
     const double s = spec.stop.fronts[k].s0;
     const std::string key = fmt::format("stop.front[{}].s0", k);
     if (!(s >= 0 && s <= ell))
-      fail_at(spec, key, fmt::format("{} = {} is outside the string: allowed 0 <= s0 <= {:g} m", key, text_of(spec, key), ell));
+      fail_at(spec, key, fmt::format("{} = {} is outside the string: allowed 0 <= s0 <= {} m", key, text_of(spec, key), ell));
     const std::string& name = names[static_cast<std::size_t>(stop_fronts[k])];
     const double s_start = name == "fold" ? fx.fold->s0 : name == "heap_start" ? s_lo : s_hi;
     if (std::abs(s - s_start) <= kPlaceTolerance * ell)

@@ -77,7 +77,7 @@ int link_count(const SceneSpec& spec, double length, bool closed) {
     const double links = std::round(length / *spec.link_length);
     if (links > kMaxNodes)
       fail_at(spec, "string.link_length",
-              fmt::format("string.link_length = {:g} m asks for {:.3g} links on {:g} m: allowed at most {} nodes",
+              fmt::format("string.link_length = {} m asks for {:.3g} links on {} m: allowed at most {} nodes",
                           *spec.link_length, links, length, kMaxNodes));
     return std::max(minimum, static_cast<int>(links));
   }

@@ -364,6 +364,8 @@ TEST_CASE("a reduced run at g = 1e-100 or l = 1e90 stops at its t_max, a tiny fr
   ReducedSetup tiny = make(Problem::kFalling, 0.5, 0.01, 1.0);
   tiny.chain.length = 5e-324;
   CHECK_THROWS_WITH(solve_reduced(tiny), "--length = 5e-324 is out of range: allowed 1e-100 <= length <= 1e+100");
-  tiny.chain.length = 1e-60;  // each scale in range, but lambda g l^2 = 9.81e-120 J is not
-  CHECK_THROWS_WITH(solve_reduced(tiny), Contains("the energy scale lambda g l^2 = 9.81e-120 J is out of the range"));
+  tiny.chain.length = 1e-60;  // each scale in range, but lambda g l^2 = 9.81e-220 J is not
+  tiny.chain.density = 1e-100;
+  CHECK_THROWS_WITH(solve_reduced(tiny), Contains("the energy scale lambda g l^2 = 9.81") &&
+                                             Contains("e-220 J is out of the range the solver can represent"));
 }
