@@ -47,12 +47,26 @@ std::string normalized_indices(const std::string& key) {
   return out;
 }
 
-/// The point's overrides with `f=` replaced by the key it stands for.
-std::vector<std::string> resolve_keys(const SweepScene& scene, const std::vector<std::string>& point) {
+/// The point's overrides with `f=` replaced by the key it stands for; throws InputError if two of them
+/// (or one and the sweep's t_end) set one scene key. `canonical` caches the scene key of each grid key
+/// (`f` parses the scene).
+std::vector<std::string> resolve_keys(const SweepScene& scene, const std::vector<std::string>& point,
+                                      std::map<std::string, std::string>& canonical) {
   std::vector<std::string> out;
+  std::map<std::string, std::string> seen;  // scene key -> the grid key that sets it
+  if (scene.t_end) seen["stop.t_end"] = scene.t_end_origin;
   for (const std::string& o : point) {
     const std::string key = key_of(o);
-    out.push_back(key == "f" ? canonical_sweep_key(scene, key) + o.substr(key.size()) : o);
+    auto it = canonical.find(key);
+    if (it == canonical.end()) it = canonical.emplace(key, canonical_sweep_key(scene, key)).first;
+    out.push_back(key == "f" ? it->second + o.substr(key.size()) : o);
+    const auto [previous, fresh] = seen.emplace(it->second, key);
+    if (fresh) continue;
+    const bool t_end = scene.t_end && previous->second == scene.t_end_origin;
+    throw InputError(fmt::format(
+        "the grid key {} and {} {} both set {}: a row would show one value while the other ran; give one of them",
+        t_end ? key : previous->second, t_end ? "the sweep's" : "the grid key", t_end ? previous->second : key,
+        it->second));
   }
   return out;
 }
@@ -98,23 +112,7 @@ std::string canonical_sweep_key(const SweepScene& scene, const std::string& key)
 
 void check_sweep_points(const SweepScene& scene, const std::vector<std::vector<std::string>>& points) {
   std::map<std::string, std::string> canonical;  // grid key as written -> scene key (f: parsed once)
-  for (const auto& point : points) {
-    std::map<std::string, std::string> seen;  // scene key -> the grid key that set it
-    if (scene.t_end) seen["stop.t_end"] = scene.t_end_origin;
-    for (const std::string& o : point) {
-      const std::string key = key_of(o);
-      auto it = canonical.find(key);
-      if (it == canonical.end()) it = canonical.emplace(key, canonical_sweep_key(scene, key)).first;
-      const auto [previous, fresh] = seen.emplace(it->second, key);
-      if (fresh) continue;
-      const std::string& other = previous->second;
-      throw InputError(fmt::format(
-          "the grid key {} and {} {} both set {}: a row would show one value while the other ran; give one of them",
-          other == scene.t_end_origin && scene.t_end ? key : other,
-          other == scene.t_end_origin && scene.t_end ? "the sweep's" : "the grid key",
-          other == scene.t_end_origin && scene.t_end ? other : key, it->second));
-    }
-  }
+  for (const auto& point : points) resolve_keys(scene, point, canonical);
 }
 
 SweepAxis parse_grid_axis(const std::string& argument) {
@@ -165,9 +163,9 @@ nlohmann::json run_sweep_point(const SweepScene& scene, const std::vector<std::s
   nlohmann::json summary;
   std::string status, error;
   try {
-    check_sweep_points(scene, {point});
+    std::map<std::string, std::string> canonical;
     std::vector<std::string> overrides = scene.overrides;
-    for (const std::string& o : resolve_keys(scene, point)) overrides.push_back(o);
+    for (const std::string& o : resolve_keys(scene, point, canonical)) overrides.push_back(o);
     SceneSpec spec = parse_scene_text(scene.text, scene.source, overrides);
     if (scene.t_end) replace_t_end(spec, *scene.t_end, scene.t_end_origin);
     summary = run_point(spec);
