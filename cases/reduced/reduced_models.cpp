@@ -107,6 +107,10 @@ TimeToEnd time_to_end(Problem problem, double f, double eta0) {
   return {};
 }
 
+/// The smallest hanging fraction η of the sliding chain at its start: far above the smallest normal
+/// double even in units of the shortest length a chain may have (kMinScale).
+constexpr double kMinHangingFraction = 1e-150;
+
 /// x rounded up to two significant digits, as the double nearest to that decimal (so that the
 /// limit printed, and typed back by a user, is exactly the limit checked).
 double round_up_2(double x) {
@@ -162,6 +166,16 @@ void ReducedSetup::validate() const {
                                  "allowed force = 0",
                                  force, to_string(problem)));
   require_positive("--t-max", t_max_over_t0);
+  if (problem == Problem::kSliding && e0 == 0.0) {
+    // Up to t_max the chain follows its branch η = τ²/(3 + 2f) (τ = t/t0), whose hanging length
+    // must stay a normal number: the model divides by it.
+    const double lowest = round_up_2(std::sqrt((3.0 + 2.0 * chain.dissipation) * kMinHangingFraction));
+    if (t_max_over_t0 < lowest)
+      throw InputError(fmt::format("--t-max = {} is out of range for the sliding chain from eta0 = 0: allowed t_max >= "
+                                   "{} (the hanging length at t_max, eta = t_max^2/(3 + 2f) = {} of l, would "
+                                   "underflow)",
+                                   t_max_over_t0, lowest, t_max_over_t0 * t_max_over_t0 / (3.0 + 2.0 * chain.dissipation)));
+  }
   if (!std::isfinite(t_max_over_t0 * chain.t0()))
     throw InputError(fmt::format("--t-max = {} is out of range: t_max t0 = {} x {} s overflows; allowed t_max <= {}",
                                  t_max_over_t0, t_max_over_t0, chain.t0(),

@@ -331,6 +331,14 @@ TEST_CASE("a reduced run honours t_max exactly, whatever its size relative to t0
     CHECK_THAT(d(run.summary["eta_stop"]), WithinRel(tau * tau / (3 + 2 * f), 1e-9));
     CHECK(run.series.column("t").back() <= tau * s.chain.t0());
   }
+  // Where the branch's hanging length would underflow (t_max = 2.2e-162 escaped as an internal
+  // "y <= 0"), t_max is refused with its smallest value, and that value runs.
+  ReducedSetup tiny = make(Problem::kSliding, f, 0.01, 0.0);
+  tiny.t_max_over_t0 = 2.2227587494850775e-162;
+  CHECK_THROWS_WITH(solve_reduced(tiny), Contains("--t-max = 2.2227587494850775e-162 is out of range for the sliding "
+                                                  "chain from eta0 = 0: allowed t_max >= 2e-75"));
+  tiny.t_max_over_t0 = 2e-75;
+  CHECK_THAT(d(solve_reduced(tiny).summary["eta_stop"]), WithinRel(4e-150 / (3 + 2 * f), 1e-9));
   // The folded chain too.
   ReducedSetup folded = make(Problem::kFolded, f, 0.01, 0.0);
   folded.t_max_over_t0 = 1e-7;

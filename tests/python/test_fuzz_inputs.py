@@ -31,8 +31,11 @@ SCALE = int(os.environ.get("CHAINSIM_FUZZ_EXAMPLES", "1"))
 RANDOM = os.environ.get("CHAINSIM_FUZZ_RANDOM") == "1"
 
 
+DEADLINE = int(os.environ["CHAINSIM_FUZZ_DEADLINE_MS"]) if "CHAINSIM_FUZZ_DEADLINE_MS" in os.environ else None
+
+
 def fuzz_settings(examples):
-    return settings(max_examples=examples * SCALE, deadline=None, derandomize=not RANDOM, database=None,
+    return settings(max_examples=examples * SCALE, deadline=DEADLINE, derandomize=not RANDOM, database=None,
                     suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large])
 
 
@@ -218,6 +221,7 @@ def keyword_names(kwargs):
 @example(problem="falling", kwargs={"t_max": 1e-7})
 @example(problem="falling", kwargs={"gravity": 1e-100, "t_max": 1e-49})
 @example(problem="falling", kwargs={"length": 5e-324})
+@example(problem="sliding", kwargs={"t_max": 2.2227587494850775e-162})
 def test_reduced_with_any_keywords(problem, kwargs):
     kwargs.setdefault("max_steps", 20000)
     ends_well(lambda: chainsim.reduced(problem, **kwargs), keyword_names(kwargs) + ["problem"])
