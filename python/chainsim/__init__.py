@@ -177,7 +177,8 @@ class Scene:
     @classmethod
     def from_dict(cls, scene, name="<dict>"):
         """A scene from a dict of sections, e.g. {"string": {"length": 1.0, "nodes": 41}, "shape": {...},
-        "stop": {"t_end": 1.0}}; lists of dicts are arrays of tables ("effects": {"heap": [{...}]})."""
+        "stop": {"t_end": 1.0}}; lists of dicts are arrays of tables ("effects": {"heap": [{...}]}). numpy scalars
+        and arrays are taken as their values; a value no scene can hold raises ChainsimInputError naming its key."""
         return cls(_core.scene_toml_text(scene), name)
 
     def set(self, key=None, value=None, **keys):
@@ -296,6 +297,9 @@ def sweep(target, grid, *, t_end=None, workers=None, client=None):
 
     Columns: the grid keys, status (completed | stopped | failed | error | interrupted), error, wall_time_s,
     then the run's summary (stats.json flattened: nested keys as "a.b"). A failed point is a row with its error.
+    Refused before any point runs (ChainsimInputError): a grid that is not a dict of lists, an axis without values,
+    and two keys that set one scene key (f and effects.heap[0].f, or stop.t_end with t_end): a row would show
+    one value while the other ran.
     """
     import pandas as pd
 
