@@ -15,10 +15,13 @@ on each run (by default the draws are fixed, so that a CI run is reproducible).
 """
 import math
 import os
+import tempfile
 
 import numpy as np
 import pytest
 
+# Hypothesis keeps caches (its Unicode tables) in ./.hypothesis unless told otherwise: not in the source tree.
+os.environ.setdefault("HYPOTHESIS_STORAGE_DIRECTORY", os.path.join(tempfile.gettempdir(), "chainsim_hypothesis"))
 hypothesis = pytest.importorskip("hypothesis")
 from hypothesis import HealthCheck, example, given, settings, strategies as st  # noqa: E402
 
