@@ -405,7 +405,9 @@ TEST_CASE("solver.slack and solver.max_wall_s are parsed and checked, and check_
   }
 }
 
-TEST_CASE("--t-end is located at the option in every message about stop.t_end (issue #21)", "[unit][scene]") {
+TEST_CASE("an end time given on the command line (--t-end) is located at the option in every message about "
+          "stop.t_end (issue #21)",
+          "[unit][scene]") {
   // `chainsim run --t-end 1e-300` blamed "file:30:9: stop.t_end = 10.0".
   SceneSpec spec = parse_scene_text(kBase, "s.toml");
   replace_t_end(spec, 1e-300, "--t-end");
