@@ -174,7 +174,8 @@ void ReducedSetup::validate() const {
       throw InputError(fmt::format("--t-max = {} is out of range for the sliding chain from eta0 = 0: allowed t_max >= "
                                    "{} (the hanging length at t_max, eta = t_max^2/(3 + 2f) = {} of l, would "
                                    "underflow)",
-                                   t_max_over_t0, lowest, t_max_over_t0 * t_max_over_t0 / (3.0 + 2.0 * chain.dissipation)));
+                                   t_max_over_t0, lowest,
+                                   t_max_over_t0 * t_max_over_t0 / (3.0 + 2.0 * chain.dissipation)));
   }
   if (!std::isfinite(t_max_over_t0 * chain.t0()))
     throw InputError(fmt::format("--t-max = {} is out of range: t_max t0 = {} x {} s overflows; allowed t_max <= {}",

@@ -194,7 +194,8 @@ FrontScene<dim> build_front_scene(const SceneSpec& spec) {
     const double s = spec.stop.fronts[k].s0;
     const std::string key = fmt::format("stop.front[{}].s0", k);
     if (!(s >= 0 && s <= ell))
-      fail_at(spec, key, fmt::format("{} = {} is outside the string: allowed 0 <= s0 <= {} m", key, text_of(spec, key), ell));
+      fail_at(spec, key,
+              fmt::format("{} = {} is outside the string: allowed 0 <= s0 <= {} m", key, text_of(spec, key), ell));
     const std::string& name = names[static_cast<std::size_t>(stop_fronts[k])];
     const double s_start = name == "fold" ? fx.fold->s0 : name == "heap_start" ? s_lo : s_hi;
     if (std::abs(s - s_start) <= kPlaceTolerance * ell)

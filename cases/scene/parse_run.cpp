@@ -32,7 +32,8 @@ void parse_solver(const Section& top, Context& ctx) {
   integrator("max_step", [&](IntegratorOptions& o) { o.max_step = so.max_step; });
   so.initial_step = s.number("initial_step").value_or(so.initial_step);
   integrator("initial_step", [&](IntegratorOptions& o) { o.initial_step = so.initial_step; });
-  so.max_steps = static_cast<long>(s.integer_in("max_steps", 1, std::numeric_limits<long>::max()).value_or(so.max_steps));
+  so.max_steps =
+      static_cast<long>(s.integer_in("max_steps", 1, std::numeric_limits<long>::max()).value_or(so.max_steps));
   integrator("max_steps", [&](IntegratorOptions& o) { o.max_steps = so.max_steps; });
   auto model = [&](const char* key, auto set) {
     s.located(key, key, [&] {

@@ -64,8 +64,8 @@ void check_sweep_points(const SweepScene& scene, const std::vector<std::vector<s
 /// sets a key twice is an "error" row: check_sweep_points).
 nlohmann::json run_sweep_point(const SweepScene& scene, const std::vector<std::string>& point);
 
-/// Checks the points (check_sweep_points: throws InputError), then runs every point on `workers` threads (the runs share nothing but the interrupt flag); the rows are
-/// in the order of the points. After Ctrl-C (solver/interrupt.hpp) the running points end
+/// Checks the points (check_sweep_points: throws InputError), then runs every point on `workers` threads
+/// (the runs share nothing but the interrupt flag); the rows are in the order of the points. After Ctrl-C (solver/interrupt.hpp) the running points end
 /// "interrupted" and the points not started yet are rows with status "interrupted".
 std::vector<nlohmann::json> run_sweep(const SweepScene& scene, const std::vector<std::vector<std::string>>& points,
                                       int workers);

@@ -309,7 +309,8 @@ def sweep(target, grid, *, t_end=None, workers=None, client=None):
     for k in keys:
         _text_key(k)
         if isinstance(grid[k], (str, bytes, dict)) or not hasattr(grid[k], "__iter__"):
-            raise ChainsimInputError(f"the grid axis {k} = {grid[k]!r} is not a list of values, e.g. {{{k!r}: [0.1, 0.5]}}")
+            raise ChainsimInputError(f"the grid axis {k} = {grid[k]!r} is not a list of values, "
+                                     f"e.g. {{{k!r}: [0.1, 0.5]}}")
     values = [list(grid[k]) for k in keys]
     t_end = _t_end(t_end)
     if workers is not None and (isinstance(workers, (bool, np.bool_)) or not isinstance(workers, (int, np.integer))

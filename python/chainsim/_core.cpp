@@ -275,7 +275,8 @@ std::unique_ptr<Run> run_scene(const std::string& text, const std::string& sourc
 std::string shown(py::handle value) {
   const py::str text = py::repr(value);
   Py_ssize_t size = 0;
-  if (const char* data = PyUnicode_AsUTF8AndSize(text.ptr(), &size)) return std::string(data, static_cast<std::size_t>(size));
+  if (const char* data = PyUnicode_AsUTF8AndSize(text.ptr(), &size))
+    return std::string(data, static_cast<std::size_t>(size));
   PyErr_Clear();
   return py::reinterpret_steal<py::str>(PyObject_ASCII(value.ptr())).cast<std::string>();
 }
@@ -305,7 +306,8 @@ std::string integer_text(py::handle value) {
   const std::string text = py::str(value).cast<std::string>();
   const std::size_t digits = text.size() - (text[0] == '-' ? 1 : 0);
   if (digits <= 40) return text;
-  return fmt::format("{}…{} ({} digits)", text.substr(0, text.size() - digits + 12), text.substr(text.size() - 4), digits);
+  return fmt::format("{}…{} ({} digits)", text.substr(0, text.size() - digits + 12), text.substr(text.size() - 4),
+                     digits);
 }
 
 /// A real number (int, float, numpy scalar; not a bool, a string or None).
@@ -338,7 +340,8 @@ T integer_arg(const std::string& fn, const std::string& key, py::handle value) {
 }
 
 std::string text_arg(const std::string& fn, const std::string& key, py::handle value) {
-  if (!PyUnicode_Check(value.ptr())) throw InputError(fmt::format("{}(): {} = {} must be a string", fn, key, shown(value)));
+  if (!PyUnicode_Check(value.ptr()))
+    throw InputError(fmt::format("{}(): {} = {} must be a string", fn, key, shown(value)));
   return utf8(value, fmt::format("{}(): {}", fn, key));
 }
 
