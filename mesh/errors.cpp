@@ -21,14 +21,16 @@ void require_in_range(std::string_view name, double value, double lo, double hi,
   if (std::isfinite(value) && lo_ok && hi_ok) return;
   const std::string sym = bare_name(name);
   std::string range;
+  // Values and bounds in their shortest round-trip form: a value just outside a bound never prints
+  // as the bound (10000001 is not "1e+07", 1.0000000000000002 is not "1").
   if (std::isfinite(lo) && std::isfinite(hi))
-    range = fmt::format("{:g} {} {} {} {:g}", lo, lo_bound == Bound::kClosed ? "<=" : "<", sym,
+    range = fmt::format("{} {} {} {} {}", lo, lo_bound == Bound::kClosed ? "<=" : "<", sym,
                         hi_bound == Bound::kClosed ? "<=" : "<", hi);
   else if (std::isfinite(lo))
-    range = fmt::format("{} {} {:g}", sym, lo_bound == Bound::kClosed ? ">=" : ">", lo);
+    range = fmt::format("{} {} {}", sym, lo_bound == Bound::kClosed ? ">=" : ">", lo);
   else
-    range = fmt::format("{} {} {:g}", sym, hi_bound == Bound::kClosed ? "<=" : "<", hi);
-  throw InputError(fmt::format("{} = {:g} is out of range: allowed {}", name, value, range));
+    range = fmt::format("{} {} {}", sym, hi_bound == Bound::kClosed ? "<=" : "<", hi);
+  throw InputError(fmt::format("{} = {} is out of range: allowed {}", name, value, range));
 }
 
 void require_positive(std::string_view name, double value) {
@@ -37,7 +39,7 @@ void require_positive(std::string_view name, double value) {
 
 void require_finite(std::string_view name, double value) {
   if (!std::isfinite(value))
-    throw InputError(fmt::format("{} = {:g} is not a finite number", name, value));
+    throw InputError(fmt::format("{} = {} is not a finite number", name, value));
 }
 
 void verify_failed(const char* condition, const char* file, int line, const std::string& msg) {

@@ -50,6 +50,12 @@ enum class Bound { kClosed, kOpen };
 void require_in_range(std::string_view name, double value, double lo, double hi,
                       Bound lo_bound = Bound::kClosed, Bound hi_bound = Bound::kClosed);
 
+/// The range of a physical scale (a length, a density, |g|, a speed, a time, a force) that the solvers
+/// accept: they form squares and products of the scales (energies, tensions), which must stay finite
+/// and normal, so an input scale lies in [kMinScale, kMaxScale] and a derived one (a product of two)
+/// in [kMinScale², kMaxScale²].
+inline constexpr double kMinScale = 1e-100, kMaxScale = 1e100;
+
 /// Throws InputError unless value > 0 (finite).
 void require_positive(std::string_view name, double value);
 

@@ -81,8 +81,10 @@ StringCaseRun solve_string_case(const StringCaseSetup& setup) {
         if (bend == 0) {
           x.col(i) = sigma * tilted;
         } else {
-          const double R = y0 / bend, phi = tilt + sigma / R;
-          x.col(i) = Vec<2>(R * (std::cos(tilt) - std::cos(phi)), R * (std::sin(phi) - std::sin(tilt)));
+          // The arc of radius R = y0/bend turning by delta = sigma/R, written without the cancellation of
+          // cos(tilt) - cos(tilt + delta) (bend = 2e-14 degrees put the heap point 1.6 cm off the shape).
+          const double R = y0 / bend, delta = sigma / R, chord = 2 * R * std::sin(delta / 2);
+          x.col(i) = chord * Vec<2>(std::sin(tilt + delta / 2), std::cos(tilt + delta / 2));
         }
       }
       heaps.push_back({HeapSpec<2>::Side::kAfter, Vec<2>::Zero(), f, y0, up});

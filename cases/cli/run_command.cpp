@@ -204,11 +204,7 @@ int run_scene_command(const RunCommandOptions& options, std::ostream& out) {
   try {
     // 1. Scene (and the command line's overrides).
     SceneSpec spec = parse_scene(options.scene, options.overrides);
-    if (options.t_end) {
-      if (!(*options.t_end > 0 && std::isfinite(*options.t_end)))
-        throw InputError(fmt::format("--t-end = {:g} is out of range: allowed t_end > 0", *options.t_end));
-      spec.stop.t_end = *options.t_end;
-    }
+    if (options.t_end) replace_t_end(spec, *options.t_end, "--t-end");
     if (options.max_wall) {
       if (!(*options.max_wall > 0 && std::isfinite(*options.max_wall)))
         throw InputError(fmt::format("--max-wall = {:g} is out of range: allowed max_wall > 0 (s)", *options.max_wall));

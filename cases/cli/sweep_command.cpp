@@ -54,6 +54,7 @@ int run_sweep_command(const SweepCommandOptions& options, std::ostream& out) {
   // the command's error (exit 2), a bad point is a row.
   const SweepScene scene{read_scene_file(options.scene), options.scene, options.overrides, options.t_end};
   parse_scene_text(scene.text, scene.source, scene.overrides);  // the file's own errors, located
+  check_sweep_points(scene, points);                             // a key set twice, before any output
   const std::filesystem::path dir = options.out.empty()
                                         ? std::filesystem::path("results") / "sweep" /
                                               std::filesystem::path(options.scene).stem()

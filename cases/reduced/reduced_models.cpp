@@ -3,6 +3,7 @@
 
 #include <chrono>
 #include <cmath>
+#include <limits>
 #include <string>
 
 #include <fmt/format.h>
@@ -55,10 +56,18 @@ std::string to_string(Problem problem) {
 }
 
 void ChainParameters::validate() const {
-  require_positive("--length", length);
-  require_positive("--density", density);
-  require_positive("--gravity", gravity);
+  // Each scale, and the energy scale λ g ℓ² the ledger and the tolerances use, in the range the
+  // solvers accept (mesh/errors.hpp): ℓ = 5e-324 made the energy scale 0 (an internal error).
+  for (const auto& [name, value] : {std::pair{"--length", length}, {"--density", density}, {"--gravity", gravity}}) {
+    require_positive(name, value);
+    require_in_range(name, value, kMinScale, kMaxScale);
+  }
   require_in_range("--f", dissipation, 0.0, 1.0);
+  const double energy = density * gravity * length * length;
+  if (!(energy >= kMinScale * kMinScale && energy <= kMaxScale * kMaxScale))
+    throw InputError(fmt::format("--length = {}, --density = {}, --gravity = {}: the energy scale lambda g l^2 = {} J "
+                                 "is out of the range the solver can represent: allowed {} to {}",
+                                 length, density, gravity, energy, kMinScale * kMinScale, kMaxScale * kMaxScale));
 }
 
 double ChainParameters::t0() const { return std::sqrt(2.0 * length / gravity); }
@@ -98,6 +107,10 @@ TimeToEnd time_to_end(Problem problem, double f, double eta0) {
   return {};
 }
 
+/// The smallest hanging fraction η of the sliding chain at its start: far above the smallest normal
+/// double even in units of the shortest length a chain may have (kMinScale).
+constexpr double kMinHangingFraction = 1e-150;
+
 /// x rounded up to two significant digits, as the double nearest to that decimal (so that the
 /// limit printed, and typed back by a user, is exactly the limit checked).
 double round_up_2(double x) {
@@ -133,7 +146,7 @@ void ReducedSetup::validate() const {
   if (problem != Problem::kSliding && eps < min_cutoff()) {
     const double f = chain.dissipation;
     throw InputError(fmt::format(
-        "--eps = {:g} is out of range for the {} chain with f = {:g}, eta0 = {:g}: allowed {:g} <= eps < {:g}. The "
+        "--eps = {} is out of range for the {} chain with f = {}, eta0 = {}: allowed {} <= eps < {}. The "
         "exact time left between that cutoff and the singular end of the fall is {:.2g} t0, less than {:g} t0 "
         "(about 10^3 round-off units of t): the run cannot resolve the cutoff",
         eps, to_string(problem), f, e0, min_cutoff(), problem == Problem::kFalling ? e0 : 1.0 - e0,
@@ -144,15 +157,30 @@ void ReducedSetup::validate() const {
     const double weight = chain.density * chain.gravity * chain.length;
     if (e0 == 0.0 && force > weight)
       throw InputError(fmt::format(
-          "--force = {:g} N exceeds the chain's weight lambda g l = {:g} N: released at eta0 = 0, the free end would "
-          "rise above its start at once, out of the model's domain eta >= 0; allowed 0 <= force <= {:g} N at "
+          "--force = {} N exceeds the chain's weight lambda g l = {} N: released at eta0 = 0, the free end would "
+          "rise above its start at once, out of the model's domain eta >= 0; allowed 0 <= force <= {} N at "
           "eta0 = 0 (from eta0 > 0 a larger force lifts the fold to the fixed end, where the run stops)",
           force, weight, weight));
   } else if (force != 0.0)
-    throw InputError(fmt::format("--force = {:g} applies to the folded chain only (the {} chain has no loaded end): "
+    throw InputError(fmt::format("--force = {} applies to the folded chain only (the {} chain has no loaded end): "
                                  "allowed force = 0",
                                  force, to_string(problem)));
   require_positive("--t-max", t_max_over_t0);
+  if (problem == Problem::kSliding && e0 == 0.0) {
+    // Up to t_max the chain follows its branch η = τ²/(3 + 2f) (τ = t/t0), whose hanging length
+    // must stay a normal number: the model divides by it.
+    const double lowest = round_up_2(std::sqrt((3.0 + 2.0 * chain.dissipation) * kMinHangingFraction));
+    if (t_max_over_t0 < lowest)
+      throw InputError(fmt::format("--t-max = {} is out of range for the sliding chain from eta0 = 0: allowed t_max >= "
+                                   "{} (the hanging length at t_max, eta = t_max^2/(3 + 2f) = {} of l, would "
+                                   "underflow)",
+                                   t_max_over_t0, lowest,
+                                   t_max_over_t0 * t_max_over_t0 / (3.0 + 2.0 * chain.dissipation)));
+  }
+  if (!std::isfinite(t_max_over_t0 * chain.t0()))
+    throw InputError(fmt::format("--t-max = {} is out of range: t_max t0 = {} x {} s overflows; allowed t_max <= {}",
+                                 t_max_over_t0, t_max_over_t0, chain.t0(),
+                                 std::numeric_limits<double>::max() / chain.t0()));
   integrator.validate();
 }
 
@@ -171,8 +199,10 @@ struct Snapshot {
 /// The ODE for one problem: state (y, ẏ, E_shock, E_heap, E_force), where E_k = ∫ W_k dt.
 class ReducedOde : public OdeSystem {
  public:
-  explicit ReducedOde(const ReducedSetup& s)
-      : s_(s), l_(s.chain.length), lam_(s.chain.density), g_(s.chain.gravity), f_(s.chain.dissipation) {}
+  /// `t_max`: the run's end (s), which bounds its time scale.
+  ReducedOde(const ReducedSetup& s, double t_max)
+      : s_(s), l_(s.chain.length), lam_(s.chain.density), g_(s.chain.gravity), f_(s.chain.dissipation),
+        t_max_(t_max) {}
 
   int size() const override { return 5; }
 
@@ -261,11 +291,13 @@ class ReducedOde : public OdeSystem {
     return scale;
   }
 
-  double time_scale() const override { return s_.chain.t0(); }
+  /// t0, or the run's length if shorter: the integrator's step-size floor is a fraction of this, so
+  /// it stays below the steps a run of any length takes (a run of 1e-7 t0 has steps far below 1e-14 t0).
+  double time_scale() const override { return std::min(s_.chain.t0(), t_max_); }
 
  private:
   const ReducedSetup& s_;
-  double l_, lam_, g_, f_;
+  double l_, lam_, g_, f_, t_max_;
 };
 
 /// The recorded series, bounded before the run: rows of accepted steps 0, k, 2k, … (stride k), the
@@ -322,21 +354,25 @@ ReducedRun solve_reduced(const ReducedSetup& setup) {
   const double eta0 = setup.initial_eta();
 
   // 1. Initial state: at rest, except the sliding chain from η0 = 0, which starts on its
-  //    non-trivial branch y = a t²/2 at η = kSlidingStartEta (see reduced_models.hpp).
+  //    non-trivial branch y = a t²/2 at η = kSlidingStartEta (see reduced_models.hpp), or at the
+  //    safety stop if that comes first: the branch is the exact solution up to there.
+  //    Every time is on the clock of the release (t = 0): the run ends at t_max = t_max/t0 · t0
+  //    exactly, whatever its size relative to t0 and to t_start.
+  const double t_max = setup.t_max_over_t0 * t0;
   double t_start = 0.0;
   Eigen::VectorXd u0 = Eigen::VectorXd::Zero(5);
   u0[0] = eta0 * l;
   const bool sliding_branch = setup.problem == Problem::kSliding && eta0 == 0.0;
   if (sliding_branch) {
     const double a = g / (3.0 + 2.0 * f);
-    u0[0] = kSlidingStartEta * l;
-    t_start = std::sqrt(2.0 * u0[0] / a);
+    t_start = std::min(std::sqrt(2.0 * kSlidingStartEta * l / a), t_max);
+    u0[0] = 0.5 * a * t_start * t_start;
     u0[1] = a * t_start;
   }
 
   // 2. Integrator: record the accepted steps (thinned to max_rows), with steps no longer than t0/500
   //    by default.
-  ReducedOde ode(setup);
+  ReducedOde ode(setup, t_max);
   IntegratorOptions opts = setup.integrator;
   if (opts.max_step == 0) opts.max_step = t0 / 500.0;
   Integrator integrator(ode, t_start, u0, opts);
@@ -360,12 +396,11 @@ ReducedRun solve_reduced(const ReducedSetup& setup) {
   record(t_start, u0);
 
   // 3. Advance step by step until a stop event (or the safety time).
-  const double t_max = t_start + setup.t_max_over_t0 * t0;
   std::string stop_reason = "t_max";
-  std::string stop_detail = fmt::format("the safety stop t_max = {:g} t0 was reached before a stop event",
+  std::string stop_detail = fmt::format("the safety stop t_max = {} t0 was reached before a stop event",
                                         setup.t_max_over_t0);
   int turning_points = 0;
-  for (;;) {
+  while (integrator.time() < t_max) {
     const auto outcome = integrator.advance(t_max, /*one_step=*/true);
     record(integrator.time(), integrator.state());
     if (outcome == Integrator::Outcome::kReachedTarget) break;
@@ -426,7 +461,7 @@ ReducedRun solve_reduced(const ReducedSetup& setup) {
       {"stop_detail", stop_detail},
       {"t_start", t_start},
       {"t_stop", t_stop},
-      {"t_stop_over_t0", t_stop / t0},
+      {"t_stop_over_t0", stop_reason == "t_max" ? setup.t_max_over_t0 : t_stop / t0},  // t_max as given
       {"eta_stop", eta_stop},
       {"P_stop", q.P},
       {"P_stop_over_P0", q.P / P0},

@@ -33,9 +33,9 @@ std::string to_string(Problem problem);
 
 /// The chain's constants, SI units.
 struct ChainParameters {
-  double length = 1.0;       ///< ℓ (m), > 0
-  double density = 1.0;      ///< λ (kg/m), > 0
-  double gravity = 9.81;     ///< g (m/s²), > 0
+  double length = 1.0;       ///< ℓ (m), in [1e-100, 1e100] (kMinScale, kMaxScale)
+  double density = 1.0;      ///< λ (kg/m), in [1e-100, 1e100]
+  double gravity = 9.81;     ///< g (m/s²), in [1e-100, 1e100]; λ g ℓ² in [1e-200, 1e200]
   double dissipation = 0.83; ///< f, the shock dissipation parameter, in [0, 1]
   void validate() const;
   double t0() const;         ///< sqrt(2 ℓ / g): time of free fall from height ℓ (s)

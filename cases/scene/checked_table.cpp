@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 namespace chainsim::scene_parse {
 
@@ -115,6 +116,17 @@ std::optional<long long> Section::integer(const std::string& key) const {
   if (!n) return std::nullopt;
   if (!n->is_integer()) wrong_type(key, "an integer");
   return n->value<long long>();
+}
+
+std::optional<long long> Section::integer_in(const std::string& key, long long lo, long long hi) const {
+  const auto v = integer(key);
+  if (v && (*v < lo || *v > hi)) {
+    const std::string sym = key;
+    fail(key, hi == std::numeric_limits<long long>::max() || hi == std::numeric_limits<long>::max()
+                  ? fmt::format("{} = {} is out of range: allowed {} >= {}", full(key), *v, sym, lo)
+                  : fmt::format("{} = {} is out of range: allowed {} <= {} <= {}", full(key), *v, lo, sym, hi));
+  }
+  return v;
 }
 
 std::optional<bool> Section::boolean(const std::string& key) const {

@@ -77,6 +77,8 @@ class Section {
                    Bound hi_bound = Bound::kClosed) const;
   std::optional<double> positive(const std::string& key) const;
   std::optional<long long> integer(const std::string& key) const;
+  /// An integer in [lo, hi], the message printing it and the bounds as integers.
+  std::optional<long long> integer_in(const std::string& key, long long lo, long long hi) const;
   std::optional<bool> boolean(const std::string& key) const;
   std::optional<std::string> string(const std::string& key) const;
   /// A string that must be one of `choices`.

@@ -79,6 +79,12 @@ FrontScene<dim> build_front_scene(const SceneSpec& spec) {
     fail_at(spec, first_front,
             fmt::format("{} on a closed string: fronts are tracked on open strings only (string.closed = true)",
                         fx.heaps.empty() ? "[effects.fold]" : "[[effects.heap]]"));
+  if (chain.num_links() < 2) {
+    const std::string key = spec.link_length ? "string.link_length" : "string.nodes";
+    fail_at(spec, key,
+            fmt::format("{} = {} gives {} link: a string with fronts needs at least 2 links (allowed nodes >= 3)", key,
+                        text_of(spec, key), chain.num_links()));
+  }
   for (std::size_t k = 0; k < fx.heaps.size(); ++k) {
     const HeapEntry& heap = fx.heaps[k];
     const EndSpec& end = heap.side == "start" ? spec.start : spec.end;
@@ -96,10 +102,10 @@ FrontScene<dim> build_front_scene(const SceneSpec& spec) {
   if (fx.plane) {
     plane_point = as_vec<dim>(spec, fx.plane->point, "effects.plane.point");
     const Vec<dim> n = as_vec<dim>(spec, fx.plane->normal, "effects.plane.normal");
-    if (!(n.norm() > 0))
+    if (n.isZero(0.0))
       fail_at(spec, "effects.plane.normal",
               fmt::format("effects.plane.normal = {} is zero: a plane needs a normal", text_of(spec, "effects.plane.normal")));
-    plane_normal = n.normalized();
+    plane_normal = n.stableNormalized();  // [0, 1e300] too: its norm overflows, its direction does not
   }
   for (std::size_t k = 0; k < fx.heaps.size(); ++k) {
     const HeapEntry& heap = fx.heaps[k];
@@ -108,9 +114,9 @@ FrontScene<dim> build_front_scene(const SceneSpec& spec) {
     const bool inside = start ? (heap.s0 >= 0 && heap.s0 < ell) : (heap.s0 > 0 && heap.s0 <= ell * (1 + 1e-12));
     if (!inside)
       fail_at(spec, key + ".s0",
-              fmt::format("{}.s0 = {} is outside the string: allowed {} for side = \"{}\" (the string is {:g} m long)",
+              fmt::format("{}.s0 = {} is outside the string: allowed {} for side = \"{}\" (the string is {} m long)",
                           key, text_of(spec, key + ".s0"),
-                          start ? fmt::format("0 <= s0 < {:g}", ell) : fmt::format("0 < s0 <= {:g}", ell), heap.side,
+                          start ? fmt::format("0 <= s0 < {}", ell) : fmt::format("0 < s0 <= {}", ell), heap.side,
                           ell));
     const Vec<dim> point = as_vec<dim>(spec, heap.point, key + ".point");
     const Vec<dim> on_shape = parts.curve->point(heap.s0);
@@ -162,7 +168,7 @@ FrontScene<dim> build_front_scene(const SceneSpec& spec) {
     const bool end_heap = std::any_of(fx.heaps.begin(), fx.heaps.end(), [](const HeapEntry& e) { return e.side == "end"; });
     if (!((start_heap ? s0 > s_lo : s0 >= 0) && s0 < s_hi))
       fail_at(spec, key,
-              fmt::format("effects.fold.s0 = {} is {}: allowed {:g} {} s0 < {:g}", text_of(spec, key),
+              fmt::format("effects.fold.s0 = {} is {}: allowed {} {} s0 < {}", text_of(spec, key),
                           start_heap || end_heap ? "not between the heaps" : "outside the string", s_lo,
                           start_heap ? "<" : "<=", s_hi));
     const double d = kTangentStep * ell;
@@ -188,7 +194,8 @@ FrontScene<dim> build_front_scene(const SceneSpec& spec) {
     const double s = spec.stop.fronts[k].s0;
     const std::string key = fmt::format("stop.front[{}].s0", k);
     if (!(s >= 0 && s <= ell))
-      fail_at(spec, key, fmt::format("{} = {} is outside the string: allowed 0 <= s0 <= {:g} m", key, text_of(spec, key), ell));
+      fail_at(spec, key,
+              fmt::format("{} = {} is outside the string: allowed 0 <= s0 <= {} m", key, text_of(spec, key), ell));
     const std::string& name = names[static_cast<std::size_t>(stop_fronts[k])];
     const double s_start = name == "fold" ? fx.fold->s0 : name == "heap_start" ? s_lo : s_hi;
     if (std::abs(s - s_start) <= kPlaceTolerance * ell)
@@ -213,13 +220,17 @@ FrontScene<dim> build_front_scene(const SceneSpec& spec) {
   for (const auto& p : parts.prescribed) d["prescribed"].push_back(fmt::format("node {}: {}", p.node, p.path->description()));
   const StringModelOptions mo = parts.model;
   const std::string fit_key = fold && heaps.empty() ? "effects.fold.s0" : first_front;
+  // Located at the front and naming it: the tracker's messages speak of "the heap's plane", "the fold".
   scene.model = at_key(spec, fit_key, [&] {
     try {
       return std::make_unique<StringModel<dim>>(make_front_model<dim>(std::move(parts.chain), std::move(parts.forces),
                                                                       std::move(parts.prescribed), heaps, fold,
                                                                       options, mo));
     } catch (const RecoverableError& e) {  // a degenerate front geometry found while placing the fronts
-      throw InputError(e.what());
+      throw InputError(fmt::format("{}: {}", fit_key, e.what()));
+    } catch (const InputError& e) {
+      if (spec.located(e.what())) throw;
+      throw InputError(fmt::format("{}: {}", fit_key, e.what()));
     }
   });
   const FrontTracker<dim>& tracker = *front_tracker(*scene.model);

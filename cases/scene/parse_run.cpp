@@ -1,5 +1,6 @@
 // [solver], [output], [stop] and the top-level model key: how the scene runs (parse_sections.hpp).
 #include <algorithm>
+#include <limits>
 
 #include "cases/scene/parse_sections.hpp"
 #include "solver/integrator.hpp"
@@ -31,7 +32,8 @@ void parse_solver(const Section& top, Context& ctx) {
   integrator("max_step", [&](IntegratorOptions& o) { o.max_step = so.max_step; });
   so.initial_step = s.number("initial_step").value_or(so.initial_step);
   integrator("initial_step", [&](IntegratorOptions& o) { o.initial_step = so.initial_step; });
-  so.max_steps = static_cast<long>(s.integer("max_steps").value_or(so.max_steps));
+  so.max_steps =
+      static_cast<long>(s.integer_in("max_steps", 1, std::numeric_limits<long>::max()).value_or(so.max_steps));
   integrator("max_steps", [&](IntegratorOptions& o) { o.max_steps = so.max_steps; });
   auto model = [&](const char* key, auto set) {
     s.located(key, key, [&] {

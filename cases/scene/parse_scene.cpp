@@ -3,6 +3,7 @@
 // (checked_table.hpp), after the command line's overrides (scene_overrides.hpp); every key read is
 // located in the scene text (scene_text.hpp).
 // See docs/scenes.md for every key.
+#include <cmath>
 #include <cstdint>
 #include <fstream>
 #include <system_error>
@@ -58,6 +59,20 @@ std::string SceneSpec::where(const std::string& key) const {
     k = cut == std::string::npos ? "" : k.substr(0, cut);
   }
   return source + ":1:1";
+}
+
+bool SceneSpec::located(const std::string& message) const {
+  if (message.rfind(source + ":", 0) == 0) return true;
+  for (const auto& [key, location] : locations)
+    if (!location.where.empty() && message.rfind(location.where + ":", 0) == 0) return true;
+  return false;
+}
+
+void replace_t_end(SceneSpec& spec, double t_end, const std::string& origin) {
+  if (!(t_end > 0 && std::isfinite(t_end)))
+    throw InputError(fmt::format("{} = {} is out of range: allowed t_end > 0 (s)", origin, t_end));
+  spec.stop.t_end = t_end;
+  spec.locations["stop.t_end"] = {origin, fmt::format("{}", t_end)};
 }
 
 SceneSpec parse_scene_text(std::string_view text, const std::string& source) { return parse_scene_text(text, source, {}); }

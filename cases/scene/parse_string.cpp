@@ -63,11 +63,7 @@ void parse_string(const Section& top, Context& ctx) {
   Section s(subtable(top, "string"), "string", ctx, {"length", "density", "nodes", "link_length", "closed", "dimension"});
   spec.length = s.positive("length");
   spec.density = s.positive("density").value_or(spec.density);
-  if (auto n = s.integer("nodes")) {
-    s.located("nodes", "string.nodes",
-              [&] { require_in_range("string.nodes", static_cast<double>(*n), 2, static_cast<double>(kMaxNodes)); });
-    spec.nodes = static_cast<int>(*n);
-  }
+  if (auto n = s.integer_in("nodes", 2, kMaxNodes)) spec.nodes = static_cast<int>(*n);
   spec.link_length = s.positive("link_length");
   if (spec.nodes && spec.link_length)
     s.fail("link_length", fmt::format("string.link_length = {} and string.nodes = {} both set the resolution: give "

@@ -33,7 +33,7 @@ std::string degrees(double radians) {
 
 template <int dim>
 double angle_between(const Vec<dim>& a, const Vec<dim>& b) {
-  const double c = a.dot(b) / (a.norm() * b.norm());
+  const double c = a.stableNormalized().dot(b.stableNormalized());  // no overflow for huge vectors
   return std::acos(std::clamp(c, -1.0, 1.0));
 }
 
@@ -66,7 +66,7 @@ ReducedSetup match(const SceneSpec& spec) {
   const Vec<dim> g = as_vec<dim>(spec, *fx.gravity, "effects.gravity.g");
   if (!(g.norm() > 0)) refuse("needs gravity: effects.gravity.g is zero");
   if (fx.drag) refuse("has no drag: remove [effects.drag]");
-  const Vec<dim> down = g.normalized();
+  const Vec<dim> down = g.stableNormalized();
   const Chain<dim>& chain = scene.model->chain();
   const double ell = chain.length();
 
@@ -126,7 +126,7 @@ ReducedSetup match(const SceneSpec& spec) {
       if (spec.start.kind != "free")
         refuse(fmt::format("needs the falling chain's top end free: ends.start = \"{}\"", spec.start.kind));
       arms.push_back({"falling part", 0, heap.s0, heap.s0, point, down});
-      setup.eta0 = heap.s0 / ell;
+      setup.eta0 = std::min(heap.s0 / ell, 1.0);  // s0 = ℓ as written may exceed the chain's length by round-off
       setup.eps = cutoff("heap_end", 0.0, heap.s0, "s0 = eps l") / ell;
     } else {
       setup.problem = Problem::kSliding;

@@ -100,6 +100,9 @@ struct SceneSpec {
   /// "file:line:column" of `key`, or of the nearest enclosing section written in the file, else
   /// "file:1:1" (a key that is missing altogether concerns the whole file).
   std::string where(const std::string& key) const;
+  /// True if `message` already starts with a location of this scene ("file:line:column: ", or an
+  /// option such as "--set KEY=VALUE: " or "--t-end: ").
+  bool located(const std::string& message) const;
 
   /// model = "string" (the string solver, with front tracking if the scene has fronts) or "reduced".
   std::string model = "string";
@@ -179,6 +182,12 @@ std::string read_scene_file(const std::filesystem::path& file);
 /// The same from text; `source` names it in messages.
 SceneSpec parse_scene_text(std::string_view text, const std::string& source);
 SceneSpec parse_scene_text(std::string_view text, const std::string& source, const std::vector<std::string>& overrides);
+
+/// Replaces [stop] t_end by the value of an option (`--t-end` of `chainsim run` and `chainsim sweep`,
+/// the t_end keyword in Python), named `origin` in messages: checked (t_end > 0, finite) and, for every
+/// later message about stop.t_end (the scales, the output budget), located at `origin` with the value
+/// given, not at the file's line. Throws InputError.
+void replace_t_end(SceneSpec& spec, double t_end, const std::string& origin);
 
 /// A scene ready to run.
 template <int dim>

@@ -34,7 +34,7 @@ auto at_key(const SceneSpec& spec, const std::string& key, F&& f) -> decltype(f(
     return f();
   } catch (const InputError& e) {
     const std::string message = e.what();
-    if (message.rfind(spec.source + ":", 0) == 0) throw;
+    if (spec.located(message)) throw;
     throw InputError(fmt::format("{}: {}", spec.where(key), message));
   }
 }

@@ -77,7 +77,7 @@ int link_count(const SceneSpec& spec, double length, bool closed) {
     const double links = std::round(length / *spec.link_length);
     if (links > kMaxNodes)
       fail_at(spec, "string.link_length",
-              fmt::format("string.link_length = {:g} m asks for {:.3g} links on {:g} m: allowed at most {} nodes",
+              fmt::format("string.link_length = {} m asks for {:.3g} links on {} m: allowed at most {} nodes",
                           *spec.link_length, links, length, kMaxNodes));
     return std::max(minimum, static_cast<int>(links));
   }
@@ -92,9 +92,8 @@ int link_count(const SceneSpec& spec, double length, bool closed) {
 /// The scales of a run must leave its scaled problem well inside the double range: the solver forms
 /// squares and products of them (energies λ v² ℓ, tensions λ (|g| ℓ + v²) + |F|, the reach
 /// ℓ + v t_end + |g| t_end²), so each nonzero input scale lies in [kMinScale, kMaxScale] and each
-/// derived one in [kMinScale², kMaxScale²]. A scene outside is refused at its key before the run,
-/// rather than ending in a non-finite value at its first step.
-constexpr double kMinScale = 1e-100, kMaxScale = 1e100;
+/// derived one in [kMinScale², kMaxScale²] (mesh/errors.hpp). A scene outside is refused at its key
+/// before the run, rather than ending in a non-finite value at its first step.
 
 struct Scale {
   std::string key;   ///< the scene key that sets it
@@ -106,7 +105,7 @@ void check_scales(const SceneSpec& spec, const std::vector<Scale>& inputs, const
   auto check = [&](const Scale& s, double lo, double hi) {
     if (s.value == 0 || (s.value >= lo && s.value <= hi)) return;
     fail_at(spec, s.key,
-            fmt::format("{} = {}: {} is {:.3g}, out of the range the solver can represent: allowed {:g} to {:g} "
+            fmt::format("{} = {}: {} is {}, out of the range the solver can represent: allowed {} to {} "
                         "(or 0); the scaled problem would overflow or underflow",
                         s.key, text_of(spec, s.key), s.what, s.value, lo, hi));
   };
@@ -239,7 +238,8 @@ SceneParts<dim> build_scene_parts(const SceneSpec& spec) {
                   {"effects.gravity.g", "|g| (m/s^2)", gn},
                   {velocity_key, "the fastest initial or driven speed (m/s)", v_max},
                   {"stop.t_end", "the run's length (s)", t_end},
-                  {force_key, "the largest end load (N)", force}},
+                  {force_key, "the largest end load (N)", force},
+                  {"solver.stabilization_time", "the Baumgarte time (s)", so.stabilization_time.value_or(0.0)}},
                  {{"effects.gravity.g", "the tension scale density (|g| length + v^2) + |F| (N)", tension},
                   {"stop.t_end", "the reach length + v t_end + |g| t_end^2 (m)",
                    length + v_max * t_end + gn * t_end * t_end},

@@ -2,6 +2,8 @@
 #include "cases/scene/scene_sweep.hpp"
 
 #include <atomic>
+#include <cctype>
+#include <map>
 #include <chrono>
 #include <cmath>
 #include <set>
@@ -29,17 +31,42 @@ std::string front_f_key(const SceneSpec& spec) {
   return spec.effects.fold ? "effects.fold.f" : "effects.heap[0].f";
 }
 
-/// The point's overrides with `f=` replaced by the key it stands for.
-std::vector<std::string> resolve_keys(const SweepScene& scene, const std::vector<std::string>& point) {
+/// The key of an override "KEY=VALUE".
+std::string key_of(const std::string& override_text) { return override_text.substr(0, override_text.find('=')); }
+
+/// A dotted key with every index written without leading zeros ("heap[007]" -> "heap[7]").
+std::string normalized_indices(const std::string& key) {
+  std::string out;
+  for (std::size_t i = 0; i < key.size(); ++i) {
+    out += key[i];
+    if (key[i] != '[') continue;
+    std::size_t j = i + 1;
+    while (j + 1 < key.size() && key[j] == '0' && std::isdigit(static_cast<unsigned char>(key[j + 1]))) ++j;
+    i = j - 1;
+  }
+  return out;
+}
+
+/// The point's overrides with `f=` replaced by the key it stands for; throws InputError if two of them
+/// (or one and the sweep's t_end) set one scene key. `canonical` caches the scene key of each grid key
+/// (`f` parses the scene).
+std::vector<std::string> resolve_keys(const SweepScene& scene, const std::vector<std::string>& point,
+                                      std::map<std::string, std::string>& canonical) {
   std::vector<std::string> out;
-  std::optional<std::string> f_key;
+  std::map<std::string, std::string> seen;  // scene key -> the grid key that sets it
+  if (scene.t_end) seen["stop.t_end"] = scene.t_end_origin;
   for (const std::string& o : point) {
-    if (o.rfind("f=", 0) == 0) {
-      if (!f_key) f_key = front_f_key(parse_scene_text(scene.text, scene.source, scene.overrides));
-      out.push_back(*f_key + o.substr(1));
-    } else {
-      out.push_back(o);
-    }
+    const std::string key = key_of(o);
+    auto it = canonical.find(key);
+    if (it == canonical.end()) it = canonical.emplace(key, canonical_sweep_key(scene, key)).first;
+    out.push_back(key == "f" ? it->second + o.substr(key.size()) : o);
+    const auto [previous, fresh] = seen.emplace(it->second, key);
+    if (fresh) continue;
+    const bool t_end = scene.t_end && previous->second == scene.t_end_origin;
+    throw InputError(fmt::format(
+        "the grid key {} and {} {} both set {}: a row would show one value while the other ran; give one of them",
+        t_end ? key : previous->second, t_end ? "the sweep's" : "the grid key", t_end ? previous->second : key,
+        it->second));
   }
   return out;
 }
@@ -77,6 +104,16 @@ void flatten_into(nlohmann::json& row, const std::string& prefix, const nlohmann
 }
 
 }  // namespace
+
+std::string canonical_sweep_key(const SweepScene& scene, const std::string& key) {
+  if (key == "f") return front_f_key(parse_scene_text(scene.text, scene.source, scene.overrides));
+  return normalized_indices(key);
+}
+
+void check_sweep_points(const SweepScene& scene, const std::vector<std::vector<std::string>>& points) {
+  std::map<std::string, std::string> canonical;  // grid key as written -> scene key (f: parsed once)
+  for (const auto& point : points) resolve_keys(scene, point, canonical);
+}
 
 SweepAxis parse_grid_axis(const std::string& argument) {
   const auto eq = argument.find('=');
@@ -126,14 +163,11 @@ nlohmann::json run_sweep_point(const SweepScene& scene, const std::vector<std::s
   nlohmann::json summary;
   std::string status, error;
   try {
+    std::map<std::string, std::string> canonical;
     std::vector<std::string> overrides = scene.overrides;
-    for (const std::string& o : resolve_keys(scene, point)) overrides.push_back(o);
+    for (const std::string& o : resolve_keys(scene, point, canonical)) overrides.push_back(o);
     SceneSpec spec = parse_scene_text(scene.text, scene.source, overrides);
-    if (scene.t_end) {
-      if (!(*scene.t_end > 0 && std::isfinite(*scene.t_end)))
-        throw InputError(fmt::format("t_end = {:g} is out of range: allowed t_end > 0", *scene.t_end));
-      spec.stop.t_end = *scene.t_end;
-    }
+    if (scene.t_end) replace_t_end(spec, *scene.t_end, scene.t_end_origin);
     summary = run_point(spec);
     status = summary.value("status", "completed");
     error = summary.value("error", "");
@@ -156,6 +190,7 @@ nlohmann::json run_sweep_point(const SweepScene& scene, const std::vector<std::s
 
 std::vector<nlohmann::json> run_sweep(const SweepScene& scene, const std::vector<std::vector<std::string>>& points,
                                       int workers) {
+  check_sweep_points(scene, points);
   std::vector<nlohmann::json> rows(points.size());
   std::atomic<std::size_t> next{0};
   auto work = [&] {

@@ -32,6 +32,7 @@ struct SweepScene {
   std::string source;
   std::vector<std::string> overrides;  ///< "KEY=VALUE", before each point's own
   std::optional<double> t_end;         ///< replaces [stop] t_end (s), > 0
+  std::string t_end_origin = "--t-end";  ///< how the user gave t_end, for messages
 };
 
 /// One axis of a grid: a key (dotted, as for --set, or `f`) and its values as TOML values ("0.5", "101").
@@ -48,11 +49,23 @@ SweepAxis parse_grid_axis(const std::string& argument);
 /// an empty grid, an axis without values, or a key given twice.
 std::vector<std::vector<std::string>> sweep_points(const std::vector<SweepAxis>& grid);
 
-/// Runs one point (see the file comment for the row). Never throws for a bad point.
+/// The scene key a grid key sets: `f` is the key of the scene's only front's dissipation, an index
+/// is read as a number (effects.heap[00].f is effects.heap[0].f). Throws InputError for `f` in a
+/// scene without exactly one front.
+std::string canonical_sweep_key(const SweepScene& scene, const std::string& key);
+
+/// Refuses, before anything runs, points whose keys set one scene key twice: two grid keys that name
+/// the same key (an alias and its full key: f and effects.heap[0].f), or a grid key stop.t_end with
+/// the sweep's own t_end. Each row is labelled with the values of its grid keys, so a key set twice
+/// would label it with a value that did not run. Throws InputError naming both spellings.
+void check_sweep_points(const SweepScene& scene, const std::vector<std::vector<std::string>>& points);
+
+/// Runs one point (see the file comment for the row). Never throws for a bad point (a point that
+/// sets a key twice is an "error" row: check_sweep_points).
 nlohmann::json run_sweep_point(const SweepScene& scene, const std::vector<std::string>& point);
 
-/// Runs every point on `workers` threads (the runs share nothing but the interrupt flag); the rows are
-/// in the order of the points. After Ctrl-C (solver/interrupt.hpp) the running points end
+/// Checks the points (check_sweep_points: throws InputError), then runs every point on `workers` threads
+/// (the runs share nothing but the interrupt flag); the rows are in the order of the points. After Ctrl-C (solver/interrupt.hpp) the running points end
 /// "interrupted" and the points not started yet are rows with status "interrupted".
 std::vector<nlohmann::json> run_sweep(const SweepScene& scene, const std::vector<std::vector<std::string>>& points,
                                       int workers);

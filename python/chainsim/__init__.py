@@ -11,6 +11,7 @@
 Every number comes from the C++ library (the extension chainsim._core), through the code the command-line
 tool runs; nothing of the solver is written again in Python.
 """
+import inspect
 import itertools
 import json
 import os
@@ -30,25 +31,54 @@ def _main_thread():
     return threading.current_thread() is threading.main_thread()
 
 
-def _toml_value(value):
-    """A Python value as TOML text (for --set overrides and grid values)."""
+def _toml_value(value, key):
+    """A Python value as TOML text (for --set overrides and grid values); ChainsimInputError naming `key` for a
+    value no scene key can hold."""
     if isinstance(value, (bool, np.bool_)):
         return "true" if value else "false"
     if isinstance(value, (int, np.integer)):
+        if not -2**63 <= int(value) < 2**63:
+            raise ChainsimInputError(f"{key} = {value} is out of range: allowed integers from {-2**63} to {2**63 - 1}")
         return str(int(value))
     if isinstance(value, (float, np.floating)):
         return repr(float(value))
     if isinstance(value, str):
-        return json.dumps(value)
+        return json.dumps(value)  # ASCII, escaped: TOML reads it back (and refuses a lone surrogate, at the key)
     if isinstance(value, (list, tuple, np.ndarray)):
-        return "[" + ", ".join(_toml_value(v) for v in value) + "]"
+        return "[" + ", ".join(_toml_value(v, key) for v in value) + "]"
     if isinstance(value, dict):
-        return "{ " + ", ".join(f"{k} = {_toml_value(v)}" for k, v in value.items()) + " }"
-    raise ChainsimInputError(f"{value!r} cannot be a scene value: allowed a number, a string, a bool, a list or a dict")
+        return "{ " + ", ".join(f"{json.dumps(str(k))} = {_toml_value(v, key)}" for k, v in value.items()) + " }"
+    raise ChainsimInputError(f"{key} = {value!r} cannot be a scene value: allowed a number, a string, a bool, a list "
+                             "or a dict")
+
+
+def _text_key(key):
+    """A scene key given in Python: a str that UTF-8 can hold."""
+    if not isinstance(key, str):
+        raise ChainsimInputError(f"{key!r} is not a scene key: write a dotted key such as string.nodes")
+    try:
+        key.encode("utf-8")
+    except UnicodeEncodeError:
+        raise ChainsimInputError(f"{key!r} is not a scene key: it holds a lone surrogate") from None
+    if any(ord(c) < 0x20 for c in key):
+        raise ChainsimInputError(f"{key!r} is not a scene key: it holds a control character")
+    return key
 
 
 def _override(key, value):
-    return f"{key}={_toml_value(value)}"
+    return f"{_text_key(key)}={_toml_value(value, key)}"
+
+
+def _t_end(t_end):
+    """The t_end keyword: None or a number (its range is checked with the scene, located at t_end)."""
+    if t_end is None:
+        return None
+    if isinstance(t_end, (bool, np.bool_)) or not isinstance(t_end, (int, float, np.integer, np.floating)):
+        raise ChainsimInputError(f"t_end = {t_end!r} must be a number (s)")
+    try:
+        return float(t_end)
+    except OverflowError:
+        raise ChainsimInputError(f"t_end = {t_end!r} is out of range: allowed t_end > 0 (s), below 1.8e308") from None
 
 
 class ReducedResult:
@@ -147,8 +177,9 @@ class Scene:
     @classmethod
     def from_dict(cls, scene, name="<dict>"):
         """A scene from a dict of sections, e.g. {"string": {"length": 1.0, "nodes": 41}, "shape": {...},
-        "stop": {"t_end": 1.0}}; lists of dicts are arrays of tables ("effects": {"heap": [{...}]})."""
-        return cls(_core.scene_toml_text(json.dumps(scene)), name)
+        "stop": {"t_end": 1.0}}; lists of dicts are arrays of tables ("effects": {"heap": [{...}]}). numpy scalars
+        and arrays are taken as their values; a value no scene can hold raises ChainsimInputError naming its key."""
+        return cls(_core.scene_toml_text(scene), name)
 
     def set(self, key=None, value=None, **keys):
         """A new scene with keys set as `chainsim run --set KEY=VALUE` sets them: scene.set("string.nodes", 101),
@@ -168,7 +199,7 @@ class Scene:
 
         A numerical failure raises NumericalError, whose `result` holds the run up to the failure. Ctrl-C stops
         the run at its next accepted step and raises KeyboardInterrupt."""
-        run = _core.run_scene(self.text, self.source, self.overrides, t_end, _main_thread())
+        run = _core.run_scene(self.text, self.source, self.overrides, _t_end(t_end), _main_thread())
         if self.effective.get("model") == "reduced":
             return ReducedResult(run.arrays()["series"], json.loads(run.summary()))
         result = Result(run)
@@ -247,7 +278,7 @@ def _reduced_point(task):
         result = reduced(problem, **params)
         row = json.loads(_core.flatten_summary(json.dumps(result.summary)))
         row.update(status="completed", error="")
-    except (ChainsimInputError, NumericalError, TypeError) as e:
+    except (ChainsimInputError, NumericalError) as e:
         row = {"status": "failed" if isinstance(e, NumericalError) else "error", "error": str(e)}
     row["wall_time_s"] = time.perf_counter() - start
     return row
@@ -266,26 +297,50 @@ def sweep(target, grid, *, t_end=None, workers=None, client=None):
 
     Columns: the grid keys, status (completed | stopped | failed | error | interrupted), error, wall_time_s,
     then the run's summary (stats.json flattened: nested keys as "a.b"). A failed point is a row with its error.
+    Refused before any point runs (ChainsimInputError): a grid that is not a dict of lists, an axis without values,
+    and two keys that set one scene key (f and effects.heap[0].f, or stop.t_end with t_end): a row would show
+    one value while the other ran.
     """
     import pandas as pd
 
-    if not grid:
-        raise ChainsimInputError("a sweep needs a grid: {key: [values], ...}")
+    if not isinstance(grid, dict) or not grid:
+        raise ChainsimInputError(f"a sweep needs a grid: {{key: [values], ...}}, not {grid!r}")
     keys = list(grid)
+    for k in keys:
+        _text_key(k)
+        if isinstance(grid[k], (str, bytes, dict)) or not hasattr(grid[k], "__iter__"):
+            raise ChainsimInputError(f"the grid axis {k} = {grid[k]!r} is not a list of values, "
+                                     f"e.g. {{{k!r}: [0.1, 0.5]}}")
     values = [list(grid[k]) for k in keys]
+    t_end = _t_end(t_end)
+    if workers is not None and (isinstance(workers, (bool, np.bool_)) or not isinstance(workers, (int, np.integer))
+                                or workers < 1):
+        raise ChainsimInputError(f"workers = {workers!r} is out of range: allowed an integer >= 1 (None: every core)")
+    # The grid's own checks (an axis without values), the same as `chainsim sweep`'s.
+    points = _core.sweep_points([(k, ["0"] * len(vs)) for k, vs in zip(keys, values)])
     params = [dict(zip(keys, combo)) for combo in itertools.product(*values)]
     if isinstance(target, str):
+        _core.check_problem(target)
+        allowed = [p for p in inspect.signature(reduced).parameters if p != "problem"]
+        for k in keys:
+            if k not in allowed:
+                raise ChainsimInputError(f"the grid key {k} is not a keyword of reduced(): allowed {', '.join(allowed)}")
+        if t_end is not None:
+            raise ChainsimInputError("t_end applies to Scene sweeps: a reduced sweep takes t_max (units of t0) as a "
+                                     "grid key")
         tasks = [(target, p) for p in params]
         point = _reduced_point
     elif isinstance(target, Scene):
-        points = _core.sweep_points([(k, [_toml_value(v) for v in vs]) for k, vs in zip(keys, values)])
+        points = _core.sweep_points([(k, [_toml_value(v, k) for v in vs]) for k, vs in zip(keys, values)])
         assert len(points) == len(params)
+        # A scene key set twice (an alias and its full key, or stop.t_end with t_end) is refused before any runs.
+        _core.check_sweep_points(target.text, target.source, target.overrides, t_end, points)
         tasks = [(target.text, target.source, target.overrides, t_end, p) for p in points]
         point = _scene_point
     else:
         raise ChainsimInputError(f"sweep() runs a Scene or a problem name (falling, folded, sliding), not {target!r}")
 
-    workers = workers or len(os.sched_getaffinity(0)) or 1
+    workers = int(workers or len(os.sched_getaffinity(0)) or 1)
     if client is not None:
         rows = client.gather(client.map(point, tasks, pure=False))
     elif point is _scene_point:

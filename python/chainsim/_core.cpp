@@ -3,7 +3,9 @@
 // (SceneRun = `chainsim run`, solve_reduced = `chainsim reduced`, compare_with_reduced = `chainsim
 // compare`, run_sweep / run_sweep_point = `chainsim sweep`). JSON documents cross as text (json.loads
 // on the Python side: doubles round-trip exactly); arrays as numpy arrays (copies).
+#include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <limits>
 #include <memory>
 #include <optional>
@@ -169,6 +171,15 @@ py::dict frames_dict(const SceneRun<dim>& run) {
   return out;
 }
 
+/// Raises `type` with the message `what`. Messages quote what the user wrote, which need not be valid
+/// UTF-8 (the bytes of a scene file): decoded with backslash escapes, so that the error raised is always
+/// the one thrown, never a UnicodeDecodeError.
+void set_error(PyObject* type, const char* what) {
+  const py::object message = py::reinterpret_steal<py::object>(
+      PyUnicode_DecodeUTF8(what, static_cast<Py_ssize_t>(std::strlen(what)), "backslashreplace"));
+  if (message) PyErr_SetObject(type, message.ptr());
+}
+
 /// A finished run of a scene: the string solver's (2D or 3D) or the reduced model's.
 class Run {
  public:
@@ -237,11 +248,7 @@ std::unique_ptr<Run> run_string(const SceneSpec& spec, bool handle_sigint) {
 SceneSpec parse(const std::string& text, const std::string& source, const std::vector<std::string>& overrides,
                 std::optional<double> t_end) {
   SceneSpec spec = parse_scene_text(text, source, overrides);
-  if (t_end) {
-    if (!(*t_end > 0 && std::isfinite(*t_end)))
-      throw InputError(fmt::format("t_end = {:g} is out of range: allowed t_end > 0 (s)", *t_end));
-    spec.stop.t_end = *t_end;
-  }
+  if (t_end) replace_t_end(spec, *t_end, "t_end");
   return spec;
 }
 
@@ -262,29 +269,157 @@ std::unique_ptr<Run> run_scene(const std::string& text, const std::string& sourc
   return spec.dimension == 3 ? run_string<3>(spec, handle_sigint) : run_string<2>(spec, handle_sigint);
 }
 
+// --- Python values to C++ values, every refusal an InputError naming the key ----------------------
+
+/// repr(value), for messages (ascii(value) if the repr is no valid text).
+std::string shown(py::handle value) {
+  const py::str text = py::repr(value);
+  Py_ssize_t size = 0;
+  if (const char* data = PyUnicode_AsUTF8AndSize(text.ptr(), &size))
+    return std::string(data, static_cast<std::size_t>(size));
+  PyErr_Clear();
+  return py::reinterpret_steal<py::str>(PyObject_ASCII(value.ptr())).cast<std::string>();
+}
+
+/// A numpy scalar or array as the Python value it holds (a number, a bool, a list); other values as they are.
+py::object plain(py::handle value) {
+  if (py::hasattr(value, "dtype") && py::hasattr(value, "tolist")) return value.attr("tolist")();
+  return py::reinterpret_borrow<py::object>(value);
+}
+
+bool is_bool(py::handle value) { return PyBool_Check(value.ptr()); }
+
+/// Python text as UTF-8; InputError naming `at` for text UTF-8 cannot hold (a lone surrogate).
+std::string utf8(py::handle text, const std::string& at) {
+  Py_ssize_t size = 0;
+  const char* data = PyUnicode_AsUTF8AndSize(text.ptr(), &size);
+  if (!data) {
+    PyErr_Clear();
+    throw InputError(fmt::format("{} = {} is not valid text: it holds a lone surrogate, which UTF-8 cannot hold", at,
+                                 shown(text)));
+  }
+  return std::string(data, static_cast<std::size_t>(size));
+}
+
+/// A Python int as text, long ones shortened ("1000000000…0000 (401 digits)").
+std::string integer_text(py::handle value) {
+  const std::string text = py::str(value).cast<std::string>();
+  const std::size_t digits = text.size() - (text[0] == '-' ? 1 : 0);
+  if (digits <= 40) return text;
+  return fmt::format("{}…{} ({} digits)", text.substr(0, text.size() - digits + 12), text.substr(text.size() - 4),
+                     digits);
+}
+
+/// A real number (int, float, numpy scalar; not a bool, a string or None).
+double real_arg(const std::string& fn, const std::string& key, py::handle value) {
+  const py::object v = plain(value);
+  if (is_bool(v) || !(PyFloat_Check(v.ptr()) || PyLong_Check(v.ptr())))
+    throw InputError(fmt::format("{}(): {} = {} must be a number", fn, key, shown(value)));
+  const double x = PyFloat_AsDouble(v.ptr());
+  if (x == -1.0 && PyErr_Occurred()) {  // an int beyond the double range
+    PyErr_Clear();
+    throw InputError(fmt::format("{}(): {} = {} is out of range: allowed a number below 1.8e308 in magnitude", fn,
+                                 key, integer_text(v)));
+  }
+  return x;
+}
+
+/// An integer (int or numpy integer; not a bool or a float) within the range of T.
+template <class T>
+T integer_arg(const std::string& fn, const std::string& key, py::handle value) {
+  const py::object v = plain(value);
+  if (is_bool(v) || !PyLong_Check(v.ptr()))
+    throw InputError(fmt::format("{}(): {} = {} must be an integer", fn, key, shown(value)));
+  int overflow = 0;
+  const long long n = PyLong_AsLongLongAndOverflow(v.ptr(), &overflow);
+  if (overflow != 0 || n < std::numeric_limits<T>::min() || n > std::numeric_limits<T>::max())
+    throw InputError(fmt::format("{}(): {} = {} is out of range: allowed integers from {} to {}", fn, key,
+                                 integer_text(v), std::numeric_limits<T>::min(),
+                                 std::numeric_limits<T>::max()));
+  return static_cast<T>(n);
+}
+
+std::string text_arg(const std::string& fn, const std::string& key, py::handle value) {
+  if (!PyUnicode_Check(value.ptr()))
+    throw InputError(fmt::format("{}(): {} = {} must be a string", fn, key, shown(value)));
+  return utf8(value, fmt::format("{}(): {}", fn, key));
+}
+
+/// A scene given as Python values (Scene.from_dict) as JSON, in memory: NaN and inf stay numbers (the
+/// scene's checks refuse them at their key, as in a file), numpy scalars and arrays become their
+/// values, and whatever no scene can hold is refused naming its key.
+nlohmann::json scene_value(py::handle value, const std::string& at, int depth = 0) {
+  constexpr int kMaxDepth = 32;
+  const std::string where = at.empty() ? "the scene" : at;
+  if (depth > kMaxDepth)
+    throw InputError(fmt::format("{} is nested deeper than {} levels: no scene key is", where, kMaxDepth));
+  const py::object v = plain(value);
+  if (v.is_none()) return nullptr;  // scene_toml_text refuses it, naming the key
+  if (is_bool(v)) return v.cast<bool>();
+  if (PyLong_Check(v.ptr())) {
+    int overflow = 0;
+    const long long n = PyLong_AsLongLongAndOverflow(v.ptr(), &overflow);
+    if (overflow != 0)
+      throw InputError(fmt::format("{} = {} is out of range: allowed integers from {} to {}", where, integer_text(v),
+                                   std::numeric_limits<long long>::min(),
+                                   std::numeric_limits<long long>::max()));
+    return n;
+  }
+  if (PyFloat_Check(v.ptr())) return v.cast<double>();
+  if (PyUnicode_Check(v.ptr())) return utf8(v, where);
+  if (PyDict_Check(v.ptr())) {
+    nlohmann::json object = nlohmann::json::object();
+    for (const auto& [key, item] : py::reinterpret_borrow<py::dict>(v)) {
+      if (!PyUnicode_Check(key.ptr()))
+        throw InputError(fmt::format("{} has the key {}: the keys of a scene are strings", where, shown(key)));
+      if (!PyUnicode_AsUTF8AndSize(key.ptr(), nullptr)) {
+        PyErr_Clear();
+        throw InputError(fmt::format("{} has the key {}: it holds a lone surrogate, which UTF-8 cannot hold", where,
+                                     shown(key)));
+      }
+      const std::string name = utf8(key, where);
+      if (std::any_of(name.begin(), name.end(), [](char c) { return static_cast<unsigned char>(c) < 0x20; }))
+        throw InputError(fmt::format("{} has the key {}: no scene key holds a control character", where, shown(key)));
+      object[name] = scene_value(item, at.empty() ? name : at + "." + name, depth + 1);
+    }
+    return object;
+  }
+  if (PyList_Check(v.ptr()) || PyTuple_Check(v.ptr())) {
+    nlohmann::json array = nlohmann::json::array();
+    std::size_t k = 0;
+    for (const auto& item : v) array.push_back(scene_value(item, fmt::format("{}[{}]", at, k++), depth + 1));
+    return array;
+  }
+  throw InputError(fmt::format("{} = {} cannot be a scene value: allowed a number, a string, a bool, a list or a dict",
+                               where, shown(value)));
+}
+
 /// The chain's and the integrator's settings shared by reduced() and compare(): keyword -> field.
 template <class Setup>
 void set_common(Setup& s, const py::dict& kw) {
+  constexpr bool string_case = std::is_same_v<Setup, StringCaseSetup>;
+  const std::string fn = string_case ? "compare" : "reduced";
   for (const auto& [key, value] : kw) {
-    const std::string k = py::str(key);
-    if (k == "f") s.chain.dissipation = py::cast<double>(value);
-    else if (k == "eta0") { if (!value.is_none()) s.eta0 = py::cast<double>(value); }
-    else if (k == "eps") s.eps = py::cast<double>(value);
-    else if (k == "force") s.force = py::cast<double>(value);
-    else if (k == "length") s.chain.length = py::cast<double>(value);
-    else if (k == "density") s.chain.density = py::cast<double>(value);
-    else if (k == "gravity") s.chain.gravity = py::cast<double>(value);
-    else if (k == "t_max") s.t_max_over_t0 = py::cast<double>(value);
-    else if (k == "method") s.integrator.method = py::cast<std::string>(value);
-    else if (k == "rtol") s.integrator.rtol = py::cast<double>(value);
-    else if (k == "atol") s.integrator.atol = py::cast<double>(value);
-    else if (k == "max_step") s.integrator.max_step = py::cast<double>(value);
-    else if (k == "max_steps") s.integrator.max_steps = py::cast<long>(value);
-    else if constexpr (std::is_same_v<Setup, StringCaseSetup>) {
-      if (k == "nodes") s.nodes = py::cast<int>(value);
-      else if (k == "tilt_deg") s.tilt_deg = py::cast<double>(value);
-      else if (k == "bend_deg") s.bend_deg = py::cast<double>(value);
-      else if (k == "frame_interval") s.frame_interval = py::cast<double>(value);
+    const std::string k = utf8(key, fn + "() keyword");
+    auto real = [&] { return real_arg(fn, k, value); };
+    if (k == "f") s.chain.dissipation = real();
+    else if (k == "eta0") { if (!value.is_none()) s.eta0 = real(); }
+    else if (k == "eps") s.eps = real();
+    else if (k == "force") s.force = real();
+    else if (k == "length") s.chain.length = real();
+    else if (k == "density") s.chain.density = real();
+    else if (k == "gravity") s.chain.gravity = real();
+    else if (k == "t_max") s.t_max_over_t0 = real();
+    else if (k == "method") s.integrator.method = text_arg(fn, k, value);
+    else if (k == "rtol") s.integrator.rtol = real();
+    else if (k == "atol") s.integrator.atol = real();
+    else if (k == "max_step") s.integrator.max_step = real();
+    else if (k == "max_steps") s.integrator.max_steps = integer_arg<long>(fn, k, value);
+    else if constexpr (string_case) {
+      if (k == "nodes") s.nodes = integer_arg<int>(fn, k, value);
+      else if (k == "tilt_deg") s.tilt_deg = real();
+      else if (k == "bend_deg") s.bend_deg = real();
+      else if (k == "frame_interval") s.frame_interval = real();
       else throw InputError(fmt::format("compare() got an unknown keyword {}", k));
     } else {
       throw InputError(fmt::format("reduced() got an unknown keyword {}", k));
@@ -292,9 +427,16 @@ void set_common(Setup& s, const py::dict& kw) {
   }
 }
 
-py::tuple reduced(const std::string& problem, const py::dict& kw) {
+Problem problem_arg(const std::string& fn, py::handle problem) {
+  if (!PyUnicode_Check(problem.ptr()))
+    throw InputError(fmt::format("{}(): problem = {} is not a known problem: allowed falling, folded, sliding", fn,
+                                 shown(problem)));
+  return parse_problem(utf8(problem, fn + "(): problem"));
+}
+
+py::tuple reduced(py::handle problem, const py::dict& kw) {
   ReducedSetup setup;
-  setup.problem = parse_problem(problem);
+  setup.problem = problem_arg("reduced", problem);
   set_common(setup, kw);
   ReducedRun r{CsvTable(series_columns()), {}};
   {
@@ -304,9 +446,9 @@ py::tuple reduced(const std::string& problem, const py::dict& kw) {
   return py::make_tuple(table_dict(r.series), r.summary.dump());
 }
 
-py::tuple compare(const std::string& problem, const py::dict& kw) {
+py::tuple compare(py::handle problem, const py::dict& kw) {
   StringCaseSetup setup;
-  setup.problem = parse_problem(problem);
+  setup.problem = problem_arg("compare", problem);
   set_common(setup, kw);
   setup.validate();
   std::optional<Comparison> c;
@@ -320,7 +462,7 @@ py::tuple compare(const std::string& problem, const py::dict& kw) {
 
 SweepScene sweep_scene(const std::string& text, const std::string& source, const std::vector<std::string>& overrides,
                        std::optional<double> t_end) {
-  return SweepScene{text, source, overrides, t_end};
+  return SweepScene{text, source, overrides, t_end, "t_end"};
 }
 
 }  // namespace
@@ -333,9 +475,9 @@ PYBIND11_MODULE(_core, m) {
     try {
       if (p) std::rethrow_exception(p);
     } catch (const InputError& e) {
-      PyErr_SetString(input_error.ptr(), e.what());
+      set_error(input_error.ptr(), e.what());
     } catch (const NumericalError& e) {
-      PyErr_SetString(numerical_error.ptr(), e.what());
+      set_error(numerical_error.ptr(), e.what());
     }
   });
 
@@ -352,8 +494,11 @@ PYBIND11_MODULE(_core, m) {
         "parses and checks a scene (as `chainsim run` reads it); returns the effective scene as JSON text");
   m.def("read_scene_file", [](const std::filesystem::path& path) { return read_scene_file(path); }, py::arg("path"),
         "the text of a scene file, read as `chainsim run` reads it");
-  m.def("scene_toml_text", [](const std::string& json) { return scene_toml_text(nlohmann::json::parse(json)); },
-        py::arg("json"), "a scene given as JSON text, written as TOML");
+  m.def("scene_toml_text", [](py::handle scene) { return scene_toml_text(scene_value(scene, "")); }, py::arg("scene"),
+        "a scene given as a dict of sections (numpy values too), written as TOML; ChainsimInputError naming the key "
+        "of a value no scene can hold");
+  m.def("check_problem", [](py::handle problem) { problem_arg("sweep", problem); }, py::arg("problem"),
+        "refuses (ChainsimInputError) a name that is not a canonical problem");
   m.def("run_scene", &run_scene, py::arg("text"), py::arg("source"), py::arg("overrides"),
         py::arg("t_end") = py::none(), py::arg("handle_sigint") = false,
         "builds and runs a scene as `chainsim run` does (the GIL released; with handle_sigint, Ctrl-C stops the run "
@@ -369,6 +514,13 @@ PYBIND11_MODULE(_core, m) {
           return sweep_points(axes);
         },
         py::arg("grid"), "the grid's points as lists of KEY=VALUE overrides");
+  m.def("check_sweep_points",
+        [](const std::string& text, const std::string& source, const std::vector<std::string>& overrides,
+           std::optional<double> t_end, const std::vector<std::vector<std::string>>& points) {
+          check_sweep_points(sweep_scene(text, source, overrides, t_end), points);
+        },
+        py::arg("text"), py::arg("source"), py::arg("overrides"), py::arg("t_end"), py::arg("points"),
+        "refuses (ChainsimInputError) points that set one scene key twice, before any runs");
   m.def("run_sweep_point",
         [](const std::string& text, const std::string& source, const std::vector<std::string>& overrides,
            std::optional<double> t_end, const std::vector<std::string>& point) {

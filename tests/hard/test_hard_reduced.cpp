@@ -296,3 +296,84 @@ TEST_CASE("an order-2 method at the default rtol = 1e-13 ends at the step budget
     CHECK(e.time() < exact::falling_fall_time(0.83) * s.chain.t0());
   }
 }
+
+TEST_CASE("a reduced run honours t_max exactly, whatever its size relative to t0 (issue #21)", "[hard][reduced]") {
+  // `chainsim reduced falling --t-max 1e-7` exited 3 "stalled" (the step floor 1e-14 t0 was above
+  // the steps such a run takes); `chainsim reduced sliding --t-max 1e-6` stopped at t/t0 = 0.00216,
+  // 2000 times past t_max (the sliding branch starts at eta = 1e-6, and t_max counted from there).
+  const double f = 0.5;
+  for (double tau : {1e-12, 1e-7, 1e-3, 0.5}) {
+    CAPTURE(tau);
+    ReducedSetup s = make(Problem::kFalling, f, 0.01, 1.0);
+    s.t_max_over_t0 = tau;
+    const ReducedRun run = solve_reduced(s);
+    require_all_finite(run.series);
+    REQUIRE(run.summary["stop_reason"] == "t_max");
+    CHECK(d(run.summary["t_stop_over_t0"]) == tau);
+    CHECK_THAT(d(run.summary["t_stop"]), WithinRel(tau * s.chain.t0(), 1e-15));
+    // Released from rest, y = l - g t^2/2 (1 + O(tau^2)): the speed at the stop, |ydot| = g t, to the
+    // O((1+f) tau^2) of the next term; and eta against the exact solution where 1 - eta is resolved.
+    const double t = tau * s.chain.t0(), ydot = run.series.column("ydot").back();
+    CHECK_THAT(ydot, WithinRel(-s.chain.gravity * t, 1e-9 + 2 * tau * tau));
+    if (tau >= 1e-3) CHECK_THAT(d(run.summary["eta_stop"]), WithinAbs(exact::falling_eta(f, tau), 1e-12));
+  }
+  // The sliding chain from eta0 = 0 on its exact branch eta = tau^2/(3 + 2f) (y = a t^2/2, a = g/(3+2f)),
+  // before the branch's start at eta = 1e-6 (tau = 0.00224) and after it (integrated).
+  for (double tau : {1e-9, 1e-6, 1e-3, 0.01}) {
+    CAPTURE(tau);
+    ReducedSetup s = make(Problem::kSliding, f, 0.01, 0.0);
+    s.t_max_over_t0 = tau;
+    const ReducedRun run = solve_reduced(s);
+    require_all_finite(run.series);
+    REQUIRE(run.summary["stop_reason"] == "t_max");
+    CHECK(d(run.summary["t_stop_over_t0"]) == tau);
+    CHECK_THAT(d(run.summary["t_stop"]), WithinRel(tau * s.chain.t0(), 1e-15));
+    CHECK_THAT(d(run.summary["eta_stop"]), WithinRel(tau * tau / (3 + 2 * f), 1e-9));
+    CHECK(run.series.column("t").back() <= tau * s.chain.t0());
+  }
+  // Where the branch's hanging length would underflow (t_max = 2.2e-162 escaped as an internal
+  // "y <= 0"), t_max is refused with its smallest value, and that value runs.
+  ReducedSetup tiny = make(Problem::kSliding, f, 0.01, 0.0);
+  tiny.t_max_over_t0 = 2.2227587494850775e-162;
+  CHECK_THROWS_WITH(solve_reduced(tiny), Contains("--t-max = 2.2227587494850775e-162 is out of range for the sliding "
+                                                  "chain from eta0 = 0: allowed t_max >= 2e-75"));
+  tiny.t_max_over_t0 = 2e-75;
+  CHECK_THAT(d(solve_reduced(tiny).summary["eta_stop"]), WithinRel(4e-150 / (3 + 2 * f), 1e-9));
+  // The folded chain too.
+  ReducedSetup folded = make(Problem::kFolded, f, 0.01, 0.0);
+  folded.t_max_over_t0 = 1e-7;
+  const ReducedRun fr = solve_reduced(folded);
+  CHECK(fr.summary["stop_reason"] == "t_max");
+  CHECK(d(fr.summary["t_stop_over_t0"]) == 1e-7);
+}
+
+TEST_CASE("a reduced run at g = 1e-100 or l = 1e90 stops at its t_max, a tiny fraction of t0 (issue #21)",
+          "[hard][reduced]") {
+  // A scene's t_end = 2 s is 1.4e-50 t0 at g = 1e-100 (t0 = 1.4e50 s): it stalled at the step floor 1e-14 t0.
+  for (auto [g, l] : {std::pair{1e-100, 1.0}, std::pair{9.81, 1e90}}) {
+    CAPTURE(g, l);
+    ReducedSetup s = make(Problem::kFalling, 0.5, 0.01, 1.0);
+    s.chain.gravity = g;
+    s.chain.length = l;
+    s.t_max_over_t0 = 2.0 / s.chain.t0();
+    const ReducedRun run = solve_reduced(s);
+    require_all_finite(run.series);
+    REQUIRE(run.summary["stop_reason"] == "t_max");
+    CHECK_THAT(d(run.summary["t_stop"]), WithinRel(2.0, 1e-15));
+    CHECK_THAT(run.series.column("ydot").back(), WithinRel(-g * 2.0, 1e-9));  // free fall from rest, |ydot| = g t
+  }
+  // A t_max whose time t_max t0 overflows is refused with the allowed range.
+  ReducedSetup huge = make(Problem::kFalling, 0.5, 0.01, 1.0);
+  huge.chain.gravity = 1e-100;
+  huge.chain.length = 1e100;  // t0 = 1.4e100 s
+  huge.t_max_over_t0 = 1e300;
+  CHECK_THROWS_WITH(solve_reduced(huge), Contains("--t-max = 1e+300 is out of range") && Contains("allowed t_max <="));
+  // Scales beyond the solver's range are refused with it (l = 5e-324 made the energy scale 0: an internal error).
+  ReducedSetup tiny = make(Problem::kFalling, 0.5, 0.01, 1.0);
+  tiny.chain.length = 5e-324;
+  CHECK_THROWS_WITH(solve_reduced(tiny), "--length = 5e-324 is out of range: allowed 1e-100 <= length <= 1e+100");
+  tiny.chain.length = 1e-60;  // each scale in range, but lambda g l^2 = 9.81e-220 J is not
+  tiny.chain.density = 1e-100;
+  CHECK_THROWS_WITH(solve_reduced(tiny), Contains("the energy scale lambda g l^2 = 9.81") &&
+                                             Contains("e-220 J is out of the range the solver can represent"));
+}

@@ -146,6 +146,63 @@ def test_scene_from_dict_runs_like_its_file():
     np.testing.assert_allclose(np.linalg.norm(np.diff(r.positions, axis=1), axis=2), 0.1, rtol=1e-7)
 
 
+def test_dict_scenes_take_numpy_values_and_refuse_at_the_key_what_no_scene_holds():
+    """Issue #21: numpy int64, float32, ndarray and np.bool_ raised a bare TypeError (scene.set took them);
+    NaN, inf, 10**400 and lone surrogates raised RuntimeError "[json.exception.parse_error.101]"."""
+    d = {"string": {"length": np.float32(1.0), "density": 0.1, "nodes": np.int64(11), "closed": np.bool_(False)},
+         "shape": {"kind": "polyline", "points": np.array([[0.0, 0.0], [0.04998, -0.99875]])},
+         "ends": {"start": "fixed"}, "effects": {"gravity": {"g": [np.float64(0.0), -9.81]}},
+         "output": {"interval": 0.05}, "stop": {"t_end": 0.2}}
+    scene = chainsim.Scene.from_dict(d)
+    plain = chainsim.Scene.from_dict({**d, "string": {"length": 1.0, "density": 0.1, "nodes": 11, "closed": False},
+                                      "shape": {"kind": "polyline", "points": [[0.0, 0.0], [0.04998, -0.99875]]},
+                                      "effects": {"gravity": {"g": [0.0, -9.81]}}})
+    assert scene.effective == plain.effective
+    bad = [({"string": {"length": float("nan")}}, r"<dict>:\d+:\d+: string.length = nan must be a finite number"),
+           ({"string": {"length": -math.inf}}, r"<dict>:\d+:\d+: string.length = -inf must be a finite number"),
+           ({"effects": {"gravity": {"g": [0.0, math.inf]}}}, r"effects.gravity.g = .* finite"),
+           ({"string": {"nodes": 10**400}}, r"string.nodes = 1000.*\(401 digits\) is out of range"),
+           ({"solver": {"method": "erk\ud800"}}, r"solver.method = 'erk\\ud800' is not valid text"),
+           ({"solver": {"\ud800": 1}}, r"solver has the key '\\ud800'"),
+           ({"solver": {"rtol": None}}, r"solver.rtol = null cannot be written"),
+           ({"solver": {"rtol": 1j}}, r"solver.rtol = 1j cannot be a scene value"),
+           ({"solver": {3: 1}}, r"solver has the key 3")]
+    for change, message in bad:
+        with pytest.raises(chainsim.ChainsimInputError, match=message):
+            chainsim.Scene.from_dict({**d, **change})
+
+
+def test_reduced_and_compare_keywords_of_the_wrong_type_are_refused_as_input():
+    """Issue #21: reduced(f="0.5") and compare(nodes=10**20) raised RuntimeError "Unable to cast"; inside a sweep
+    that aborted the whole sweep instead of giving an error row."""
+    with pytest.raises(chainsim.ChainsimInputError, match=r"reduced\(\): f = '0.5' must be a number"):
+        chainsim.reduced("falling", f="0.5")
+    with pytest.raises(chainsim.ChainsimInputError, match=r"compare\(\): nodes = 100000000000000000000 is out of range"):
+        chainsim.compare("falling", nodes=10**20)
+    with pytest.raises(chainsim.ChainsimInputError, match=r"compare\(\): nodes = 10.0 must be an integer"):
+        chainsim.compare("falling", nodes=10.0)
+    with pytest.raises(chainsim.ChainsimInputError, match=r"reduced\(\): method = 8 must be a string"):
+        chainsim.reduced("falling", method=8)
+    with pytest.raises(chainsim.ChainsimInputError, match=r"problem = 3 is not a known problem"):
+        chainsim.reduced(3)
+    # numpy scalars are numbers
+    r = chainsim.reduced("falling", f=np.float32(0.5), max_steps=np.int64(100000))
+    assert r.summary["parameters"]["f"] == 0.5
+    df = chainsim.sweep("falling", {"f": ["x", 0.5]})
+    assert list(df.status) == ["error", "completed"]
+    assert "f = 'x' must be a number" in df.error[0]
+
+
+def test_reduced_runs_stop_at_t_max_of_any_size():
+    """Issue #21: `chainsim reduced sliding --t-max 1e-6` reported "stop: t_max" at t/t0 = 0.00216."""
+    for problem in ("falling", "folded", "sliding"):
+        r = chainsim.reduced(problem, t_max=1e-6)
+        assert r.summary["stop_reason"] == "t_max" and r.summary["t_stop_over_t0"] == 1e-6
+        assert r.series["t"][-1] == pytest.approx(1e-6 * r.summary["t0"], rel=1e-15)
+    # the sliding chain on its branch eta = tau^2/(3 + 2f), f = 0.83 by default
+    assert r.summary["eta_stop"] == pytest.approx(1e-12 / (3 + 2 * 0.83), rel=1e-9)
+
+
 def test_numerical_failure_raises_with_the_partial_result():
     scene = chainsim.Scene.from_file(os.path.join(SCENES, "hanging_chain.toml")).set(
         **{"string.nodes": 11, "solver.max_steps": 5})
@@ -212,6 +269,30 @@ def test_sweep_on_a_local_dask_cluster_with_a_bad_point():
     assert (good.status == "completed").all() and (good.t_stop == 0.2).all()
     assert (good.nodes == good["string.nodes"]).all()
     assert (good.relative_energy_drift < 1e-6).all()   # the ledger closes on every mesh
+
+
+def test_sweep_refuses_an_alias_and_its_full_key_before_any_run(tmp_path):
+    """Issue #21: --grid f=0.1 --grid effects.heap[0].f=0.9 ran f = 0.9 in a row labelled f = 0.1."""
+    scene_file = os.path.join(SCENES, "falling_chain.toml")
+    r = cli("sweep", scene_file, "--grid", "f=0.1", "--grid", "effects.heap[0].f=0.9", "--out", str(tmp_path / "s"),
+            check=False)
+    assert r.returncode == 2 and not (tmp_path / "s").exists()
+    assert "the grid key f and the grid key effects.heap[0].f both set effects.heap[0].f" in r.stderr
+    scene = chainsim.Scene.from_file(scene_file)
+    with pytest.raises(chainsim.ChainsimInputError, match=r"grid key f and the grid key effects.heap\[0\].f"):
+        chainsim.sweep(scene, {"f": [0.1], "effects.heap[0].f": [0.9]})
+    with pytest.raises(chainsim.ChainsimInputError, match=r"grid key stop.t_end and the sweep's t_end"):
+        chainsim.sweep(scene, {"stop.t_end": [0.1]}, t_end=0.2)
+    with pytest.raises(chainsim.ChainsimInputError, match=r"the grid axis f = 0.5 is not a list"):
+        chainsim.sweep(scene, {"f": 0.5})
+    with pytest.raises(chainsim.ChainsimInputError, match=r"has no values"):
+        chainsim.sweep("falling", {"f": []})
+    with pytest.raises(chainsim.ChainsimInputError, match=r"not a keyword of reduced\(\)"):
+        chainsim.sweep("falling", {"nodes": [3]})
+    # each row shows the value that ran: the alias and the full key give the same stop
+    a = chainsim.sweep(scene, {"f": [0.9]}, t_end=0.1)
+    b = chainsim.sweep(scene, {"effects.heap[0].f": [0.9]}, t_end=0.1)
+    assert a.t_stop[0] == b.t_stop[0] and a.f[0] == 0.9
 
 
 def test_cli_sweep_writes_one_row_per_point(tmp_path):

@@ -86,7 +86,17 @@ TEST_CASE("bad scenes are refused with the location, the key, the value and what
        "s.toml:3:11: string.density = -0.1 is out of range: allowed density > 0"},
       {"one node",
        edit(kBase, "nodes = 11", "nodes = 1"),
-       "s.toml:4:9: string.nodes = 1 is out of range: allowed 2 <= nodes <= 1e+07"},
+       "s.toml:4:9: string.nodes = 1 is out of range: allowed 2 <= nodes <= 10000000"},
+      {"one node too many (issue #21: it printed 'nodes = 1e+07 ... nodes <= 1e+07')",
+       edit(kBase, "nodes = 11", "nodes = 10000001"),
+       "s.toml:4:9: string.nodes = 10000001 is out of range: allowed 2 <= nodes <= 10000000"},
+      {"a node count beyond every integer type but int64's",
+       edit(kBase, "nodes = 11", "nodes = 9223372036854775807"),
+       "s.toml:4:9: string.nodes = 9223372036854775807 is out of range: allowed 2 <= nodes <= 10000000"},
+      {"a Baumgarte time below the solver's range (issue #21: exit 3 'non-finite' at t = 0)",
+       kBase + std::string("[solver]\nstabilization_time = 1e-300\n"),
+       "s.toml:19:22: solver.stabilization_time = 1e-300: the Baumgarte time (s) is 1e-300, out of the range the "
+       "solver can represent: allowed 1e-100 to 1e+100 (or 0); the scaled problem would overflow or underflow"},
       {"a fourth dimension",
        edit(kBase, "nodes = 11", "nodes = 11\ndimension = 4"),
        "s.toml:5:13: string.dimension = 4 is not allowed; valid values: 2, 3"},
@@ -181,7 +191,7 @@ TEST_CASE("bad scenes are refused with the location, the key, the value and what
        "s.toml:19:8: solver.rtol = 1 is out of range: allowed 1e-14 <= rtol <= 0.01"},
       {"an absolute tolerance of a million",
        kBase + std::string("[solver]\natol = 1e6\n"),
-       "s.toml:19:8: solver.atol = 1e+06 is out of range: allowed 0 < atol <= 0.01"},
+       "s.toml:19:8: solver.atol = 1000000 is out of range: allowed 0 < atol <= 0.01"},
       {"an unknown tension backend",
        kBase + std::string("[solver]\nbackend = \"lu\"\n"),
        "s.toml:19:11: solver.backend = \"lu\" is not a tension solver: allowed auto, " + backends},
@@ -315,10 +325,13 @@ TEST_CASE("bad scenes with fronts, and scenes the reduced model does not fit, ar
        "s.toml:29:6: stop.front[0].s0 = 1.0 is where the heap_end front starts: a stop event needs a front that gets there"},
       {"two heaps closer than two links (the front model's own check, located at the first heap)",
        edit(S, "[stop]", "[[effects.heap]]\nside = \"end\"\ns0 = 0.85\npoint = [0.0, -0.05]\n\n[stop]"),
-       "s.toml:14:1: the heaps are less than two links apart: use more nodes"},
+       "s.toml:14:1: effects.heap[0]: the heaps are less than two links apart: use more nodes"},
       {"a chain lying along its table (a degenerate contact, located at the heap)",
        edit(F, "points = [[0.0, 1.0], [0.0, 0.0]]", "points = [[1.0, 0.0], [0.0, 0.0]]"),
-       "s.toml:14:1: the initial shape does not fit the fronts: the string meets the heap's plane at a grazing angle (n·t = 0 at node 19)"},
+       "s.toml:14:1: effects.heap[0]: the initial shape does not fit the fronts: the string meets the heap's plane at a grazing angle (n·t = 0 at node 19)"},
+      {"a string with fronts of one link (issue #21: the message did not name string.nodes)",
+       edit(F, "nodes = 21", "nodes = 2"),
+       "s.toml:5:9: string.nodes = 2 gives 1 link: a string with fronts needs at least 2 links (allowed nodes >= 3)"},
       {"a misspelt model", edit(F, "model = \"string\"", "model = \"reduce\""),
        "s.toml:1:9: model = \"reduce\" is not allowed; valid values: string, reduced (did you mean \"reduced\"?)"},
       {"reduced: no front", "model = \"reduced\"\n" + kBase,
@@ -390,4 +403,32 @@ TEST_CASE("solver.slack and solver.max_wall_s are parsed and checked, and check_
     INFO(c.what);
     CHECK(error_of(c.text) == c.message);
   }
+}
+
+TEST_CASE("an end time given on the command line (--t-end) is located at the option in every message about "
+          "stop.t_end (issue #21)",
+          "[unit][scene]") {
+  // `chainsim run --t-end 1e-300` blamed "file:30:9: stop.t_end = 10.0".
+  SceneSpec spec = parse_scene_text(kBase, "s.toml");
+  replace_t_end(spec, 1e-300, "--t-end");
+  CHECK(spec.stop.t_end == 1e-300);
+  try {
+    check_scene(spec);
+    FAIL("a run of 1e-300 s was not refused");
+  } catch (const InputError& e) {
+    CHECK(std::string(e.what()) ==
+          "--t-end: stop.t_end = 1e-300: the run's length (s) is 1e-300, out of the range the solver can represent: "
+          "allowed 1e-100 to 1e+100 (or 0); the scaled problem would overflow or underflow");
+  }
+  CHECK_THROWS_WITH(replace_t_end(spec, -1, "--t-end"), "--t-end = -1 is out of range: allowed t_end > 0 (s)");
+  CHECK_THROWS_WITH(replace_t_end(spec, NAN, "t_end"), "t_end = nan is out of range: allowed t_end > 0 (s)");
+}
+
+TEST_CASE("a plane's normal of any representable size is a direction (issue #21)", "[unit][scene]") {
+  // normal = [0, 1e300] said "must be a nonzero vector": its norm overflows, its direction does not.
+  const std::string huge = edit(test::kFallingBase, "normal = [0.0, 1.0]", "normal = [0.0, 1e300]");
+  CHECK(error_of(huge).empty());
+  CHECK(error_of(edit(huge, "model = \"string\"", "model = \"reduced\"")).empty());
+  CHECK_THAT(error_of(edit(test::kFallingBase, "normal = [0.0, 1.0]", "normal = [0.0, 0.0]")),
+             Catch::Contains("effects.plane.normal = [0.0, 0.0] is zero"));
 }

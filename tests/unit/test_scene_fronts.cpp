@@ -489,3 +489,23 @@ TEST_CASE("a scene with fronts takes every tension backend, the slack check, the
   CHECK(implicit["energy_residual"].get<double>() < 1e-6);
   CHECK(implicit["momentum_residual"].get<double>() < 1e-6);
 }
+
+TEST_CASE("model = reduced scenes at g = 1e-100 and l = 1e90 run to their t_end (issue #21)", "[unit][scene]") {
+  // The scene's t_end = 1 s is 7e-51 t0 at g = 1e-100 and 4e-45 t0 at l = 1e90: the run stalled (exit 3).
+  const std::string reduced = with_model(test::kFallingBase, "reduced");
+  const std::string weak = test::edit(reduced, "g = [0.0, -9.81]", "g = [0.0, -1e-100]");
+  std::string long_chain = test::edit(reduced, "length = 1.0", "length = 1e90");
+  long_chain = test::edit(long_chain, "points = [[0.0, 1.0], [0.0, 0.0]]", "points = [[0.0, 1e90], [0.0, 0.0]]");
+  long_chain = test::edit(long_chain, "s0 = 1.0", "s0 = 1e90");
+  long_chain = test::edit(long_chain, "s0 = 0.01", "s0 = 1e88");
+  for (const std::string* text : {&weak, static_cast<const std::string*>(&long_chain)}) {
+    const SceneSpec spec = parse_scene_text(*text, "r.toml");
+    const ReducedSetup setup = match_canonical_problem(spec);
+    // s0 = l as written may exceed the discretized length by round-off: eta0 <= 1 all the same.
+    CHECK(setup.initial_eta() <= 1.0);
+    CHECK_THAT(setup.initial_eta(), WithinAbs(1.0, 1e-15));
+    const ReducedRun run = solve_reduced(setup);
+    CHECK(run.summary["stop_reason"] == "t_max");
+    CHECK_THAT(run.summary["t_stop"].get<double>(), WithinRel(1.0, 1e-15));
+  }
+}

@@ -86,3 +86,37 @@ TEST_CASE("a scene given as JSON is the scene of the same TOML", "[unit][sweep]"
   CHECK_THROWS_WITH(scene_toml_text({{"string", {{"length", nullptr}}}}), Catch::Contains("string.length = null"));
   CHECK_THROWS_AS(scene_toml_text(nlohmann::json::array()), InputError);
 }
+
+TEST_CASE("a sweep refuses, before any run, two grid keys that set one scene key (issue #21)", "[unit][sweep]") {
+  // `chainsim sweep falling.toml --grid f=0.1 --grid effects.heap[0].f=0.9` ran one point with f = 0.9 and
+  // labelled its row f = 0.1 (its t_stop was the f = 0.9 answer).
+  const SweepScene falling{kFallingBase, "falling.toml", {}, std::nullopt};
+  auto grid = [](std::initializer_list<const char*> axes) {
+    std::vector<SweepAxis> out;
+    for (const char* a : axes) out.push_back(parse_grid_axis(a));
+    return sweep_points(out);
+  };
+  const auto alias = grid({"f=0.1", "effects.heap[0].f=0.9"});
+  CHECK_THROWS_WITH(run_sweep(falling, alias, 1),
+                    Catch::Contains("the grid key f and the grid key effects.heap[0].f both set effects.heap[0].f"));
+  CHECK_THROWS_AS(check_sweep_points(falling, alias), InputError);
+  // Another spelling of an index is the same key.
+  CHECK_THROWS_WITH(check_sweep_points(falling, grid({"effects.heap[00].f=0.1", "effects.heap[0].f=0.9"})),
+                    Catch::Contains("effects.heap[00].f and the grid key effects.heap[0].f"));
+  // stop.t_end on the grid and the sweep's own t_end.
+  const SweepScene timed{kFallingBase, "falling.toml", {}, 0.2};
+  CHECK_THROWS_WITH(check_sweep_points(timed, grid({"stop.t_end=0.1,0.3"})),
+                    Catch::Contains("the grid key stop.t_end and the sweep's --t-end both set stop.t_end"));
+  // A point run on its own (the Dask path) is an error row, not a mislabelled run.
+  const nlohmann::json row = run_sweep_point(falling, alias[0]);
+  CHECK(row["status"] == "error");
+  CHECK(!row.contains("t_stop"));
+  // Keys that set different scene keys still run, and each row's values are the ones that ran: the
+  // alias f and the full key give the same stop time (the quadrature's, t0 ξ(ε; f)).
+  const double t0 = std::sqrt(2 * 1.0 / 9.81);
+  for (const char* key : {"f", "effects.heap[0].f"}) {
+    const auto rows = run_sweep(falling, grid({(std::string(key) + "=0.9").c_str()}), 1);
+    REQUIRE(rows[0]["status"] == "stopped");
+    CHECK(rows[0]["t_stop"].get<double>() == Approx(t0 * exact::xi(Problem::kFalling, 0.9, 0.01, 1.0)).epsilon(1e-6));
+  }
+}
