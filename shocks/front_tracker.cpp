@@ -14,17 +14,11 @@ namespace chainsim {
 
 namespace {
 /// A heap takes in an arc's end node when its partial link shrinks to kRemove·h and gives out a new
-/// node when it grows to kInsert·h: the partial link stays in [h/2, 7h/4], away from zero length
-/// (where its direction is undefined). A crossing moves the partial link by h: to 3h/2 after a
-/// removal, to 3h/4 after an insertion, a quarter link inside the band either way. With a band
-/// exactly one link wide (insertion at 3h/2) a front at exactly h/2 past a node sat on both
-/// thresholds at once, and a root function that is zero where the integration starts is no root to
-/// ARKODE: the front ran past the threshold unseen and its partial link shrank to nothing (the
-/// falling chain from eta0 = 0.5 on 4, 6 and 10 nodes stalled).
-constexpr double kRemove = 0.5, kInsert = 1.75;
-/// The initial partial link lies in (kLayoutMin·h, (kLayoutMin + 1)·h], plus this fraction of a link
-/// (strictly inside the band even when s0/h is a half-integer up to round-off).
-constexpr double kLayoutMin = 0.5, kLayoutMargin = 1e-6;
+/// node when it grows to kInsert·h: the partial link stays in [h/2, 3h/2], away from zero length
+/// (where its direction is undefined). A front that starts on a threshold (exactly h/2 past a node)
+/// and moves across it crosses at t = 0 (StringModel::events_at_start): ARKODE reports no root
+/// function that is zero where the integration starts.
+constexpr double kRemove = 0.5, kInsert = 1.5;
 /// The last node of an arc cannot be taken in; the run stops when its partial link is this short.
 constexpr double kLastPartial = 1e-3;
 /// A heap whose content is below this fraction of the string's length (64 ε) is empty.
@@ -233,11 +227,12 @@ std::vector<ArcRange> FrontTracker<dim>::initial_arcs(const Chain<dim>& chain) {
   std::vector<ArcRange> arcs;
   auto node_at_or_before = [&](double s) { return std::clamp(static_cast<int>(std::floor(s / h_ + 1e-9)), 0, n_ - 1); };
   int first = 0, last = n_ - 1;
-  // Each heap's partial link starts in (h/2, 3h/2] (kLayoutMin), never on a crossing threshold.
+  // Each heap's partial link starts in [h/2, 3h/2) (up to 1e-9 h); one on its removal threshold
+  // crosses it at t = 0 if it moves out of the band (StringModel::events_at_start).
   if (before)
-    first = std::min(n_ - 1, static_cast<int>(std::floor(before->s0 / h_ + kLayoutMin + 1 + kLayoutMargin)));
+    first = std::min(n_ - 1, static_cast<int>(std::ceil((before->s0 + kRemove * h_) / h_ - 1e-9)));
   if (after)
-    last = std::max(first, static_cast<int>(std::ceil(after->s0 / h_ - kLayoutMin - 1 - kLayoutMargin)));
+    last = std::max(first, static_cast<int>(std::floor((after->s0 - kRemove * h_) / h_ + 1e-9)));
   if (fold) {
     const int a = node_at_or_before(fold->s0);
     if (a < first || a + 1 > last) throw InputError("the fold must lie inside the moving part of the string");

@@ -20,6 +20,9 @@ constexpr double kCollapsedLink = 1e-6;
 /// cannot be represented more accurately than its end points' coordinates.
 constexpr double kProjectionTolerance = 1e-14;
 constexpr double kRoundoffUlps = 64;
+/// The largest share of the physical acceleration scale the drift control's response to round-off
+/// may take (evaluate_current).
+constexpr double kDriftRoundoff = 1e-6;
 constexpr int kProjectionIterations = 60;
 }  // namespace
 
@@ -267,18 +270,21 @@ double StringModel<dim>::evaluate_current(double t) {
     links();
     system_->zero();
     assemble_matrix();
-    const double beta2 = beta_ * beta_;
-    // The position term of the drift control acts on the link error beyond the projection's
-    // tolerance (the round-off of the coordinates): a state the projection calls exact, as a string
-    // at rest, gets no artificial tension. β² = 1/τ_b² is large when τ_b is short (a scene whose only
-    // time scale is a short t_end), and turned the round-off of a string at rest into T = −1.5e165 N.
+    // The position term β² C of the drift control turns the round-off of the link lengths (the
+    // constraint tolerance δ) into accelerations β² δ h. It may not exceed kDriftRoundoff of the
+    // physical acceleration scale (physical_scales().tension / λℓ: weight, loads, drivers, speeds),
+    // so β² is capped there: a string with none of them (at rest without weight or load) gets no
+    // position term and no artificial tension, however short τ_b (β² = 1/τ_b² turned its round-off
+    // into T = −1.5e165 N with τ_b = 1e-91 s). Ordinary runs are far below the cap (falling chain:
+    // β² δ h = 1.7e-10 m/s² against 1e-5 m/s²) and keep β² = 1/τ_b².
     const double tolerance = constraint_tolerance();
+    const double a_physical = physical_scales().tension / (chain_.density() * chain_.length());
+    const double h_ref = std::isfinite(h_min_) ? h_min_ : chain_.length();
+    beta2_ = std::min(beta_ * beta_, kDriftRoundoff * a_physical / (tolerance * h_ref));
     for_each_link([&](int j, int u, int) {
       const int a = chain_.link_start(j), b = chain_.link_end(j);
       const double h = chain_.link_length(j), l = l_[j];
-      const double error = l - h, band = tolerance * h;
-      const double beyond = error > band ? error - band : error < -band ? error + band : 0.0;
-      const double stab = 2 * alpha_ * dx_.col(j).dot(dv_.col(j)) + beta2 * beyond * 0.5 * (l + h);
+      const double stab = 2 * alpha_ * dx_.col(j).dot(dv_.col(j)) + beta2_ * 0.5 * (l * l - h * h);
       system_->rhs(u) = -dv_.col(j).squaredNorm() / l - e_.col(j).dot(b_.col(b) - b_.col(a)) - stab / l;
     });
     const Eigen::VectorXd& T = system_->solve(t);
@@ -576,7 +582,7 @@ typename StringModel<dim>::PhysicalScales StringModel<dim>::physical_scales() co
     if (path_of_[i] < 0)
       loads += (force_.col(i) + force_nc_.col(i) - m_[i] * g).norm();
     else
-      a_driven = std::max(a_driven, a_.col(i).norm());
+      a_driven = std::max(a_driven, b_.col(i).norm());  // the path's acceleration
   }
   const double statics = lambda * g.norm() * ell + loads;
   return {statics + lambda * (v2_max + ell * a_driven), ell * statics};
@@ -600,6 +606,40 @@ std::optional<SlackReport> StringModel<dim>::find_slack(double t, const Eigen::R
   const double T_worst = T[link_unknown_[static_cast<std::size_t>(worst)]];
   if (!(T_worst < -options_.slack_tolerance * scale)) return std::nullopt;
   return SlackReport{t, worst, chain_.link_midpoint(worst), T_worst, scale};
+}
+
+template <int dim>
+std::vector<int> StringModel<dim>::events_at_start(double t0, const Eigen::Ref<const Eigen::VectorXd>& y0) {
+  const int m = num_events();
+  std::vector<int> found(static_cast<std::size_t>(m), 0);
+  if (m == 0) return found;
+  const std::vector<int> dirs = event_directions();
+  Eigen::VectorXd g0(m), g2(m);
+  events(t0, y0, g0);
+  bool on_threshold = false;
+  for (int k = 0; k < m; ++k) on_threshold = on_threshold || (dirs[k] != 0 && g0[k] * dirs[k] >= 0);
+  if (!on_threshold) return found;
+  // Two explicit Euler steps of δ: g(2δ) − g(0) = 2δ ġ + O(δ²), and 2δ² g̈ at rest (ġ = 0).
+  const int nx = dim * num_free_;
+  Eigen::VectorXd f(y0.size());
+  rhs(t0, y0, f);
+  const double speed = f.head(nx).cwiseAbs().maxCoeff(), accel = f.segment(nx, nx).cwiseAbs().maxCoeff();
+  double h_min = INFINITY;
+  for (int j = 0; j < chain_.num_links(); ++j) h_min = std::min(h_min, chain_.link_length(j));
+  const double reach = kStartProbe * h_min;
+  double delta = INFINITY;
+  if (speed > 0) delta = reach / speed;
+  if (accel > 0) delta = std::min(delta, std::sqrt(reach / accel));
+  if (!std::isfinite(delta)) return found;  // nothing moves
+  const Eigen::VectorXd y1 = y0 + delta * f;
+  rhs(t0 + delta, y1, f);
+  const Eigen::VectorXd y2 = y1 + delta * f;
+  events(t0 + 2 * delta, y2, g2);
+  for (int k = 0; k < m; ++k)
+    if (dirs[k] != 0 && g0[k] * dirs[k] >= 0 && (g2[k] - g0[k]) * dirs[k] > 0) found[static_cast<std::size_t>(k)] = dirs[k];
+  unpack_state(t0, y0);
+  refresh();
+  return found;
 }
 
 template <int dim>
