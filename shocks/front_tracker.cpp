@@ -15,10 +15,18 @@ namespace chainsim {
 namespace {
 /// A heap takes in an arc's end node when its partial link shrinks to kRemove·h and gives out a new
 /// node when it grows to kInsert·h: the partial link stays in [h/2, 3h/2], away from zero length
-/// (where its direction is undefined). A front that starts on a threshold (exactly h/2 past a node)
-/// and moves across it crosses at t = 0 (StringModel::events_at_start): ARKODE reports no root
-/// function that is zero where the integration starts.
-constexpr double kRemove = 0.5, kInsert = 1.5;
+/// (where its direction is undefined), widened by kHysteresis·h on either side. The initial layout
+/// puts the partial link in [h/2, 3h/2) (up to 1e-9 h), and a crossing moves it by h, so that every
+/// root function starts at least ~kHysteresis·h from zero. With the thresholds at exactly h/2 and
+/// 3h/2, a front starting exactly h/2 past a node had a root function that was zero where the
+/// integration starts, which ARKODE does not report: the falling chain from eta0 = 0.5 on 4, 6 and 10
+/// nodes ran past it unseen and stalled. Crossing it at t = 0 instead left the partial link on the
+/// other threshold with a front at rest, whose first steps move it by less than the round-off of
+/// the partial link (1e-23 m against 1e-17 m): that sign noise gave the opposite crossing at
+/// t = 1.5e-9 s (14 nodes). A band wider by a quarter link avoided both but used the end interpolant
+/// further from the nodes and cost the swinging sliding chain its convergence (order -1.08).
+constexpr double kHysteresis = 1e-6;
+constexpr double kRemove = 0.5 - kHysteresis, kInsert = 1.5 + kHysteresis;
 /// The last node of an arc cannot be taken in; the run stops when its partial link is this short.
 constexpr double kLastPartial = 1e-3;
 /// A heap whose content is below this fraction of the string's length (64 ε) is empty.
@@ -227,12 +235,12 @@ std::vector<ArcRange> FrontTracker<dim>::initial_arcs(const Chain<dim>& chain) {
   std::vector<ArcRange> arcs;
   auto node_at_or_before = [&](double s) { return std::clamp(static_cast<int>(std::floor(s / h_ + 1e-9)), 0, n_ - 1); };
   int first = 0, last = n_ - 1;
-  // Each heap's partial link starts in [h/2, 3h/2) (up to 1e-9 h); one on its removal threshold
-  // crosses it at t = 0 if it moves out of the band (StringModel::events_at_start).
+  // Each heap's partial link starts in [h/2, 3h/2) (up to 1e-9 h), inside the thresholds by about
+  // kHysteresis·h.
   if (before)
-    first = std::min(n_ - 1, static_cast<int>(std::ceil((before->s0 + kRemove * h_) / h_ - 1e-9)));
+    first = std::min(n_ - 1, static_cast<int>(std::ceil((before->s0 + 0.5 * h_) / h_ - 1e-9)));
   if (after)
-    last = std::max(first, static_cast<int>(std::floor((after->s0 - kRemove * h_) / h_ + 1e-9)));
+    last = std::max(first, static_cast<int>(std::floor((after->s0 - 0.5 * h_) / h_ + 1e-9)));
   if (fold) {
     const int a = node_at_or_before(fold->s0);
     if (a < first || a + 1 > last) throw InputError("the fold must lie inside the moving part of the string");

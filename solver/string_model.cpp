@@ -609,40 +609,6 @@ std::optional<SlackReport> StringModel<dim>::find_slack(double t, const Eigen::R
 }
 
 template <int dim>
-std::vector<int> StringModel<dim>::events_at_start(double t0, const Eigen::Ref<const Eigen::VectorXd>& y0) {
-  const int m = num_events();
-  std::vector<int> found(static_cast<std::size_t>(m), 0);
-  if (m == 0) return found;
-  const std::vector<int> dirs = event_directions();
-  Eigen::VectorXd g0(m), g2(m);
-  events(t0, y0, g0);
-  bool on_threshold = false;
-  for (int k = 0; k < m; ++k) on_threshold = on_threshold || (dirs[k] != 0 && g0[k] * dirs[k] >= 0);
-  if (!on_threshold) return found;
-  // Two explicit Euler steps of δ: g(2δ) − g(0) = 2δ ġ + O(δ²), and 2δ² g̈ at rest (ġ = 0).
-  const int nx = dim * num_free_;
-  Eigen::VectorXd f(y0.size());
-  rhs(t0, y0, f);
-  const double speed = f.head(nx).cwiseAbs().maxCoeff(), accel = f.segment(nx, nx).cwiseAbs().maxCoeff();
-  double h_min = INFINITY;
-  for (int j = 0; j < chain_.num_links(); ++j) h_min = std::min(h_min, chain_.link_length(j));
-  const double reach = kStartProbe * h_min;
-  double delta = INFINITY;
-  if (speed > 0) delta = reach / speed;
-  if (accel > 0) delta = std::min(delta, std::sqrt(reach / accel));
-  if (!std::isfinite(delta)) return found;  // nothing moves
-  const Eigen::VectorXd y1 = y0 + delta * f;
-  rhs(t0 + delta, y1, f);
-  const Eigen::VectorXd y2 = y1 + delta * f;
-  events(t0 + 2 * delta, y2, g2);
-  for (int k = 0; k < m; ++k)
-    if (dirs[k] != 0 && g0[k] * dirs[k] >= 0 && (g2[k] - g0[k]) * dirs[k] > 0) found[static_cast<std::size_t>(k)] = dirs[k];
-  unpack_state(t0, y0);
-  refresh();
-  return found;
-}
-
-template <int dim>
 EventAction StringModel<dim>::handle_events(double t, Eigen::VectorXd& y, const std::vector<int>& found) {
   CHAINSIM_VERIFY(module_ != nullptr, "events come from a module");
   unpack_state(t, y);

@@ -182,15 +182,6 @@ class StringModel final : public OdeSystem {
   /// tension is zero (free fall, or rest without weight or load) is not slack by round-off; nothing
   /// otherwise, and never when the physical scale is zero. One tension solve.
   std::optional<SlackReport> find_slack(double t, const Eigen::Ref<const Eigen::VectorXd>& y);
-  /// The root functions that ARKODE cannot report at the start (t0, y0): those at or past their
-  /// threshold (g·d >= 0 for the event's direction d) that move across it (ġ·d > 0, or at rest
-  /// g̈·d > 0). ARKODE reports sign changes after t0 only, so a front that starts exactly on a
-  /// crossing threshold (a heap's partial link of exactly h/2) and moves out of its band would cross
-  /// unseen. The motion is probed by two explicit Euler steps that move the fastest node by
-  /// kStartProbe of the shortest link (by its speed, or at rest by its acceleration). Returns one
-  /// entry per root function (its direction where found, else 0), for handle_events.
-  std::vector<int> events_at_start(double t0, const Eigen::Ref<const Eigen::VectorXd>& y0);
-  static constexpr double kStartProbe = 1e-6;
   /// Acts on the root functions found at (t, y) (the module's events): `y` is replaced by the new,
   /// possibly longer or shorter, state after a transfer.
   EventAction handle_events(double t, Eigen::VectorXd& y, const std::vector<int>& found);

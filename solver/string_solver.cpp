@@ -21,8 +21,6 @@ constexpr int kMaxDenseOrder = Integrator::kMaxDenseOrder;
 /// that ARKODE shortened to end at a frame, one interval after the previous one, ends a few rounding
 /// units short of the interval.
 constexpr double kStepOfFrames = 1 - 1e-9;
-/// Crossings acted on at t0 at most (StringModel::events_at_start), one per pass.
-constexpr int kMaxStartEvents = 8;
 }  // namespace
 
 void StringSolverOptions::validate() const {
@@ -361,22 +359,6 @@ const RunSummary& StringSolver<dim>::run() {
     // 1. A consistent initial state.
     model_.make_consistent(t0);
     Eigen::VectorXd y0 = model_.state_from_chain();
-    // A root function at or past its threshold at t0 and moving across it is no root to ARKODE (it
-    // reports sign changes after t0): a front that starts exactly on a crossing threshold crosses
-    // here, at t0 (one crossing per call, as at any event).
-    for (int pass = 0; pass < kMaxStartEvents; ++pass) {
-      const std::vector<int> found = model_.events_at_start(t0, y0);
-      if (std::none_of(found.begin(), found.end(), [](int e) { return e != 0; })) break;
-      const EventAction action = model_.handle_events(t0, y0, found);
-      if (action.kind == EventAction::Kind::kStop) {
-        record_frame(t0, y0);
-        if (options_.record_steps) record_sample(t0, y0);
-        finish("stopped");
-        summary_.t_stop = t0;
-        summary_.stop_reason = action.reason;
-        return summary_;
-      }
-    }
     // An impulsive start: the energy the jump of the velocities gave is the drivers' work at t = 0.
     const auto& impulsive = model_.impulsive_start();
     summary_.impulsive_start = impulsive.detected();
