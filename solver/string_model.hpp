@@ -166,7 +166,8 @@ class StringModel final : public OdeSystem {
 
   /// max_j | |Δx_j| − h_j | / h_j at (t, y) over the links of the arcs, without a tension solve.
   double max_constraint_violation(double t, const Eigen::Ref<const Eigen::VectorXd>& y) const;
-  /// The physical scales of the current state, after an evaluation (never the round-off of a solve):
+  /// The physical scales of the current state (never the round-off of a solve), from its velocities,
+  /// forces and the drivers' accelerations (valid once evaluate_current has set the forces):
   ///   tension  λ (|g| ℓ + max |v|² + ℓ max |a_driven|) + Σ |F_i − m_i g|: the weight, the centripetal
   ///            tension, what the drivers' accelerations ask of the whole string, and every other
   ///            applied force (end loads, drag) on the moving nodes;
@@ -257,7 +258,8 @@ class StringModel final : public OdeSystem {
   void links();
   /// The relative accuracy to which link lengths are known after links(): the larger of the
   /// projection's tolerance and the round-off of the coordinates, kRoundoffUlps · ε · x_max / h_min.
-  /// The projection converges to it, and the drift control ignores link errors within it.
+  /// The projection converges to it, and the drift control's response to it stays below the
+  /// physical accelerations (evaluate_current caps β²).
   double constraint_tolerance() const;
   void assemble_matrix();
   Eigen::VectorXd pack(const Eigen::Ref<const Eigen::VectorXd>& ledgers) const;
