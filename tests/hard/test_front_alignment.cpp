@@ -1,9 +1,10 @@
 // Fronts on any mesh (issue #21): the three canonical problems on every node count from the smallest
 // the setup accepts (4) to 40, each from several starts η0 — the paper's, 0.25, 0.5 and two that put
 // the front exactly on a node and exactly h/2 past one — against the reduced ODE, with the bounds of
-// the canonical tests (test_front_tracking.cpp). A front at exactly h/2 used to sit on its
-// heap's removal threshold; ARKODE ignores a root function that is zero where the integration starts, so the front ran past the threshold unseen and the run stalled ("time
-// integration stalled at t = 0.1419 s", the falling chain from η0 = 0.5 on 4, 6 and 10 nodes).
+// the canonical tests (test_front_tracking.cpp). A front at exactly h/2 used to sit on its heap's
+// removal threshold; ARKODE ignores a root function that is zero where the integration starts, so
+// the front ran past the threshold unseen and the run stalled ("time integration stalled at
+// t = 0.1419 s", the falling chain from η0 = 0.5 on 4, 6 and 10 nodes).
 #include <cmath>
 #include <string>
 #include <vector>
