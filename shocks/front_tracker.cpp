@@ -15,8 +15,18 @@ namespace chainsim {
 namespace {
 /// A heap takes in an arc's end node when its partial link shrinks to kRemove·h and gives out a new
 /// node when it grows to kInsert·h: the partial link stays in [h/2, 3h/2], away from zero length
-/// (where its direction is undefined).
-constexpr double kRemove = 0.5, kInsert = 1.5;
+/// (where its direction is undefined), widened by kHysteresis·h on either side. The initial layout
+/// puts the partial link in [h/2, 3h/2) (up to 1e-9 h), and a crossing moves it by h, so that every
+/// root function starts at least ~kHysteresis·h from zero. With the thresholds at exactly h/2 and
+/// 3h/2, a front starting exactly h/2 past a node had a root function that was zero where the
+/// integration starts, which ARKODE does not report: the falling chain from eta0 = 0.5 on 4, 6 and 10
+/// nodes ran past it unseen and stalled. Crossing it at t = 0 instead left the partial link on the
+/// other threshold with a front at rest, whose first steps move it by less than the round-off of
+/// the partial link (1e-23 m against 1e-17 m): that sign noise gave the opposite crossing at
+/// t = 1.5e-9 s (14 nodes). A band wider by a quarter link avoided both but used the end interpolant
+/// further from the nodes and cost the swinging sliding chain its convergence (order -1.08).
+constexpr double kHysteresis = 1e-6;
+constexpr double kRemove = 0.5 - kHysteresis, kInsert = 1.5 + kHysteresis;
 /// The last node of an arc cannot be taken in; the run stops when its partial link is this short.
 constexpr double kLastPartial = 1e-3;
 /// A heap whose content is below this fraction of the string's length (64 ε) is empty.
@@ -145,11 +155,19 @@ HeapGeometry<dim> heap_geometry(const Points<dim>& x, const Points<dim>& v, cons
     throw RecoverableError(
         fmt::format("the string meets the heap's plane at a grazing angle (n·t = {:.3g} at node {})", n.dot(e_last), node));
   double t = sigma * n.dot(point - x.col(node)) / n.dot(e_last);  // the last link's crossing
+  // Converged when the step is below 1e-14 h, or at the round-off of the curve: Newton no longer
+  // halves a step already below 1e-9 h. The curve is extrapolated past the end node when an accepted
+  // step carries the contact beyond the insertion threshold (the root is then found inside the step),
+  // and its round-off grows with the distance: 2.5 h out, steps of 1e-16 m against a test of 1e-16 m
+  // never passed, and a pick-up from a table failed at an accepted state whenever its output times
+  // gave it such a step (output.interval = 0.01 s, not 0.001 s).
   bool converged = false;
+  double previous = INFINITY;
   for (int it = 0; it < 30 && !converged; ++it) {
     const double dt = -n.dot(c.position(t) - point) / n.dot(c.slope(t));
     t += dt;
-    converged = std::abs(dt) <= 1e-14 * h;
+    converged = std::abs(dt) <= 1e-14 * h || (std::abs(dt) <= 1e-9 * h && std::abs(dt) > 0.5 * previous);
+    previous = std::abs(dt);
   }
   if (!converged) throw RecoverableError(fmt::format("the string near node {} does not meet the heap's plane", node));
   g.l = sigma * t;
@@ -217,8 +235,12 @@ std::vector<ArcRange> FrontTracker<dim>::initial_arcs(const Chain<dim>& chain) {
   std::vector<ArcRange> arcs;
   auto node_at_or_before = [&](double s) { return std::clamp(static_cast<int>(std::floor(s / h_ + 1e-9)), 0, n_ - 1); };
   int first = 0, last = n_ - 1;
-  if (before) first = std::min(n_ - 1, static_cast<int>(std::ceil((before->s0 + kRemove * h_) / h_ - 1e-9)));
-  if (after) last = std::max(first, static_cast<int>(std::floor((after->s0 - kRemove * h_) / h_ + 1e-9)));
+  // Each heap's partial link starts in [h/2, 3h/2) (up to 1e-9 h), inside the thresholds by about
+  // kHysteresis·h.
+  if (before)
+    first = std::min(n_ - 1, static_cast<int>(std::ceil((before->s0 + 0.5 * h_) / h_ - 1e-9)));
+  if (after)
+    last = std::max(first, static_cast<int>(std::floor((after->s0 - 0.5 * h_) / h_ + 1e-9)));
   if (fold) {
     const int a = node_at_or_before(fold->s0);
     if (a < first || a + 1 > last) throw InputError("the fold must lie inside the moving part of the string");
@@ -239,9 +261,8 @@ std::vector<ArcRange> FrontTracker<dim>::initial_arcs(const Chain<dim>& chain) {
       if (!(norm > 0) || !std::isfinite(norm)) throw InputError("the normal of a heap's plane must be a nonzero vector");
       front.on_plane = true;
       front.normal = *spec.plane_normal / norm;
-      const ArcRange& arc = arcs[static_cast<std::size_t>(arc_minus >= 0 ? arc_minus : arc_plus)];
-      if (arc.num_links() < 1)
-        throw InputError("a heap on a plane needs at least one full link next to it (its direction is the string's)");
+      // An arc with no full link next to the heap takes the direction of its partial link from the
+      // initial shape (initialize()).
     }
     return front;
   };
@@ -275,9 +296,26 @@ std::vector<ArcRange> FrontTracker<dim>::initial_arcs(const Chain<dim>& chain) {
 
 template <int dim>
 void FrontTracker<dim>::initialize(StringModel<dim>& model) {
-  for (const Front& front : fronts_) {
+  for (Front& front : fronts_) {
     if (!front.on_plane) continue;
-    const int inner = heap_end(model, front).inner;
+    const HeapEnd end = heap_end(model, front);
+    if (model.arcs()[static_cast<std::size_t>(end.arc)].num_links() == 0) {
+      // No full link: the string runs straight from the end node to the heap point (the direction
+      // the front keeps until a node comes out).
+      const Vec<dim> d = front.point - model.x().col(end.node);
+      if (!(d.norm() > 1e-9 * h_))
+        throw InputError(fmt::format("the initial shape does not fit the heap on the plane: node {} lies on the heap "
+                                     "point, so the string's direction there is undefined",
+                                     end.node));
+      front.last_direction = d.normalized();
+      const double height = front.normal.dot(model.x().col(end.node) - front.point);
+      if (height < 0)
+        throw InputError(fmt::format("the normal of the heap's plane must point to the string's side: node {} is "
+                                     "{:.6g} m from the plane along it",
+                                     end.node, height));
+      continue;
+    }
+    const int inner = end.inner;
     const double height = front.normal.dot(model.x().col(inner) - front.point);
     if (height < 0)  // on the plane itself: the grazing check below says more
       throw InputError(fmt::format("the normal of the heap's plane must point to the string's side: node {} is "
@@ -467,6 +505,22 @@ void FrontTracker<dim>::add_mass_and_forces(const StringModel<dim>& model, Eigen
   for (int i = 0; i < n_; ++i)
     if (model.in_arc(i) && !model.is_prescribed(i) && !(mass[i] > 1e-12 * lambda_ * h_))
       throw RecoverableError(fmt::format("node {} has lost its mass (a front overshot it)", i));
+}
+
+template <int dim>
+std::optional<double> FrontTracker<dim>::front_tension_at(const StringModel<dim>& model, int node) const {
+  for (std::size_t k = 0; k < fronts_.size(); ++k) {
+    const Front& front = fronts_[k];
+    const FrontState<dim>& s = fs_[k];
+    if (front.kind == FrontKind::kHeap) {
+      const HeapEnd end = heap_end(model, front);
+      if (end.node == node) return end.after ? s.tension_minus : s.tension_plus;
+    } else {
+      if (model.arcs()[static_cast<std::size_t>(front.arc_minus)].last == node) return s.tension_minus;
+      if (model.arcs()[static_cast<std::size_t>(front.arc_plus)].first == node) return s.tension_plus;
+    }
+  }
+  return std::nullopt;
 }
 
 template <int dim>

@@ -42,7 +42,8 @@
 ///
 /// Front crossings are ARKODE root events (two per front): a heap takes the end node in when the
 /// partial link shrinks to h/2 (every other node keeps its state) and gives out a new node when it
-/// grows to 3h/2 (at the interpolant's position and velocity there); a fold moves the node it reaches
+/// grows to 7h/4 (at the interpolant's position and velocity there; the band is wider than a link,
+/// so that no crossing, and no initial layout, leaves a front on a threshold); a fold moves the node it reaches
 /// from one arc to the other, its material moving with its momentum (mass parcels). What a crossing
 /// changes in the lumped momentum and energy is booked (heap impulse, W_remesh; zero for straight
 /// motions). Then the string rebuilds its arcs, projects positions and velocities onto the link
@@ -155,6 +156,9 @@ class FrontTracker final : public StringModule<dim> {
                             const std::vector<int>& found) override;
   long transfers() const override { return transfers_; }
   int num_fronts() const override { return static_cast<int>(fronts_.size()); }
+  /// The tension at an arc's end node on its front's side, after an evaluation: the end tension of
+  /// the jump conditions (τ at a heap, τ∓ at a fold), which its partial link carries to the node.
+  std::optional<double> front_tension_at(const StringModel<dim>& model, int node) const override;
 
  private:
   /// The arc end at a heap front: its end node, the node inside the arc next to it, the node that

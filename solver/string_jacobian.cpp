@@ -122,7 +122,7 @@ void StringJacobian<dim>::linearize(double t, const Eigen::Ref<const Eigen::Vect
     const V e = m.e_.col(link);
     return Mat::Identity() - e * e.transpose();
   };
-  const double alpha = m.alpha_, beta2 = m.beta_ * m.beta_;
+  const double alpha = m.alpha_, beta2 = m.beta2_;  // β² as the evaluation capped it
 
   m.for_each_link([&](int j, int u, int next) {
     const int a = chain.link_start(j), b = chain.link_end(j);

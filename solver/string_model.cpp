@@ -20,6 +20,9 @@ constexpr double kCollapsedLink = 1e-6;
 /// cannot be represented more accurately than its end points' coordinates.
 constexpr double kProjectionTolerance = 1e-14;
 constexpr double kRoundoffUlps = 64;
+/// The largest share of the physical acceleration scale the drift control's response to round-off
+/// may take (evaluate_current).
+constexpr double kDriftRoundoff = 1e-6;
 constexpr int kProjectionIterations = 60;
 }  // namespace
 
@@ -34,7 +37,8 @@ const char* to_string(SlackPolicy policy) {
 
 std::string SlackReport::message() const {
   return fmt::format("slack at t = {:.9g} s: link {} (s = {:.6g} m from node 0) has tension T = {:.6g} N < 0 "
-                     "(tension scale {:.6g} N, the larger of max |T| and lambda (|g| l + max |v|^2)); an inextensible string "
+                     "(tension scale {:.6g} N, the larger of max |T| and the physical tension lambda (|g| l + max |v|^2 + l max "
+                     "|a_driven|) + sum |loads|); an inextensible string "
                      "cannot push, so the model does not apply",
                      t, link, s_mid, tension, scale);
 }
@@ -126,6 +130,7 @@ void StringModel<dim>::rebuild() {
   std::vector<int> arc_links;
   std::vector<bool> arc_closed;
   int unknown = 0;
+  h_min_ = INFINITY;
   const double lambda = chain_.density();
   for (std::size_t k = 0; k < arcs_.size(); ++k) {
     const ArcRange& arc = arcs_[k];
@@ -137,6 +142,7 @@ void StringModel<dim>::rebuild() {
       base_mass_[chain_.link_start(j)] += 0.5 * lambda * chain_.link_length(j);
       base_mass_[chain_.link_end(j)] += 0.5 * lambda * chain_.link_length(j);
     }
+    for (int q = 0; q < arc.num_links(); ++q) h_min_ = std::min(h_min_, chain_.link_length(arc.first + q));
     unknown += arc.num_links();
     arc_links.push_back(arc.num_links());
     arc_closed.push_back(arc.closed);
@@ -190,6 +196,7 @@ void StringModel<dim>::fill_moving(double t, const Eigen::Ref<const Eigen::Vecto
 
 template <int dim>
 void StringModel<dim>::links() {
+  x_max_ = 0;
   for_each_link([&](int j, int, int) {
     const int a = chain_.link_start(j), b = chain_.link_end(j);
     dx_.col(j) = x_.col(b) - x_.col(a);
@@ -199,7 +206,13 @@ void StringModel<dim>::links() {
       throw RecoverableError(fmt::format("link {} has collapsed to length {:g}", j, l));
     l_[j] = l;
     e_.col(j) = dx_.col(j) / l;
+    x_max_ = std::max({x_max_, x_.col(a).cwiseAbs().maxCoeff(), x_.col(b).cwiseAbs().maxCoeff()});
   });
+}
+
+template <int dim>
+double StringModel<dim>::constraint_tolerance() const {
+  return std::max(kProjectionTolerance, kRoundoffUlps * std::numeric_limits<double>::epsilon() * x_max_ / h_min_);
 }
 
 template <int dim>
@@ -257,11 +270,21 @@ double StringModel<dim>::evaluate_current(double t) {
     links();
     system_->zero();
     assemble_matrix();
-    const double beta2 = beta_ * beta_;
+    // The position term β² C of the drift control turns the round-off of the link lengths (the
+    // constraint tolerance δ) into accelerations β² δ h. It may not exceed kDriftRoundoff of the
+    // physical acceleration scale (physical_scales().tension / λℓ: weight, loads, drivers, speeds),
+    // so β² is capped there: a string with none of them (at rest without weight or load) gets no
+    // position term and no artificial tension, however short τ_b (β² = 1/τ_b² turned its round-off
+    // into T = −1.5e165 N with τ_b = 1e-91 s). Ordinary runs are far below the cap (falling chain:
+    // β² δ h = 1.7e-10 m/s² against 1e-5 m/s²) and keep β² = 1/τ_b².
+    const double tolerance = constraint_tolerance();
+    const double a_physical = physical_scales().tension / (chain_.density() * chain_.length());
+    const double h_ref = std::isfinite(h_min_) ? h_min_ : chain_.length();
+    beta2_ = std::min(beta_ * beta_, kDriftRoundoff * a_physical / (tolerance * h_ref));
     for_each_link([&](int j, int u, int) {
       const int a = chain_.link_start(j), b = chain_.link_end(j);
       const double h = chain_.link_length(j), l = l_[j];
-      const double stab = 2 * alpha_ * dx_.col(j).dot(dv_.col(j)) + beta2 * 0.5 * (l * l - h * h);
+      const double stab = 2 * alpha_ * dx_.col(j).dot(dv_.col(j)) + beta2_ * 0.5 * (l * l - h * h);
       system_->rhs(u) = -dv_.col(j).squaredNorm() / l - e_.col(j).dot(b_.col(b) - b_.col(a)) - stab / l;
     });
     const Eigen::VectorXd& T = system_->solve(t);
@@ -346,15 +369,11 @@ void StringModel<dim>::project(double t) {
       target.col(b) += w_[b] * nu[u] * e_.col(j);
     });
   };
-  double h_min = INFINITY, x_max = 0;
-  for_each_link([&](int j, int, int) { h_min = std::min(h_min, chain_.link_length(j)); });
-  for (int i = 0; i < chain_.num_nodes(); ++i)
-    if (in_arc(i)) x_max = std::max(x_max, x_.col(i).cwiseAbs().maxCoeff());
-  const double roundoff = kRoundoffUlps * std::numeric_limits<double>::epsilon() * x_max / h_min;
-  const double tolerance = std::max(kProjectionTolerance, roundoff);
-  double violation = 0, previous = INFINITY;
+  double violation = 0, previous = INFINITY, roundoff = 0;
   for (int iteration = 0;; ++iteration) {
     links();
+    const double tolerance = constraint_tolerance();
+    roundoff = tolerance;
     violation = 0;
     for_each_link([&](int j, int, int) {
       violation = std::max(violation, std::abs(l_[j] - chain_.link_length(j)) / chain_.link_length(j));
@@ -363,8 +382,8 @@ void StringModel<dim>::project(double t) {
     if (violation <= tolerance || (violation < 1e3 * tolerance && violation > 0.5 * previous)) break;
     if (iteration == kProjectionIterations || !std::isfinite(violation))
       throw NumericalError(fmt::format("at t = {:.9g} s the links cannot be projected onto their lengths: after {} "
-                                       "projection steps a link is still off by {:.3g} of its length (round-off "
-                                       "level of the coordinates {:.3g})",
+                                       "projection steps a link is still off by {:.3g} of its length (tolerance "
+                                       "{:.3g}: the round-off level of the coordinates, at least 1e-14)",
                                        t, iteration, violation, roundoff),
                            t);
     previous = violation;
@@ -397,10 +416,13 @@ double StringModel<dim>::make_consistent(double t0) {
     x_.col(p.node) = p.path->position(t0);
     v_.col(p.node) = p.path->velocity(t0);
   }
-  const Points<dim> x_start = x_;
+  const Points<dim> x_start = x_, v_start = v_;
+  double K_start = 0;
   try {
     refresh();
+    K_start = kinetic_energy();
     project(t0);
+    refresh();
   } catch (const RecoverableError& e) {
     throw InputError(fmt::format("the initial shape is degenerate: {}", e.what()));
   } catch (const NumericalError& e) {
@@ -411,8 +433,15 @@ double StringModel<dim>::make_consistent(double t0) {
   chain_.positions() = x_;
   chain_.velocities() = v_;
   double moved = 0;
-  for (int i = 0; i < chain_.num_nodes(); ++i)
-    if (in_arc(i)) moved = std::max(moved, (x_.col(i) - x_start.col(i)).norm());
+  for (int i = 0; i < chain_.num_nodes(); ++i) {
+    if (!in_arc(i)) continue;
+    moved = std::max(moved, (x_.col(i) - x_start.col(i)).norm());
+    impulsive_start_.max_speed_change =
+        std::max(impulsive_start_.max_speed_change, (v_.col(i) - v_start.col(i)).norm());
+    impulsive_start_.speed_scale =
+        std::max({impulsive_start_.speed_scale, v_.col(i).norm(), v_start.col(i).norm()});
+  }
+  impulsive_start_.kinetic_energy += kinetic_energy() - K_start;
   return moved;
 }
 
@@ -508,8 +537,15 @@ typename StringModel<dim>::Snapshot StringModel<dim>::snapshot(double t, const E
     for_each_link([&](int j, int, int) {
       if (chain_.link_start(j) == p.node || chain_.link_end(j) == p.node) T = s.tension[j];
     });
+    // No link of an arc at the node: a front sits next to it (a fold at the fixed end), and the
+    // tension there is the front's end tension, carried by its partial link.
+    if (std::isnan(T) && module_)
+      if (const std::optional<double> front = module_->front_tension_at(*this, p.node)) T = *front;
     s.end_tensions.push_back(T);
   }
+  const PhysicalScales scales = physical_scales();
+  s.tension_scale = scales.tension;
+  s.energy_scale = scales.energy;
   if (module_) {
     ModuleLedger<dim>& extra = s;
     const Vec<dim> prescribed_support = s.support;
@@ -536,15 +572,32 @@ double StringModel<dim>::max_constraint_violation(double t, const Eigen::Ref<con
 }
 
 template <int dim>
+typename StringModel<dim>::PhysicalScales StringModel<dim>::physical_scales() const {
+  const double lambda = chain_.density(), ell = chain_.length();
+  const Vec<dim> g = gravity();
+  double v2_max = 0, loads = 0, a_driven = 0;
+  for (int i = 0; i < chain_.num_nodes(); ++i) {
+    if (!in_arc(i)) continue;
+    v2_max = std::max(v2_max, v_.col(i).squaredNorm());
+    if (path_of_[i] < 0)
+      loads += (force_.col(i) + force_nc_.col(i) - m_[i] * g).norm();
+    else
+      a_driven = std::max(a_driven, b_.col(i).norm());  // the path's acceleration
+  }
+  const double statics = lambda * g.norm() * ell + loads;
+  return {statics + lambda * (v2_max + ell * a_driven), ell * statics};
+}
+
+template <int dim>
 std::optional<SlackReport> StringModel<dim>::find_slack(double t, const Eigen::Ref<const Eigen::VectorXd>& y) {
   if (!system_) return std::nullopt;
   unpack_state(t, y);
   evaluate_current(t);
   const Eigen::VectorXd& T = system_->solution();
-  double v2_max = 0;
-  for (int i = 0; i < v_.cols(); ++i)
-    if (in_arc(i)) v2_max = std::max(v2_max, v_.col(i).squaredNorm());
-  const double physical = chain_.density() * (gravity().norm() * chain_.length() + v2_max);
+  // A string with no weight, load, speed or driver has zero exact tension: whatever the solve gives
+  // is round-off, never slack.
+  const double physical = physical_scales().tension;
+  if (!(physical > 0)) return std::nullopt;
   const double scale = std::max(T.cwiseAbs().maxCoeff(), physical);
   int worst = -1;
   for_each_link([&](int j, int u, int) {

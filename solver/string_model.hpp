@@ -120,6 +120,20 @@ class StringModel final : public OdeSystem {
   /// become the projected ones. Returns the largest position correction (m). Throws InputError if
   /// the projection fails (e.g. fixed ends further apart than the string is long).
   double make_consistent(double t0);
+  /// What the projection of the initial velocities did (make_consistent, summed over its calls): the
+  /// kinetic energy it gave the string (J; K after − K before, the scene's velocities with the
+  /// prescribed nodes at their paths' velocities) and the largest change of a node's velocity (m/s).
+  /// An inextensible string cannot start at rest while a driven end moves: its velocities jump to
+  /// the compatible ones at t = 0 (an impulsive start), and the runner books the energy given.
+  struct ImpulsiveStart {
+    double kinetic_energy = 0;    ///< J
+    double max_speed_change = 0;  ///< m/s
+    double speed_scale = 0;       ///< m/s: the largest speed before or after
+    /// The velocities changed beyond round-off (kImpulsiveSpeed of the speed scale).
+    bool detected() const { return max_speed_change > kImpulsiveSpeed * speed_scale; }
+    static constexpr double kImpulsiveSpeed = 1e-9;
+  };
+  const ImpulsiveStart& impulsive_start() const { return impulsive_start_; }
   /// The ODE state of the chain's current positions and velocities, with every ledger zero.
   Eigen::VectorXd state_from_chain() const;
 
@@ -145,14 +159,29 @@ class StringModel final : public OdeSystem {
     /// the string (N), and the tension of the link at it (N; the pivot tension of a hanging chain).
     std::vector<Vec<dim>> end_reactions;
     std::vector<double> end_tensions;
+    /// The physical scales of this state (physical_scales()): a tension (N) and an energy (J).
+    double tension_scale = 0, energy_scale = 0;
   };
   Snapshot snapshot(double t, const Eigen::Ref<const Eigen::VectorXd>& y);
 
   /// max_j | |Δx_j| − h_j | / h_j at (t, y) over the links of the arcs, without a tension solve.
   double max_constraint_violation(double t, const Eigen::Ref<const Eigen::VectorXd>& y) const;
+  /// The physical scales of the current state (never the round-off of a solve), from its velocities,
+  /// forces and the drivers' accelerations (valid once evaluate_current has set the forces):
+  ///   tension  λ (|g| ℓ + max |v|² + ℓ max |a_driven|) + Σ |F_i − m_i g|: the weight, the centripetal
+  ///            tension, what the drivers' accelerations ask of the whole string, and every other
+  ///            applied force (end loads, drag) on the moving nodes;
+  ///   energy   ℓ (λ |g| ℓ + Σ |F_i − m_i g|): the work of the weight and of the loads along the string
+  ///            (the kinetic energy and the work done are added by the runner, which sees the run).
+  /// Both are zero only for a string with no weight, load, speed or driver: its exact tension is zero.
+  struct PhysicalScales {
+    double tension = 0, energy = 0;
+  };
+  PhysicalScales physical_scales() const;
   /// The most negative link if some T_j < −slack_tolerance·scale at (t, y), where scale is the larger
-  /// of max |T| and a physical tension λ (|g| ℓ + max |v|²) (so that a string whose exact tension is
-  /// zero, as in free fall, is not slack by round-off); nothing otherwise. One tension solve.
+  /// of max |T| and the physical tension scale (physical_scales()), so that a string whose exact
+  /// tension is zero (free fall, or rest without weight or load) is not slack by round-off; nothing
+  /// otherwise, and never when the physical scale is zero. One tension solve.
   std::optional<SlackReport> find_slack(double t, const Eigen::Ref<const Eigen::VectorXd>& y);
   /// Acts on the root functions found at (t, y) (the module's events): `y` is replaced by the new,
   /// possibly longer or shorter, state after a transfer.
@@ -225,7 +254,13 @@ class StringModel final : public OdeSystem {
   Eigen::VectorXd projected_state(double t, const Eigen::Ref<const Eigen::VectorXd>& y);
 
  private:
+  /// Link geometry (dx_, dv_, l_, e_) of the arcs and the largest coordinate x_max_ of their nodes.
   void links();
+  /// The relative accuracy to which link lengths are known after links(): the larger of the
+  /// projection's tolerance and the round-off of the coordinates, kRoundoffUlps · ε · x_max / h_min.
+  /// The projection converges to it, and the drift control's response to it stays below the
+  /// physical accelerations (evaluate_current caps β²).
+  double constraint_tolerance() const;
   void assemble_matrix();
   Eigen::VectorXd pack(const Eigen::Ref<const Eigen::VectorXd>& ledgers) const;
   void unpack_state(double t, const Eigen::Ref<const Eigen::VectorXd>& y);
@@ -256,11 +291,16 @@ class StringModel final : public OdeSystem {
   Eigen::VectorXd w_;            // 1/m_i for free nodes, 0 otherwise
   int num_free_ = 0;
   double alpha_ = 0, beta_ = 0;
+  /// β² of the last evaluation: 1/τ_b², capped where its response to round-off would exceed the
+  /// physical accelerations (evaluate_current); the Jacobian uses the same value.
+  double beta2_ = 0;
   Vec<dim> external_ = Vec<dim>::Zero();
   // workspace
   Points<dim> x_, v_, a_, force_, force_nc_, module_force_, tension_force_, b_, reaction_;
   Points<dim> dx_, dv_, e_;
   Eigen::VectorXd l_;
+  double x_max_ = 0, h_min_ = INFINITY;
+  ImpulsiveStart impulsive_start_;
 };
 
 template <int dim>

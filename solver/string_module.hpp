@@ -17,6 +17,7 @@
 ///     string rebuilds its arcs and projects the state back onto the constraints);
 ///   - its contributions to snapshots (fronts, supports, heaps).
 /// A string without a module runs the same code with one arc and none of these.
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -116,6 +117,10 @@ class StringModule {
   virtual long transfers() const = 0;
   /// Number of fronts (entries of ModuleLedger::fronts).
   virtual int num_fronts() const = 0;
+  /// The tension (N) the module's partial link carries at `node`, an arc's end node next to a front,
+  /// after an evaluation; nothing if no front is next to it. A prescribed node whose arc has no full
+  /// link (a fold at the fixed end) reports this tension: the one-sided limit at the node.
+  virtual std::optional<double> front_tension_at(const StringModel<dim>& model, int node) const = 0;
 };
 
 }  // namespace chainsim

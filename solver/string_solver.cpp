@@ -115,6 +115,16 @@ nlohmann::json to_json(const RunSummary& s) {
                   {"T", s.slack->tension},
                   {"message", s.slack->message()}});
   j["slack"] = slack;
+  nlohmann::json impulsive = {{"detected", s.impulsive_start},
+                              {"kinetic_energy", s.impulsive_energy},
+                              {"max_speed_change", s.impulsive_speed_change}};
+  if (s.impulsive_start)
+    impulsive["message"] = fmt::format(
+        "the initial velocities are not compatible with the inextensible string (a driven end moving at t = 0 "
+        "while the string is at rest): they jumped at t = 0 by up to {:.6g} m/s, giving the string {:.6g} J of "
+        "kinetic energy, booked as the drivers' work at t = 0 (W_applied)",
+        s.impulsive_speed_change, s.impulsive_energy);
+  j["impulsive_start"] = impulsive;
   if (!s.error.empty()) j["error"] = s.error;
   return j;
 }
@@ -213,7 +223,8 @@ std::vector<double> StringSolver<dim>::measured_forces(const typename StringMode
 template <int dim>
 void StringSolver<dim>::book(double t, const typename StringModel<dim>::Snapshot& snap) {
   if (!have_start_) {
-    e0_ = snap.kinetic + snap.potential;
+    // K0 + V0 before an impulsive start, whose energy W_applied holds at t = 0 (zero otherwise).
+    e0_ = snap.kinetic + snap.potential - snap.work;
     v0_ = snap.potential;
     p0_ = snap.momentum;
     have_start_ = true;
@@ -223,9 +234,12 @@ void StringSolver<dim>::book(double t, const typename StringModel<dim>::Snapshot
     throw NumericalError(fmt::format("the solution is no longer finite at t = {:.9g} s", t), t);
   summary_.energy_drift = std::max(summary_.energy_drift, std::abs(drift));
   summary_.final_energy_drift = drift;
+  // The scale is physical, never the round-off of a state at rest: what the run moves (K, V − V0 and
+  // the work booked) and the weight and loads over the string's length (StringModel::physical_scales).
   summary_.energy_scale =
-      std::max(summary_.energy_scale, snap.kinetic + std::abs(snap.potential - v0_) + std::abs(snap.work) +
-                                          std::abs(snap.w_shocks) + std::abs(snap.w_heaps));
+      std::max({summary_.energy_scale, snap.energy_scale,
+                snap.kinetic + std::abs(snap.potential - v0_) + std::abs(snap.work) + std::abs(snap.w_shocks) +
+                    std::abs(snap.w_heaps)});
   summary_.max_constraint_violation = std::max(summary_.max_constraint_violation, snap.max_violation);
   if (snap.has_momentum_ledger) {
     summary_.max_momentum_residual =
@@ -322,7 +336,15 @@ const RunSummary& StringSolver<dim>::run() {
   try {
     // 1. A consistent initial state.
     model_.make_consistent(t0);
-    const Eigen::VectorXd y0 = model_.state_from_chain();
+    Eigen::VectorXd y0 = model_.state_from_chain();
+    // An impulsive start: the energy the jump of the velocities gave is the drivers' work at t = 0.
+    const auto& impulsive = model_.impulsive_start();
+    summary_.impulsive_start = impulsive.detected();
+    summary_.impulsive_speed_change = impulsive.max_speed_change;
+    if (summary_.impulsive_start) {
+      summary_.impulsive_energy = impulsive.kinetic_energy;
+      y0[model_.work_index()] = impulsive.kinetic_energy;
+    }
     integrator = std::make_unique<Integrator>(model_, t0, y0, options_.integrator);
     record_frame(t0, y0);
     if (options_.record_steps) record_sample(t0, y0);

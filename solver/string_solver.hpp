@@ -108,11 +108,21 @@ struct RunSummary {
   double wall_s = 0;               ///< wall-clock time of the integration (s)
   double energy_drift = 0;         ///< max over frames and samples of |drift| (J), see the file comment
   double final_energy_drift = 0;   ///< the signed drift at the last record (J)
-  double energy_scale = 0;         ///< max of K + |V − V0| + |W_applied| + |W_shocks| + |W_heaps| (J)
+  /// The physical energy scale (J): the max over frames and samples of K + |V − V0| + |W_applied| +
+  /// |W_shocks| + |W_heaps| and of ℓ (λ |g| ℓ + Σ |loads|) (StringModel::physical_scales), so that a
+  /// string at rest is judged against its weight, never against the round-off of its energy.
+  double energy_scale = 0;
   double max_momentum_residual = 0, momentum_scale = 0;  ///< with a momentum ledger (fronts)
   double max_constraint_violation = 0;  ///< max over accepted steps of | |Δx_j| − h_j | / h_j
   SlackPolicy slack_policy = SlackPolicy::kIgnore;
   std::optional<SlackReport> slack;  ///< the first slack found at an accepted step (checked unless ignored)
+  /// An impulsive start (StringModel::ImpulsiveStart): the initial velocities were not compatible
+  /// with the links (e.g. a string at rest whose driven end moves at t = 0) and jumped to the
+  /// compatible ones, giving the string `impulsive_energy` (J). The energy ledger books it as work
+  /// of the drivers at t = 0: W_applied starts at it, and K0 is the kinetic energy before the jump.
+  bool impulsive_start = false;
+  double impulsive_energy = 0;        ///< J
+  double impulsive_speed_change = 0;  ///< the largest jump of a node's velocity (m/s)
   long tension_solves = 0;
   long transfers = 0;              ///< nodes moved across fronts
   long frames = 0;
@@ -143,7 +153,8 @@ struct RunSummary {
 
 /// The summary as JSON: status, stop_reason, t_end, t_stop, steps, rhs_evals, wall_s, energy_drift
 /// (J) and relative_energy_drift, energy_residual (relative, the same number) and momentum_residual
-/// (relative), max_constraint_violation, slack ({policy, detected, t, link, s, T, message}), transfers, tension_solves, frames, samples, the model's
+/// (relative), max_constraint_violation, slack ({policy, detected, t, link, s, T, message}),
+/// impulsive_start ({detected, kinetic_energy (J), max_speed_change (m/s), message}), transfers, tension_solves, frames, samples, the model's
 /// description (dimension, nodes, links, effects, prescribed, root functions, tension unknowns,
 /// stabilization time, backend) and ARKODE's statistics.
 nlohmann::json to_json(const RunSummary& summary);
