@@ -196,7 +196,8 @@ std::vector<nlohmann::json> run_sweep(const SweepScene& scene, const std::vector
   auto work = [&] {
     for (std::size_t k; (k = next.fetch_add(1)) < points.size();)
       rows[k] = interrupt_requested()
-                    ? nlohmann::json{{"status", "interrupted"}, {"error", "not run: interrupted by the user"},
+                    ? nlohmann::json{{"status", "interrupted"},
+                                     {"error", fmt::format("not run: interrupted by {}", interrupt_cause())},
                                      {"wall_time_s", 0.0}}
                     : run_sweep_point(scene, points[k]);
   };
