@@ -1,5 +1,6 @@
 #include "mesh/errors.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 #include <fmt/format.h>
@@ -8,9 +9,14 @@ namespace chainsim {
 
 namespace {
 std::string bare_name(std::string_view name) {
-  // "--f" -> "f", "string.length" -> "length": the symbol used in the range expression.
-  auto pos = name.find_last_of(".-");
-  return std::string(pos == std::string_view::npos ? name : name.substr(pos + 1));
+  // "--f" -> "f", "--t-max" -> "t_max", "string.length" -> "length": the symbol used in the range
+  // expression (an option's inner dashes are part of its name).
+  const auto start = name.find_first_not_of('-');
+  if (start != std::string_view::npos) name.remove_prefix(start);
+  const auto dot = name.find_last_of('.');
+  std::string sym(dot == std::string_view::npos ? name : name.substr(dot + 1));
+  std::replace(sym.begin(), sym.end(), '-', '_');
+  return sym;
 }
 }  // namespace
 

@@ -42,8 +42,9 @@
 ///
 /// Front crossings are ARKODE root events (two per front): a heap takes the end node in when the
 /// partial link shrinks to h/2 (every other node keeps its state) and gives out a new node when it
-/// grows to 7h/4 (at the interpolant's position and velocity there; the band is wider than a link,
-/// so that no crossing, and no initial layout, leaves a front on a threshold); a fold moves the node it reaches
+/// grows to 3h/2 (at the interpolant's position and velocity there), both thresholds moved out by
+/// 1e-6 h so that no crossing, and no initial layout, leaves a front on a threshold (docs/shocks.md,
+/// "Model"); a fold moves the node it reaches
 /// from one arc to the other, its material moving with its momentum (mass parcels). What a crossing
 /// changes in the lumped momentum and energy is booked (heap impulse, W_remesh; zero for straight
 /// motions). Then the string rebuilds its arcs, projects positions and velocities onto the link

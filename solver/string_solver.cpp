@@ -351,7 +351,9 @@ const RunSummary& StringSolver<dim>::run() {
     check_slack(t0, y0);
     // 2. Step by step to each output time: constraints (and slack) are checked at accepted steps,
     //    root functions acted on where they vanish.
-    const auto n_out = static_cast<long>(std::ceil(options_.t_end / options_.output_interval - 1e-9));
+    // At least one: a t_end far below the output interval is still integrated to (the last frame is t_end).
+    const auto n_out =
+        std::max(1L, static_cast<long>(std::ceil(options_.t_end / options_.output_interval - 1e-9)));
     auto output_time = [&](long k) { return std::min(options_.t_end, k * options_.output_interval); };
     // At every accepted step: the constraints, slack, the caller's hook and the step record.
     auto after_step = [&](double t, const Eigen::VectorXd& y) {

@@ -125,6 +125,8 @@ int run_string_scene(const SceneSpec& spec, const std::filesystem::path& dir, bo
                        s.status, s.t_stop, s.t_end, s.wall_s, s.stats.steps, s.stats.rhs_evals, s.tension_solves,
                        fronts ? fmt::format(", {} crossings", s.transfers) : "");
     if (s.status != "completed") out << fmt::format("stop       {}\n", summary["stop_reason"].get<std::string>());
+    if (s.impulsive_start)
+      out << fmt::format("start      {}\n", summary["impulsive_start"]["message"].get<std::string>());
     out << fmt::format("ledger     energy drift {:.3e} J (max over frames{}; energy scale {:.3e} J){}\n",
                        s.energy_drift, fronts ? " and steps" : "", s.energy_scale,
                        fronts ? fmt::format(", momentum residual {:.3e} (relative)", s.relative_momentum_residual())

@@ -177,10 +177,15 @@ void ReducedSetup::validate() const {
                                    t_max_over_t0, lowest,
                                    t_max_over_t0 * t_max_over_t0 / (3.0 + 2.0 * chain.dissipation)));
   }
-  if (!std::isfinite(t_max_over_t0 * chain.t0()))
-    throw InputError(fmt::format("--t-max = {} is out of range: t_max t0 = {} x {} s overflows; allowed t_max <= {}",
-                                 t_max_over_t0, t_max_over_t0, chain.t0(),
-                                 std::numeric_limits<double>::max() / chain.t0()));
+  // The run's length in seconds is a scale like the chain's own: in [kMinScale, kMaxScale] (as a scene's
+  // stop.t_end). Below it, ARKODE's stop time rounds onto the start (t_max = 1e-200 failed with
+  // ARK_ILL_INPUT); above it, t_max t0 overflows.
+  const double t_max_s = t_max_over_t0 * chain.t0();
+  if (!(t_max_s >= kMinScale && t_max_s <= kMaxScale))
+    throw InputError(fmt::format("--t-max = {} is out of range: t_max t0 = {} s with t0 = {} s; allowed {} <= t_max <= "
+                                 "{} (t_max t0 in [{}, {}] s)",
+                                 t_max_over_t0, t_max_s, chain.t0(), kMinScale / chain.t0(), kMaxScale / chain.t0(),
+                                 kMinScale, kMaxScale));
   integrator.validate();
 }
 

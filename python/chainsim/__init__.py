@@ -62,6 +62,9 @@ def _text_key(key):
         raise ChainsimInputError(f"{key!r} is not a scene key: it holds a lone surrogate") from None
     if any(ord(c) < 0x20 for c in key):
         raise ChainsimInputError(f"{key!r} is not a scene key: it holds a control character")
+    if not key.strip():
+        raise ChainsimInputError(f"{key!r} is not a scene key: the key is empty; write a dotted key such as "
+                                 "string.nodes")
     return key
 
 

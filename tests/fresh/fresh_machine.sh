@@ -5,7 +5,8 @@
 #     bash scripts/quickstart.sh demo
 #     bash scripts/quickstart.sh test
 # A dependency that the quick start does not install, or a test that needs something only a development
-# machine has (git, a warm cache, a pip package), fails here. Run by .ci/run as its last stage; needs root.
+# machine has (git, a warm cache, a pip package, the network), fails here: the test command runs in a network
+# namespace with the loopback alone (unshare --net, iproute2's ip). Run by .ci/run as its last stage; needs root.
 #
 # Usage: bash tests/fresh/fresh_machine.sh [ROOT_DIR]    (default: a new directory under /var/tmp, removed at
 #        the end; a given ROOT_DIR is kept, and reused if it already holds a Debian root)
@@ -61,6 +62,8 @@ if ls /etc/apt/sources.list.d/*.sources >/dev/null 2>&1; then
   ls "$root"/etc/apt/sources.list.d/*.sources >/dev/null 2>&1 && rm -f "$root/etc/apt/sources.list"
 fi
 cp /etc/resolv.conf "$root/etc/resolv.conf"
+# debootstrap writes no /etc/hosts; an installed Debian has one, and local clusters resolve localhost by it.
+[ -e "$root/etc/hosts" ] || printf '127.0.0.1\tlocalhost\n::1\t\tlocalhost ip6-localhost ip6-loopback\n' >"$root/etc/hosts"
 
 step "copying the source tree (no .git, no build or results directories)"
 rm -rf "$root/src/chainsim"
@@ -78,11 +81,19 @@ in_root() {
   chroot "$root" /usr/bin/env -i HOME=/root LANG=C.UTF-8 TERM=dumb \
     PATH=/usr/local/sbin:/usr/local/bin:/usr/sbin:/usr/bin:/sbin:/bin bash -c "cd /src/chainsim && $1"
 }
+# The same without a network: a network namespace of its own with only the loopback up (Dask's local
+# clusters use it). Once the quick start has installed the packages, nothing may reach outside.
+in_root_offline() {
+  unshare --net -- bash -c 'ip link set lo up && exec "$@"' _ \
+    chroot "$root" /usr/bin/env -i HOME=/root LANG=C.UTF-8 TERM=dumb \
+    PATH=/usr/local/sbin:/usr/local/bin:/usr/sbin:/usr/bin:/sbin:/bin bash -c "cd /src/chainsim && $1"
+}
 step "in the fresh root: git is absent"
 in_root '! command -v git'
 step "in the fresh root: bash scripts/quickstart.sh demo"
 in_root 'bash scripts/quickstart.sh demo'
 in_root 'test -s results/summary.csv && test -s results/figures/falling_chain.png'
-step "in the fresh root: bash scripts/quickstart.sh test"
-in_root 'bash scripts/quickstart.sh test'
+step "in the fresh root, without a network: bash scripts/quickstart.sh test"
+in_root_offline '! getent hosts deb.debian.org >/dev/null'
+in_root_offline 'bash scripts/quickstart.sh test'
 step "done"

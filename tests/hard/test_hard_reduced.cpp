@@ -347,6 +347,34 @@ TEST_CASE("a reduced run honours t_max exactly, whatever its size relative to t0
   CHECK(d(fr.summary["t_stop_over_t0"]) == 1e-7);
 }
 
+TEST_CASE("a t_max whose run length t_max t0 is out of the scale range is refused before the run, with its bounds",
+          "[hard][reduced]") {
+  // `chainsim reduced falling --t-max 1e-200` exited 3 with ARK_ILL_INPUT ("tstop is behind current t"):
+  // t_max t0 = 4.5e-201 s rounds onto the start. The run's length is a scale, in [1e-100, 1e100] s.
+  for (Problem p : {Problem::kFalling, Problem::kFolded}) {
+    for (double tau : {1e-200, 1e-300, 5e-324, 1e101}) {
+      CAPTURE(to_string(p), tau);
+      ReducedSetup s = make(p, 0.5, 0.01, p == Problem::kFalling ? 1.0 : 0.5);
+      s.t_max_over_t0 = tau;
+      try {
+        solve_reduced(s);
+        FAIL("accepted");
+      } catch (const InputError& e) {
+        const std::string m = e.what();
+        CHECK_THAT(m, Catch::Matchers::StartsWith("--t-max = "));
+        CHECK_THAT(m, Catch::Matchers::Contains("allowed "));
+        CHECK_THAT(m, Catch::Matchers::Contains(" <= t_max <= "));
+      }
+    }
+    // Just inside the range: the run ends at t_max exactly.
+    ReducedSetup s = make(p, 0.5, 0.01, p == Problem::kFalling ? 1.0 : 0.5);
+    s.t_max_over_t0 = 1e-99;
+    const ReducedRun run = solve_reduced(s);
+    CHECK(run.summary["stop_reason"] == "t_max");
+    CHECK(d(run.summary["t_stop_over_t0"]) == 1e-99);
+  }
+}
+
 TEST_CASE("a reduced run at g = 1e-100 or l = 1e90 stops at its t_max, a tiny fraction of t0 (issue #21)",
           "[hard][reduced]") {
   // A scene's t_end = 2 s is 1.4e-50 t0 at g = 1e-100 (t0 = 1.4e50 s): it stalled at the step floor 1e-14 t0.
@@ -367,7 +395,7 @@ TEST_CASE("a reduced run at g = 1e-100 or l = 1e90 stops at its t_max, a tiny fr
   huge.chain.gravity = 1e-100;
   huge.chain.length = 1e100;  // t0 = 1.4e100 s
   huge.t_max_over_t0 = 1e300;
-  CHECK_THROWS_WITH(solve_reduced(huge), Contains("--t-max = 1e+300 is out of range") && Contains("allowed t_max <="));
+  CHECK_THROWS_WITH(solve_reduced(huge), Contains("--t-max = 1e+300 is out of range") && Contains(" <= t_max <= 0.7071067811865476"));
   // Scales beyond the solver's range are refused with it (l = 5e-324 made the energy scale 0: an internal error).
   ReducedSetup tiny = make(Problem::kFalling, 0.5, 0.01, 1.0);
   tiny.chain.length = 5e-324;

@@ -54,6 +54,9 @@ TEST_CASE("a force-free string at rest carries no tension and is not slack, howe
     REQUIRE_FALSE(run.run().has_value());
     const RunSummary& s = run.solver().summary();
     CHECK(s.status == "completed");
+    // Integrated to t_end, however far below the output interval (a run of 1e-90 s once "completed" at
+    // t = 0 after 0 steps: no output time was counted before t_end).
+    CHECK(s.t_stop == t_end);
     CHECK_FALSE(s.slack.has_value());
     for (const auto& frame : run.solver().frames())
       for (int j = 0; j < frame.tension.size(); ++j) REQUIRE(frame.tension[j] == 0.0);

@@ -401,6 +401,44 @@ TEST_CASE("the summary lists the outputs the run wrote: no forces.csv where none
                                                     "tension.csv"});
 }
 
+TEST_CASE("the printed summary says so when the run starts impulsively", "[unit][cli]") {
+  // A chain at rest whose driven end moves at 2 m/s from t = 0: its velocities jump at t = 0. The
+  // summary's text said nothing of it (stats.json did). The lifted 0.2 m (0.25 kg/m) moves at v but for
+  // the half link lumped on the heap's end node: 1/2 (0.25) (0.2 - h/2) (2)^2 = 0.0875 J with h = 0.05 m.
+  const std::filesystem::path dir = temp_dir("cli_impulsive");
+  std::filesystem::create_directories(dir);
+  const std::filesystem::path scene = dir / "pick_up.toml";
+  std::ofstream(scene) << R"(model = "string"
+[string]
+length = 1.0
+density = 0.25
+nodes = 21
+[shape]
+kind = "polyline"
+points = [[-0.8, 0.0], [0.0, 0.0], [0.0, 0.2]]
+[ends]
+end = { kind = "driven", path = "linear", velocity = [0.0, 2.0] }
+[effects.gravity]
+g = [0.0, -9.81]
+[[effects.heap]]
+side = "start"
+s0 = 0.8
+f = 0.0
+point = [0.0, 0.0]
+[stop]
+t_end = 0.05
+)";
+  const Result r = run("run " + scene.string() + " --quiet --out " + (dir / "d").string());
+  REQUIRE(r.status == 0);
+  CHECK_THAT(r.output, Catch::Matchers::Contains("start      the initial velocities are not compatible"));
+  CHECK_THAT(r.output, Catch::Matchers::Contains("giving the string 0.0875 J of kinetic energy"));
+  // A run that starts at rest says nothing of it.
+  const std::string hanging = std::string(CHAINSIM_SOURCE_DIR) + "/cases/scenes/hanging_chain.toml";
+  const Result quiet = run("run " + hanging + " --t-end 0.01 --quiet --out " + (dir / "e").string());
+  REQUIRE(quiet.status == 0);
+  CHECK_THAT(quiet.output, !Catch::Matchers::Contains("start      "));
+}
+
 TEST_CASE("paths and --set keys that are not UTF-8 give JSON with U+FFFD and the run's own exit code",
           "[unit][cli]") {
   const std::filesystem::path dir = temp_dir("cli_not_utf8");
