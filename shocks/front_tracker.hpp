@@ -5,7 +5,7 @@
 ///
 /// Material. An open string of N equal links (material length h = ℓ/N), nodes i = 0..N at material
 /// coordinate s_i = i h. The material line is cut at *fronts* into *arcs* (runs of moving nodes) and
-/// *heaps* (quiescent, shapeless reservoirs). Two kinds of front:
+/// *heaps* (quiescent, shapeless reservoirs). Two kinds of front (each a FrontKind, front_kind.hpp):
 ///
 ///   heap   a quiescent heap, either fed through a fixed point x0 (a pile under a hole, an edge:
 ///          *pinned*) or lying on a plane (the table under a falling chain). The arc ends in a

@@ -27,7 +27,8 @@
 ///   heap reaction  R = τ e + λ w v_k   (e the tangent from the arc into the heap, w = dl/dt the rate
 ///                  at which the arc gains material, v_k its end's velocity)
 ///   heap power     W* = τ e·v_k + ½ λ w |v_k|² − W_s
-/// For a string moving along itself (v_k = v t) R and W* + W_s reduce to Φ*± and W*± (tested).
+/// For a string moving along itself (v_k = v t) R = Φ*± and W* = W*± − W_s at the arc's end tension τ,
+/// which is W*± at the heap's own τ* = λ v² (tested).
 ///
 /// Reversing the orientation of s (s → ℓ − s) flips t and ṡ0 and swaps the sides; every formula
 /// here is invariant under that change (tested).
