@@ -5,7 +5,7 @@
 ///
 /// Material. An open string of N equal links (material length h = ℓ/N), nodes i = 0..N at material
 /// coordinate s_i = i h. The material line is cut at *fronts* into *arcs* (runs of moving nodes) and
-/// *heaps* (quiescent, shapeless reservoirs). Two kinds of front:
+/// *heaps* (quiescent, shapeless reservoirs). Two kinds of front (each a FrontKind, front_kind.hpp):
 ///
 ///   heap   a quiescent heap, either fed through a fixed point x0 (a pile under a hole, an edge:
 ///          *pinned*) or lying on a plane (the table under a falling chain). The arc ends in a
@@ -61,37 +61,19 @@
 ///              contact was when it arrived, so the heaps' potential energy needs their first moment
 /// Ledgers: K + V − (K0 + V0) − W_applied − W_shocks − W_heaps − W_remesh → 0 and
 ///          p − p0 − impulse → 0 (p = Σ m_i v_i; heaps are at rest), to the discretization error.
-#include <cmath>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
 
 #include <Eigen/Core>
 
+#include "shocks/fold_front.hpp"
+#include "shocks/front_kind.hpp"
+#include "shocks/heap_front.hpp"
 #include "solver/string_model.hpp"
 
 namespace chainsim {
-
-/// A quiescent heap holding the material on one side of a front.
-template <int dim>
-struct HeapSpec {
-  enum class Side { kBefore, kAfter };
-  Side side = Side::kAfter;  ///< kAfter: the heap holds s > s0 (string runs into it at its end, e.g.
-                             ///< falling chain); kBefore: it holds s < s0 (feeds the string, sliding chain)
-  Vec<dim> point = Vec<dim>::Zero();  ///< x0 (m)
-  double dissipation = 0;             ///< f of the internal shock at x0, in [0, 1]
-  double s0 = 0;                      ///< initial material coordinate of the front (m), in (0, ℓ)
-  /// Unset: the front is pinned at `point` (a hole or an edge the string runs through). Set: the
-  /// heap lies on the smooth plane through `point` with this normal (pointing to the string's side),
-  /// and the contact slides along the plane where the string meets it (a table under a falling chain).
-  std::optional<Vec<dim>> plane_normal;
-};
-
-/// A fold (internal shock) between the arc before and the arc after s0.
-struct FoldSpec {
-  double dissipation = 0;  ///< f, in [0, 1]
-  double s0 = 0;           ///< initial material coordinate of the fold (m), in [0, ℓ)
-};
 
 struct FrontOptions {
   /// Stop when a front's material coordinate reaches this value (front index, s (m)); the run also
@@ -103,38 +85,29 @@ struct FrontOptions {
   std::vector<StopAt> stop_at;
 };
 
+/// The module of a string with fronts. It keeps what every kind of front shares (front_kind.hpp): the
+/// layout of the arcs, the booking of the ledgers and of the crossings, the stop events; each front's
+/// own physics is its FrontKind (HeapFront, FoldFront).
 template <int dim>
 class FrontTracker final : public StringModule<dim> {
  public:
-  enum class FrontKind { kHeap, kFold };
-  struct Front {
-    FrontKind kind = FrontKind::kHeap;
-    double dissipation = 0;
-    Vec<dim> point = Vec<dim>::Zero();  ///< heap point x0 (on a plane: a point of the plane)
-    bool on_plane = false;               ///< the contact slides along the plane (point, normal)
-    Vec<dim> normal = Vec<dim>::Zero();  ///< unit normal of the plane, towards the string's side
-    Vec<dim> last_direction = Vec<dim>::Zero();  ///< on a plane, once the arc has no full link left:
-                                                 ///< the direction its partial link keeps
-    Vec<dim> last_curvature = Vec<dim>::Zero();  ///< on a plane, once the arc has one full link left:
-                                                 ///< the second derivative x'' its end keeps
-    int arc_minus = -1, arc_plus = -1;  ///< arcs on either side (−1: the heap's side)
+  /// The fronts, in order of s: fronts()[k] is front k's FrontKind.
+  class Fronts {
+   public:
+    explicit Fronts(const std::vector<std::unique_ptr<FrontKind<dim>>>& fronts) : fronts_(&fronts) {}
+    const FrontKind<dim>& operator[](std::size_t k) const { return *(*fronts_)[k]; }
+    std::size_t size() const { return fronts_->size(); }
+
+   private:
+    const std::vector<std::unique_ptr<FrontKind<dim>>>* fronts_;
   };
 
   /// Heaps (at most one per side) and an optional fold, in any order; they are kept in order of s.
   FrontTracker(std::vector<HeapSpec<dim>> heaps, std::optional<FoldSpec> fold, const FrontOptions& options);
 
-  const std::vector<Front>& fronts() const { return fronts_; }
-  int num_folds() const;
-  /// A fold is a tight bight: its arms leave it along one line. The jump conditions allow a
-  /// dissipative kink nowhere else (docs/shocks.md), so a run stops when the arms open wider than
-  /// this angle from antiparallel (and a fold that starts wider is refused).
-  static constexpr double kMaxFoldOpeningDeg = 20;
-  /// The folded link's material (length h) must span its chord |x_b − x_a|. The fold crosses a node
-  /// when the chord's component along the fold direction (the bisector of the arms) reaches h: with
-  /// arms on one line the chord is then h, with arms within kMaxFoldOpeningDeg of antiparallel at
-  /// most h / cos(kMaxFoldOpeningDeg / 2). The run stops when the chord passes that (the fold has come
-  /// apart, docs/shocks.md "A fold whose arms turn apart").
-  static double max_fold_chord() { return 1 / std::cos(0.5 * kMaxFoldOpeningDeg * kPi / 180); }
+  Fronts fronts() const { return Fronts(fronts_); }
+  /// The state front k wrote at the last evaluation.
+  const FrontState<dim>& front_state(std::size_t k) const { return fs_[k]; }
 
   // --- StringModule ------------------------------------------------------------------------------
   std::vector<ArcRange> initial_arcs(const Chain<dim>& chain) override;
@@ -146,10 +119,10 @@ class FrontTracker final : public StringModule<dim> {
   double potential_correction(const StringModel<dim>& model, const Eigen::Ref<const Eigen::VectorXd>& ledger) const override;
   void fill(const StringModel<dim>& model, const Eigen::Ref<const Eigen::VectorXd>& ledger,
             ModuleLedger<dim>& out) const override;
-  /// Two per front (crossings), one per stop condition, one per fold (it opens past kMaxFoldOpeningDeg
-  /// or comes apart: its chord passes max_fold_chord() h).
+  /// Two per front (crossings), one per stop condition, then the fronts' own checks (a fold: one,
+  /// it opens past FoldFront::kMaxOpeningDeg or comes apart).
   int num_events() const override {
-    return 2 * static_cast<int>(fronts_.size()) + static_cast<int>(options_.stop_at.size()) + num_folds();
+    return 2 * static_cast<int>(fronts_.size()) + static_cast<int>(options_.stop_at.size()) + num_checks();
   }
   void events(const StringModel<dim>& model, Eigen::Ref<Eigen::VectorXd> g) const override;
   std::vector<int> event_directions() const override;
@@ -162,33 +135,19 @@ class FrontTracker final : public StringModule<dim> {
   std::optional<double> front_tension_at(const StringModel<dim>& model, int node) const override;
 
  private:
-  /// The arc end at a heap front: its end node, the node inside the arc next to it, the node that
-  /// comes out of the heap next, and whether the end node can be taken in / a node given out.
-  struct HeapEnd {
-    bool after = true;  ///< the heap holds s > s0
-    int arc = 0, node = 0, inner = 0, outer = 0;
-    bool removable = false, insertable = false;
-  };
-  HeapEnd heap_end(const StringModel<dim>& model, const Front& front) const;
-  double heap_mass(std::size_t front) const;  // needs the front states
-  std::string fold_opened_message(std::size_t front) const;  // needs the front states
-  std::string fold_apart_message(const StringModel<dim>& model, std::size_t front, double t) const;
-  /// Moves the node a front reached across it (heap: in or out; fold: from one arc to the other).
-  EventAction transfer(StringModel<dim>& model, std::size_t front, int e0);
+  int num_checks() const;
+  /// The fronts of the specs, checked and in order of s (heap before, fold, heap after).
+  std::vector<std::unique_ptr<FrontKind<dim>>> make_fronts(double ell);
 
   std::vector<HeapSpec<dim>> heap_specs_;
   std::optional<FoldSpec> fold_spec_;
   FrontOptions options_;
-  double h_ = 0, lambda_ = 0, ell_ = 0;
-  int n_ = 0;
-  std::vector<Front> fronts_;
-  std::vector<double> expected_s0_;  // where each front is meant to start (m)
+  FrontMaterial material_;
+  std::vector<std::unique_ptr<FrontKind<dim>>> fronts_;
   std::vector<FrontState<dim>> fs_;
-  std::vector<double> fold_chord_;  // per front: a fold's |x_b − x_a| / h (0 for a heap)
-  std::vector<Vec<dim>> partial_mid_;  // per heap front: the midpoint of the string from the end node to it
   long transfers_ = 0;
   double w_remesh_ = 0;
-  Vec<dim> heap_moment0_ = Vec<dim>::Zero();  // Σ heap mass × point at t = 0
+  Vec<dim> heap_moment0_ = Vec<dim>::Zero();  // Σ held mass × its first moment at t = 0
 };
 
 /// The string with fronts: a StringModel whose module is a FrontTracker. `prescribed` nodes must

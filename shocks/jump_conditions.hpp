@@ -1,8 +1,9 @@
 #pragma once
 /// @file jump_conditions.hpp
 /// The jump conditions at a shock (docs/model.md §2–3) as pure pointwise functions of
-/// the states on the two sides. No mesh, no time integration: the front-tracking junctions build
-/// their rows from these, and the tests check them against hand-derived states.
+/// the states on the two sides. No mesh, no time integration: every kind of front
+/// (front_kind.hpp) computes its tensions, powers and reaction with these, and the tests check them
+/// against hand-derived states and against the running fronts.
 ///
 /// Conventions. s is the material coordinate; "+" is the side of larger s, "−" the side of smaller
 /// s; [ψ] = ψ⁺ − ψ⁻. ṡ0 is the speed of the front in the material (m/s); t± the unit tangents,
@@ -17,6 +18,17 @@
 /// External shock at a quiescent heap (a string moving along itself, v = v t, v uniform):
 ///   Φ*± = ±(τ*± − λ v²) t*±,   W*± = ±(τ*± − ½ λ v²) v
 /// (+: the string runs into the heap at its + end; −: it is drawn out of the heap at its − end).
+///
+/// The forms the fronts use (a fold, a heap seen from a string of any shape):
+///   end tensions   τ∓ = λ ṡ0² (1 ± f sgn ṡ0)  (a front whose sides move apart at [v] = 2 ṡ0 e,
+///                  [τ] = τ⁺ − τ⁻ = −2 f λ sgn(ṡ0) ṡ0² as above; τ⁻ + τ⁺ = 2 λ ṡ0², the momentum balance)
+///   shock power    W_s = −k f λ |ṡ0|³ for k internal shocks of |[v]|² = 2 ṡ0² each (k = 2: a fold,
+///                  whose |[v]|² = 4 ṡ0²; k = 1: the contact of a heap)
+///   heap reaction  R = τ e + λ w v_k   (e the tangent from the arc into the heap, w = dl/dt the rate
+///                  at which the arc gains material, v_k its end's velocity)
+///   heap power     W* = τ e·v_k + ½ λ w |v_k|² − W_s
+/// For a string moving along itself (v_k = v t) R = Φ*± and W* = W*± − W_s at the arc's end tension τ,
+/// which is W*± at the heap's own τ* = λ v² (tested).
 ///
 /// Reversing the orientation of s (s → ℓ − s) flips t and ṡ0 and swaps the sides; every formula
 /// here is invariant under that change (tested).
@@ -91,6 +103,36 @@ Vector<dim> heap_force(bool into_heap, double tension, double density, double sp
 /// W*± = ±(τ* − ½ λ v²) v: the power the heap supplies at the external shock (W; negative: a loss).
 inline double heap_power(bool into_heap, double tension, double density, double speed) {
   return (into_heap ? 1.0 : -1.0) * (tension - 0.5 * density * speed * speed) * speed;
+}
+
+/// τ∓ = λ ṡ0² (1 ± f sgn ṡ0): the end tension on the − side (`side` < 0) or the + side (`side` > 0)
+/// of a front moving at ṡ0 through the material (N).
+inline double end_tension(double dissipation, double density, double s0_dot, int side) {
+  return side < 0 ? density * s0_dot * s0_dot * (1 + dissipation * sign(s0_dot))
+                  : density * s0_dot * s0_dot * (1 - dissipation * sign(s0_dot));
+}
+
+/// W_s = −k f λ |ṡ0|³ (W): the power of `shocks` internal shocks of |[v]|² = 2 ṡ0² each at a front
+/// moving at ṡ0 (−Σ dissipation_rate).
+inline double shock_power(double dissipation, double density, double s0_dot, int shocks) {
+  return -shocks * dissipation * density * std::abs(s0_dot) * s0_dot * s0_dot;
+}
+
+/// R = τ e + λ w v_k: the force the support of a quiescent heap exerts on the string (N). `tangent`
+/// e points from the arc into the heap, `inflow` w is the rate at which the arc gains material,
+/// `end_velocity` v_k is the velocity of the arc's end.
+template <int dim>
+Vector<dim> heap_reaction(double tension, const Vector<dim>& tangent, const Vector<dim>& end_velocity, double density,
+                          double inflow) {
+  return tension * tangent + density * inflow * end_velocity;
+}
+
+/// W* = τ e·v_k + ½ λ w |v_k|² − W_s: the power a quiescent heap exchanges with the string (W), the
+/// arguments as heap_reaction's and W_s the power of the internal shock at its contact.
+template <int dim>
+double heap_power(double tension, const Vector<dim>& tangent, const Vector<dim>& end_velocity, double density,
+                  double inflow, double shock_power) {
+  return tension * tangent.dot(end_velocity) + 0.5 * density * inflow * end_velocity.squaredNorm() - shock_power;
 }
 
 }  // namespace chainsim::jump

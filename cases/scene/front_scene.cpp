@@ -237,7 +237,7 @@ FrontScene<dim> build_front_scene(const SceneSpec& spec) {
   d["fronts"] = nlohmann::json::array();
   for (std::size_t k = 0; k < names.size(); ++k) {
     const auto& front = tracker.fronts()[k];
-    nlohmann::json f = {{"name", names[k]}, {"kind", front.kind == FrontTracker<dim>::FrontKind::kFold ? "fold" : "heap"},
+    nlohmann::json f = {{"name", names[k]}, {"kind", front.name()},
                         {"f", front.dissipation}};
     if (names[k] == "fold") {
       f["s0"] = fold->s0;
@@ -247,7 +247,7 @@ FrontScene<dim> build_front_scene(const SceneSpec& spec) {
                                        [&](const HeapEntry& e) { return e.side == (start ? "start" : "end"); });
       f["side"] = heap.side;
       f["s0"] = heap.s0;
-      f["point"] = to_array<dim>(front.point);
+      f["point"] = to_array<dim>(dynamic_cast<const HeapFront<dim>&>(front).point());
       f["on_plane"] = heap.on_plane;
       if (heap.on_plane) f["plane_normal"] = to_array<dim>(*plane_normal);
     }

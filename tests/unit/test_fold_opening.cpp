@@ -1,6 +1,6 @@
 // A fold is a tight bight: the jump conditions allow a dissipative kink only where its two arms are
 // antiparallel (docs/shocks.md). the front tracker measures how far its arms are from that (the fold's
-// "opening") and stops the run, through an ARKODE root, when it passes kMaxFoldOpeningDeg; a fold
+// "opening") and stops the run, through an ARKODE root, when it passes FoldFront::kMaxOpeningDeg; a fold
 // that starts wider is refused.
 #include <catch2/catch.hpp>
 

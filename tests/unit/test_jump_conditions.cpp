@@ -115,3 +115,91 @@ TEST_CASE("energy: the dissipation equals the power lost across the front", "[un
   }
   CHECK(dissipation_rate(0.0, lam, 2.0, jv2) == 0.0);  // f = 0: an elastic shock dissipates nothing
 }
+
+// The forms the fronts compute with (front_kind.hpp): end tensions, shock power, heap reaction and heap
+// power, at the states of the paper's three problems, derived by hand and against the functions above.
+
+TEST_CASE("end tensions: the paper's tau at the table, the hole and the bight, and [tau] of the energy balance",
+          "[unit][shocks]") {
+  const double lam = 1.3, f = 0.83;
+  for (double ydot : {-2.3, 1.4}) {
+    CAPTURE(ydot);
+    const double s = ydot > 0 ? 1.0 : -1.0;
+    // Falling chain (ẏ < 0) and its reverse: the moving arc on the − side of the front, ṡ0 = ẏ:
+    // τ⁻ = (1 + f sgn ẏ) λ ẏ² ((1 − f) λ ẏ² while it falls).
+    CHECK_THAT(end_tension(f, lam, ydot, -1), WithinAbs((1 + f * s) * lam * ydot * ydot, kExact));
+    // Sliding chain: the moving arc on the + side, ṡ0 = −ẏ: τ⁺ = (1 + f sgn ẏ) λ ẏ² ((1 + f) λ ẏ² while it slides out).
+    CHECK_THAT(end_tension(f, lam, -ydot, +1), WithinAbs((1 + f * s) * lam * ydot * ydot, kExact));
+    // Folded chain, ṡ0 = ẏ: τ⁺ − τ⁻ is the tension jump of the energy balance with |[v]|² = 4 ẏ², and
+    // τ⁻ + τ⁺ = 2 λ ẏ² balances the momentum of arms on one line (t⁻ = −e_y, t⁺ = e_y, v⁺ − v⁻ = −2ẏ e_y).
+    const double tm = end_tension(f, lam, ydot, -1), tp = end_tension(f, lam, ydot, +1);
+    CHECK_THAT(tp - tm, WithinAbs(tension_jump(f, lam, ydot, 4 * ydot * ydot), kExact));
+    Side<2> minus{-ey, V2::Zero(), tm};
+    Side<2> plus{ey, -2 * ydot * ey, tp};
+    CHECK_THAT(momentum_residual(minus, plus, V2(V2::Zero()), lam, ydot).norm(), WithinAbs(0.0, kExact));
+    // Orientation: reversing s swaps the sides and flips ṡ0.
+    CHECK(end_tension(f, lam, ydot, -1) == end_tension(f, lam, -ydot, +1));
+  }
+}
+
+TEST_CASE("shock power: k internal shocks of |[v]|^2 = 2 s0dot^2 each dissipate k f lambda |s0dot|^3",
+          "[unit][shocks]") {
+  const double lam = 0.7, f = 0.6;
+  for (double sd : {-2.3, 0.9}) {
+    CAPTURE(sd);
+    // A heap's contact (the falling chain's |[v]|² = 2 ẏ², above) and a fold (|[v]|² = 4 ṡ0²).
+    CHECK_THAT(shock_power(f, lam, sd, 1), WithinAbs(-dissipation_rate(f, lam, sd, 2 * sd * sd), kExact));
+    CHECK_THAT(shock_power(f, lam, sd, 2), WithinAbs(-dissipation_rate(f, lam, sd, 4 * sd * sd), kExact));
+    CHECK_THAT(shock_power(f, lam, sd, 2), WithinAbs(-2 * f * lam * std::abs(sd * sd * sd), kExact));
+    CHECK(shock_power(f, lam, sd, 1) == shock_power(f, lam, -sd, 1));  // orientation
+    CHECK(shock_power(f, lam, sd, 1) <= 0);
+    CHECK(shock_power(0.0, lam, sd, 2) == 0);
+  }
+}
+
+TEST_CASE("heap reaction and power at the table and the hole: the concentrated force and the paper's W*",
+          "[unit][shocks]") {
+  SECTION("falling chain: the string runs into the heap on the table") {
+    // e from the arc into the heap = −e_y, end velocity v e = −ẏ e, the arc gains material at w = ẏ < 0.
+    const double lam = 0.7, f = 0.83, ydot = -2.3;
+    const V2 e = -ey, v_end = -ydot * e;
+    const double tau = end_tension(f, lam, ydot, -1), w_s = shock_power(f, lam, ydot, 1);
+    // R is the table's force Φ0 = f λ ẏ² e_y that balances the momentum at x0 (first test case)...
+    Side<2> minus{-ey, -ydot * (-ey), tau};
+    Side<2> plus{ex, -ydot * ex, lam * ydot * ydot};
+    const V2 R = heap_reaction<2>(tau, e, v_end, lam, ydot);
+    CHECK_THAT((R - required_force(minus, plus, lam, ydot)).norm(), WithinAbs(0.0, kExact));
+    CHECK_THAT((R - f * lam * ydot * ydot * ey).norm(), WithinAbs(0.0, kExact));
+    // ... and W* the paper's external shock −½ λ ẏ³ (the heap's own τ* = λ v², feeling no force), which
+    // is W*+ at the arc's end tension less the shock's power.
+    const double W = heap_power<2>(tau, e, v_end, lam, ydot, w_s);
+    CHECK_THAT(W, WithinAbs(-0.5 * lam * ydot * ydot * ydot, kExact));
+    CHECK_THAT(W, WithinAbs(heap_power(true, lam * ydot * ydot, lam, -ydot), kExact));
+    CHECK_THAT(W, WithinAbs(heap_power(true, tau, lam, -ydot) - w_s, kExact));
+    CHECK_THAT((R - heap_force<2>(true, tau, lam, -ydot, e)).norm(), WithinAbs(0.0, kExact));
+  }
+  SECTION("sliding chain: the heap feeds a hole, the string hangs below it") {
+    // e from the hanging arc up into the hole = e_y, end velocity −ẏ e_y, w = ẏ > 0, ṡ0 = −ẏ.
+    const double lam = 2.0, f = 0.83, ydot = 1.4;
+    const V2 e = ey, v_end = -ydot * ey;
+    const double tau = end_tension(f, lam, -ydot, +1), w_s = shock_power(f, lam, -ydot, 1);
+    Side<2> minus{ex, ydot * ex, lam * ydot * ydot};
+    Side<2> plus{-ey, -ydot * ey, tau};
+    const V2 R = heap_reaction<2>(tau, e, v_end, lam, ydot);
+    CHECK_THAT((R - required_force(minus, plus, lam, -ydot)).norm(), WithinAbs(0.0, kExact));
+    const double W = heap_power<2>(tau, e, v_end, lam, ydot, w_s);
+    CHECK_THAT(W, WithinAbs(-0.5 * lam * ydot * ydot * ydot, kExact));
+    CHECK_THAT(W, WithinAbs(heap_power(false, lam * ydot * ydot, lam, ydot), kExact));
+    CHECK_THAT(W, WithinAbs(heap_power(false, tau, lam, ydot) - w_s, kExact));
+    CHECK_THAT((R - heap_force<2>(false, tau, lam, ydot, plus.tangent)).norm(), WithinAbs(0.0, kExact));
+    CHECK_THAT(w_s, WithinAbs(-f * lam * ydot * ydot * ydot, kExact));
+  }
+  SECTION("a string moving along itself into the heap at any angle: R = Phi*+ and W* = W*+ - W_s") {
+    const double lam = 1.1, f = 0.3, v = 1.7;
+    const V3 t = V3(0.3, -0.4, 0.5).normalized();
+    const double tau = end_tension(f, lam, -v, -1), w_s = shock_power(f, lam, -v, 1);
+    CHECK_THAT((heap_reaction<3>(tau, t, v * t, lam, -v) - heap_force<3>(true, tau, lam, v, t)).norm(),
+               WithinAbs(0.0, kExact));
+    CHECK_THAT(heap_power<3>(tau, t, v * t, lam, -v, w_s), WithinAbs(heap_power(true, tau, lam, v) - w_s, kExact));
+  }
+}

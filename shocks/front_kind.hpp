@@ -1,0 +1,123 @@
+#pragma once
+/// @file front_kind.hpp
+/// What one kind of front does (docs/shocks.md; the recipe "a new kind of front" in
+/// docs/architecture.md). The tracker (front_tracker.hpp) keeps what all kinds share: the arcs, the
+/// booking of the ledgers and of the crossings, the stop events. A kind says
+///   - how it cuts the material into arcs (its share of the initial layout: `trim`, `cut`);
+///   - the masses and known loads it adds at every evaluation, and its FrontState (`evaluate`), whose
+///     tensions, powers and reaction it computes with the jump conditions (jump_conditions.hpp);
+///   - its two root functions (`crossings`) and what a crossing does (`cross`), and any root function
+///     of its own that stops the run (`num_checks`, `checks`, `check_failed`);
+///   - its share of the ledgers: the material it holds outside the arcs (`held_mass`, its first
+///     moment), and the potential energy of its partial links (`potential_moment`).
+/// Implementations: HeapFront (heap_front.hpp), FoldFront (fold_front.hpp).
+#include <cmath>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+#include <fmt/format.h>
+
+#include "mesh/errors.hpp"
+#include "solver/string_model.hpp"
+
+namespace chainsim {
+
+/// The material the fronts cut: set once the chain is known.
+struct FrontMaterial {
+  double h = 0;       ///< material length of a link (m)
+  double lambda = 0;  ///< linear density (kg/m)
+  double ell = 0;     ///< length of the string (m)
+  int n = 0;          ///< number of nodes
+};
+
+/// The initial layout while the fronts cut it: the moving nodes run from `first` to `last`; each
+/// entry of `splits` ends an arc at that node (the next one starts at the node after); `arc` is the
+/// arc on the side of larger s of the fronts cut so far.
+struct FrontLayout {
+  int first = 0, last = 0;
+  std::vector<int> splits;
+  int arc = 0;
+};
+
+template <int dim>
+class FrontKind {
+ public:
+  virtual ~FrontKind() = default;
+
+  double dissipation = 0;  ///< f of the front's internal shock, in [0, 1]
+  double expected_s0 = 0;  ///< where the front is meant to start (m)
+  int arc_minus = -1, arc_plus = -1;  ///< arcs on either side (−1: the side of a reservoir, e.g. a heap)
+
+  /// "heap", "fold": the kind's name in messages and in the scene description.
+  virtual const char* name() const = 0;
+  /// What the scene places at the front's material point s0, for messages ("heap point", "fold").
+  virtual const char* placed() const = 0;
+
+  /// The material, before the layout.
+  void bind(const FrontMaterial& material) { m_ = material; }
+
+  // --- layout ------------------------------------------------------------------------------------
+  /// First pass over the fronts in order of s: bound the moving part of the material.
+  virtual void trim(FrontLayout& /*layout*/) const {}
+  /// Second pass, in order of s: split the moving part and take the arcs on either side.
+  virtual void cut(FrontLayout& layout) = 0;
+  /// Checks of the initial shape before the first evaluation (InputError).
+  virtual void initialize(const StringModel<dim>& /*model*/) {}
+  /// Checks of the initial state after the first evaluation (InputError).
+  virtual void check_initial(const FrontState<dim>& /*state*/) const {}
+
+  // --- one evaluation ----------------------------------------------------------------------------
+  /// Adds the front's masses and known loads and writes its state (the jump conditions).
+  virtual void evaluate(const StringModel<dim>& model, FrontState<dim>& state, Eigen::VectorXd& mass,
+                        Points<dim>& force) = 0;
+  /// The end tension of the jump conditions at an arc's end node on the front's side, if `node` is one.
+  virtual std::optional<double> tension_at(const StringModel<dim>& model, const FrontState<dim>& state,
+                                           int node) const = 0;
+
+  // --- ledgers -----------------------------------------------------------------------------------
+  /// Mass the front holds outside the arcs (kg): a heap's content.
+  virtual double held_mass(const FrontState<dim>& /*state*/) const { return 0; }
+  /// Adds the rate of the first moment of that mass (kg m/s).
+  virtual void add_held_moment_rate(const FrontState<dim>& /*state*/, Vec<dim>& /*rate*/) const {}
+  /// Adds the first moment (kg m) of the held mass at the start, or the change `held_mass − before` a
+  /// crossing made (laid at the front).
+  virtual void add_held_moment(const FrontState<dim>& /*state*/, double /*before*/, Vec<dim>& /*moment*/) const {}
+  /// Adds the held mass and the force the front's support exerts on the system (its reaction, and the
+  /// weight of the held mass under the uniform field g).
+  virtual void add_support(const FrontState<dim>& /*state*/, const Vec<dim>& /*g*/, double& /*mass*/,
+                           Vec<dim>& /*support*/) const {}
+  /// The correction to the lumped potential g·Σ m x of the front's partial links: g·(their first
+  /// moment about their midpoints − the lumped one) (kg m²/s²).
+  virtual double potential_moment(const StringModel<dim>& model, const FrontState<dim>& state,
+                                  const Vec<dim>& g) const = 0;
+
+  // --- events ------------------------------------------------------------------------------------
+  /// The front's two crossing root functions, g[0] and g[1].
+  virtual void crossings(const StringModel<dim>& model, const FrontState<dim>& state, double* g) const = 0;
+  /// The direction ARKODE watches g[1] in (g[0]: −1).
+  virtual int second_direction() const = 0;
+  /// Acts on a crossing (e0: g[0] was found, else g[1]): moves material between the arcs or the front.
+  virtual EventAction cross(StringModel<dim>& model, const FrontState<dim>& state, int e0) = 0;
+  /// Root functions of the front's own that stop the run (positive while it may go on).
+  virtual int num_checks() const { return 0; }
+  virtual void checks(const FrontState<dim>& /*state*/, double* /*g*/) const {}
+  virtual std::string check_failed(const StringModel<dim>& /*model*/, const FrontState<dim>& /*state*/,
+                                   double /*t*/) const {
+    return {};
+  }
+
+ protected:
+  FrontMaterial m_;
+};
+
+/// d / |d|, or a RecoverableError naming `what` when d has no length.
+template <int dim>
+Vec<dim> unit_vector(const Vec<dim>& d, const char* what) {
+  const double n = d.norm();
+  if (!(n > 0) || !std::isfinite(n)) throw RecoverableError(fmt::format("{} has zero length", what));
+  return d / n;
+}
+
+}  // namespace chainsim
