@@ -12,6 +12,7 @@
 #        the end; a given ROOT_DIR is kept, and reused if it already holds a Debian root)
 # Environment: FRESH_MIRROR overrides the Debian archive (default: the first one in /etc/apt's sources).
 set -euo pipefail
+export PATH="$PATH:/usr/sbin:/sbin"  # debootstrap, chroot and ip live there
 src=$(cd "$(dirname "$0")/../.." && pwd)
 [ "$(id -u)" -eq 0 ] || { echo "fresh_machine.sh: needs root (debootstrap, chroot, mount)" >&2; exit 2; }
 
@@ -42,12 +43,16 @@ cleanup() {
 }
 trap cleanup EXIT
 
+# The tools of this stage on the host: debootstrap, and iproute2's ip for the offline namespace.
+tools=()
+command -v debootstrap >/dev/null || tools+=(debootstrap)
+command -v ip >/dev/null || tools+=(iproute2)
+if [ ${#tools[@]} -gt 0 ]; then
+  step "installing ${tools[*]}"
+  apt-get update -qq
+  DEBIAN_FRONTEND=noninteractive apt-get install -y -qq -o DPkg::Lock::Timeout=600 "${tools[@]}" >/dev/null
+fi
 if [ ! -x "$root/usr/bin/apt-get" ]; then
-  if ! command -v debootstrap >/dev/null; then
-    step "installing debootstrap"
-    apt-get update -qq
-    DEBIAN_FRONTEND=noninteractive apt-get install -y -qq -o DPkg::Lock::Timeout=600 debootstrap >/dev/null
-  fi
   step "debootstrap --variant=minbase bookworm from $mirror"
   debootstrap --variant=minbase bookworm "$root" "$mirror" >"$root.debootstrap.log" 2>&1 \
     || { tail -n 30 "$root.debootstrap.log" >&2; exit 1; }
