@@ -13,6 +13,7 @@
 
 #include "cases/scene/scene.hpp"
 #include "cases/scene/scene_run.hpp"
+#include "tests/unit/test_scene_support.hpp"
 
 using namespace chainsim;
 
@@ -133,36 +134,6 @@ TEST_CASE("the folded chain's fixed end reports the fold's tension while the fol
 
 namespace {
 
-/// A chain pulled up at `speed` by its driven end out of a heap on a table: 0.8 m in the heap, 0.2 m
-/// lifted and at rest, `nodes` nodes, output frames every `interval`.
-std::string pick_up(int nodes, double speed, double interval, bool on_plane) {
-  return fmt::format(R"(model = "string"
-[string]
-length = 1.0
-density = 0.25
-nodes = {}
-[shape]
-kind = "polyline"
-points = [[-0.8, 0.0], [0.0, 0.0], [0.0, 0.2]]
-[ends]
-end = {{ kind = "driven", path = "linear", velocity = [0.0, {:g}] }}
-[effects.gravity]
-g = [0.0, -9.81]
-[[effects.heap]]
-side = "start"
-s0 = 0.8
-f = 0.0
-point = [0.0, 0.0]
-{}
-[output]
-interval = {:g}
-[stop]
-t_end = 1.0
-)",
-                     nodes, speed,
-                     on_plane ? "on_plane = true\n[effects.plane]\npoint = [0.0, 0.0]\nnormal = [0.0, 1.0]" : "on_plane = false",
-                     interval);
-}
 
 }  // namespace
 
@@ -181,7 +152,7 @@ TEST_CASE("a pick-up from a table runs on every output interval and books its im
     for (bool on_plane : {true, false})
       for (double interval : {0.01, 0.0037, 0.001}) {
         INFO(c.nodes << " nodes, " << c.speed << " m/s, interval " << interval << (on_plane ? ", on a plane" : ", pinned"));
-        const SceneSpec spec = parse_scene_text(pick_up(c.nodes, c.speed, interval, on_plane), "s.toml");
+        const SceneSpec spec = parse_scene_text(test::pick_up(c.nodes, c.speed, interval, on_plane), "s.toml");
         SceneRun<2> run(spec);
         run.run();
         const nlohmann::json s = run.summary();

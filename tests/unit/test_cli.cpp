@@ -19,6 +19,8 @@
 #include <catch2/catch.hpp>
 #include <nlohmann/json.hpp>
 
+#include "tests/unit/test_scene_support.hpp"
+
 extern char** environ;
 
 namespace {
@@ -408,27 +410,8 @@ TEST_CASE("the printed summary says so when the run starts impulsively", "[unit]
   const std::filesystem::path dir = temp_dir("cli_impulsive");
   std::filesystem::create_directories(dir);
   const std::filesystem::path scene = dir / "pick_up.toml";
-  std::ofstream(scene) << R"(model = "string"
-[string]
-length = 1.0
-density = 0.25
-nodes = 21
-[shape]
-kind = "polyline"
-points = [[-0.8, 0.0], [0.0, 0.0], [0.0, 0.2]]
-[ends]
-end = { kind = "driven", path = "linear", velocity = [0.0, 2.0] }
-[effects.gravity]
-g = [0.0, -9.81]
-[[effects.heap]]
-side = "start"
-s0 = 0.8
-f = 0.0
-point = [0.0, 0.0]
-[stop]
-t_end = 0.05
-)";
-  const Result r = run("run " + scene.string() + " --quiet --out " + (dir / "d").string());
+  std::ofstream(scene) << chainsim::test::pick_up(21, 2.0, 0.01, false);
+  const Result r = run("run " + scene.string() + " --t-end 0.05 --quiet --out " + (dir / "d").string());
   REQUIRE(r.status == 0);
   CHECK_THAT(r.output, Catch::Matchers::Contains("start      the initial velocities are not compatible"));
   CHECK_THAT(r.output, Catch::Matchers::Contains("giving the string 0.0875 J of kinetic energy"));

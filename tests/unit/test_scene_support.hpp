@@ -8,6 +8,7 @@
 #include <string>
 
 #include <catch2/catch.hpp>
+#include <fmt/format.h>
 
 #include "cases/scene/front_scene.hpp"
 #include "cases/scene/scene.hpp"
@@ -146,5 +147,36 @@ point = [0.0, 0.0]
 [stop]
 t_end = 1.0
 )";
+
+/// A chain pulled up at `speed` by its driven end out of a heap on a table: 0.8 m in the heap, 0.2 m
+/// lifted and at rest, `nodes` nodes, output frames every `interval`.
+inline std::string pick_up(int nodes, double speed, double interval, bool on_plane) {
+  return fmt::format(R"(model = "string"
+[string]
+length = 1.0
+density = 0.25
+nodes = {}
+[shape]
+kind = "polyline"
+points = [[-0.8, 0.0], [0.0, 0.0], [0.0, 0.2]]
+[ends]
+end = {{ kind = "driven", path = "linear", velocity = [0.0, {:g}] }}
+[effects.gravity]
+g = [0.0, -9.81]
+[[effects.heap]]
+side = "start"
+s0 = 0.8
+f = 0.0
+point = [0.0, 0.0]
+{}
+[output]
+interval = {:g}
+[stop]
+t_end = 1.0
+)",
+                     nodes, speed,
+                     on_plane ? "on_plane = true\n[effects.plane]\npoint = [0.0, 0.0]\nnormal = [0.0, 1.0]" : "on_plane = false",
+                     interval);
+}
 
 }  // namespace chainsim::test
