@@ -139,8 +139,8 @@ struct RunSummary {
   IntegratorStats stats;
   std::vector<StepSample> samples;     ///< after every accepted step (StringSolverOptions::record_steps)
   /// Names of the measured forces (forces.csv, the end of series.csv): per prescribed node i,
-  /// R_node<i>_x.. (its support's or driver's force on the string, N) and T_node<i> (the tension of the
-  /// link at it, N); per front k, R_front<k>_x.. (the force of the heap's support on the string at
+  /// R_node{i}_x.. (its support's or driver's force on the string, N) and T_node{i} (the tension of the
+  /// link at it, N); per front k, R_front{k}_x.. (the force of the heap's support on the string at
   /// the front, N; zero for a fold).
   std::vector<std::string> force_columns;
   /// energy_drift / energy_scale (0 if the scale is 0).

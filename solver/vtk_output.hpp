@@ -9,7 +9,7 @@
 /// (the string as part 0, its fronts as part 1). Points are always 3D for VTK: a 2D string is
 /// written with z = 0. Files are written through AtomicFile, in one of two encodings:
 ///   - binary (default): every array as raw little- or big-endian (the machine's, declared in the file)
-///     bytes in one <AppendedData encoding="raw"> block, each preceded by its size in bytes (UInt64
+///     bytes in one AppendedData block (encoding "raw"), each preceded by its size in bytes (UInt64
 ///     header); exact, and about a third of the ASCII size;
 ///   - ascii: the values as text, each double in the shortest form that reads back to the same double
 ///     (so also exact); readable by eye, larger and slower to read.

@@ -117,8 +117,10 @@ def fall_time_figure(fall_times, out_dir):
     d, s = fall_times
     fig, axes = plt.subplots(1, 3, figsize=(13, 3.8), dpi=DPI)
     for ax, (title, series, string_key) in zip(axes, FALL_TIME_PANELS):
+        colors = []
         for key, label in series:
             line, = ax.plot(d["f"], d[key + "_exact"], "-", label=f"quadrature {label}")
+            colors.append(line.get_color())
             ax.plot(d["f"], d[key + "_ode"], "o", ms=3.5, mfc="none", color=line.get_color(),
                     label=f"reduced ODE ($\\varepsilon=10^{{-6}}$) {label}")
             if key == string_key:
@@ -128,7 +130,16 @@ def fall_time_figure(fall_times, out_dir):
         ax.set_ylabel("$t_f/t_0$")
         ax.set_title(title)
         ax.grid(alpha=0.3)
-        ax.legend(fontsize=7)
+        if len(series) == 1:
+            ax.legend(fontsize=7)
+        else:  # one entry per eta0 (its colour), one per model (its marker): outside, so it hides no curve
+            handles = [Line2D([], [], color=c, lw=2, label=label) for c, (_, label) in zip(colors, series)]
+            handles += [Line2D([], [], color="k", lw=1.3, label="quadrature"),
+                        Line2D([], [], color="k", marker="o", ms=3.5, mfc="none", ls="none",
+                               label="reduced ODE ($\\varepsilon=10^{-6}$)"),
+                        Line2D([], [], color="k", marker="x", ms=7, mew=1.5, ls="none",
+                               label="string solver ($\\varepsilon=10^{-4}$), $\\eta_0=0$")]
+            ax.legend(handles=handles, fontsize=7, loc="upper left", bbox_to_anchor=(1.02, 1.0), borderaxespad=0)
     fig.tight_layout()
     return save(fig, out_dir, "fall_time_vs_f.png", DPI)
 
@@ -259,24 +270,36 @@ AGREEMENT = (("rel_diff_string_reduced", "string vs reduced ODE", "x"),
              ("rel_diff_reduced_quadrature", "reduced ODE vs quadrature", "o"),
              ("rel_diff_string_quadrature", "string vs quadrature", "+"),
              ("energy_residual_string", "string: energy ledger residual (relative)", "s"))
+# The bounds tests/problems/test_canonical_job.cpp holds each quantity to, drawn on its own panel.
+STOP_TIME_BOUND = 1e-9   # string vs ODE and string vs quadrature (reduced ODE vs quadrature: 1e-10)
+LEDGER_BOUND = 1e-7      # the string run's energy ledger
 
 
 def agreement_figure(rows, out_dir):
-    fig, ax = plt.subplots(figsize=(8, 4), dpi=DPI)
+    """Two panels on one row of labels: the three-way differences of the stop times against their test bound,
+    and, apart (another quantity, another bound), the string run's energy-ledger residual."""
+    fig, (ax1, ax2) = plt.subplots(2, 1, figsize=(8, 6.2), sharex=True, dpi=DPI,
+                                   gridspec_kw={"height_ratios": [1.5, 1]})
     labels = [f"{r['problem']}\n$f$={r['f']:g}" for r in rows]
     xs = range(len(rows))
     tiny = 1e-17  # exact agreement drawn at the bottom of the log axis
-    for key, label, marker in AGREEMENT:
-        ax.semilogy(xs, [max(r[key], tiny) for r in rows], marker, ms=6, mfc="none", label=label)
-    ax.axhline(1e-9, color="tab:red", lw=0.8, ls="--")
-    ax.text(len(rows) - 0.5, 1.3e-9, "test bound string vs ODE", ha="right", fontsize=7, color="tab:red")
-    ax.set_xticks(list(xs))
-    ax.set_xticklabels(labels, fontsize=7)
-    ax.set_ylabel("relative difference or residual")
-    ax.set_ylim(1e-16, 1e-6)
-    ax.grid(alpha=0.3, which="major")
-    ax.legend(fontsize=7, loc="upper left")
-    ax.set_title(f"Stop times $t_{{\\rm stop}}$ three ways (string solver: {rows[0]['nodes']:g} nodes)", fontsize=10)
+    colors = plt.rcParams["axes.prop_cycle"].by_key()["color"]
+    for (key, label, marker), color in zip(AGREEMENT, colors):
+        ax = ax2 if key == "energy_residual_string" else ax1
+        ax.semilogy(xs, [max(r[key], tiny) for r in rows], marker, ms=6, mfc="none", color=color, label=label)
+    for ax, bound, text, bottom in ((ax1, STOP_TIME_BOUND, "test bound, string vs ODE and vs quadrature", 1e-16),
+                                    (ax2, LEDGER_BOUND, "test bound, energy ledger", 1e-16)):
+        ax.axhline(bound, color="tab:red", lw=0.8, ls="--")
+        ax.text(len(rows) - 0.5, bound * 1.6, text, ha="right", va="bottom", fontsize=7, color="tab:red")
+        ax.set_ylim(bottom, bound * 100)
+        ax.grid(alpha=0.3, which="major")
+        ax.legend(fontsize=7, loc="upper left")
+    ax1.set_ylabel("relative difference of $t_{\\rm stop}$")
+    ax2.set_ylabel("relative residual")
+    ax2.set_xticks(list(xs))
+    ax2.set_xticklabels(labels, fontsize=7)
+    ax1.set_title(f"Stop times $t_{{\\rm stop}}$ three ways, and the string run's energy ledger "
+                  f"(string solver: {rows[0]['nodes']:g} nodes)", fontsize=10)
     fig.tight_layout()
     return save(fig, out_dir, "agreement.png", DPI)
 
