@@ -204,7 +204,7 @@ def main(argv=None):
                                          stderr=subprocess.STDOUT, stdin=subprocess.DEVNULL, timeout=300)
                     actual = run.stdout.decode("utf-8", "replace").splitlines()
                     why = compare(expected, actual, rtol, ignore)
-                    rel = path.resolve().relative_to(ROOT)
+                    rel = os.path.relpath(path.resolve(), ROOT)
                     if why:
                         failures += 1
                         print(f"{rel}:{line}: FAIL  $ {command.splitlines()[0]}\n      {why}")

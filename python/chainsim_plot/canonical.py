@@ -28,7 +28,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 from matplotlib.lines import Line2D  # noqa: E402
 
-from .figures import save  # noqa: E402
+from .figures import choose_times, save, time_colors  # noqa: E402
 from .readers import RunError, load_run, read_table  # noqa: E402
 
 DPI = 130
@@ -67,13 +67,6 @@ def curves(data_dir, problem, f):
     """The reduced ODE, the quadrature and the string run of one problem at one f."""
     stem = os.path.join(data_dir, f"{problem}_f{f:.2f}")
     return tuple(read(stem + suffix, CURVE) for suffix in ("_ode.csv", "_exact.csv", "_string.csv"))
-
-
-def every(n, count):
-    """About `count` evenly spaced indices of range(n), always with the last one."""
-    step = max(1, n // count)
-    picks = list(range(0, n, step))
-    return picks if picks[-1] == n - 1 else picks + [n - 1]
 
 
 def spread(xs, ys, count, phase):
@@ -349,23 +342,23 @@ def scene_figure(scene, out_dir):
     stem = run.name
     frames, front = run.nodes, run.fronts[0]
     t0 = math.sqrt(2 * ell / g)
-    picks = every(len(frames), 6)
-    fig, (ax1, ax2) = plt.subplots(1, 2, figsize=(12, 4.6), gridspec_kw={"width_ratios": [1.25, 1]}, dpi=DPI)
-    cmap = plt.get_cmap("viridis")
-    for j, k in enumerate(picks):
+    picks = choose_times(frames.times, count=6)  # evenly spaced in time: no two snapshots nearly the same
+    fig, (ax1, ax2) = plt.subplots(1, 2, figsize=(12, 4.6), gridspec_kw={"width_ratios": [1, 1]}, dpi=DPI)
+    for color, k in zip(time_colors(len(picks)), picks):
         x = frames.positions(k)
-        ax1.plot(x[:, 0], x[:, 1], ".-", color=cmap(j / max(1, len(picks) - 1)), ms=3, lw=1,
-                 label=f"$t/t_0$ = {frames.times[k] / t0:.3f}")
+        ax1.plot(x[:, 0], x[:, 1], ".-", color=color, ms=3, lw=1, label=f"$t/t_0$ = {frames.times[k] / t0:.3f}")
     ts, contact = run.series["t"], front.positions()
     ax1.plot(contact[[0, -1], 0], contact[[0, -1], 1], **SHOCK)
     ax1.plot(contact[:, 0], contact[:, 1], "-", color="tab:red", lw=3, alpha=0.5,
              label="path of the contact (shock):\nthe landed chain lies there")
     ax1.axhline(0, color="k", lw=0.8)
     ax1.set_aspect("equal")
-    ax1.set_xlim(-0.05, 1.05)
+    xs = np.concatenate([frames.positions(k)[:, 0] for k in picks] + [contact[:, 0]])
+    pad = 0.05 * ell
+    ax1.set_xlim(xs.min() - pad, xs.max() + pad)  # the chain's extent, not the length: no empty half
     ax1.set_xlabel("x (m)")
     ax1.set_ylabel("y (m)")
-    ax1.legend(fontsize=7, loc="upper right")
+    ax1.legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.02, 1.0), borderaxespad=0)  # beside: hides nothing
     ax1.set_title("the string's nodes at several times", fontsize=9)
     ax2.plot(ts / t0, front.s0 / ell, "-", label="length above the table, string")
     ax2.plot(ts / t0, contact[:, 0] / ell, "-", label="contact position $x_0$ on the table")

@@ -55,6 +55,23 @@ def semilogy_abs(ax, t, r, **kw):
     return float(a.max()) if a.size else 0.0
 
 
+def plain_axis(ax, *series):
+    """No offset notation on the y-axis ("1e-13 - 1" for round-off on a constant), and a curve that is
+    constant to round-off (spread below 1e-9 of its size) drawn flat in a window of +-5% around it (+-1 at
+    zero), not zoomed into its round-off."""
+    ax.ticklabel_format(axis="y", useOffset=False)
+    values = np.concatenate([np.asarray(s, dtype=float).ravel() for s in series]) if series else np.array([])
+    values = values[np.isfinite(values)]
+    if values.size == 0:
+        return
+    lo, hi = values.min(), values.max()
+    size = max(abs(lo), abs(hi))
+    if hi - lo <= 1e-9 * size or size == 0:
+        mid = 0.5 * (lo + hi)
+        half = 0.05 * abs(mid) if mid != 0 else 1.0
+        ax.set_ylim(mid - half, mid + half)
+
+
 def choose_times(times, wanted=None, count=6):
     """Indices of the frames to draw: the nearest to each wanted time, or `count` frames spread evenly
     from the first to the last."""
@@ -70,8 +87,10 @@ def choose_times(times, wanted=None, count=6):
 
 
 def time_colors(n):
+    """n colours from dark blue (first) to green (last): viridis without its yellow end, which is hardly
+    visible on white."""
     cmap = plt.get_cmap("viridis")
-    return [cmap(k / max(1, n - 1)) for k in range(n)]
+    return [cmap(0.8 * k / max(1, n - 1)) for k in range(n)]
 
 
 PROJECTIONS = {2: [(0, 1)], 3: [(0, 1), (0, 2)]}
@@ -344,6 +363,32 @@ def energy_figure(run, out_dir):
 
 # --- tension ---------------------------------------------------------------------------------------
 
+SLACK_TOLERANCE = 1e-8  # as the solver's slack check (docs/scenes.md, slack_tolerance): T < -1e-8 max|T| is slack
+
+
+def tension_map(ax, s, times, grid):
+    """T(s, t) as a colour map; returns (mesh, has slack, top clipped). Each sign gets the whole of its half of
+    the colour scale (a diverging map centred on 0 with its own range on each side), so a little slack does not
+    squeeze the positive tension into the pale middle; the top of the scale is the 99.5th percentile of the
+    positive tension, so a short spike (the whip at the tip) does not wash out the rest (it shows as
+    the colour bar's arrow)."""
+    grid = np.asarray(grid, dtype=float)
+    finite = grid[np.isfinite(grid)]
+    top = float(np.max(np.abs(finite))) if finite.size else 0.0
+    if top == 0.0:
+        return ax.pcolormesh(s, times, grid, shading="nearest", cmap="viridis"), False, False
+    positive = finite[finite > 0]
+    vmax = float(np.percentile(positive, 99.5)) if positive.size else top
+    clipped = positive.size > 0 and vmax < positive.max()
+    low = float(finite.min())
+    neg = low < -SLACK_TOLERANCE * top
+    if not neg:
+        return (ax.pcolormesh(s, times, grid, shading="nearest", cmap="viridis", vmin=max(low, 0.0), vmax=vmax),
+                False, clipped)
+    norm = matplotlib.colors.TwoSlopeNorm(vmin=low, vcenter=0.0, vmax=max(vmax, 1e-300))
+    return ax.pcolormesh(s, times, grid, shading="nearest", cmap="RdBu_r", norm=norm), True, clipped
+
+
 def tension_figure(run, out_dir, wanted=None):
     tab = run.tension
     if tab is None or len(tab) == 0 or "T" not in tab or "s_mid" not in tab:
@@ -370,11 +415,8 @@ def tension_figure(run, out_dir, wanted=None):
         n = bounds[1]
         grid = tab["T"].reshape(len(times), n)
         s = tab["s_mid"][:n]
-        lim = np.max(np.abs(grid)) or 1.0
-        neg = np.min(grid) < 0
-        m = axes[0][1].pcolormesh(s, times, grid, shading="nearest", cmap="RdBu_r" if neg else "viridis",
-                                  vmin=-lim if neg else None, vmax=lim if neg else None)
-        fig.colorbar(m, ax=axes[0][1], label="T (N)")
+        m, neg, clipped = tension_map(axes[0][1], s, times, grid)
+        fig.colorbar(m, ax=axes[0][1], label="T (N)", extend="max" if clipped else "neither")
         decorate(axes[0][1], "s (m)", "t (s)", "T(s, t)" + (" (blue: slack, T < 0)" if neg else ""), legend=False)
     fig.suptitle(f"{run.name}: tension", fontsize=10)
     fig.tight_layout()
@@ -394,6 +436,8 @@ def fronts_figure(run, out_dir):
             ax2.plot(t, f.s0dot, label=f.name)
     decorate(ax1, "t (s)", "s0 (m)", "front positions in the material, s0(t)")
     decorate(ax2, "t (s)", "ds0/dt (m/s)", "front speeds in the material")
+    plain_axis(ax1, *[f.s0 for f in run.fronts])
+    plain_axis(ax2, *[f.s0dot for f in run.fronts if f.s0dot is not None])
     fig.suptitle(f"{run.name}: fronts", fontsize=10)
     fig.tight_layout()
     return save(fig, out_dir, "fronts.png")
