@@ -17,7 +17,7 @@ import sys
 
 docs = pathlib.Path(__file__).resolve().parent
 root = docs.parent
-build = pathlib.Path(os.environ.get("CHAINSIM_BUILD_DIR", root / "build")).resolve()
+build = (root / os.environ.get("CHAINSIM_BUILD_DIR", "build")).resolve()  # relative: to the root (Sphinx runs this file in docs/)
 sys.path[:0] = [str(build / "python"), str(root / "python")]
 
 project = "chainsim"
