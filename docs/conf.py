@@ -58,7 +58,10 @@ if missing:
 shutil.rmtree(gallery, ignore_errors=True)
 gallery.mkdir()
 for nb in sources:
-    shutil.copyfile(executed / nb.name, gallery / nb.name)
+    # The notebooks link to the guides as seen from examples/notebooks/ (../../docs/model.md, right on the
+    # repository and in Jupyter); from docs/gallery/ the same page is ../model.md.
+    text = (executed / nb.name).read_text(encoding="utf-8")
+    (gallery / nb.name).write_text(text.replace("](../../docs/", "](../"), encoding="utf-8")
 
 html_theme = "sphinx_rtd_theme"
 html_title = "chainsim"
