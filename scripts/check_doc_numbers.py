@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Runs every command the docs quote with its output, and compares what it prints now with the quote.
+r"""Runs every command the docs quote with its output, and compares what it prints now with the quote.
 
 A quoted output is a fenced block whose info string is `sh checked` (GitHub and the site show it as `sh`; the
 words after `sh` are ignored by both):
@@ -9,7 +9,7 @@ words after `sh` are ignored by both):
     chainsim: error: --f = 1.5 is out of range: allowed 0 <= f <= 1
     ```
 
-- A line starting with `$ ` is a command (a line ending in `\\` continues it); the lines up to the next command
+- A line starting with `$ ` is a command (a line ending in `\` continues it); the lines up to the next command
   are its expected output (stdout and stderr together, as a terminal shows them). A line `...` stands for any
   number of lines (a quote may leave out the middle of a report).
 - The commands of one file run in order, with bash, in one scratch directory per file (so a command may use
