@@ -14,6 +14,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "python"))
+from chainsim_plot.figures import time_colors  # noqa: E402
 from chainsim_plot.readers import Frames, read_table  # noqa: E402
 
 
@@ -30,13 +31,13 @@ def energy(path):
 
 def draw(ax, data, picks, closed=False, title="", equal=True):
     times = list(data)
-    cmap = plt.get_cmap("viridis")
+    colors = time_colors(len(picks))
     for k, i in enumerate(picks):
         t = times[min(i, len(times) - 1)]
         pts = data[t]
         xs = [p[1] for p in pts] + ([pts[0][1]] if closed else [])
         ys = [p[2] for p in pts] + ([pts[0][2]] if closed else [])
-        ax.plot(xs, ys, "-o", ms=1.5, lw=1, color=cmap(k / max(1, len(picks) - 1)), label=f"t = {t:g} s")
+        ax.plot(xs, ys, "-o", ms=1.5, lw=1, color=colors[k], label=f"t = {t:g} s")
     if equal:
         ax.set_aspect("equal")
     ax.set_title(title, fontsize=10)
