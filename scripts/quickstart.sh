@@ -22,7 +22,9 @@ packages=(cmake make g++ libeigen3-dev libsuitesparse-dev libsundials-dev catch2
           libtomlplusplus-dev nlohmann-json3-dev libfmt-dev libboost-dev libbenchmark-dev python3-matplotlib python3-numpy
           python3-pil python3-pytest python3-vtk9 ffmpeg clang libclang-rt-14-dev
           python3-dev pybind11-dev python3-pandas python3-dask python3-distributed python3-hypothesis
-          python3-scipy)   # chainsim fit / chainsim.fit: scipy.optimize.least_squares (docs/fit.md)
+          python3-scipy   # chainsim fit / chainsim.fit: scipy.optimize.least_squares (docs/fit.md)
+          python3-pip python3-venv python3-build python3-xarray python3-netcdf4 python3-tqdm mypy)
+          # pip install . (pyproject.toml) into a venv; Result.to_xarray/to_netcdf; sweep progress bars; mypy
 missing=()
 for p in "${packages[@]}"; do dpkg -s "$p" >/dev/null 2>&1 || missing+=("$p"); done
 if [ ${#missing[@]} -gt 0 ]; then
