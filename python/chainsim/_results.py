@@ -499,6 +499,20 @@ class ReducedResult:
         return pd.DataFrame({k: v for k, v in self.series.items() if k != "t"},
                             index=pd.Index(self.series["t"], name="t"))
 
+    def to_xarray(self) -> Dataset:
+        """The series as an xarray Dataset on the dimension ``time`` (t in s), the summary as JSON text in
+        ``attrs["summary"]``.
+
+        Returns
+        -------
+        xarray.Dataset
+        """
+        import xarray as xr
+        ds = xr.Dataset({k: ("time", v) for k, v in self.series.items() if k != "t"},
+                        coords={"time": ("time", self.series["t"], {"units": "s"})})
+        ds.attrs["summary"] = json.dumps(self.summary)
+        return ds
+
     def _repr_html_(self) -> str:
         s = self.summary
         rows = [(k, s.get(k)) for k in ("problem", "t_stop", "t_stop_over_t0", "t_stop_over_t0_exact") if k in s]

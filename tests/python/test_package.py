@@ -216,6 +216,10 @@ def test_to_xarray_has_dims_units_and_round_trips_through_netcdf(tmp_path):
         np.testing.assert_array_equal(back["moving"].values, result.nodes["moving"])
         assert back["T"].attrs["units"] == "N"
         assert eval_json(back.attrs["summary"]) == result.summary
+    reduced = chainsim.reduced("falling", f=0.5)
+    rds = reduced.to_xarray()
+    np.testing.assert_array_equal(rds["eta"].values, reduced.series["eta"])
+    np.testing.assert_array_equal(reduced.to_dataframe()["eta"].to_numpy(), reduced.series["eta"])
 
 
 def eval_json(text):
@@ -305,6 +309,8 @@ def test_plot_returns_figures_and_writes_only_when_asked(tmp_path, monkeypatch):
     paths = result.plot("run")   # the older form: the run directory and `chainsim plot`'s files
     assert os.path.exists("run/stats.json") and sorted(os.path.basename(p) for p in paths) == \
         ["energy.png", "fronts.png", "snapshots.png", "tension.png"]
+    paths = chainsim.plot("run", animate=True, html=True, fps=10)   # `chainsim plot run --animate --html`
+    assert paths[-1] == os.path.join("run", "figures", "animation.html") and os.path.exists(paths[-1])
 
 
 # ------------------------------------------------------------------------------------------------------------------
