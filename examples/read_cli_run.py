@@ -19,7 +19,7 @@ run_dir = os.path.join(out, "whip_crack")
 subprocess.run([binary(), "run", scene_file, "--out", run_dir, "--t-end", t_end, "--quiet"], check=True)
 
 run = chainsim.read_run(run_dir)                      # the CLI's files, by column name
-print(f"{run.kind} run: {len(run.nodes)} frames, status {run.summary['status']}, t_stop {run.summary['t_stop']} s")
+print(f"{run.kind} run: {len(run.t)} frames, status {run.summary['status']}, t_stop {run.summary['t_stop']} s")
 energy = run.energy
 print(f"energy ledger: max |drift| = {np.max(np.abs(energy['drift'])):.3e} J over {len(energy['t'])} frames")
 

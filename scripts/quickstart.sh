@@ -27,15 +27,17 @@ packages=(cmake make g++ libeigen3-dev libsuitesparse-dev libsundials-dev catch2
           libtomlplusplus-dev nlohmann-json3-dev libfmt-dev libboost-dev libbenchmark-dev python3-matplotlib python3-numpy
           python3-pil python3-pytest python3-vtk9 ffmpeg clang libclang-rt-14-dev
           python3-dev pybind11-dev python3-pandas python3-dask python3-distributed python3-hypothesis
-          python3-scipy)   # chainsim fit / chainsim.fit: scipy.optimize.least_squares (docs/fit.md)
+          python3-scipy   # chainsim fit / chainsim.fit: scipy.optimize.least_squares (docs/fit.md)
+          python3-pip python3-venv python3-build python3-xarray python3-netcdf4 python3-tqdm mypy)
+          # pip install . (pyproject.toml) into a venv; Result.to_xarray/to_netcdf; sweep progress bars; mypy
 # The documentation site and its checks, for `docs` only (demo and test do not pay for them): Sphinx with
 # myst-parser (the Markdown of docs/), numpydoc (the Python reference), breathe + Doxygen (the C++ reference),
-# nbsphinx + pandoc (the gallery), nbclient + ipykernel (the notebooks), xarray + netCDF4 (their exports),
-# Chromium (tests/docs/ opens HTML in it headless), pip/build/venv (the pip install check).
+# nbsphinx + pandoc (the gallery), nbclient + ipykernel (the notebooks), Chromium (tests/docs/ opens HTML in it
+# headless).
 if [ "$job" = docs ]; then
   packages+=(python3-sphinx python3-myst-parser python3-numpydoc python3-breathe doxygen python3-sphinx-rtd-theme
              python3-nbsphinx pandoc python3-nbclient python3-nbformat python3-nbconvert python3-ipykernel
-             python3-xarray python3-netcdf4 chromium python3-pip python3-build python3-venv)
+             chromium)
 fi
 missing=()
 for p in "${packages[@]}"; do dpkg -s "$p" >/dev/null 2>&1 || missing+=("$p"); done

@@ -52,6 +52,7 @@ int run_compare_command(CompareCommandOptions options, std::ostream& out);
 struct PlotCommandOptions {
   std::string run_dir;
   bool animate = false;
+  bool html = false;  ///< --html: the animation as one self-contained HTML page
   std::string speed, fps, times, format;
 };
 /// Runs /usr/bin/python3 (else python3 on PATH) -m chainsim_plot (run_python_module, python_command.hpp);

@@ -189,7 +189,11 @@ int main(int argc, char** argv) {
   cmd_plot->add_option("--speed", plot.speed, "animation speed in units of real time, > 0 (default 1)");
   cmd_plot->add_option("--fps", plot.fps, "animation frames per second, an integer >= 1 (default 25)");
   cmd_plot->add_option("--times", plot.times, "times of the snapshots and tension profiles (s), e.g. 0,0.1,0.2");
-  cmd_plot->add_option("--format", plot.format, "animation format: mp4 | gif (default mp4 if ffmpeg is installed)");
+  cmd_plot->add_option("--format", plot.format,
+                       "animation format: mp4 | gif | html (default mp4 if ffmpeg is installed, else gif)");
+  cmd_plot->add_flag("--html", plot.html,
+                     "with --animate: RUN_DIR/figures/animation.html, one self-contained page with play and scrub "
+                     "controls (the frames embedded) that any browser opens");
 
   chainsim::FitCommandOptions fit;  // chainsim fit (cases/cli/fit_options.hpp)
   auto* cmd_fit = chainsim::add_fit_command(app, fit);

@@ -16,6 +16,7 @@ namespace {
 std::vector<std::string> plot_arguments(const PlotCommandOptions& options) {
   std::vector<std::string> args = {options.run_dir};
   if (options.animate) args.emplace_back("--animate");
+  if (options.html) args.emplace_back("--html");
   const std::pair<const char*, const std::string*> values[] = {
       {"--speed", &options.speed}, {"--fps", &options.fps}, {"--times", &options.times}, {"--format", &options.format}};
   for (const auto& [name, value] : values)

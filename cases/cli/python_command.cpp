@@ -21,8 +21,19 @@ namespace chainsim {
 
 namespace {
 
-/// Debian's interpreter (it has matplotlib and numpy), else the first python3 on PATH.
-std::string python_interpreter() {
+/// The directory of this executable ("" if unknown).
+std::filesystem::path executable_dir() {
+  std::error_code ec;
+  const std::filesystem::path exe = std::filesystem::read_symlink("/proc/self/exe", ec);
+  return ec ? std::filesystem::path() : exe.parent_path();
+}
+
+/// The interpreter: the python3 beside an installed executable (pip puts `chainsim` in a virtual
+/// environment's bin/, beside the interpreter the packages were built for), else Debian's (it has
+/// matplotlib and numpy), else the first python3 on PATH.
+std::string python_interpreter(bool installed) {
+  const std::filesystem::path dir = executable_dir();
+  if (installed && !dir.empty() && access((dir / "python3").c_str(), X_OK) == 0) return (dir / "python3").string();
   const char* debian = "/usr/bin/python3";
   return access(debian, X_OK) == 0 ? debian : "python3";
 }
@@ -30,13 +41,17 @@ std::string python_interpreter() {
 /// The directories holding the packages: beside an installed executable (PREFIX/bin/chainsim ->
 /// PREFIX/CHAINSIM_PYTHON_INSTALL_DIR) if `probe` is there, else the build tree's python/ (the
 /// compiled module chainsim, when built) and the source tree's python/ the executable was built from.
-std::string python_path(const std::string& probe) {
+std::string python_path(const std::string& probe, bool& installed) {
+  installed = false;
 #ifdef CHAINSIM_PYTHON_INSTALL_DIR
   std::error_code ec;
-  const std::filesystem::path exe = std::filesystem::read_symlink("/proc/self/exe", ec);
-  if (!ec) {
-    const std::filesystem::path installed = exe.parent_path().parent_path() / CHAINSIM_PYTHON_INSTALL_DIR;
-    if (std::filesystem::exists(installed / probe, ec)) return installed.string();
+  const std::filesystem::path dir = executable_dir();
+  if (!dir.empty()) {
+    const std::filesystem::path packages = dir.parent_path() / CHAINSIM_PYTHON_INSTALL_DIR;
+    if (std::filesystem::exists(packages / probe, ec)) {
+      installed = true;
+      return packages.string();
+    }
   }
 #endif
 #ifdef CHAINSIM_PYTHON_BUILD_DIR
@@ -50,7 +65,8 @@ std::string python_path(const std::string& probe) {
 
 int run_python_module(const std::string& command, const std::string& module, const std::string& probe,
                       const std::vector<std::string>& module_args) {
-  const std::string path = python_path(probe);
+  bool installed = false;
+  const std::string path = python_path(probe, installed);
   bool found = false;
   std::string::size_type start = 0;
   while (!found && start <= path.size()) {
@@ -65,7 +81,7 @@ int run_python_module(const std::string& command, const std::string& module, con
                              command, probe, path, command);
     return 1;
   }
-  const std::string python = python_interpreter();
+  const std::string python = python_interpreter(installed);
   std::vector<std::string> args = {python, "-m", module};
   args.insert(args.end(), module_args.begin(), module_args.end());
   std::vector<char*> argv;

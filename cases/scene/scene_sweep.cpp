@@ -158,6 +158,10 @@ std::vector<std::vector<std::string>> sweep_points(const std::vector<SweepAxis>&
 }
 
 nlohmann::json run_sweep_point(const SweepScene& scene, const std::vector<std::string>& point) {
+  return run_sweep_point(scene, point, run_point);
+}
+
+nlohmann::json run_sweep_point(const SweepScene& scene, const std::vector<std::string>& point, const PointRun& run) {
   const auto start = std::chrono::steady_clock::now();
   nlohmann::json row = nlohmann::json::object();
   nlohmann::json summary;
@@ -168,7 +172,7 @@ nlohmann::json run_sweep_point(const SweepScene& scene, const std::vector<std::s
     for (const std::string& o : resolve_keys(scene, point, canonical)) overrides.push_back(o);
     SceneSpec spec = parse_scene_text(scene.text, scene.source, overrides);
     if (scene.t_end) replace_t_end(spec, *scene.t_end, scene.t_end_origin);
-    summary = run_point(spec);
+    summary = run(spec);
     status = summary.value("status", "completed");
     error = summary.value("error", "");
   } catch (const InputError& e) {
@@ -189,17 +193,19 @@ nlohmann::json run_sweep_point(const SweepScene& scene, const std::vector<std::s
 }
 
 std::vector<nlohmann::json> run_sweep(const SweepScene& scene, const std::vector<std::vector<std::string>>& points,
-                                      int workers) {
+                                      int workers, std::atomic<std::size_t>* done) {
   check_sweep_points(scene, points);
   std::vector<nlohmann::json> rows(points.size());
   std::atomic<std::size_t> next{0};
   auto work = [&] {
-    for (std::size_t k; (k = next.fetch_add(1)) < points.size();)
+    for (std::size_t k; (k = next.fetch_add(1)) < points.size();) {
       rows[k] = interrupt_requested()
                     ? nlohmann::json{{"status", "interrupted"},
                                      {"error", fmt::format("not run: interrupted by {}", interrupt_cause())},
                                      {"wall_time_s", 0.0}}
                     : run_sweep_point(scene, points[k]);
+      if (done) ++*done;
+    }
   };
   const int n = std::max(1, std::min<int>(workers, static_cast<int>(points.size())));
   std::vector<std::thread> threads;

@@ -17,6 +17,8 @@
 ///   wall_time_s   wall-clock time of the whole point: parsing, building, running (s)
 ///   and the run's summary (stats.json) flattened: top-level numbers, strings and booleans as they
 ///   are, nested objects as "parent.child", arrays of numbers as "name[k]" (other arrays left out).
+#include <atomic>
+#include <functional>
 #include <optional>
 #include <string>
 #include <vector>
@@ -24,6 +26,8 @@
 #include <nlohmann/json.hpp>
 
 namespace chainsim {
+
+struct SceneSpec;
 
 /// The scene a sweep varies: its TOML text (a file's content, with `source` naming the file in
 /// messages), overrides applied to every point first, and an optional end time for every run.
@@ -64,11 +68,18 @@ void check_sweep_points(const SweepScene& scene, const std::vector<std::vector<s
 /// sets a key twice is an "error" row: check_sweep_points).
 nlohmann::json run_sweep_point(const SweepScene& scene, const std::vector<std::string>& point);
 
+/// What runs a point's scene: its summary (stats.json, with "error" for a numerical failure); it may throw
+/// InputError or NumericalError. The Python module passes one that keeps the run (chainsim.sweep(results=True)).
+using PointRun = std::function<nlohmann::json(const SceneSpec&)>;
+/// run_sweep_point with the scene of the point run by `run` (the row is made as above).
+nlohmann::json run_sweep_point(const SweepScene& scene, const std::vector<std::string>& point, const PointRun& run);
+
 /// Checks the points (check_sweep_points: throws InputError), then runs every point on `workers` threads
 /// (the runs share nothing but the interrupt flag); the rows are in the order of the points. After Ctrl-C (solver/interrupt.hpp) the running points end
 /// "interrupted" and the points not started yet are rows with status "interrupted".
+/// `done`, if given, counts the points ended (a progress bar reads it from another thread).
 std::vector<nlohmann::json> run_sweep(const SweepScene& scene, const std::vector<std::vector<std::string>>& points,
-                                      int workers);
+                                      int workers, std::atomic<std::size_t>* done = nullptr);
 
 /// The summary flattened into a row's columns (see the file comment).
 nlohmann::json flatten_summary(const nlohmann::json& summary);

@@ -4,8 +4,11 @@
 // compare`, run_sweep / run_sweep_point = `chainsim sweep`). JSON documents cross as text (json.loads
 // on the Python side: doubles round-trip exactly); arrays as numpy arrays (copies).
 #include <algorithm>
+#include <atomic>
+#include <chrono>
 #include <cmath>
 #include <cstring>
+#include <future>
 #include <limits>
 #include <memory>
 #include <optional>
@@ -230,19 +233,24 @@ class Run {
   Variant run_;
 };
 
+/// Builds and runs a scene without the GIL (the caller releases it): the string solver's run, or the
+/// reduced model's for model = "reduced". Throws InputError for an inconsistent scene.
 template <int dim>
-std::unique_ptr<Run> run_string(const SceneSpec& spec, bool handle_sigint) {
+std::unique_ptr<Run> run_string(const SceneSpec& spec) {
   auto run = std::make_unique<SceneRun<dim>>(spec);
-  std::optional<NumericalError> failure;
-  {
-    clear_interrupt();
-    ScopedSigintHandler sigint(handle_sigint);
-    py::gil_scoped_release release;
-    failure = run->run();
-  }
+  const std::optional<NumericalError> failure = run->run();
   auto out = std::make_unique<Run>(Run::Variant(std::move(run)));
   if (failure) out->error = failure->what();
   return out;
+}
+
+std::unique_ptr<Run> run_spec(const SceneSpec& spec) {
+  if (spec.model == "reduced") {
+    ReducedRun r = solve_reduced(match_canonical_problem(spec));
+    r.summary["t_end"] = spec.stop.t_end;
+    return std::make_unique<Run>(Run::Variant(std::move(r)));
+  }
+  return spec.dimension == 3 ? run_string<3>(spec) : run_string<2>(spec);
 }
 
 SceneSpec parse(const std::string& text, const std::string& source, const std::vector<std::string>& overrides,
@@ -256,17 +264,10 @@ std::unique_ptr<Run> run_scene(const std::string& text, const std::string& sourc
                                const std::vector<std::string>& overrides, std::optional<double> t_end,
                                bool handle_sigint) {
   const SceneSpec spec = parse(text, source, overrides, t_end);
-  if (spec.model == "reduced") {
-    const ReducedSetup setup = match_canonical_problem(spec);
-    ReducedRun r{CsvTable(series_columns()), {}};
-    {
-      py::gil_scoped_release release;
-      r = solve_reduced(setup);
-    }
-    r.summary["t_end"] = spec.stop.t_end;
-    return std::make_unique<Run>(Run::Variant(std::move(r)));
-  }
-  return spec.dimension == 3 ? run_string<3>(spec, handle_sigint) : run_string<2>(spec, handle_sigint);
+  clear_interrupt();
+  ScopedSigintHandler sigint(handle_sigint);
+  py::gil_scoped_release release;
+  return run_spec(spec);
 }
 
 // --- Python values to C++ values, every refusal an InputError naming the key ----------------------
@@ -469,6 +470,8 @@ SweepScene sweep_scene(const std::string& text, const std::string& source, const
 
 PYBIND11_MODULE(_core, m) {
   m.doc() = "chainsim's C++ library (see the package chainsim and docs/python.md)";
+  m.attr("__version__") = CHAINSIM_VERSION;          // project(chainsim VERSION ...)
+  m.attr("version_text") = CHAINSIM_VERSION_TEXT;    // `chainsim --version`
   static py::exception<InputError> input_error(m, "ChainsimInputError", PyExc_ValueError);
   static py::exception<NumericalError> numerical_error(m, "NumericalError", PyExc_RuntimeError);
   py::register_exception_translator([](std::exception_ptr p) {
@@ -530,25 +533,68 @@ PYBIND11_MODULE(_core, m) {
         },
         py::arg("text"), py::arg("source"), py::arg("overrides"), py::arg("t_end"), py::arg("point"),
         "one sweep point as `chainsim sweep` runs it: the row as JSON text");
+  m.def("run_sweep_point_full",
+        [](const std::string& text, const std::string& source, const std::vector<std::string>& overrides,
+           std::optional<double> t_end, const std::vector<std::string>& point) {
+          const SweepScene scene = sweep_scene(text, source, overrides, t_end);
+          std::unique_ptr<Run> kept;
+          std::string row;
+          {
+            py::gil_scoped_release release;
+            row = run_sweep_point(scene, point, [&](const SceneSpec& spec) {
+                    kept = run_spec(spec);
+                    nlohmann::json summary = nlohmann::json::parse(kept->summary());
+                    if (spec.model == "reduced") summary["status"] = "completed";  // as `chainsim sweep`'s rows
+                    if (!kept->error.empty()) summary["error"] = kept->error;
+                    return summary;
+                  }).dump();
+          }
+          py::object run = kept ? py::cast(std::move(kept)) : py::none();
+          return py::make_tuple(row, run);
+        },
+        py::arg("text"), py::arg("source"), py::arg("overrides"), py::arg("t_end"), py::arg("point"),
+        "one sweep point as run_sweep_point runs it, and its run: (row as JSON text, Run or None for a refused "
+        "point)");
   m.def("run_sweep",
         [](const std::string& text, const std::string& source, const std::vector<std::string>& overrides,
            std::optional<double> t_end, const std::vector<std::vector<std::string>>& points, int workers,
-           bool handle_sigint) {
+           bool handle_sigint, py::object progress) {
           const SweepScene scene = sweep_scene(text, source, overrides, t_end);
           std::vector<nlohmann::json> rows;
           {
             clear_interrupt();
             ScopedSigintHandler sigint(handle_sigint);
             py::gil_scoped_release release;
-            rows = run_sweep(scene, points, workers);
+            if (progress.is_none()) {
+              rows = run_sweep(scene, points, workers);
+            } else {  // the sweep on its own thread; this one reports the points ended, every 0.1 s
+              std::atomic<std::size_t> done{0};
+              auto sweep = std::async(std::launch::async, [&] { rows = run_sweep(scene, points, workers, &done); });
+              std::size_t shown = 0;
+              bool report = true;
+              for (bool ended = false; !ended;) {
+                ended = sweep.wait_for(std::chrono::milliseconds(100)) == std::future_status::ready;
+                const std::size_t now = done.load();
+                if (!report || now == shown) continue;
+                py::gil_scoped_acquire acquire;
+                try {
+                  progress(now);
+                } catch (py::error_already_set&) {  // a broken progress bar does not stop the sweep
+                  report = false;
+                }
+                shown = now;
+              }
+              sweep.get();  // rethrows check_sweep_points' InputError
+            }
           }
           std::vector<std::string> out;
           for (const auto& r : rows) out.push_back(r.dump());
           return out;
         },
         py::arg("text"), py::arg("source"), py::arg("overrides"), py::arg("t_end"), py::arg("points"),
-        py::arg("workers"), py::arg("handle_sigint") = false,
-        "the points on `workers` threads, as `chainsim sweep` runs them: rows as JSON text");
+        py::arg("workers"), py::arg("handle_sigint") = false, py::arg("progress") = py::none(),
+        "the points on `workers` threads, as `chainsim sweep` runs them: rows as JSON text; `progress(n)` is called "
+        "with the number of points ended as they end");
   m.def("flatten_summary", [](const std::string& json) { return flatten_summary(nlohmann::json::parse(json)).dump(); },
         py::arg("json"), "a summary flattened into a sweep row's columns");
   m.def("interrupt_requested", &interrupt_requested);

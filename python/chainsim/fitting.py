@@ -50,16 +50,32 @@ def _error(message):
 # Data
 
 class Data:
-    """One measured series: times `t` (s, strictly increasing), the values of an `observable` that chainsim outputs,
-    and their standard deviations `sigma` (a number, an array, or None: estimated from the residuals).
+    """One measured series: times, the values of an observable that chainsim outputs, and their standard deviations.
 
-    observable  a column of the model's series.csv (reduced: y, ydot, P, eta, ...; string runs with fronts:
-                s0_0, front_0_y, support_y, ...) or forces.csv, "node[K].x" (a node's coordinate), or "t_stop"
-                (a stop time: `t` is then unused; each value is one measured stop time)
-    settings    keys that hold for this series only (a drop from another height: {"eta0": 0.8}, or scene keys
-                {"string.length": 0.8}); series with the same `run` label share one model run
-    run         label of the run (drop) the series belongs to: per-run parameters (per_run=) are fitted once per
-                label. Default: each series its own run.
+    Parameters
+    ----------
+    t : array_like or None
+        Times (s), strictly increasing (unused for ``observable="t_stop"``).
+    values : array_like
+        The measured values.
+    observable : str
+        A column of the model's series.csv (reduced: y, ydot, P, eta, ...; string runs with fronts: s0_0,
+        front_0_y, support_y, ...) or forces.csv, ``"node[K].x"`` (a node's coordinate), or ``"t_stop"`` (a stop
+        time: each value is one measured stop time).
+    sigma : float or array_like, optional
+        Standard deviations of the values (None: estimated from the residuals).
+    settings : dict, optional
+        Keys that hold for this series only (a drop from another height: ``{"eta0": 0.8}``, or scene keys
+        ``{"string.length": 0.8}``); series with the same `run` label share one model run.
+    run : str, optional
+        Label of the run (drop) the series belongs to: per-run parameters (``per_run=``) are fitted once per
+        label. Default: each series its own run.
+    name : str, optional
+        How tables and figures name the series (default: the observable).
+    lines : list of int, optional
+        The file's line of each value, for messages (`from_csv` sets them).
+    columns : dict, optional
+        The file's column names of t, the values and sigma, for messages (`from_csv` sets them).
     """
 
     def __init__(self, t, values, observable, sigma=None, settings=None, run=None, name=None, lines=None,
@@ -118,11 +134,37 @@ class Data:
 
     @classmethod
     def from_csv(cls, path, observable=None, time="t", sigma=None, settings=None, run=None, column=None):
-        """Reads a CSV file: a header row naming the columns, then one row per point; lines starting with # are
-        comments. `time` names the time column (s); `observable` the model output the values are, and `column`
-        the column that holds them (default: the observable's name; without either, the only column that is
-        neither the time nor sigma); `sigma` a column of standard deviations, or a number (default: the column
-        "sigma" if there is one, else estimated from the residuals)."""
+        """Reads a CSV file: a header row naming the columns, then one row per point (lines starting with # are
+        comments).
+
+        Parameters
+        ----------
+        path : str or os.PathLike
+            The CSV file.
+        observable : str, optional
+            The model output the values are (see `Data`).
+        time : str, optional
+            The time column (s), default ``"t"``.
+        sigma : str or float, optional
+            A column of standard deviations, or a number (default: the column "sigma" if there is one, else
+            estimated from the residuals).
+        settings : dict, optional
+            As for `Data`.
+        run : str, optional
+            As for `Data`.
+        column : str, optional
+            The column that holds the values (default: the observable's name; without either, the only column
+            that is neither the time nor sigma).
+
+        Returns
+        -------
+        Data
+
+        Raises
+        ------
+        ChainsimInputError
+            Unsorted times, NaN, a missing column: with the file, line, column and value.
+        """
         path = os.fspath(path)
         try:
             with open(path, newline="") as handle:
@@ -462,21 +504,41 @@ class _Problem:
 
 
 class FitResult:
-    """The result of chainsim.fit: see docs/fit.md.
+    """The result of `chainsim.fit` (docs/fit.md).
 
-    value, sd, interval       {name: best value}, {name: standard deviation}, {name: (low, high)} (covariance, 95%)
-    profile_interval          {name: (low, high)} from the profile likelihood (the profiled parameter)
-    profile                   {"parameter", "values", "delta_chi2"} (delta chi-square / s^2 along the profile)
-    on_bound                  {name: "lower" | "upper"} for a parameter that ends on its bound
-    covariance, names         the covariance matrix and the order of its rows
-    series                    per series: name, observable, n, rms, residual_norm, noise (estimated or given sigma)
-    chi2, dof, s2             weighted sum of squares, N - p, chi2 / dof (the residual variance)
+    Parameters
+    ----------
+    **fields
+        The attributes below (`fit` makes it).
+
+    Attributes
+    ----------
+    value, sd, interval : dict
+        {name: best value}, {name: standard deviation}, {name: (low, high)} (covariance, 95%).
+    profile_interval : dict
+        {name: (low, high)} from the profile likelihood (the profiled parameter).
+    profile : dict
+        {"parameter", "values", "delta_chi2"} (delta chi-square / s^2 along the profile).
+    on_bound : dict
+        {name: "lower" | "upper"} for a parameter that ends on its bound.
+    covariance, names : numpy.ndarray, list
+        The covariance matrix and the order of its rows.
+    series : list of dict
+        Per series: name, observable, n, rms, residual_norm, noise (estimated or given sigma).
+    chi2, dof, s2 : float
+        Weighted sum of squares, N - p, chi2 / dof (the residual variance).
     """
 
     def __init__(self, **fields):
         self.__dict__.update(fields)
 
     def to_dict(self):
+        """The fit as plain JSON values (what fit.json holds).
+
+        Returns
+        -------
+        dict
+        """
         keys = ("target", "names", "value", "sd", "interval", "profile_interval", "profile_parameter", "on_bound",
                 "covariance", "correlation", "chi2", "dof", "points", "s2", "absolute_sigma", "series", "profile",
                 "optimizer", "evaluations", "wall_s", "warnings", "threshold")
@@ -512,8 +574,21 @@ class FitResult:
         return f"<FitResult {parts}>"
 
     def write(self, directory, figures=True):
-        """Writes fit.json (last: its presence means the set is complete), fit_table.txt, fit_series.csv (data,
-        model and residuals) and, with figures, fit.png and profile.png; returns the paths."""
+        """Writes the files of ``chainsim fit --out``.
+
+        Parameters
+        ----------
+        directory : str or os.PathLike
+            Where: fit.json (last: its presence means the set is complete), fit_table.txt, fit_series.csv (data,
+            model and residuals).
+        figures : bool, optional
+            Also fit.png and profile.png (default True).
+
+        Returns
+        -------
+        list of str
+            The paths written.
+        """
         os.makedirs(directory, exist_ok=True)
         written = []
         rows = ["series,observable,t,data,model,residual,sigma"]
@@ -612,23 +687,43 @@ def _profile_bound(problem, x_best, j, chi2_min, s2, sd, direction, diff_step, m
 
 def fit(target, data, free=None, *, bounds=None, per_run=(), fixed=None, profile="f", profile_points=21,
         absolute_sigma=False, workers=None, client=None, diff_step=1e-4, max_nfev=200):
-    """Fits parameters of a chainsim model to measured series; returns a FitResult.
+    """Fits parameters of a chainsim model to measured series (weighted nonlinear least squares, docs/fit.md).
 
-    target          a canonical problem ("falling", "folded", "sliding": the reduced ODE), a Scene, or a scene
-                    file's path (a scene with model = "reduced" runs the reduced ODE, any other the string solver)
-    data            a Data, a CSV file's path, or a list of them (joint fit: the shared parameters are fitted to all)
-    free            {name: start} or {name: (start, lower, upper)}: f, the reduced model's keywords (eta0, eps,
-                    force, length, density, gravity) or the scene's dotted keys, and t_offset (the release time on
-                    the data's clock). Default {"f": 0.5}. f is bounded to [0, 1], eta0 to [0, 1].
-    bounds          {name: (lower, upper)} for parameters given by their start value only
-    per_run         names of free parameters fitted once per run label (e.g. t_offset of each drop)
-    fixed           {name: value} set for every run (reduced keywords or scene keys)
-    profile         the parameter whose profile likelihood is computed (None: none); default f when it is free
-    profile_points  points of the profile drawn in the figure (0: only the interval's ends are found)
-    absolute_sigma  True: the given sigmas are the data's true standard deviations (no scaling by chi2/(N-p))
-    workers, client local threads, or a dask.distributed.Client for the model runs of the finite differences
-    diff_step       relative step of the central differences
-    max_nfev        most iterations of the optimizer: a fit that needs more raises ChainsimInputError
+    Parameters
+    ----------
+    target : str, Scene or os.PathLike
+        A canonical problem ("falling", "folded", "sliding": the reduced ODE), a Scene, or a scene file's path (a
+        scene with model = "reduced" runs the reduced ODE, any other the string solver).
+    data : Data, str, os.PathLike or list of them
+        A Data, a CSV file's path, or a list of them (joint fit: the shared parameters are fitted to all).
+    free : dict, optional
+        {name: start} or {name: (start, lower, upper)}: f, the reduced model's keywords (eta0, eps, force, length,
+        density, gravity) or the scene's dotted keys, and t_offset (the release time on the data's clock).
+        Default {"f": 0.5}. f is bounded to [0, 1], eta0 to [0, 1].
+    bounds : dict, optional
+        {name: (lower, upper)} for parameters given by their start value only.
+    per_run : sequence of str, optional
+        Names of free parameters fitted once per run label (e.g. t_offset of each drop).
+    fixed : dict, optional
+        {name: value} set for every run (reduced keywords or scene keys).
+    profile : str or None, optional
+        The parameter whose profile likelihood is computed (None: none); default f when it is free.
+    profile_points : int, optional
+        Points of the profile drawn in the figure (0: only the interval's ends are found).
+    absolute_sigma : bool, optional
+        True: the given sigmas are the data's true standard deviations (no scaling by chi2/(N-p)).
+    workers : int, optional
+        Local threads for the model runs of the finite differences.
+    client : dask.distributed.Client, optional
+        Runs the model runs as Dask tasks instead.
+    diff_step : float, optional
+        Relative step of the central differences.
+    max_nfev : int, optional
+        Most iterations of the optimizer: a fit that needs more raises ChainsimInputError.
+
+    Returns
+    -------
+    FitResult
     """
     from . import Scene
     start = time.perf_counter()

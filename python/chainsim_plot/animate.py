@@ -1,10 +1,13 @@
-"""The string in motion: an MP4 (ffmpeg) or, without ffmpeg, a GIF (Pillow).
+"""The string in motion: an MP4 (ffmpeg) or, without ffmpeg, a GIF (Pillow), or one self-contained HTML page
+with play and scrub controls (matplotlib's JavaScript HTML writer, the frames embedded as PNG: `--html`).
 
 Video frame j shows the recorded frame nearest to t_j = t_first + j * speed / fps, so the video runs
 at `speed` times real time: a run from t_first to t_last gives floor((t_last - t_first) * fps / speed) + 1
 frames (`frame_count`).
 """
+import html
 import math
+import re
 import shutil
 
 import matplotlib
@@ -25,9 +28,32 @@ def has_ffmpeg():
     return shutil.which("ffmpeg") is not None and animation.writers.is_available("ffmpeg")
 
 
+# The HTML page's buttons: matplotlib's template draws their icons with Font Awesome from a CDN; the page
+# carries its own glyphs instead, so that it opens anywhere, offline.
+_FONT_AWESOME = re.compile(r'<link rel="stylesheet"\s+href="https://[^"]*font-awesome[^"]*">\s*')
+_GLYPHS = """<style>
+.anim-buttons button i { font-style: normal; }
+.fa-minus::before { content: "\\2212"; } .fa-plus::before { content: "+"; }
+.fa-fast-backward::before { content: "\\21E4"; } .fa-fast-forward::before { content: "\\21E5"; }
+.fa-step-backward::before { content: "\\2190"; } .fa-step-forward::before { content: "\\2192"; }
+.fa-play::before { content: "\\25B6"; } .fa-pause::before { content: "||"; }
+.fa-flip-horizontal.fa-play::before { content: "\\25C0"; }
+</style>
+"""
+
+
+def _self_contained(path, title):
+    """Makes matplotlib's HTML animation a whole page that needs nothing from the network."""
+    with open(path) as fh:
+        body = _FONT_AWESOME.sub("", fh.read())
+    with open(path, "w") as fh:
+        fh.write(f"<!DOCTYPE html>\n<html><head><meta charset=\"utf-8\"><title>{html.escape(title)}</title>\n"
+                 f"{_GLYPHS}</head><body>\n{body}\n</body></html>\n")
+
+
 def animate(run, out_path, speed=1.0, fps=25, fmt=None):
-    """Writes the animation of `run` to out_path (extension .mp4 or .gif, from `fmt`: "mp4", "gif" or None
-    = mp4 when ffmpeg is installed) and returns the path written."""
+    """Writes the animation of `run` to out_path (extension .mp4, .gif or .html, from `fmt`: "mp4", "gif",
+    "html" or None = mp4 when ffmpeg is installed) and returns the path written and its frame count."""
     frames = run.nodes
     if frames is None:
         raise RunError(f"{run.path}: --animate needs nodes.csv (the run wrote no node frames)")
@@ -72,11 +98,18 @@ def animate(run, out_path, speed=1.0, fps=25, fmt=None):
         clock.set_text(f"t = {tk:8.4f} s")
         return lines + markers
 
-    writer = (animation.FFMpegWriter(fps=fps, codec="libx264", extra_args=["-pix_fmt", "yuv420p"])
-              if fmt == "mp4" else animation.PillowWriter(fps=fps))
+    if fmt == "html":
+        # Every frame embedded (no limit: the writer would drop the frames beyond animation.embed_limit).
+        writer = animation.HTMLWriter(fps=fps, embed_frames=True, default_mode="once", embed_limit=float("inf"))
+    elif fmt == "mp4":
+        writer = animation.FFMpegWriter(fps=fps, codec="libx264", extra_args=["-pix_fmt", "yuv420p"])
+    else:
+        writer = animation.PillowWriter(fps=fps)
     anim = animation.FuncAnimation(fig, draw, frames=n, blit=False)
     anim.save(out_path, writer=writer)
     plt.close(fig)
+    if fmt == "html":
+        _self_contained(out_path, f"{run.name}: the string in motion")
     return out_path, n
 
 

@@ -1,4 +1,4 @@
-"""`chainsim plot RUN_DIR [--animate] [--speed X] [--times t1,t2,...] [--fps N] [--format mp4|gif]`.
+"""`chainsim plot RUN_DIR [--animate [--html]] [--speed X] [--times t1,t2,...] [--fps N] [--format mp4|gif|html]`.
 
 Draws the run in RUN_DIR into RUN_DIR/figures/ and prints the path of every file it writes. Exit codes as
 for every chainsim command: 0 success, 2 bad input (an option, a missing or unreadable run directory, a
@@ -46,8 +46,8 @@ def _times(text):
 
 
 def _format(text):
-    if text not in ("mp4", "gif"):
-        raise argparse.ArgumentTypeError(f"--format = '{text}' is not a known format: allowed mp4, gif")
+    if text not in ("mp4", "gif", "html"):
+        raise argparse.ArgumentTypeError(f"--format = '{text}' is not a known format: allowed mp4, gif, html")
     return text
 
 
@@ -61,7 +61,10 @@ def parser():
                    help="animation speed, in units of real time (default 1: real time), > 0")
     p.add_argument("--fps", type=_positive("--fps", int), default=25, help="animation frames per second (default 25)")
     p.add_argument("--format", type=_format, default=None,
-                   help="animation format (default: mp4 if ffmpeg is installed, else gif)")
+                   help="animation format: mp4, gif or html (default: mp4 if ffmpeg is installed, else gif)")
+    p.add_argument("--html", action="store_true",
+                   help="with --animate: RUN_DIR/figures/animation.html, one self-contained page with play and scrub "
+                        "controls that any browser opens (the same as --format html)")
     p.add_argument("--times", type=_times, default=None,
                    help="times (s) of the snapshots and tension profiles, e.g. 0,0.1,0.2 (default: 6 spread "
                         "over the run)")
@@ -77,7 +80,6 @@ def plot_run(run_dir, times=None, animate=False, speed=1.0, fps=25, fmt=None, ou
 
 
 def _plot_held(run_dir, times, animate, speed, fps, fmt, out_dir):
-    from . import figures
     from .readers import RunError, is_canonical, load_run
 
     out_dir = out_dir or os.path.join(run_dir, "figures")
@@ -93,25 +95,47 @@ def _plot_held(run_dir, times, animate, speed, fps, fmt, out_dir):
         raise RunError(f"--times needs node frames or tensions, and {run_dir} has neither (a {run.kind} run)")
     if animate and run.nodes is None:
         raise RunError(f"--animate needs nodes.csv, and {run_dir} has none (a {run.kind} run)")
-    written = []
-    if run.kind == "reduced":
-        written.append(figures.reduced_figure(run, out_dir))
-    if run.kind == "compare":
-        written.append(figures.compare_figure(run, out_dir))
-    if run.nodes is not None:
-        written.append(figures.snapshots_figure(run, out_dir, times))
-    written.append(figures.energy_figure(run, out_dir))
-    written.append(figures.tension_figure(run, out_dir, times))
-    written.append(figures.fronts_figure(run, out_dir))
+    written = list(draw(run, out_dir, times).values())
     if animate:
         from .animate import animate as make_animation
         path, _ = make_animation(run, os.path.join(out_dir, "animation"), speed=speed, fps=fps, fmt=fmt)
         written.append(path)
-    return [path for path in written if path]
+    return written
+
+
+def draw(run, out_dir=None, times=None):
+    """The figures of a run read by `readers.load_run` (or made by chainsim.Result): {name: path written} into
+    out_dir, or with out_dir None {name: matplotlib Figure}, nothing written (closed to pyplot, so that a
+    notebook shows only what it displays)."""
+    from . import figures
+
+    drawn = {}
+    if run.kind == "reduced":
+        drawn["reduced"] = figures.reduced_figure(run, out_dir)
+    if run.kind == "compare":
+        drawn["compare"] = figures.compare_figure(run, out_dir)
+    if run.nodes is not None:
+        drawn["snapshots"] = figures.snapshots_figure(run, out_dir, times)
+    drawn["energy"] = figures.energy_figure(run, out_dir)
+    drawn["tension"] = figures.tension_figure(run, out_dir, times)
+    drawn["fronts"] = figures.fronts_figure(run, out_dir)
+    drawn = {name: item for name, item in drawn.items() if item}
+    if out_dir is None:
+        import matplotlib.pyplot as plt
+        for fig in drawn.values():
+            plt.close(fig)
+    return drawn
 
 
 def main(argv=None):
-    args = parser().parse_args(argv)
+    p = parser()
+    args = p.parse_args(argv)
+    if args.html:
+        if args.format not in (None, "html"):
+            p.error(f"--html writes an HTML page, and --format = '{args.format}' asks for another format: give one")
+        if not args.animate:
+            p.error("--html is the format of the animation: give it with --animate")
+        args.format = "html"
     try:
         import matplotlib  # noqa: F401
         import numpy  # noqa: F401

@@ -28,7 +28,10 @@ FRONT_COLOR = "tab:red"
 # --- helpers --------------------------------------------------------------------------------------
 
 def save(fig, out_dir, name, dpi=DPI):
-    """Writes fig to out_dir/name (creating out_dir), closes it and returns the path."""
+    """Writes fig to out_dir/name (creating out_dir), closes it and returns the path; with out_dir None
+    (chainsim.Result.plot()), writes nothing and returns the figure, open."""
+    if out_dir is None:
+        return fig
     os.makedirs(out_dir, exist_ok=True)
     path = os.path.join(out_dir, name)
     fig.savefig(path, dpi=dpi)

@@ -1,11 +1,13 @@
 // Sweeps (cases/scene/scene_sweep.hpp) and scenes given as JSON (scene_json.hpp: scene_toml_text).
 // The sweep's threads run here under the sanitizers too (the Python tests do not).
+#include <atomic>
 #include <cmath>
 
 #include <catch2/catch.hpp>
 #include <nlohmann/json.hpp>
 
 #include "cases/reduced/reduced_models.hpp"
+#include "cases/scene/scene.hpp"
 #include "cases/scene/scene_json.hpp"
 #include "cases/scene/scene_sweep.hpp"
 #include "mesh/errors.hpp"
@@ -118,5 +120,36 @@ TEST_CASE("a sweep refuses, before any run, two grid keys that set one scene key
     const auto rows = run_sweep(falling, grid({(std::string(key) + "=0.9").c_str()}), 1);
     REQUIRE(rows[0]["status"] == "stopped");
     CHECK(rows[0]["t_stop"].get<double>() == Approx(t0 * exact::xi(Problem::kFalling, 0.9, 0.01, 1.0)).epsilon(1e-6));
+  }
+}
+
+TEST_CASE("a sweep point run by another runner (the Python module's, which keeps the run); the points ended counted",
+          "[unit][sweep]") {
+  const SweepScene falling{kFallingBase, "falling.toml", {}, std::nullopt};
+  // The runner gets the point's scene with its overrides applied (f is the front's key), and its summary makes
+  // the row as run_point's does.
+  std::vector<std::pair<int, double>> seen;
+  const nlohmann::json row = run_sweep_point(falling, {"f=0.25", "string.nodes=7"}, [&](const SceneSpec& spec) {
+    seen.emplace_back(*spec.nodes, spec.effects.heaps.at(0).dissipation);
+    return nlohmann::json{{"status", "stopped"}, {"t_stop", 0.5}, {"integrator", {{"steps", 3}}}};
+  });
+  REQUIRE(seen.size() == 1);
+  CHECK(seen[0] == std::make_pair(7, 0.25));
+  CHECK(row["status"] == "stopped");
+  CHECK(row["error"] == "");
+  CHECK(row["t_stop"] == 0.5);
+  CHECK(row["integrator.steps"] == 3);
+  // What the runner throws is the row's error, as for run_point.
+  const nlohmann::json bad = run_sweep_point(falling, {"f=0.25"}, [](const SceneSpec&) -> nlohmann::json {
+    throw InputError("falling.toml: refused here");
+  });
+  CHECK(bad["status"] == "error");
+  CHECK(bad["error"] == "falling.toml: refused here");
+  // The counter a progress bar reads: one per point, on any number of threads.
+  const auto points = sweep_points({parse_grid_axis("f=0,0.5,1"), parse_grid_axis("string.nodes=6,11")});
+  for (int workers : {1, 2}) {
+    std::atomic<std::size_t> done{0};
+    run_sweep(falling, points, workers, &done);
+    CHECK(done.load() == points.size());
   }
 }
