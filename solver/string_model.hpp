@@ -1,9 +1,9 @@
 #pragma once
 /// @file string_model.hpp
 /// The one discrete inextensible string of chainsim, as an ODE system (docs/string_solver.md).
-/// Every model runs on it: a plain string, and a string whose motion carries shocks, whose front
-/// tracking is a module (string_module.hpp, shocks/front_tracker.hpp) that cuts the material into
-/// arcs and adds the jump conditions of its fronts.
+/// Every model runs on it: a plain string, and a string with a module (string_module.hpp; front
+/// tracking is one, shocks/front_tracker.hpp) that cuts the material into arcs and adds the masses,
+/// loads and ledgers of its fronts.
 ///
 /// Momentum per free node i (the tension T_j acts along the link unit vector e_j, from node j towards
 /// node j+1):
@@ -16,8 +16,8 @@
 /// come from their EndPath.
 ///
 /// Arcs. The moving nodes form arcs (ArcRange: runs of nodes with no front inside; one arc, open or
-/// closed, without a module). Each arc owns a block of the tension system; nodes in no arc (inside
-/// a heap) have no equation of motion. Masses are lumped per arc, m_i = Σ ½ λ h_j over the arc's
+/// closed, without a module). Each arc owns a block of the tension system; nodes in no arc (held by
+/// the module) have no equation of motion. Masses are lumped per arc, m_i = Σ ½ λ h_j over the arc's
 /// links at node i, plus what the module adds (a partial link's material).
 ///
 /// ODE state y = [ x of the free nodes (dim each, node order) | v of the free nodes | W_applied |
@@ -208,8 +208,10 @@ class StringModel final : public OdeSystem {
   /// Tensions (per tension unknown) and accelerations of the last evaluation (rhs or snapshot).
   const Eigen::VectorXd& tensions() const { return system_->solution(); }
   const Points<dim>& accelerations() const { return a_; }
-  /// The constant vector g of the gravity effect (zero without gravity).
-  Vec<dim> gravity() const;
+  /// The sum of the uniform fields the forces declare (Force::uniform_field; gravity's g, zero
+  /// without one): the weight per unit mass in the physical scales, and what the module books for
+  /// material not lumped on nodes.
+  Vec<dim> uniform_field() const;
 
   /// Evaluates accelerations a_ (and tensions) from all-node x, v at time t; returns dW/dt.
   /// Public for tests: the core of rhs().
@@ -221,7 +223,7 @@ class StringModel final : public OdeSystem {
   std::vector<ArcRange>& arcs() { return arcs_; }
   /// After the arcs change: free-node slots, lumped masses and the tension system anew.
   void rebuild();
-  /// Index of the arc holding `node`, or −1 (inside a heap).
+  /// Index of the arc holding `node`, or −1 (in no arc: held by the module).
   int arc_of(int node) const { return arc_of_[static_cast<std::size_t>(node)]; }
   bool in_arc(int node) const { return arc_of(node) >= 0; }
   /// The current positions and velocities of all nodes (the state being evaluated).
