@@ -52,10 +52,7 @@ namespace chainsim {
 template <int dim>
 class StringJacobian;
 
-/// What a run does when the tension goes negative beyond round-off (slack: an inextensible string
-/// cannot push, so the model no longer applies): stop with a NumericalError, record the first
-/// occurrence and go on, or not check at all.
-enum class SlackPolicy { kStop, kWarn, kIgnore };
+/// SlackPolicy (defaults.hpp): what a run does at a slack link.
 /// "stop", "warn", "ignore".
 const char* to_string(SlackPolicy policy);
 
@@ -71,13 +68,13 @@ struct SlackReport {
 
 struct StringModelOptions {
   /// Baumgarte time scale τ_b (s) of the link-constraint stabilisation (α = β = 1/τ_b); 0 = off.
-  double stabilization_time = 0;
+  double stabilization_time = defaults::kLibraryStabilizationTime;
   /// Tension solver: "auto", "tridiagonal", "klu" or "eigen" (tension_system.hpp).
-  std::string backend = "auto";
+  std::string backend = defaults::kBackend;
   /// Slack (negative tension) at accepted steps: stop, warn or ignore (StringSolver).
-  SlackPolicy slack = SlackPolicy::kIgnore;
+  SlackPolicy slack = defaults::kLibrarySlack;
   /// Slack means T_j < −slack_tolerance · max_k |T_k| (relative, so round-off is not slack).
-  double slack_tolerance = 1e-8;
+  double slack_tolerance = defaults::kSlackTolerance;
   void validate() const;
 };
 
@@ -195,9 +192,10 @@ class StringModel final : public OdeSystem {
   const StringModelOptions& options() const { return options_; }
   const StringModule<dim>* module() const { return module_.get(); }
   bool is_prescribed(int node) const { return path_of_[static_cast<std::size_t>(node)] >= 0; }
+  /// Nodes with an equation of motion: in an arc and not prescribed.
   int num_free_nodes() const { return num_free_; }
-  /// Nodes with an equation of motion (free and in an arc).
-  int num_moving_nodes() const { return num_free_; }
+  /// An alias of num_free_nodes() (series.csv's moving_nodes).
+  int num_moving_nodes() const { return num_free_nodes(); }
   int work_index() const { return 2 * dim * num_free_; }
   /// Baumgarte coefficients α, β (1/s).
   double alpha() const { return alpha_; }

@@ -104,7 +104,6 @@ nlohmann::json to_json(const RunSummary& s) {
                       {"prescribed", s.prescribed},
                       {"root_functions", s.root_functions},
                       {"tension_unknowns", s.tension_unknowns},
-                      {"junction_unknowns", s.junction_unknowns},
                       {"stabilization_time", s.stabilization_time},
                       {"stats", to_json(s.stats)}};
   nlohmann::json slack = {{"policy", to_string(s.slack_policy)}, {"detected", s.slack.has_value()}};
@@ -204,10 +203,7 @@ void StringSolver<dim>::describe_model() {
   for (const auto& p : model_.prescribed())
     summary_.prescribed.push_back(fmt::format("node {}: {}", p.node, p.path->description()));
   summary_.root_functions = model_.num_events();
-  int links_in_arcs = 0;
-  for (const ArcRange& arc : model_.arcs()) links_in_arcs += arc.num_links();
   summary_.tension_unknowns = model_.has_tension_system() ? model_.tension_system().size() : 0;
-  summary_.junction_unknowns = summary_.tension_unknowns - links_in_arcs;
   summary_.stabilization_time = model_.options().stabilization_time;
   summary_.tension_backend = model_.has_tension_system() ? model_.tension_system().backend_name() : "none";
   summary_.t_end = options_.t_end;

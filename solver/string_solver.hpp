@@ -58,7 +58,7 @@ struct OutputEstimate {
 struct StringSolverOptions {
   IntegratorOptions integrator;
   double t_end = 1.0;            ///< end time (s), > 0 ([stop] t_end)
-  double output_interval = 0.1;  ///< time between frames (s); frames at 0, Δ, 2Δ, …, t_end, and at a stop
+  double output_interval = defaults::kLibraryOutputInterval;  ///< time between frames (s); frames at 0, Δ, 2Δ, …, t_end, and at a stop
   bool record_steps = false;     ///< a StepSample after every accepted step (series.csv)
   void validate() const;
   /// Largest memory the frames may take until the outputs are written (bytes).
@@ -150,7 +150,6 @@ struct RunSummary {
   std::vector<std::string> prescribed;  ///< prescribed nodes, e.g. "node 0: fixed"
   int root_functions = 0;          ///< event functions registered with the integrator (OdeSystem::num_events)
   int tension_unknowns = 0;        ///< size of the tension system at the start
-  int junction_unknowns = 0;       ///< unknowns beyond one per link: none (fronts enter as known loads)
   double stabilization_time = 0;   ///< Baumgarte time scale used (s)
   IntegratorStats stats;
   std::vector<StepSample> samples;     ///< after every accepted step (StringSolverOptions::record_steps)
@@ -171,7 +170,8 @@ struct RunSummary {
 };
 
 /// The summary as JSON: status, stop_reason, t_end, t_stop, steps, rhs_evals, wall_s, energy_drift
-/// (J) and relative_energy_drift, energy_residual (relative, the same number) and momentum_residual
+/// (J) and relative_energy_drift, energy_residual (relative: the same number as relative_energy_drift;
+/// energy_residual_abs is it in J, as series.csv's energy_residual column) and momentum_residual
 /// (relative), max_constraint_violation, slack ({policy, detected, t, link, s, T, message}),
 /// impulsive_start ({detected, kinetic_energy (J), max_speed_change (m/s), message}), transfers, tension_solves, frames, samples, the model's
 /// description (dimension, nodes, links, effects, prescribed, root functions, tension unknowns,
