@@ -93,7 +93,15 @@ struct IntegratorOptions {
   /// Wall-clock budget (s) of the Integrator from its construction; 0 = none. Past it the run ends
   /// with NumericalError naming the time reached.
   double max_wall_s = 0;
+  /// Everything: validate_method() and validate_numbers(). Where the options enter (a command's
+  /// options, a scene's keys, a set-up's validate()) they are checked once, located; the Integrator,
+  /// the one user of the method, checks the numbers and loads the method's table (an unknown name is
+  /// refused there, with the same message).
   void validate() const;
+  /// `method` names a known method (an alias, "auto" or an ARKODE_* table): throws InputError.
+  void validate_method() const;
+  /// The tolerances, step limits and budgets: throws InputError naming the field.
+  void validate_numbers() const;
 };
 
 /// The methods "auto" chooses between (integrator.hpp, IntegratorOptions::method).

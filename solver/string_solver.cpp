@@ -24,7 +24,7 @@ constexpr double kStepOfFrames = 1 - 1e-9;
 }  // namespace
 
 void StringSolverOptions::validate() const {
-  integrator.validate();
+  integrator.validate_numbers();  // the method is checked by the Integrator that loads it
   require_positive("stop.t_end", t_end);
   require_in_range("output.interval", output_interval, 0.0, INFINITY, Bound::kOpen);
 }
