@@ -25,16 +25,19 @@ struct Integration {
 /// tolerance near the round-off of a string's link lengths, for the library's unit uses (tests,
 /// benchmarks), which ask for their own figures when it matters.
 inline constexpr Integration kLibrary{"erk8", 1e-10, 1e-12};
-/// A scene ([solver] method, rtol, atol; `chainsim run`, `sweep`, Python's Scene): a string of many
-/// nodes, whose discretization error (O(h²) in the link length) is far above 1e-8 at every node count
-/// a scene uses; tighter tolerances only cost steps (docs/scenes.md, [solver]).
+/// A scene ([solver] method, rtol, atol; `chainsim run`, `sweep`, Python's Scene; docs/scenes.md,
+/// [solver]): a string of many nodes, whose spatial discretization error is the larger part of a
+/// scene's error at the node counts scenes use (docs/work-precision.md); the example scenes close
+/// their energy ledger to 1e-9 of its scale at this tolerance (tests/unit/test_scene.cpp).
 inline constexpr Integration kScene{"erk8", 1e-8, 1e-10};
-/// The canonical problems on the string solver (`chainsim compare`, `canonical`): compared with their
-/// reduced ODE to ~1e-9 (docs/reduced.md); the fifth-order method is the cheapest at that tolerance
-/// for these straight-line motions (docs/work-precision.md).
+/// The canonical problems on the string solver (`chainsim compare`, `canonical`): straight-line
+/// motions that the string reproduces exactly for every node count, compared with their reduced ODE;
+/// for these scenes with fronts erk5 is the cheapest method at most accuracies measured
+/// (docs/work-precision.md), and rtol 1e-9 keeps the comparison far below the figures' resolution.
 inline constexpr Integration kCanonicalString{"erk5", 1e-9, 1e-11};
-/// The reduced ODEs (`chainsim reduced`, the reference of `compare`): one or two unknowns, checked
-/// against exact quadratures to ~1e-12, so the tolerance sits near round-off.
+/// The reduced ODEs (`chainsim reduced`, the reference of `compare`; docs/reduced.md, "Method"): one
+/// or two unknowns, cheap at any tolerance, checked against exact quadratures: the tolerance sits near
+/// round-off so that the reference is never the larger error.
 inline constexpr Integration kReduced{"erk8", 1e-13, 1e-15};
 
 /// Accepted steps allowed over a whole run (IntegratorOptions::max_steps, [solver] max_steps).

@@ -48,7 +48,7 @@ class Force {
   /// not only the nodes: a uniform field a (m/s²) gives every mass m the force m a and the potential
   /// energy −m a·x, so its energy per unit length of string at x is −λ a·x, and the potential of any
   /// piece of material is −a·(its first moment ∫ x dm). That is what a module needs where material
-  /// is not lumped on nodes (a front's partial link, the material a heap holds): the fronts book
+  /// is not lumped on nodes (a front's partial link, the material a front holds off the arcs): the fronts book
   /// every declared field (StringModel::uniform_field). Nothing for a force that is not a uniform
   /// field; a module that cannot book such a conservative force refuses it (InputError).
   virtual std::optional<Vec<dim>> uniform_field() const { return std::nullopt; }
