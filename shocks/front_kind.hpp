@@ -41,6 +41,25 @@ struct FrontLayout {
   int arc = 0;
 };
 
+/// Geometry and jump quantities of one front at one state (what the kinds compute and the tracker
+/// books; the outputs see its FrontRecord, solver/string_module.hpp).
+template <int dim>
+struct FrontState {
+  double s0 = 0;         ///< material coordinate of the front (m)
+  double s0_dot = 0;     ///< its speed in the material (m/s)
+  double l_minus = 0, l_plus = 0;  ///< partial-link lengths on either side (heap side: 0)
+  Vec<dim> direction = Vec<dim>::Zero();  ///< e: heap: from the arc to x0; fold: into the fold along arc A
+  Vec<dim> position = Vec<dim>::Zero();   ///< x0 (m)
+  double tension_minus = 0, tension_plus = 0;  ///< τ∓ at the front (N); heap side: 0
+  double inflow = 0;       ///< heap: w, speed of material entering the arc (m/s)
+  double power_shock = 0;  ///< W_s = −D (W)
+  double power_heap = 0;   ///< W* (W), heaps only
+  Vec<dim> reaction = Vec<dim>::Zero();  ///< heap: the support's reaction on the string at the front (N)
+  double opening = 0;  ///< fold: angle between arc A's end link and arc B's first link reversed (rad)
+  bool heap = false;   ///< a heap's front (else a fold)
+  Vec<dim> plane_normal = Vec<dim>::Zero();  ///< a heap on a plane: the plane's unit normal; else zero
+};
+
 template <int dim>
 class FrontKind {
  public:

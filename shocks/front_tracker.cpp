@@ -57,6 +57,7 @@ std::vector<std::unique_ptr<FrontKind<dim>>> FrontTracker<dim>::make_fronts(doub
 
 template <int dim>
 std::vector<ArcRange> FrontTracker<dim>::initial_arcs(const Chain<dim>& chain) {
+  if (chain.closed()) throw InputError("fronts are tracked on open strings only");
   const int L = chain.num_links();
   const double h = chain.link_length(0);
   for (int j = 1; j < L; ++j)
@@ -89,6 +90,13 @@ std::vector<ArcRange> FrontTracker<dim>::initial_arcs(const Chain<dim>& chain) {
 
 template <int dim>
 void FrontTracker<dim>::initialize(StringModel<dim>& model) {
+  // The fronts book the potential of the material off the nodes (partial links, heaps) in uniform
+  // fields only (potential_correction): any other potential would leave the energy ledger open.
+  for (const auto& force : model.forces())
+    if (force->conservative() && !force->uniform_field())
+      throw InputError(fmt::format("the {} effect is conservative but not a uniform field: the fronts book the "
+                                   "potential energy of the partial links and of the heaps in uniform fields only",
+                                   force->name()));
   for (auto& front : fronts_) front->initialize(model);
   try {
     model.refresh();
@@ -156,27 +164,43 @@ template <int dim>
 double FrontTracker<dim>::potential_correction(const StringModel<dim>& model,
                                                const Eigen::Ref<const Eigen::VectorXd>& ledger) const {
   // The string's V lumps every mass on a node: a partial link of length l on its end node. The
-  // potential energy counts it at its midpoint, and the held material at its first moment.
-  const Vec<dim> g = model.gravity();
+  // potential energy counts it at its midpoint, and the held material at its first moment, in every
+  // uniform field the forces declare (initialize() refuses any other conservative force).
+  const Vec<dim> g = model.uniform_field();
   double first_moment = g.dot(heap_moment0_ + ledger.template segment<dim>(2 + dim));
   for (std::size_t k = 0; k < fronts_.size(); ++k) first_moment += fronts_[k]->potential_moment(model, fs_[k], g);
   return -first_moment;
 }
 
 template <int dim>
+std::vector<LedgerTerm> FrontTracker<dim>::ledger_terms() const {
+  using K = LedgerTerm::Kind;
+  return {{"W_shocks", K::kWork}, {"W_heaps", K::kWork}, {"W_remesh", K::kNumerical}, {"heap_mass", K::kQuantity}};
+}
+
+template <int dim>
+std::vector<FrontField> FrontTracker<dim>::front_fields() const {
+  return {{"heap", false}, {"reaction", true}, {"plane_normal", true}};
+}
+
+template <int dim>
 void FrontTracker<dim>::fill(const StringModel<dim>& model, const Eigen::Ref<const Eigen::VectorXd>& ledger,
                              ModuleLedger<dim>& out) const {
-  out.fronts = fs_;
-  out.w_shocks = ledger[0];
-  out.w_heaps = ledger[1];
+  out.fronts.clear();
+  for (const FrontState<dim>& s : fs_) {
+    FrontRecord<dim> r{s.s0, s.s0_dot, s.position, s.reaction, {s.heap ? 1.0 : 0.0}};
+    for (int d = 0; d < dim; ++d) r.fields.push_back(s.reaction[d]);
+    for (int d = 0; d < dim; ++d) r.fields.push_back(s.plane_normal[d]);
+    out.fronts.push_back(std::move(r));
+  }
   out.impulse = ledger.template segment<dim>(2);
-  out.heap_moment = heap_moment0_ + ledger.template segment<dim>(2 + dim);
-  out.w_remesh = w_remesh_;
   out.has_momentum_ledger = true;
-  out.heap_mass = 0;
+  double heap_mass = 0;
   out.support.setZero();
-  const Vec<dim> g = model.gravity();
-  for (std::size_t k = 0; k < fronts_.size(); ++k) fronts_[k]->add_support(fs_[k], g, out.heap_mass, out.support);
+  const Vec<dim> g = model.uniform_field();
+  for (std::size_t k = 0; k < fronts_.size(); ++k) fronts_[k]->add_support(fs_[k], g, heap_mass, out.support);
+  // In the order of ledger_terms().
+  out.terms = {ledger[0], ledger[1], w_remesh_, heap_mass};
 }
 
 template <int dim>

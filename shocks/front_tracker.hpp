@@ -117,6 +117,10 @@ class FrontTracker final : public StringModule<dim> {
   void ledger_rates(const StringModel<dim>& model, Eigen::Ref<Eigen::VectorXd> rates) const override;
   Eigen::VectorXd ledger_scale(double mass, double speed, double length) const override;
   double potential_correction(const StringModel<dim>& model, const Eigen::Ref<const Eigen::VectorXd>& ledger) const override;
+  /// W_shocks, W_heaps (work), W_remesh (numerical), heap_mass (kg).
+  std::vector<LedgerTerm> ledger_terms() const override;
+  /// heap (1 for a heap's front, 0 for a fold), reaction, plane_normal (a heap on a plane: its unit normal).
+  std::vector<FrontField> front_fields() const override;
   void fill(const StringModel<dim>& model, const Eigen::Ref<const Eigen::VectorXd>& ledger,
             ModuleLedger<dim>& out) const override;
   /// Two per front (crossings), one per stop condition, then the fronts' own checks (a fold: one,

@@ -4,6 +4,7 @@
 /// and the prescribed motions of fixed and driven ends.
 ///
 ///   Gravity   f_i = m_i g                 conservative: booked in V = −Σ m_i g·x_i
+///   UniformField  f_i = m_i a             any other uniform field (a UniformField, as gravity is)
 ///   Drag      f_i = −c m_i v_i            c in 1/s (a relaxation rate), its power goes to W_applied
 ///   EndLoad   f_node = F0 + A sin(ω t)    on one free node, its power goes to W_applied
 ///
@@ -13,6 +14,7 @@
 /// system with its acceleration (see tension_system.hpp).
 #include <cmath>
 #include <memory>
+#include <optional>
 #include <string>
 
 #include <fmt/format.h>
@@ -42,27 +44,45 @@ class Force {
   virtual bool conservative() const { return false; }
   /// Potential energy (J) of the configuration; 0 for non-conservative forces.
   virtual double potential(const NodeState<dim>& /*s*/) const { return 0; }
+  /// A conservative force declares here what material anywhere on the string has of its potential,
+  /// not only the nodes: a uniform field a (m/s²) gives every mass m the force m a and the potential
+  /// energy −m a·x, so its energy per unit length of string at x is −λ a·x, and the potential of any
+  /// piece of material is −a·(its first moment ∫ x dm). That is what a module needs where material
+  /// is not lumped on nodes (a front's partial link, the material a front holds off the arcs): the fronts book
+  /// every declared field (StringModel::uniform_field). Nothing for a force that is not a uniform
+  /// field; a module that cannot book such a conservative force refuses it (InputError).
+  virtual std::optional<Vec<dim>> uniform_field() const { return std::nullopt; }
 };
 
-/// Uniform gravity g (m/s²): f_i = m_i g, V = −Σ m_i g·x_i.
+/// A uniform field a (m/s²): f_i = m_i a, V = −Σ m_i a·x_i (gravity is one, Gravity).
 template <int dim>
-class Gravity final : public Force<dim> {
+class UniformField : public Force<dim> {
  public:
-  explicit Gravity(const Vec<dim>& g) : g_(g) {}
-  std::string name() const override { return "gravity"; }
-  const Vec<dim>& g() const { return g_; }
+  UniformField(const Vec<dim>& a, std::string name) : a_(a), name_(std::move(name)) {}
+  std::string name() const override { return name_; }
+  const Vec<dim>& field() const { return a_; }
   void add_force(const NodeState<dim>& s, Points<dim>& force) const override {
-    for (int i = 0; i < force.cols(); ++i) force.col(i) += s.mass[i] * g_;
+    for (int i = 0; i < force.cols(); ++i) force.col(i) += s.mass[i] * a_;
   }
   bool conservative() const override { return true; }
   double potential(const NodeState<dim>& s) const override {
     double v = 0;
-    for (int i = 0; i < s.x.cols(); ++i) v -= s.mass[i] * g_.dot(s.x.col(i));
+    for (int i = 0; i < s.x.cols(); ++i) v -= s.mass[i] * a_.dot(s.x.col(i));
     return v;
   }
+  std::optional<Vec<dim>> uniform_field() const override { return a_; }
 
  private:
-  Vec<dim> g_;
+  Vec<dim> a_;
+  std::string name_;
+};
+
+/// Uniform gravity g (m/s²): f_i = m_i g, V = −Σ m_i g·x_i.
+template <int dim>
+class Gravity final : public UniformField<dim> {
+ public:
+  explicit Gravity(const Vec<dim>& g) : UniformField<dim>(g, "gravity") {}
+  const Vec<dim>& g() const { return this->field(); }
 };
 
 /// Linear drag against the velocity: f_i = −c m_i v_i, c (1/s) >= 0.

@@ -16,6 +16,8 @@
 
 #include <Eigen/Core>
 
+#include "defaults.hpp"
+
 namespace chainsim {
 
 /// The ODE  y' = F(t, y)  plus optional event functions g_k(t, y) whose zeros ARKODE locates.
@@ -80,18 +82,26 @@ struct IntegratorOptions {
   /// "dirk5" (Kvaerno 7-4-5), "dirk4" (ARK 4-3-6 DIRK), "dirk3" (ARK 3-2-4 DIRK), "dirk2" (SDIRK 2-1-2),
   /// or "auto": kAutoImplicit when OdeSystem::explicit_stiffness() >= Integrator::kAutoImplicitStiffness
   /// and the system has no event functions, kAutoExplicit otherwise.
-  std::string method = "erk8";
-  double rtol = 1e-10;   ///< relative tolerance, in [1e-14, 1e-2]
-  double atol = 1e-12;   ///< absolute tolerance relative to OdeSystem::state_scale(), > 0
+  std::string method = defaults::kLibrary.method;
+  double rtol = defaults::kLibrary.rtol;  ///< relative tolerance, in [1e-14, 1e-2]
+  double atol = defaults::kLibrary.atol;  ///< absolute tolerance relative to OdeSystem::state_scale(), > 0
   double max_step = 0;   ///< largest step (s); 0 = no limit
   double initial_step = 0;  ///< first step (s); 0 = ARKODE's estimate
   /// Accepted steps allowed in total over the Integrator's life (every advance() call and every
   /// event polish counted), >= 1. Past it the run ends with NumericalError (ARK_TOO_MUCH_WORK).
-  long max_steps = 500000;
+  long max_steps = defaults::kMaxSteps;
   /// Wall-clock budget (s) of the Integrator from its construction; 0 = none. Past it the run ends
   /// with NumericalError naming the time reached.
   double max_wall_s = 0;
+  /// Everything: validate_method() and validate_numbers(). Where the options enter (a command's
+  /// options, a scene's keys, a set-up's validate()) they are checked once, located; the Integrator,
+  /// the one user of the method, checks the numbers and loads the method's table (an unknown name is
+  /// refused there, with the same message).
   void validate() const;
+  /// `method` names a known method (an alias, "auto" or an ARKODE_* table): throws InputError.
+  void validate_method() const;
+  /// The tolerances, step limits and budgets: throws InputError naming the field.
+  void validate_numbers() const;
 };
 
 /// The methods "auto" chooses between (integrator.hpp, IntegratorOptions::method).

@@ -262,7 +262,7 @@ template <int dim>
 bool StringModel<dim>::newton_solver_exact() const {
   if (module_ || !system_) return false;
   for (const auto& force : forces_)
-    if (!dynamic_cast<const Gravity<dim>*>(force.get()) && !dynamic_cast<const EndLoad<dim>*>(force.get())) return false;
+    if (!dynamic_cast<const UniformField<dim>*>(force.get()) && !dynamic_cast<const EndLoad<dim>*>(force.get())) return false;
   return true;
 }
 

@@ -62,7 +62,6 @@ StringModel<dim>::StringModel(Chain<dim> chain, std::vector<std::unique_ptr<Forc
   const int n = chain_.num_nodes(), L = chain_.num_links();
   // 1. The arcs: the whole string, or the module's layout.
   if (module_) {
-    if (chain_.closed()) throw InputError("fronts are tracked on open strings only");
     arcs_ = module_->initial_arcs(chain_);
     num_ledgers_ = module_->num_ledgers();
   } else {
@@ -79,7 +78,7 @@ StringModel<dim>::StringModel(Chain<dim> chain, std::vector<std::unique_ptr<Forc
       throw InputError(fmt::format("prescribed node {} does not exist: the string has nodes 0..{}", node, n - 1));
     if (path_of_[node] >= 0) throw InputError(fmt::format("node {} has two prescribed motions", node));
     CHAINSIM_VERIFY(prescribed_[k].path != nullptr, "a prescribed node needs a path");
-    if (!in_arc(node)) throw InputError(fmt::format("prescribed node {} lies inside a heap", node));
+    if (!in_arc(node)) throw InputError(fmt::format("prescribed node {} lies in no arc (the module holds it)", node));
     path_of_[node] = static_cast<int>(k);
   }
   for (const auto& force : forces_) {
@@ -90,7 +89,7 @@ StringModel<dim>::StringModel(Chain<dim> chain, std::vector<std::unique_ptr<Forc
       if (path_of_[load->node()] >= 0)
         throw InputError(fmt::format("node {} is both loaded and prescribed: a driven or fixed end takes no load",
                                      load->node()));
-      if (!in_arc(load->node())) throw InputError(fmt::format("the end load acts on node {}, inside a heap", load->node()));
+      if (!in_arc(load->node())) throw InputError(fmt::format("the end load acts on node {}, in no arc (the module holds it)", load->node()));
     }
   }
   for (int j = 0; j < L; ++j)
@@ -156,10 +155,11 @@ void StringModel<dim>::rebuild() {
 }
 
 template <int dim>
-Vec<dim> StringModel<dim>::gravity() const {
+Vec<dim> StringModel<dim>::uniform_field() const {
+  Vec<dim> a = Vec<dim>::Zero();
   for (const auto& force : forces_)
-    if (const auto* g = dynamic_cast<const Gravity<dim>*>(force.get())) return g->g();
-  return Vec<dim>::Zero();
+    if (const std::optional<Vec<dim>> field = force->uniform_field()) a += *field;
+  return a;
 }
 
 template <int dim>
@@ -340,7 +340,7 @@ template <int dim>
 Eigen::VectorXd StringModel<dim>::state_scale() const {
   if (!module_) return {};
   const double ell = chain_.length();
-  double v2 = gravity().norm() * ell;
+  double v2 = uniform_field().norm() * ell;
   for (int i = 0; i < chain_.num_nodes(); ++i) v2 = std::max(v2, chain_.velocities().col(i).squaredNorm());
   const double speed = v2 > 0 ? std::sqrt(v2) : ell;
   const double mass = chain_.density() * ell;
@@ -537,7 +537,7 @@ typename StringModel<dim>::Snapshot StringModel<dim>::snapshot(double t, const E
     for_each_link([&](int j, int, int) {
       if (chain_.link_start(j) == p.node || chain_.link_end(j) == p.node) T = s.tension[j];
     });
-    // No link of an arc at the node: a front sits next to it (a fold at the fixed end), and the
+    // No link of an arc at the node: a front sits next to it (e.g. at the fixed end), and the
     // tension there is the front's end tension, carried by its partial link.
     if (std::isnan(T) && module_)
       if (const std::optional<double> front = module_->front_tension_at(*this, p.node)) T = *front;
@@ -574,7 +574,7 @@ double StringModel<dim>::max_constraint_violation(double t, const Eigen::Ref<con
 template <int dim>
 typename StringModel<dim>::PhysicalScales StringModel<dim>::physical_scales() const {
   const double lambda = chain_.density(), ell = chain_.length();
-  const Vec<dim> g = gravity();
+  const Vec<dim> g = uniform_field();
   double v2_max = 0, loads = 0, a_driven = 0;
   for (int i = 0; i < chain_.num_nodes(); ++i) {
     if (!in_arc(i)) continue;

@@ -1,9 +1,9 @@
 #pragma once
 /// @file string_model.hpp
 /// The one discrete inextensible string of chainsim, as an ODE system (docs/string_solver.md).
-/// Every model runs on it: a plain string, and a string whose motion carries shocks, whose front
-/// tracking is a module (string_module.hpp, shocks/front_tracker.hpp) that cuts the material into
-/// arcs and adds the jump conditions of its fronts.
+/// Every model runs on it: a plain string, and a string with a module (string_module.hpp; front
+/// tracking is one, shocks/front_tracker.hpp) that cuts the material into arcs and adds the masses,
+/// loads and ledgers of its fronts.
 ///
 /// Momentum per free node i (the tension T_j acts along the link unit vector e_j, from node j towards
 /// node j+1):
@@ -16,8 +16,8 @@
 /// come from their EndPath.
 ///
 /// Arcs. The moving nodes form arcs (ArcRange: runs of nodes with no front inside; one arc, open or
-/// closed, without a module). Each arc owns a block of the tension system; nodes in no arc (inside
-/// a heap) have no equation of motion. Masses are lumped per arc, m_i = Σ ½ λ h_j over the arc's
+/// closed, without a module). Each arc owns a block of the tension system; nodes in no arc (held by
+/// the module) have no equation of motion. Masses are lumped per arc, m_i = Σ ½ λ h_j over the arc's
 /// links at node i, plus what the module adds (a partial link's material).
 ///
 /// ODE state y = [ x of the free nodes (dim each, node order) | v of the free nodes | W_applied |
@@ -52,10 +52,7 @@ namespace chainsim {
 template <int dim>
 class StringJacobian;
 
-/// What a run does when the tension goes negative beyond round-off (slack: an inextensible string
-/// cannot push, so the model no longer applies): stop with a NumericalError, record the first
-/// occurrence and go on, or not check at all.
-enum class SlackPolicy { kStop, kWarn, kIgnore };
+/// SlackPolicy (defaults.hpp): what a run does at a slack link.
 /// "stop", "warn", "ignore".
 const char* to_string(SlackPolicy policy);
 
@@ -71,13 +68,13 @@ struct SlackReport {
 
 struct StringModelOptions {
   /// Baumgarte time scale τ_b (s) of the link-constraint stabilisation (α = β = 1/τ_b); 0 = off.
-  double stabilization_time = 0;
+  double stabilization_time = defaults::kLibraryStabilizationTime;
   /// Tension solver: "auto", "tridiagonal", "klu" or "eigen" (tension_system.hpp).
-  std::string backend = "auto";
+  std::string backend = defaults::kBackend;
   /// Slack (negative tension) at accepted steps: stop, warn or ignore (StringSolver).
-  SlackPolicy slack = SlackPolicy::kIgnore;
+  SlackPolicy slack = defaults::kLibrarySlack;
   /// Slack means T_j < −slack_tolerance · max_k |T_k| (relative, so round-off is not slack).
-  double slack_tolerance = 1e-8;
+  double slack_tolerance = defaults::kSlackTolerance;
   void validate() const;
 };
 
@@ -195,9 +192,10 @@ class StringModel final : public OdeSystem {
   const StringModelOptions& options() const { return options_; }
   const StringModule<dim>* module() const { return module_.get(); }
   bool is_prescribed(int node) const { return path_of_[static_cast<std::size_t>(node)] >= 0; }
+  /// Nodes with an equation of motion: in an arc and not prescribed.
   int num_free_nodes() const { return num_free_; }
-  /// Nodes with an equation of motion (free and in an arc).
-  int num_moving_nodes() const { return num_free_; }
+  /// An alias of num_free_nodes() (series.csv's moving_nodes).
+  int num_moving_nodes() const { return num_free_nodes(); }
   int work_index() const { return 2 * dim * num_free_; }
   /// Baumgarte coefficients α, β (1/s).
   double alpha() const { return alpha_; }
@@ -208,8 +206,10 @@ class StringModel final : public OdeSystem {
   /// Tensions (per tension unknown) and accelerations of the last evaluation (rhs or snapshot).
   const Eigen::VectorXd& tensions() const { return system_->solution(); }
   const Points<dim>& accelerations() const { return a_; }
-  /// The constant vector g of the gravity effect (zero without gravity).
-  Vec<dim> gravity() const;
+  /// The sum of the uniform fields the forces declare (Force::uniform_field; gravity's g, zero
+  /// without one): the weight per unit mass in the physical scales, and what the module books for
+  /// material not lumped on nodes.
+  Vec<dim> uniform_field() const;
 
   /// Evaluates accelerations a_ (and tensions) from all-node x, v at time t; returns dW/dt.
   /// Public for tests: the core of rhs().
@@ -221,7 +221,7 @@ class StringModel final : public OdeSystem {
   std::vector<ArcRange>& arcs() { return arcs_; }
   /// After the arcs change: free-node slots, lumped masses and the tension system anew.
   void rebuild();
-  /// Index of the arc holding `node`, or −1 (inside a heap).
+  /// Index of the arc holding `node`, or −1 (in no arc: held by the module).
   int arc_of(int node) const { return arc_of_[static_cast<std::size_t>(node)]; }
   bool in_arc(int node) const { return arc_of(node) >= 0; }
   /// The current positions and velocities of all nodes (the state being evaluated).

@@ -1,21 +1,22 @@
 #pragma once
 /// @file string_module.hpp
 /// What a module adds to the one discrete string (string_model.hpp): the interface through which
-/// front tracking (shocks/front_tracker.hpp) cuts the material into arcs and imposes the jump
-/// conditions of its fronts, without a second copy of the string.
+/// front tracking (shocks/front_tracker.hpp, one class per kind of front) cuts the material into arcs
+/// and imposes the conditions of its fronts, without a second copy of the string. The string knows no
+/// kind of front: a module's ledger terms and front fields are named by the module.
 ///
 /// The string owns everything a string has: nodes, links, lumped masses, the tension system of its
 /// arcs, the applied forces, the prescribed ends, the constraint projection, the energy ledger of
 /// the applied work, snapshots and outputs. A module owns what is particular to its fronts:
 ///   - the layout: which nodes move, cut into arcs (runs of nodes that move together); the nodes in
-///     no arc (inside a heap) have no equation of motion;
+///     no arc (held by the module) have no equation of motion;
 ///   - at every evaluation, the mass and the force it puts on nodes (a partial link's material, the
 ///     end tensions of the jump conditions) — known loads of the tension system, not new unknowns;
-///   - extra ledger components integrated with the ODE (dissipation at shocks, work exchanged with
-///     heaps, impulse of the supports, …), with their rates;
+///   - extra ledger components integrated with the ODE (work done at its fronts, impulse of its
+///     supports, …), with their rates, and the named terms it reports (ledger_terms);
 ///   - root functions and what happens at them (a node crossing a front: the layout changes, the
 ///     string rebuilds its arcs and projects the state back onto the constraints);
-///   - its contributions to snapshots (fronts, supports, heaps).
+///   - its contributions to snapshots (fronts, supports, the named terms).
 /// A string without a module runs the same code with one arc and none of these.
 #include <optional>
 #include <string>
@@ -39,34 +40,46 @@ struct ArcRange {
   int num_nodes() const { return last - first + 1; }
 };
 
-/// Geometry and jump quantities of one front at one state (what snapshots and outputs report).
+/// A front as the run's outputs show it (snapshots, frames, series.csv, forces.csv, the ParaView
+/// fronts): its place in the material and in space and the force of its support. What a kind of front
+/// computes beyond this stays in the module (shocks/front_kind.hpp, FrontState).
 template <int dim>
-struct FrontState {
-  double s0 = 0;         ///< material coordinate of the front (m)
-  double s0_dot = 0;     ///< its speed in the material (m/s)
-  double l_minus = 0, l_plus = 0;  ///< partial-link lengths on either side (heap side: 0)
-  Vec<dim> direction = Vec<dim>::Zero();  ///< e: heap: from the arc to x0; fold: into the fold along arc A
-  Vec<dim> position = Vec<dim>::Zero();   ///< x0 (m)
-  double tension_minus = 0, tension_plus = 0;  ///< τ∓ at the front (N); heap side: 0
-  double inflow = 0;       ///< heap: w, speed of material entering the arc (m/s)
-  double power_shock = 0;  ///< W_s = −D (W)
-  double power_heap = 0;   ///< W* (W), heaps only
-  Vec<dim> reaction = Vec<dim>::Zero();  ///< heap: the support's reaction on the string at the front (N)
-  double opening = 0;  ///< fold: angle between arc A's end link and arc B's first link reversed (rad)
-  bool heap = false;   ///< a heap's front (else a fold)
-  Vec<dim> plane_normal = Vec<dim>::Zero();  ///< a heap on a plane: the plane's unit normal; else zero
+struct FrontRecord {
+  double s0 = 0;      ///< material coordinate of the front (m)
+  double s0_dot = 0;  ///< its speed in the material (m/s)
+  Vec<dim> position = Vec<dim>::Zero();  ///< x0 (m)
+  Vec<dim> reaction = Vec<dim>::Zero();  ///< the force of the front's support on the string (N); zero if none
+  /// The module's further values for the ParaView fronts, in the order of StringModule::front_fields()
+  /// (a vector field: dim values).
+  std::vector<double> fields;
 };
 
-/// What a module adds to a snapshot: zero for a string without one.
+/// A field of the ParaView fronts that the module adds (a point-data array of fronts_XXXX.vtp).
+struct FrontField {
+  std::string name;
+  bool vector = false;  ///< dim components (written as 3), else one
+};
+
+/// A term the module adds to the ledgers, under the name the outputs give it.
+struct LedgerTerm {
+  enum class Kind {
+    kWork,       ///< energy exchanged (J): booked in the energy ledger and in its physical scale
+    kNumerical,  ///< energy a numerical operation changes (J): booked in the ledger, not in its scale
+    kQuantity    ///< a recorded quantity (series.csv), in no ledger
+  };
+  std::string name;  ///< the output column (energy.csv for energies, series.csv for all)
+  Kind kind = Kind::kWork;
+  bool energy() const { return kind != Kind::kQuantity; }
+};
+
+/// What a module adds to a snapshot: nothing for a string without one.
 template <int dim>
 struct ModuleLedger {
-  std::vector<FrontState<dim>> fronts;
-  double w_shocks = 0, w_heaps = 0, w_remesh = 0;  ///< J
-  Vec<dim> impulse = Vec<dim>::Zero();      ///< of all external forces (N s), when the module keeps it
-  Vec<dim> heap_moment = Vec<dim>::Zero();  ///< Σ over heaps of ∫ x dm (kg m)
-  Vec<dim> support = Vec<dim>::Zero();      ///< force of the module's supports (heaps) on the system (N)
-  double heap_mass = 0;                     ///< kg
-  bool has_momentum_ledger = false;         ///< impulse is integrated: p − p0 − impulse → 0
+  std::vector<FrontRecord<dim>> fronts;
+  std::vector<double> terms;            ///< the values of StringModule::ledger_terms(), in order
+  Vec<dim> impulse = Vec<dim>::Zero();  ///< of all external forces (N s), when the module keeps it
+  Vec<dim> support = Vec<dim>::Zero();  ///< force of the module's supports on the system (N)
+  bool has_momentum_ledger = false;     ///< impulse is integrated: p − p0 − impulse → 0
 };
 
 /// What an event means.
@@ -100,6 +113,10 @@ class StringModule {
   virtual Eigen::VectorXd ledger_scale(double mass, double speed, double length) const = 0;
   /// The potential energy the lumped masses miss (J): V = Σ forces' V(lumped) + this.
   virtual double potential_correction(const StringModel<dim>& model, const Eigen::Ref<const Eigen::VectorXd>& ledger) const = 0;
+  /// The terms it adds to the ledgers (ModuleLedger::terms), named as the outputs write them.
+  virtual std::vector<LedgerTerm> ledger_terms() const = 0;
+  /// The fields it adds to the ParaView fronts (FrontRecord::fields).
+  virtual std::vector<FrontField> front_fields() const = 0;
   /// Fills the module's part of a snapshot.
   virtual void fill(const StringModel<dim>& model, const Eigen::Ref<const Eigen::VectorXd>& ledger,
                     ModuleLedger<dim>& out) const = 0;
@@ -119,7 +136,7 @@ class StringModule {
   virtual int num_fronts() const = 0;
   /// The tension (N) the module's partial link carries at `node`, an arc's end node next to a front,
   /// after an evaluation; nothing if no front is next to it. A prescribed node whose arc has no full
-  /// link (a fold at the fixed end) reports this tension: the one-sided limit at the node.
+  /// link (a front at the fixed end) reports this tension: the one-sided limit at the node.
   virtual std::optional<double> front_tension_at(const StringModel<dim>& model, int node) const = 0;
 };
 

@@ -24,7 +24,7 @@ constexpr double kStepOfFrames = 1 - 1e-9;
 }  // namespace
 
 void StringSolverOptions::validate() const {
-  integrator.validate();
+  integrator.validate_numbers();  // the method is checked by the Integrator that loads it
   require_positive("stop.t_end", t_end);
   require_in_range("output.interval", output_interval, 0.0, INFINITY, Bound::kOpen);
 }
@@ -104,7 +104,6 @@ nlohmann::json to_json(const RunSummary& s) {
                       {"prescribed", s.prescribed},
                       {"root_functions", s.root_functions},
                       {"tension_unknowns", s.tension_unknowns},
-                      {"junction_unknowns", s.junction_unknowns},
                       {"stabilization_time", s.stabilization_time},
                       {"stats", to_json(s.stats)}};
   nlohmann::json slack = {{"policy", to_string(s.slack_policy)}, {"detected", s.slack.has_value()}};
@@ -129,21 +128,33 @@ nlohmann::json to_json(const RunSummary& s) {
   return j;
 }
 
+double LedgerValues::operator[](const std::string& name) const {
+  if (names)
+    for (std::size_t k = 0; k < names->size(); ++k)
+      if ((*names)[k].name == name) return values[k];
+  throw Error(fmt::format("the run has no ledger term '{}'", name));
+}
+
 CsvTable samples_table(const RunSummary& run) {
   std::vector<std::string> cols = {"t"};
   const std::size_t nf = run.samples.empty() ? 0 : run.samples.front().s0.size();
   const std::size_t dim = run.samples.empty() ? 0 : run.samples.front().support.size();
   const char* axes[] = {"x", "y", "z"};
+  const std::vector<LedgerTerm>& terms = run.ledger_terms;
   for (std::size_t k = 0; k < nf; ++k) {
     cols.push_back("s0_" + std::to_string(k));
     cols.push_back("s0dot_" + std::to_string(k));
     for (std::size_t d = 0; d < dim; ++d) cols.push_back("front_" + std::to_string(k) + "_" + axes[d]);
   }
-  for (const char* c : {"K", "V", "W_applied", "W_shocks", "W_heaps", "W_remesh", "energy_residual",
-                        "momentum_residual"})
-    cols.emplace_back(c);
+  for (const char* c : {"K", "V", "W_applied"}) cols.emplace_back(c);
+  for (const LedgerTerm& term : terms)
+    if (term.energy()) cols.push_back(term.name);
+  for (const char* c : {"energy_residual", "momentum_residual"}) cols.emplace_back(c);
   for (std::size_t d = 0; d < dim; ++d) cols.push_back(std::string("support_") + axes[d]);
-  for (const char* c : {"moving_mass", "heap_mass", "max_violation", "moving_nodes"}) cols.emplace_back(c);
+  cols.emplace_back("moving_mass");
+  for (const LedgerTerm& term : terms)
+    if (!term.energy()) cols.push_back(term.name);
+  for (const char* c : {"max_violation", "moving_nodes"}) cols.emplace_back(c);
   cols.insert(cols.end(), run.force_columns.begin(), run.force_columns.end());
   CsvTable table(cols);
   for (const StepSample& s : run.samples) {
@@ -153,12 +164,15 @@ CsvTable samples_table(const RunSummary& run) {
       row.push_back(s.s0_dot[k]);
       for (std::size_t d = 0; d < dim; ++d) row.push_back(s.position[k * dim + d]);
     }
-    for (double v : {s.kinetic, s.potential, s.w_applied, s.w_shocks, s.w_heaps, s.w_remesh, s.energy_residual,
-                     s.momentum_residual})
-      row.push_back(v);
+    for (double v : {s.kinetic, s.potential, s.w_applied}) row.push_back(v);
+    for (std::size_t k = 0; k < terms.size(); ++k)
+      if (terms[k].energy()) row.push_back(s.terms.values[k]);
+    for (double v : {s.energy_residual, s.momentum_residual}) row.push_back(v);
     for (double v : s.support) row.push_back(v);
-    for (double v : {s.moving_mass, s.heap_mass, s.max_violation, static_cast<double>(s.moving_nodes)})
-      row.push_back(v);
+    row.push_back(s.moving_mass);
+    for (std::size_t k = 0; k < terms.size(); ++k)
+      if (!terms[k].energy()) row.push_back(s.terms.values[k]);
+    for (double v : {s.max_violation, static_cast<double>(s.moving_nodes)}) row.push_back(v);
     row.insert(row.end(), s.forces.begin(), s.forces.end());
     table.add_row(row);
   }
@@ -189,10 +203,7 @@ void StringSolver<dim>::describe_model() {
   for (const auto& p : model_.prescribed())
     summary_.prescribed.push_back(fmt::format("node {}: {}", p.node, p.path->description()));
   summary_.root_functions = model_.num_events();
-  int links_in_arcs = 0;
-  for (const ArcRange& arc : model_.arcs()) links_in_arcs += arc.num_links();
   summary_.tension_unknowns = model_.has_tension_system() ? model_.tension_system().size() : 0;
-  summary_.junction_unknowns = summary_.tension_unknowns - links_in_arcs;
   summary_.stabilization_time = model_.options().stabilization_time;
   summary_.tension_backend = model_.has_tension_system() ? model_.tension_system().backend_name() : "none";
   summary_.t_end = options_.t_end;
@@ -204,6 +215,8 @@ void StringSolver<dim>::describe_model() {
     summary_.force_columns.push_back(fmt::format("T_node{}", p.node));
   }
   const int fronts = model_.module() ? model_.module()->num_fronts() : 0;
+  summary_.ledger_terms = model_.module() ? model_.module()->ledger_terms() : std::vector<LedgerTerm>{};
+  term_names_ = std::make_shared<const std::vector<LedgerTerm>>(summary_.ledger_terms);
   for (int k = 0; k < fronts; ++k)
     for (int d = 0; d < dim; ++d) summary_.force_columns.push_back(fmt::format("R_front{}_{}", k, axes[d]));
 }
@@ -229,17 +242,21 @@ void StringSolver<dim>::book(double t, const typename StringModel<dim>::Snapshot
     p0_ = snap.momentum;
     have_start_ = true;
   }
-  const double drift = snap.kinetic + snap.potential - e0_ - snap.work - snap.w_shocks - snap.w_heaps - snap.w_remesh;
+  // The ledger K + V − (K0 + V0) − W_applied − the module's energy terms, and its physical scale.
+  double drift = snap.kinetic + snap.potential - e0_ - snap.work;
+  double moved = snap.kinetic + std::abs(snap.potential - v0_) + std::abs(snap.work);
+  for (std::size_t k = 0; k < summary_.ledger_terms.size(); ++k) {
+    const LedgerTerm& term = summary_.ledger_terms[k];
+    if (term.energy()) drift -= snap.terms[k];
+    if (term.kind == LedgerTerm::Kind::kWork) moved += std::abs(snap.terms[k]);
+  }
   if (!snap.x.allFinite() || !snap.v.allFinite() || !std::isfinite(drift))
     throw NumericalError(fmt::format("the solution is no longer finite at t = {:.9g} s", t), t);
   summary_.energy_drift = std::max(summary_.energy_drift, std::abs(drift));
   summary_.final_energy_drift = drift;
   // The scale is physical, never the round-off of a state at rest: what the run moves (K, V − V0 and
   // the work booked) and the weight and loads over the string's length (StringModel::physical_scales).
-  summary_.energy_scale =
-      std::max({summary_.energy_scale, snap.energy_scale,
-                snap.kinetic + std::abs(snap.potential - v0_) + std::abs(snap.work) + std::abs(snap.w_shocks) +
-                    std::abs(snap.w_heaps)});
+  summary_.energy_scale = std::max({summary_.energy_scale, snap.energy_scale, moved});
   summary_.max_constraint_violation = std::max(summary_.max_constraint_violation, snap.max_violation);
   if (snap.has_momentum_ledger) {
     summary_.max_momentum_residual =
@@ -257,9 +274,7 @@ void StringSolver<dim>::record_frame(double t, const Eigen::VectorXd& y) {
   f.kinetic = snap.kinetic;
   f.potential = snap.potential;
   f.work = snap.work;
-  f.w_shocks = snap.w_shocks;
-  f.w_heaps = snap.w_heaps;
-  f.w_remesh = snap.w_remesh;
+  f.terms = {term_names_, snap.terms};
   f.drift = summary_.final_energy_drift;
   f.max_violation = snap.max_violation;
   f.forces = measured_forces(snap);
@@ -287,14 +302,11 @@ void StringSolver<dim>::record_sample(double t, const Eigen::VectorXd& y) {
   s.kinetic = snap.kinetic;
   s.potential = snap.potential;
   s.w_applied = snap.work;
-  s.w_shocks = snap.w_shocks;
-  s.w_heaps = snap.w_heaps;
-  s.w_remesh = snap.w_remesh;
+  s.terms = {term_names_, snap.terms};
   s.energy_residual = summary_.final_energy_drift;
   s.momentum_residual = snap.has_momentum_ledger ? (snap.momentum - p0_ - snap.impulse).norm() : 0.0;
   for (int d = 0; d < dim; ++d) s.support.push_back(snap.support[d]);
   s.moving_mass = snap.moving_mass;
-  s.heap_mass = snap.heap_mass;
   s.max_violation = snap.max_violation;
   s.moving_nodes = model_.num_moving_nodes();
   s.forces = measured_forces(snap);
@@ -485,11 +497,14 @@ void StringSolver<dim>::write_outputs(const std::filesystem::path& dir, const Ou
     }
     if (select.energy) {
       std::vector<std::string> energy_columns = {"t", "K", "V", "W_applied", "drift"};
-      if (fronts) energy_columns.insert(energy_columns.end(), {"W_shocks", "W_heaps", "W_remesh"});
+      const std::vector<LedgerTerm>& terms = summary_.ledger_terms;
+      for (const LedgerTerm& term : terms)
+        if (term.energy()) energy_columns.push_back(term.name);
       CsvWriter energy(dir / "energy.csv", energy_columns);
       for (const auto& f : frames_) {
         row = {f.t, f.kinetic, f.potential, f.work, f.drift};
-        if (fronts) row.insert(row.end(), {f.w_shocks, f.w_heaps, f.w_remesh});
+        for (std::size_t k = 0; k < terms.size(); ++k)
+          if (terms[k].energy()) row.push_back(f.terms.values[k]);
         energy.row(row);
       }
       energy.commit();
@@ -512,6 +527,7 @@ void StringSolver<dim>::write_outputs(const std::filesystem::path& dir, const Ou
     ensure_directory(dir / "frames");
     std::vector<PvdEntry> index;
     const VtkEncoding encoding = select.vtk_ascii ? VtkEncoding::kAscii : VtkEncoding::kBinary;
+    const std::vector<FrontField> front_fields = fronts ? model_.module()->front_fields() : std::vector<FrontField>{};
     for (std::size_t k = 0; k < frames_.size(); ++k) {
       const auto& f = frames_[k];
       const auto count = static_cast<Eigen::Index>(f.moving.size());
@@ -543,24 +559,29 @@ void StringSolver<dim>::write_outputs(const std::filesystem::path& dir, const Ou
       write_vtp(dir / "frames" / name, line, encoding);
       index.push_back({f.t, "frames/" + name, 0});
       if (!fronts) continue;
-      // The fronts: a point each, with what a user looks for (a heap's plane as its normal).
+      // The fronts: a point each, with what a user looks for (the module's fields).
       const auto nf = static_cast<Eigen::Index>(f.fronts.size());
       VtkPolyline points;
       points.vertices = true;
       points.points = Eigen::Matrix3Xd::Zero(3, nf);
-      Eigen::MatrixXd s0(1, nf), s0_dot(1, nf), heap(1, nf), reaction = Eigen::MatrixXd::Zero(3, nf),
-          normal = Eigen::MatrixXd::Zero(3, nf);
+      Eigen::MatrixXd s0(1, nf), s0_dot(1, nf);
       for (Eigen::Index q = 0; q < nf; ++q) {
-        const FrontState<dim>& front = f.fronts[static_cast<std::size_t>(q)];
+        const FrontRecord<dim>& front = f.fronts[static_cast<std::size_t>(q)];
         points.points.col(q).head(dim) = front.position;
         s0(0, q) = front.s0;
         s0_dot(0, q) = front.s0_dot;
-        heap(0, q) = front.heap ? 1.0 : 0.0;
-        reaction.col(q).head(dim) = front.reaction;
-        normal.col(q).head(dim) = front.plane_normal;
       }
-      points.point_data = {{"s0", s0}, {"s0_dot", s0_dot}, {"heap", heap}, {"reaction", reaction},
-                           {"plane_normal", normal}};
+      points.point_data = {{"s0", s0}, {"s0_dot", s0_dot}};
+      std::size_t offset = 0;  // of the field in FrontRecord::fields
+      for (const FrontField& field : front_fields) {
+        Eigen::MatrixXd values = Eigen::MatrixXd::Zero(field.vector ? 3 : 1, nf);
+        const int components = field.vector ? dim : 1;
+        for (Eigen::Index q = 0; q < nf; ++q)
+          for (int c = 0; c < components; ++c)
+            values(c, q) = f.fronts[static_cast<std::size_t>(q)].fields[offset + static_cast<std::size_t>(c)];
+        points.point_data.emplace_back(field.name, values);
+        offset += static_cast<std::size_t>(components);
+      }
       const std::string fronts_name = fmt::format("fronts_{:04d}.vtp", k);
       write_vtp(dir / "frames" / fronts_name, points, encoding);
       index.push_back({f.t, "frames/" + fronts_name, 1});

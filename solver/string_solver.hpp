@@ -6,20 +6,22 @@
 /// keeps the energy ledger (and, with fronts, the momentum ledger), and writes the outputs.
 ///
 /// Outputs (write_outputs, all through AtomicFile; which ones: OutputSelection):
-///   nodes.csv    t, node[, s], x, y[, z], vx, vy[, vz]   the moving nodes at every frame (s: with fronts)
+///   nodes.csv    t, node[, s], x, y[, z], vx, vy[, vz]   the moving nodes at every frame (s: with a module)
 ///   tension.csv  t, link, s_mid, T                       the links of the arcs; s_mid: material
 ///                                                        coordinate of the link midpoint
-///   energy.csv   t, K, V, W_applied, drift[, W_shocks, W_heaps, W_remesh]    at every frame
+///   energy.csv   t, K, V, W_applied, drift[, the module's energy terms]    at every frame (front
+///                tracking's: shocks/front_tracker.hpp, ledger_terms)
 ///   forces.csv   t and the forces people measure (RunSummary::force_columns) at every frame
-///                drift = K + V − (K0 + V0) − W_applied − W_shocks − W_heaps − W_remesh
+///                drift = K + V − (K0 + V0) − W_applied − Σ the module's energy terms
 ///   series.csv   one row per accepted step (StringSolverOptions::record_steps, on for runs with
 ///                fronts): samples_table()
 ///   frames/frame_XXXX.vtp and string.pvd                 ParaView time series: the moving string (part 0)
-///   frames/fronts_XXXX.vtp                               and, with fronts, the fronts as points (part 1:
-///                                                        s0, s0_dot, reaction, plane_normal, heap)
+///   frames/fronts_XXXX.vtp                               and, with a module, its fronts as points (part 1:
+///                                                        s0, s0_dot and the module's front_fields())
 ///   stats.json   the summary (to_json); written last, so its presence means the set is complete
 #include <filesystem>
 #include <functional>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -56,7 +58,7 @@ struct OutputEstimate {
 struct StringSolverOptions {
   IntegratorOptions integrator;
   double t_end = 1.0;            ///< end time (s), > 0 ([stop] t_end)
-  double output_interval = 0.1;  ///< time between frames (s); frames at 0, Δ, 2Δ, …, t_end, and at a stop
+  double output_interval = defaults::kLibraryOutputInterval;  ///< time between frames (s); frames at 0, Δ, 2Δ, …, t_end, and at a stop
   bool record_steps = false;     ///< a StepSample after every accepted step (series.csv)
   void validate() const;
   /// Largest memory the frames may take until the outputs are written (bytes).
@@ -69,18 +71,28 @@ struct StringSolverOptions {
   void check_output_budget(int nodes, int dim, bool fronts, const OutputSelection& select) const;
 };
 
+/// The values of a module's ledger terms at one record (StringModule::ledger_terms: names and kinds,
+/// shared by every record of a run); empty for a string without a module.
+struct LedgerValues {
+  std::shared_ptr<const std::vector<LedgerTerm>> names;
+  std::vector<double> values;  ///< in the order of *names
+  /// The value of the term `name` (e.g. "W_remesh" of front tracking); throws if the run has none.
+  double operator[](const std::string& name) const;
+};
+
 /// One recorded output time.
 template <int dim>
 struct Frame {
   double t = 0;
   Points<dim> x, v;
   Eigen::VectorXd tension;   ///< per link; NaN for a link in no arc
-  std::vector<int> moving;   ///< the nodes in an arc (all of them without fronts)
-  double kinetic = 0, potential = 0, work = 0, drift = 0;
-  double w_shocks = 0, w_heaps = 0, w_remesh = 0;
+  std::vector<int> moving;   ///< the nodes in an arc (all of them without a module)
+  double kinetic = 0, potential = 0, work = 0;
+  double drift = 0;          ///< the energy ledger's residual (J), see the file comment
+  LedgerValues terms;        ///< the module's ledger terms (their energies are energy.csv's last columns)
   double max_violation = 0;
   std::vector<double> forces;  ///< the forces people measure, in the order of force_columns()
-  std::vector<FrontState<dim>> fronts;  ///< with front tracking
+  std::vector<FrontRecord<dim>> fronts;  ///< with a module that has fronts
 };
 
 /// One accepted step (or crossing, or the stop) of a run that records its steps.
@@ -88,11 +100,14 @@ struct StepSample {
   double t = 0;
   std::vector<double> s0, s0_dot;  ///< per front (m, m/s)
   std::vector<double> position;    ///< per front, its point x0 (dim components, m)
-  double kinetic = 0, potential = 0, w_applied = 0, w_shocks = 0, w_heaps = 0, w_remesh = 0;
-  double energy_residual = 0;      ///< K + V − K0 − V0 − W_applied − W_shocks − W_heaps − W_remesh (J)
+  double kinetic = 0, potential = 0, w_applied = 0;
+  LedgerValues terms;              ///< the module's ledger terms (columns of series.csv)
+  /// The energy ledger's residual in joules: K + V − K0 − V0 − W_applied − the module's energy terms
+  /// (series.csv's energy_residual; the summary's energy_residual is relative, energy_residual_abs J).
+  double energy_residual = 0;
   double momentum_residual = 0;    ///< |p − p0 − impulse| (N s); 0 without a momentum ledger
   std::vector<double> support;     ///< force of all supports on the system (N), dim components
-  double moving_mass = 0, heap_mass = 0, max_violation = 0;
+  double moving_mass = 0, max_violation = 0;
   int moving_nodes = 0;
   std::vector<double> forces;  ///< in the order of RunSummary::force_columns
 };
@@ -109,7 +124,8 @@ struct RunSummary {
   double energy_drift = 0;         ///< max over frames and samples of |drift| (J), see the file comment
   double final_energy_drift = 0;   ///< the signed drift at the last record (J)
   /// The physical energy scale (J): the max over frames and samples of K + |V − V0| + |W_applied| +
-  /// |W_shocks| + |W_heaps| and of ℓ (λ |g| ℓ + Σ |loads|) (StringModel::physical_scales), so that a
+  /// Σ |the module's work terms| (LedgerTerm::Kind::kWork) and of
+  /// ℓ (λ |g| ℓ + Σ |loads|) (StringModel::physical_scales), so that a
   /// string at rest is judged against its weight, never against the round-off of its energy.
   double energy_scale = 0;
   double max_momentum_residual = 0, momentum_scale = 0;  ///< with a momentum ledger (fronts)
@@ -124,7 +140,7 @@ struct RunSummary {
   double impulsive_energy = 0;        ///< J
   double impulsive_speed_change = 0;  ///< the largest jump of a node's velocity (m/s)
   long tension_solves = 0;
-  long transfers = 0;              ///< nodes moved across fronts
+  long transfers = 0;              ///< the module's transfers (front tracking: nodes moved across fronts)
   long frames = 0;
   std::string tension_backend;
   // What the model holds (observable proof that a scene pays only for what it declares):
@@ -134,14 +150,16 @@ struct RunSummary {
   std::vector<std::string> prescribed;  ///< prescribed nodes, e.g. "node 0: fixed"
   int root_functions = 0;          ///< event functions registered with the integrator (OdeSystem::num_events)
   int tension_unknowns = 0;        ///< size of the tension system at the start
-  int junction_unknowns = 0;       ///< unknowns beyond one per link: none (fronts enter as known loads)
   double stabilization_time = 0;   ///< Baumgarte time scale used (s)
   IntegratorStats stats;
   std::vector<StepSample> samples;     ///< after every accepted step (StringSolverOptions::record_steps)
+  /// The module's ledger terms (StringModule::ledger_terms), the columns they add to energy.csv and
+  /// series.csv; empty without a module.
+  std::vector<LedgerTerm> ledger_terms;
   /// Names of the measured forces (forces.csv, the end of series.csv): per prescribed node i,
   /// R_node{i}_x.. (its support's or driver's force on the string, N) and T_node{i} (the tension of the
-  /// link at it, N); per front k, R_front{k}_x.. (the force of the heap's support on the string at
-  /// the front, N; zero for a fold).
+  /// link at it, N); per front k, R_front{k}_x.. (the force of the front's support on the string at
+  /// the front, N; zero for a front without one).
   std::vector<std::string> force_columns;
   /// energy_drift / energy_scale (0 if the scale is 0).
   double relative_energy_drift() const { return energy_scale > 0 ? energy_drift / energy_scale : 0.0; }
@@ -152,15 +170,16 @@ struct RunSummary {
 };
 
 /// The summary as JSON: status, stop_reason, t_end, t_stop, steps, rhs_evals, wall_s, energy_drift
-/// (J) and relative_energy_drift, energy_residual (relative, the same number) and momentum_residual
+/// (J) and relative_energy_drift, energy_residual (relative: the same number as relative_energy_drift;
+/// energy_residual_abs is it in J, as series.csv's energy_residual column) and momentum_residual
 /// (relative), max_constraint_violation, slack ({policy, detected, t, link, s, T, message}),
 /// impulsive_start ({detected, kinetic_energy (J), max_speed_change (m/s), message}), transfers, tension_solves, frames, samples, the model's
 /// description (dimension, nodes, links, effects, prescribed, root functions, tension unknowns,
 /// stabilization time, backend) and ARKODE's statistics.
 nlohmann::json to_json(const RunSummary& summary);
-/// The samples as a table (columns t, s0_k, s0dot_k, front_k_x.., K, V, W_applied, W_shocks, W_heaps,
-/// W_remesh, energy_residual, momentum_residual, support_x.., moving_mass, heap_mass, max_violation,
-/// moving_nodes).
+/// The samples as a table (columns t, s0_k, s0dot_k, front_k_x.., K, V, W_applied, the module's energy
+/// terms, energy_residual, momentum_residual, support_x.., moving_mass, the module's other terms,
+/// max_violation, moving_nodes; front tracking's terms: shocks/front_tracker.hpp).
 CsvTable samples_table(const RunSummary& run);
 
 template <int dim>
@@ -204,6 +223,7 @@ class StringSolver {
   bool have_start_ = false;
   double e0_ = 0, v0_ = 0;
   Vec<dim> p0_ = Vec<dim>::Zero();
+  std::shared_ptr<const std::vector<LedgerTerm>> term_names_;  ///< shared by the records' LedgerValues
 };
 
 }  // namespace chainsim

@@ -13,9 +13,9 @@ namespace chainsim {
 
 IntegratorOptions StringCaseSetup::default_integrator() {
   IntegratorOptions o;
-  o.method = "erk5";
-  o.rtol = 1e-9;
-  o.atol = 1e-11;
+  o.method = defaults::kCanonicalString.method;
+  o.rtol = defaults::kCanonicalString.rtol;
+  o.atol = defaults::kCanonicalString.atol;
   return o;
 }
 

@@ -113,10 +113,8 @@ int run_string_scene(const SceneSpec& spec, const std::filesystem::path& dir, bo
       out << fmt::format("fronts     {}; {} root functions (2 per front + {} stop event{})\n", join_words(names),
                          s.root_functions, stops, stops == 1 ? "" : "s");
     }
-    out << fmt::format("effects    {}; {}{} root functions, {} junction unknowns\n",
-                       s.effects.empty() ? "none" : join_words(s.effects),
-                       s.prescribed.empty() ? "" : "prescribed " + join_words(s.prescribed) + "; ", s.root_functions,
-                       s.junction_unknowns);
+    out << fmt::format("effects    {}; {}{} root functions\n", s.effects.empty() ? "none" : join_words(s.effects),
+                       s.prescribed.empty() ? "" : "prescribed " + join_words(s.prescribed) + "; ", s.root_functions);
     out << fmt::format("method     {} (order {}), rtol {:g}, atol {:g}, tension backend {}\n", s.stats.method,
                        s.stats.order, scene.solver_options().integrator.rtol,
                        scene.solver_options().integrator.atol, s.tension_backend);

@@ -75,9 +75,9 @@ double ChainParameters::P0() const { return density * length * gravity; }
 
 IntegratorOptions ReducedSetup::default_integrator() {
   IntegratorOptions o;
-  o.method = "erk8";
-  o.rtol = 1e-13;
-  o.atol = 1e-15;
+  o.method = defaults::kReduced.method;
+  o.rtol = defaults::kReduced.rtol;
+  o.atol = defaults::kReduced.atol;
   return o;
 }
 

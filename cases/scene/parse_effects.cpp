@@ -34,7 +34,9 @@ void parse_heaps(const Section& effects, Context& ctx) {
 
 void parse_effects(const Section& top, Context& ctx) {
   auto& fx = ctx.spec.effects;
-  Section s(subtable(top, "effects"), "effects", ctx, {"gravity", "drag", "heap", "fold", "plane"}, {}, "effect");
+  std::vector<std::string> names;
+  for (const EffectTable& table : effect_tables()) names.emplace_back(table.name);
+  Section s(subtable(top, "effects"), "effects", ctx, names, {}, "effect");
   if (s.has("gravity")) {
     Section g(subtable(s, "gravity"), "effects.gravity", ctx, {"g"});
     if (!g.has("g")) g.missing("g", "m/s^2, a vector [gx, gy] or [gx, gy, gz]");

@@ -15,15 +15,20 @@ void parse_solver(const Section& top, Context& ctx) {
              "check_slack", "slack_tolerance", "slack", "max_wall_s"},
             {{"t_end", "in [stop]"}, {"output_interval", "as interval in [output]"}, {"vtk", "as formats in [output]"}});
   // Each value is checked by the option struct that owns its range, one field at a time.
+  // The method is checked once, here at its key; the other fields by their ranges alone.
   auto integrator = [&](const char* key, auto set) {
     s.located(key, key, [&] {
       IntegratorOptions o;
       set(o);
-      o.validate();
+      o.validate_numbers();
     });
   };
   so.method = s.string("method").value_or(so.method);
-  integrator("method", [&](IntegratorOptions& o) { o.method = so.method; });
+  s.located("method", "method", [&] {
+    IntegratorOptions o;
+    o.method = so.method;
+    o.validate_method();
+  });
   so.rtol = s.number("rtol").value_or(so.rtol);
   integrator("rtol", [&](IntegratorOptions& o) { o.rtol = so.rtol; });
   so.atol = s.number("atol").value_or(so.atol);

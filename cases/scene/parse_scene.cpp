@@ -33,10 +33,12 @@ SceneSpec parse_table(const toml::table& root, const SourceText& text) {
   SceneSpec spec;
   spec.source = text.name();
   Context ctx{text, spec};
+  // An effect written as a section of its own is pointed to [effects.NAME].
+  Section::Moved effects;
+  for (const EffectTable& table : effect_tables())
+    effects.emplace_back(table.name, fmt::format(table.array ? "[[effects.{}]]" : "[effects.{}]", table.name));
   const Section top(root, "", ctx,
-                    {"string", "shape", "velocity", "ends", "effects", "solver", "output", "stop", "model"},
-                    {{"gravity", "[effects.gravity]"}, {"drag", "[effects.drag]"}, {"heap", "[[effects.heap]]"},
-                     {"fold", "[effects.fold]"}, {"plane", "[effects.plane]"}},
+                    {"string", "shape", "velocity", "ends", "effects", "solver", "output", "stop", "model"}, effects,
                     "section");
   scene_parse::parse_model(top, ctx);
   scene_parse::parse_string(top, ctx);
@@ -51,6 +53,12 @@ SceneSpec parse_table(const toml::table& root, const SourceText& text) {
 }
 
 }  // namespace
+
+const std::vector<EffectTable>& effect_tables() {
+  static const std::vector<EffectTable> tables = {
+      {"gravity", false}, {"drag", false}, {"heap", true}, {"fold", false}, {"plane", false}};
+  return tables;
+}
 
 std::string SceneSpec::where(const std::string& key) const {
   for (std::string k = key; !k.empty();) {

@@ -144,22 +144,23 @@ struct SceneSpec {
   bool has_fronts() const { return !effects.heaps.empty() || effects.fold.has_value(); }
   // [solver]
   struct Solver {
-    std::string method = "erk8";
-    double rtol = 1e-8, atol = 1e-10;
+    std::string method = defaults::kScene.method;
+    double rtol = defaults::kScene.rtol, atol = defaults::kScene.atol;
     double max_step = 0, initial_step = 0;
-    long max_steps = 500000;
-    std::optional<double> stabilization_time;  ///< s; default 0.1 t_char (see build_string_scene)
-    std::string backend = "auto";
-    double slack_tolerance = 1e-8;
+    long max_steps = defaults::kMaxSteps;
+    /// s; default defaults::kSceneStabilizationFraction × t_char (see build_string_scene)
+    std::optional<double> stabilization_time;
+    std::string backend = defaults::kBackend;
+    double slack_tolerance = defaults::kSlackTolerance;
     /// What a slack link (a negative tension at an accepted step) does: "stop" (a numerical failure),
     /// "warn" (reported, the run goes on) or "ignore". The older key check_slack = true / false is
     /// read as "stop" / "ignore".
-    std::string slack = "stop";
+    std::string slack = defaults::kSceneSlack;
     std::optional<double> max_wall_s;  ///< s of wall-clock time the run may take (> 0); none: no limit
   } solver;
   // [output]
   struct Output {
-    double interval = 0.05;  ///< s between frames
+    double interval = defaults::kSceneOutputInterval;  ///< s between frames
     OutputSelection select;  ///< fields and formats
   } output;
   // [stop]
@@ -172,6 +173,15 @@ struct SceneSpec {
 /// Reads a scene file. Throws InputError (with file:line:column) on a syntax error, an unknown
 /// section or key, a missing required key, or a value of the wrong type or out of range.
 SceneSpec parse_scene(const std::filesystem::path& file);
+/// The effect tables of the scene format, [effects.NAME] (or [[effects.NAME]], an array of tables):
+/// the one list the parser reads (parse_effects.cpp) and names in messages (parse_scene.cpp). Every
+/// effect a scene declares is written back by scene_to_json (scene_json.cpp); a test checks each one
+/// (tests/unit/test_scene_json.cpp).
+struct EffectTable {
+  const char* name;
+  bool array;  ///< [[effects.NAME]]: one table per instance
+};
+const std::vector<EffectTable>& effect_tables();
 /// The same with the command line's overrides "KEY=VALUE" (`chainsim run --set`, in order; see
 /// docs/scenes.md): each sets a key of the scene, creating its section or array element if the scene
 /// has none, before any check, so that a bad value or unknown key is refused as in the file, located

@@ -253,9 +253,8 @@ SceneParts<dim> build_scene_parts(const SceneSpec& spec) {
   io.initial_step = so.initial_step;
   io.max_steps = so.max_steps;
   io.max_wall_s = so.max_wall_s.value_or(0.0);
-  at_key(spec, "solver", [&] { io.validate(); });
   StringModelOptions mo;
-  mo.stabilization_time = so.stabilization_time.value_or(0.1 * t_char);
+  mo.stabilization_time = so.stabilization_time.value_or(defaults::kSceneStabilizationFraction * t_char);
   mo.backend = so.backend;
   mo.slack = so.slack == "warn" ? SlackPolicy::kWarn : so.slack == "ignore" ? SlackPolicy::kIgnore : SlackPolicy::kStop;
   mo.slack_tolerance = so.slack_tolerance;

@@ -115,25 +115,25 @@ py::dict frames_dict(const SceneRun<dim>& run) {
   tension["s_mid"] = array1(s_mid);
   tension["T"] = T;
   // energy: the ledger terms of energy.csv.
-  std::vector<double> K, V, W, drift, ws, wh, wr;
+  std::vector<double> K, V, W, drift;
   for (const auto& f : frames) {
     K.push_back(f.kinetic);
     V.push_back(f.potential);
     W.push_back(f.work);
     drift.push_back(f.drift);
-    ws.push_back(f.w_shocks);
-    wh.push_back(f.w_heaps);
-    wr.push_back(f.w_remesh);
   }
   energy["t"] = array1(t);
   energy["K"] = array1(K);
   energy["V"] = array1(V);
   energy["W_applied"] = array1(W);
   energy["drift"] = array1(drift);
-  if (run.has_fronts()) {
-    energy["W_shocks"] = array1(ws);
-    energy["W_heaps"] = array1(wh);
-    energy["W_remesh"] = array1(wr);
+  // The module's energy terms (front tracking's W_shocks, W_heaps, W_remesh), as energy.csv has them.
+  const auto& terms = run.solver().summary().ledger_terms;
+  for (std::size_t k = 0; k < terms.size(); ++k) {
+    if (!terms[k].energy()) continue;
+    std::vector<double> column;
+    for (const auto& f : frames) column.push_back(f.terms.values[k]);
+    energy[py::str(terms[k].name)] = array1(column);
   }
   // forces: the columns of forces.csv.
   const auto& names = run.solver().summary().force_columns;

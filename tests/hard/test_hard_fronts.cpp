@@ -34,7 +34,7 @@ void require_agrees_with_reduced(const Comparison& c, int nodes, double t_stop_t
     REQUIRE(std::isfinite(sample.kinetic));
     REQUIRE(std::isfinite(sample.potential));
     REQUIRE(std::isfinite(sample.energy_residual));
-    REQUIRE(sample.moving_mass + sample.heap_mass == Approx(1.0).epsilon(1e-12));
+    REQUIRE(sample.moving_mass + sample.terms["heap_mass"] == Approx(1.0).epsilon(1e-12));
   }
 }
 

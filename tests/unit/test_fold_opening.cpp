@@ -42,7 +42,7 @@ TEST_CASE("a fold's opening is the angle of its arms from antiparallel, and a fo
     StringModel<2> model = folded(degrees * kDeg);
     const auto snap = model.snapshot(0.0, model.state_from_chain());
     REQUIRE(snap.fronts.size() == 1);
-    CHECK(snap.fronts[0].opening / kDeg == Approx(degrees).margin(1e-9));
+    CHECK(front_tracker(model)->front_state(0).opening / kDeg == Approx(degrees).margin(1e-9));
   }
   try {
     folded(30 * kDeg);

@@ -84,7 +84,7 @@ TEST_CASE("heap front: the inflow is the rate of the partial link, the reaction 
       const Eigen::VectorXd y = model.state_from_chain();
       const auto snap = model.snapshot(0.0, y);
       REQUIRE(snap.fronts.size() == 1);
-      const auto& front = snap.fronts[0];
+      const FrontState<2> front = front_tracker(model)->front_state(0);  // the kind's state at the snapshot
       const double l = end_side ? front.l_minus : front.l_plus;
       CHECK(l == Approx(0.35).epsilon(1e-12));
       // w = dl/dt by central differences of the exact geometry.
@@ -132,7 +132,8 @@ TEST_CASE("heap front: a string moving along itself meets the paper's external s
       setup.V = -1.7 * kUp;  // along itself, into the heap at 1.7 m/s
       INFO("end_side " << end_side << ", on_plane " << on_plane);
       StringModel<2> model = setup.model();
-      const auto front = model.snapshot(0.0, model.state_from_chain()).fronts[0];
+      model.snapshot(0.0, model.state_from_chain());
+      const FrontState<2> front = front_tracker(model)->front_state(0);
       const double u = 1.7;
       CHECK(front.inflow == Approx(-u).epsilon(1e-12));
       // Falling chain (docs/model.md §4.1): the table holds the string with f λ ẏ² back along it, the shock

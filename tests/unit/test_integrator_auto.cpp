@@ -3,6 +3,7 @@
 #include <catch2/catch.hpp>
 
 #include "solver/integrator.hpp"
+#include "solver/string_solver.hpp"
 #include "tests/problems/string_test_support.hpp"
 
 using namespace chainsim;
@@ -27,4 +28,26 @@ TEST_CASE("method = auto: implicit from 50 links on, explicit below", "[unit][in
   CHECK(stats.implicit);
   CHECK(stats.method == "ARKODE_ARK436L2SA_DIRK_6_3_4");
   CHECK(stats.lin_solves > 0);  // the string's own Newton solver was used
+}
+
+TEST_CASE("the method is checked where it enters and where it is loaded, not at every copy of the options",
+          "[unit][integrator]") {
+  // Issue 22: a scene's run checked its method eleven times (each [solver] key, the scene's parts,
+  // the solver's options, the integrator). Now a scene checks it once at its key, and the Integrator,
+  // its one user, refuses an unknown name where it loads the table: a C++ caller that skips validate()
+  // still gets the options' message, not a crash.
+  auto chain = hanging_chain(10, 1.0, [](double) { return 0.0; }, 0.03);
+  IntegratorOptions options;
+  options.method = "rk99";
+  CHECK_NOTHROW(options.validate_numbers());
+  CHECK_THROWS_WITH(options.validate_method(), Catch::Contains("method = \"rk99\" is not a known integration method"));
+  CHECK_THROWS_AS(Integrator(*chain, 0.0, chain->state_from_chain(), options), InputError);
+  CHECK_THROWS_WITH(Integrator(*chain, 0.0, chain->state_from_chain(), options),
+                    Catch::Contains("method = \"rk99\" is not a known integration method"));
+  // The solver's options check their numbers only: the method is the Integrator's.
+  StringSolverOptions run;
+  run.integrator = options;
+  CHECK_NOTHROW(run.validate());
+  run.integrator.rtol = 1.0;
+  CHECK_THROWS_WITH(run.validate(), Catch::Contains("rtol"));
 }

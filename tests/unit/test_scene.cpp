@@ -182,7 +182,6 @@ t_end = 0.1
   CHECK(none.effects.empty());
   CHECK(none.prescribed.empty());
   CHECK(none.root_functions == 0);
-  CHECK(none.junction_unknowns == 0);
   CHECK(none.tension_unknowns == 8);
   CHECK(none.links == 8);
   CHECK(none.dimension == 2);
@@ -196,7 +195,6 @@ t_end = 0.1
   const RunSummary zero = run_text(bare + "[effects.drag]\ncoefficient = 0.0\n[ends]\nend = { kind = \"loaded\", force = [0.0, 0.0] }\n");
   CHECK(zero.effects == std::vector<std::string>{"drag", "load on node 8"});
   CHECK(zero.root_functions == 0);
-  CHECK(zero.junction_unknowns == 0);
 
   // A 3D scene runs the 3D instantiation, with the same (absent) machinery.
   const RunSummary three = run_text(R"(
@@ -216,7 +214,6 @@ t_end = 0.1
   CHECK(three.dimension == 3);
   CHECK(three.effects == std::vector<std::string>{"gravity"});
   CHECK(three.root_functions == 0);
-  CHECK(three.junction_unknowns == 0);
 }
 
 TEST_CASE("the example scenes parse, run and close their energy ledger", "[unit][scene]") {
@@ -249,7 +246,6 @@ TEST_CASE("the example scenes parse, run and close their energy ledger", "[unit]
                                           << s.max_constraint_violation);
     CHECK(s.status == "completed");
     CHECK(s.root_functions == 0);
-    CHECK(s.junction_unknowns == 0);
     // The example scenes run at rtol 1e-8; measured relative drift <= 1.2e-10 (whip_crack) and link
     // error <= 3.7e-9 (whip_crack): the bounds sit about ten times above.
     CHECK(s.relative_energy_drift() < 1e-9);
@@ -271,13 +267,12 @@ TEST_CASE("chainsim run writes every output and prints the JSON summary", "[unit
   CHECK(run_scene_command(options, out) == 0);
   const auto j = nlohmann::json::parse(out.str());
   for (const char* key : {"t_end", "steps", "rhs_evals", "wall_s", "energy_drift", "max_constraint_violation", "stats",
-                          "effects", "root_functions", "junction_unknowns", "tension_unknowns", "dimension"})
+                          "effects", "root_functions", "tension_unknowns", "dimension"})
     CHECK(j.contains(key));
   CHECK(j["status"] == "completed");
   CHECK(j["t_end"] == 0.2);
   CHECK(j["effects"] == nlohmann::json::array({"gravity"}));
   CHECK(j["root_functions"] == 0);
-  CHECK(j["junction_unknowns"] == 0);
   for (const char* file : {"nodes.csv", "tension.csv", "energy.csv", "stats.json", "string.pvd",
                            "frames/frame_0000.vtp", "frames/frame_0002.vtp"})
     CHECK(std::filesystem::exists(dir / "out" / file));

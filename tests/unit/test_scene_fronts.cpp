@@ -146,7 +146,6 @@ TEST_CASE("fronts are built only when declared: root functions and fronts in the
   CHECK(none["fronts"] == nlohmann::json::array());
   CHECK(none["num_fronts"] == 0);
   CHECK(none["root_functions"] == 0);
-  CHECK(none["junction_unknowns"] == 0);
 
   // Two root functions per front (take a node in, give one out), one per stop event, and one per fold
   // (it stops the run when the fold opens).

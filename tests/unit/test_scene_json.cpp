@@ -1,0 +1,53 @@
+// The effective scene (cases/scene/scene_json.cpp, `scene_effective` of `chainsim run --json` and
+// Python's Scene.effective) writes back every effect the scene format declares (issue 22, item 5): an
+// effect added to the parser but forgotten in scene_json.cpp fails here.
+#include <catch2/catch.hpp>
+
+#include <map>
+#include <string>
+
+#include "cases/scene/scene.hpp"
+#include "cases/scene/scene_json.hpp"
+#include "test_scene_support.hpp"
+
+using namespace chainsim;
+
+namespace {
+/// The object as a scene file writes it: nulls (derived defaults) and empty arrays left out.
+nlohmann::json written(const nlohmann::json& j) {
+  if (!j.is_object()) return j;
+  nlohmann::json out = nlohmann::json::object();
+  for (const auto& [key, value] : j.items())
+    if (!value.is_null() && !(value.is_array() && value.empty())) out[key] = written(value);
+  return out;
+}
+}  // namespace
+
+TEST_CASE("every effect table of the scene format is written back to scene_effective", "[unit][scene]") {
+  // The hanging chain of the scene tests without its gravity: each effect is declared alone.
+  const std::string base = test::edit(test::kSceneBase, "[effects.gravity]\ng = [0.0, -9.81]\n", "");
+  // One declaration of each effect, with the keys it needs (a plane lies under a heap on it).
+  const std::map<std::string, std::string> samples = {
+      {"gravity", "[effects.gravity]\ng = [0.0, -9.81]\n"},
+      {"drag", "[effects.drag]\ncoefficient = 0.5\n"},
+      {"heap", "[[effects.heap]]\nside = \"end\"\ns0 = 0.5\nf = 0.5\npoint = [0.0, -0.5]\n"},
+      {"fold", "[effects.fold]\ns0 = 0.5\nf = 0.5\n"},
+      {"plane", "[[effects.heap]]\nside = \"end\"\ns0 = 0.5\nf = 0.5\npoint = [0.0, -0.5]\non_plane = true\n"
+                "[effects.plane]\npoint = [0.0, -0.5]\nnormal = [0.0, 1.0]\n"},
+  };
+  REQUIRE(!effect_tables().empty());
+  for (const EffectTable& table : effect_tables()) {
+    const std::string name = table.name;
+    INFO("[effects." << name << "]: give this test a sample declaration of the new effect");
+    REQUIRE(samples.count(name) == 1);
+    const SceneSpec spec = parse_scene_text(base + samples.at(name), "effect.toml");
+    const nlohmann::json effective = scene_to_json(spec);
+    INFO("scene_effective: " << effective.dump());
+    REQUIRE(effective.contains("effects"));
+    CHECK(effective["effects"].contains(name));
+    CHECK(effective["effects"][name].is_array() == table.array);
+    // Written back as TOML, the effect is read again as declared.
+    const SceneSpec again = parse_scene_text(scene_toml_text(written(effective)), "again.toml");
+    CHECK(scene_to_json(again)["effects"] == effective["effects"]);
+  }
+}
