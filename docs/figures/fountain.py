@@ -200,12 +200,15 @@ def figures(results):
 
 
 def main():
+    global POT_CONTENT, NODES
     p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     sub = p.add_subparsers(dest="command", required=True)
     sub.add_parser("steady")
     ps = sub.add_parser("scene")
     ps.add_argument("--shape-pot-f", type=float, help="start on the steady shape of a pot with this f instead")
     ps.add_argument("--speed-factor", type=float, default=1.0, help="start at this multiple of the steady speed")
+    ps.add_argument("--pot-content", type=float, default=POT_CONTENT, help="m of chain in the pot (on the steady state)")
+    ps.add_argument("--nodes", type=int, default=NODES)
     pf = sub.add_parser("figures")
     pf.add_argument("results")
     args = p.parse_args()
@@ -213,6 +216,7 @@ def main():
         for k, v in steady().items():
             print(f"{k} = {v:.12g}")
     elif args.command == "scene":
+        POT_CONTENT, NODES = args.pot_content, args.nodes
         shape = None if args.shape_pot_f is None else steady(f_pot=args.shape_pot_f)
         sys.stdout.write(scene_text(steady(), shape, args.speed_factor))
     else:
