@@ -5,12 +5,9 @@
     /usr/bin/python3 docs/figures/fountain.py scene > cases/scenes/chain_fountain.toml
     /usr/bin/python3 docs/figures/fountain.py figures RESULTS   # docs/figures/fountain_*.png
 
-`figures` reads RESULTS/chain_fountain (the scene as it is) and RESULTS/chain_fountain_off (the same chain and
-heaps started 10 % slow on the steady shape of another pot, f = -0.1: a start off the steady state), written by
-    /usr/bin/python3 docs/figures/fountain.py scene --shape-pot-f -0.1 --speed-factor 0.9 > RESULTS/off.toml
-    build/chainsim run cases/scenes/chain_fountain.toml --out RESULTS/chain_fountain
-    build/chainsim run RESULTS/off.toml --out RESULTS/chain_fountain_off
-(docs/figures/run_fountain_figures.sh does all of it, the animation too).
+`figures` reads RESULTS/chain_fountain (the scene as it is) and RESULTS/chain_fountain_off (the same pot and floor,
+16 m in the pot, started 10 % slow on the steady shape of another pot, f = -0.1: a start off the steady state);
+docs/figures/run_fountain_figures.sh runs both and draws docs/figures/fountain.png and the animation.
 
 The steady state. A chain drawn from a pot at the origin (f_p < 0: T = (1 + f_p) λ v²) and running into a heap on
 the floor at (d, -H) (f_f: T = (1 - f_f) λ v²) moves along a fixed curve at the speed v on which T' = T - λ v² obeys
@@ -142,7 +139,7 @@ atol = 1e-11
 interval = 0.01       # s between node frames
 
 [stop]
-t_end = 2.0           # s, a safety stop: the pot runs empty first
+t_end = {max(2.0, math.ceil(1.5 * content / speed)):.1f}           # s, a safety stop: the pot runs empty first
 '''
 
 
@@ -155,47 +152,43 @@ def figures(results):
 
     st = steady()
     runs = {k: load_run(os.path.join(results, k)) for k in ("chain_fountain", "chain_fountain_off")}
+    names = {"chain_fountain": ("C0", "on the steady state"), "chain_fountain_off": ("C3", "started off it")}
     fig, axes = plt.subplots(1, 3, figsize=(15, 4.8))
-    # (a) the shape at the end of the run against the catenary.
+    # (a) the shape at the start and at the end of each run against the closed form's catenary.
     ax = axes[0]
     cat = catenary_points(st, 2001)
-    ax.plot(cat[:, 0], cat[:, 1], "k-", lw=3, alpha=0.3, label="steady catenary (closed form)")
-    for key, style, name in (("chain_fountain", "C0.", "on the steady state"), ("chain_fountain_off", "C3.", "started off it")):
-        run = runs[key]
-        t, x = run.nodes.times, run.nodes
-        for k, ti in ((0, t[0]), (len(t) - 1, t[-1])):
-            pos, moving = x.moving_positions(k)
-            ax.plot(pos[:, 0], pos[:, 1], style if k else style[:2] + "--", ms=2.5 if k else 0, lw=0.8,
-                    label=f"{name}, t = {ti:.2f} s")
+    ax.plot(cat[:, 0], cat[:, 1], "k-", lw=4, alpha=0.25, label="steady catenary (closed form)")
+    for key, (color, name) in names.items():
+        frames = runs[key].nodes
+        for k, style in ((0, "--"), (len(frames) - 1, "o")):
+            pos = frames.positions(k)
+            ax.plot(pos[:, 0], pos[:, 1], style, color=color, ms=2.2, lw=0.9,
+                    label=f"{name}, t = {frames.times[k]:.2f} s")
     ax.plot([0], [0], "ks", ms=6)
     ax.axhline(-H, color="k", lw=0.8)
     ax.set_aspect("equal")
     ax.set_xlabel("x (m)")
     ax.set_ylabel("y (m)")
-    ax.set_title("shape: nodes in the air against the catenary")
+    ax.set_title("shape: the nodes in the air", fontsize=10)
     ax.legend(fontsize=7, loc="lower left")
     # (b) speed and (c) rise against time.
-    for key, style, name in (("chain_fountain", "C0-", "on the steady state"), ("chain_fountain_off", "C3-", "started off it")):
-        run = runs[key]
-        t = run.nodes.times
-        speed, rise = [], []
-        for k in range(len(t)):
-            pos, vel = run.nodes.moving_positions(k, velocities=True)
-            speed.append(np.mean(np.linalg.norm(vel, axis=1)))
-            rise.append(pos[:, 1].max())
-        axes[1].plot(t, speed, style, label=name)
-        axes[2].plot(t, rise, style, label=name)
-    axes[1].axhline(st["v"], color="k", lw=3, alpha=0.3, label="closed form")
-    axes[2].axhline(st["rise"], color="k", lw=3, alpha=0.3, label="closed form")
-    axes[1].set_title("speed (mean over the nodes in the air)")
-    axes[2].set_title("rise above the pot (highest node)")
+    for key, (color, name) in names.items():
+        frames = runs[key].nodes
+        speed = [np.mean(np.linalg.norm(frames.velocities(k), axis=1)) for k in range(len(frames))]
+        rise = [frames.positions(k)[:, 1].max() for k in range(len(frames))]
+        axes[1].plot(frames.times, speed, "-", color=color, label=name)
+        axes[2].plot(frames.times, rise, "-", color=color, label=name)
+    axes[1].axhline(st["v"], color="k", lw=4, alpha=0.25, label=f"closed form, v = {st['v']:.4f} m/s")
+    axes[2].axhline(st["rise"], color="k", lw=4, alpha=0.25, label=f"closed form, y_c - a = {st['rise']:.4f} m")
+    axes[1].set_title("speed (mean over the nodes in the air)", fontsize=10)
+    axes[2].set_title("rise above the pot (the highest node)", fontsize=10)
     for ax, unit in ((axes[1], "m/s"), (axes[2], "m")):
         ax.set_xlabel("t (s)")
         ax.set_ylabel(unit)
         ax.legend(fontsize=8)
     fig.tight_layout()
     out = os.path.join(HERE, "fountain.png")
-    fig.savefig(out, dpi=110)
+    fig.savefig(out, dpi=100)
     print("wrote", out)
 
 
