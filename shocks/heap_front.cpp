@@ -241,7 +241,7 @@ typename HeapFront<dim>::End HeapFront<dim>::end(const StringModel<dim>& model) 
 
 template <int dim>
 void HeapFront<dim>::initialize(const StringModel<dim>& model) {
-  if (pot_ && !on_plane_) {
+  if (pot_ && !on_plane_) {  // a pinned pot's mouth: the tangent at the front of the initial string
     const End e = end(model);
     const HeapGeometry<dim> geo = heap_geometry<dim>(model.x(), model.v(), false, point_, normal_, last_direction_,
                                                      last_curvature_, e.node, after_,
@@ -310,9 +310,9 @@ void HeapFront<dim>::evaluate(const StringModel<dim>& model, FrontState<dim>& s,
   // The jump conditions: the arc's end tension (on the − side of the front when the heap holds s > s0),
   // the internal shock at the contact, the reaction of the heap's support and the power exchanged
   // with the heap. The end node carries the partial link, so its mass changes at λ w: d(½ m v²)/dt
-  // gains ½ λ w |v|², and the front force τ e works at τ e·v. The shock dissipates f λ |w|³ (a pot's f < 0:
-  // none, jump::heap_shock_power); the rest
-  // is exchanged with the heap (−½ λ w³ for a string moving along itself, as the paper's W*).
+  // gains ½ λ w |v|², and the front force τ e works at τ e·v. The shock dissipates f λ |w|³ (none for a pot's
+  // f < 0, jump::heap_shock_power); the rest is exchanged with the heap (−½ λ w³ for a string moving along
+  // itself, as the paper's W*; −(½ + f) λ w³ for a pot's f < 0).
   // Momentum: the heap is at rest, so the supports give d(m v)/dt − (other forces) = τ e + λ w v.
   const double tau = jump::end_tension(this->dissipation, lambda, s.s0_dot, after_ ? -1 : +1);
   s.l_minus = after_ ? l : 0;
@@ -401,13 +401,13 @@ EventAction HeapFront<dim>::cross(StringModel<dim>& model, const FrontState<dim>
     const double h = this->m_.h;
     const HeapGeometry<dim> geo = heap_geometry<dim>(x, v, on_plane_, point_, normal_, last_direction_,
                                                      last_curvature_, e.node, after_, arc.num_links(), h);
+    // A pinned pot's node comes out through its mouth instead: on the line from the pot point along the mouth,
+    // (l − h) from it, moving along it at w (docs/shocks.md, "A pot": the string leaving a pot that pushes
+    // needs its direction there as well as its point).
     const double at = after_ ? h : -h;
-    x.col(e.outer) = geo.curve.position(at);
-    v.col(e.outer) = geo.curve.velocity(at);
-    if (pot_ && !on_plane_) {
-      x.col(e.outer) = point_ + (geo.l - h) * pot_direction_;
-      v.col(e.outer) = geo.w * pot_direction_;
-    }
+    const bool mouth = pot_ && !on_plane_;
+    x.col(e.outer) = mouth ? Vec<dim>(point_ + (geo.l - h) * pot_direction_) : geo.curve.position(at);
+    v.col(e.outer) = mouth ? Vec<dim>(geo.w * pot_direction_) : geo.curve.velocity(at);
     (after_ ? arc.last : arc.first) = e.outer;
   }
   model.rebuild();

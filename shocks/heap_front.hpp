@@ -21,7 +21,8 @@ struct HeapSpec {
   /// and the contact slides along the plane where the string meets it (a table under a falling chain).
   std::optional<Vec<dim>> plane_normal;
   /// A pot (side kBefore only): a heap that may push the string out, f < 0 (the chain fountain's pot).
-  /// It draws material at τ = (1 + f) λ v² and loses (½ + f) λ v³ ≥ 0 (jump::heap_shock_power).
+  /// It draws material at τ = (1 + f) λ v² and loses (½ + f) λ v³ ≥ 0 (jump::heap_shock_power). A pinned pot
+  /// has a mouth: the nodes it gives out leave along the direction the initial string leaves its point in.
   bool pot = false;
 };
 
