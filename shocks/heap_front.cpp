@@ -182,7 +182,7 @@ void check_heap_dissipation(const HeapSpec<dim>& spec, const std::string& name) 
                                  name));
   if (spec.pot) {
     if (!(spec.dissipation >= jump::kPotMinDissipation && spec.dissipation <= 1))
-      throw InputError(fmt::format("{}.dissipation = {} is out of range: allowed {} <= f <= 1 for a pot (it loses "
+      throw InputError(fmt::format("{}.dissipation = {} is out of range: allowed {} <= dissipation <= 1 for a pot (it loses "
                                    "(1/2 + f) lambda v^3, which must not be negative)",
                                    name, spec.dissipation, jump::kPotMinDissipation));
     return;
