@@ -182,8 +182,8 @@ void check_heap_dissipation(const HeapSpec<dim>& spec, const std::string& name) 
                                  name));
   if (spec.pot) {
     if (!(spec.dissipation >= jump::kPotMinDissipation && spec.dissipation <= 1))
-      throw InputError(fmt::format("{}.dissipation = {} is out of range: allowed {} <= dissipation <= 1 for a pot (it loses "
-                                   "(1/2 + f) lambda v^3, which must not be negative)",
+      throw InputError(fmt::format("{}.dissipation = {} is out of range: allowed {} <= dissipation <= 1 for a pot (it "
+                                   "loses (1/2 + f) lambda v^3, which must not be negative)",
                                    name, spec.dissipation, jump::kPotMinDissipation));
     return;
   }
@@ -243,9 +243,9 @@ template <int dim>
 void HeapFront<dim>::initialize(const StringModel<dim>& model) {
   if (pot_ && !on_plane_) {  // a pinned pot's mouth: the tangent at the front of the initial string
     const End e = end(model);
+    const int links = model.arcs()[static_cast<std::size_t>(e.arc)].num_links();
     const HeapGeometry<dim> geo = heap_geometry<dim>(model.x(), model.v(), false, point_, normal_, last_direction_,
-                                                     last_curvature_, e.node, after_,
-                                                     model.arcs()[static_cast<std::size_t>(e.arc)].num_links(), this->m_.h);
+                                                     last_curvature_, e.node, after_, links, this->m_.h);
     pot_direction_ = -geo.e;
   }
   if (!on_plane_) return;
