@@ -1,6 +1,7 @@
 // [effects.*]: gravity, drag, heaps, fold and plane, each existing only if its section is written
 // (parse_sections.hpp).
 #include "cases/scene/parse_sections.hpp"
+#include "shocks/jump_conditions.hpp"
 
 namespace chainsim::scene_parse {
 
@@ -29,15 +30,15 @@ void parse_heaps(const Section& effects, Context& ctx) {
       h.fail("pot", fmt::format("effects.heap[{}].pot = true on side = \"{}\": a pot feeds the string; allowed only "
                                 "for side = \"start\"",
                                 k, heap.side));
-    const double f = h.number("f").value_or(0.0);
-    if (heap.pot && !(f >= -0.5 && f <= 1))
-      h.fail("f", fmt::format("effects.heap[{}].f = {} is out of range: allowed -0.5 <= f <= 1 for a pot (it loses "
+    const double f = h.number("f").value_or(0.0), lowest = jump::kPotMinDissipation;
+    if (heap.pot && !(f >= lowest && f <= 1))
+      h.fail("f", fmt::format("effects.heap[{}].f = {} is out of range: allowed {} <= f <= 1 for a pot (it loses "
                               "(1/2 + f) lambda v^3, which must not be negative)",
-                              k, h.text("f")));
-    if (!heap.pot && f < 0 && f >= -0.5)
+                              k, h.text("f"), lowest));
+    if (!heap.pot && f < 0 && f >= lowest)
       h.fail("f", fmt::format("effects.heap[{}].f = {} is out of range: allowed 0 <= f <= 1; a heap that pushes the "
-                              "string out (f < 0, down to -0.5) must be a pot: side = \"start\" with pot = true",
-                              k, h.text("f")));
+                              "string out (f < 0, down to {}) must be a pot: side = \"start\" with pot = true",
+                              k, h.text("f"), lowest));
     heap.dissipation = heap.pot ? f : h.number_in("f", 0.0, 0.0, 1.0);
     heap.point = h.vector("point");
     heap.on_plane = h.boolean("on_plane").value_or(false);
