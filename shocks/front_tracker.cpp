@@ -28,7 +28,7 @@ std::vector<std::unique_ptr<FrontKind<dim>>> FrontTracker<dim>::make_fronts(doub
   const HeapSpec<dim>* before = nullptr;
   const HeapSpec<dim>* after = nullptr;
   for (auto& heap : heap_specs_) {
-    require_in_range("heap.dissipation", heap.dissipation, 0.0, 1.0);
+    check_heap_dissipation(heap);
     if (std::abs(heap.s0 - ell) <= 1e-12 * ell) heap.s0 = ell;  // ℓ is a sum of link lengths
     if (std::abs(heap.s0) <= 1e-12 * ell) heap.s0 = 0;
     if (heap.side == HeapSpec<dim>::Side::kAfter)

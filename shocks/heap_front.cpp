@@ -175,8 +175,24 @@ HeapGeometry<dim> heap_geometry(const Points<dim>& x, const Points<dim>& v, bool
 }  // namespace
 
 template <int dim>
+void check_heap_dissipation(const HeapSpec<dim>& spec, const std::string& name) {
+  if (spec.pot && spec.side != HeapSpec<dim>::Side::kBefore)
+    throw InputError(fmt::format("{}.pot = true on a heap the string runs into: a pot feeds the string; allowed "
+                                 "only for a start heap (side before s0)",
+                                 name));
+  if (spec.pot) {
+    if (!(spec.dissipation >= jump::kPotMinDissipation && spec.dissipation <= 1))
+      throw InputError(fmt::format("{}.dissipation = {} is out of range: allowed {} <= dissipation <= 1 for a pot (it "
+                                   "loses (1/2 + f) lambda v^3, which must not be negative)",
+                                   name, spec.dissipation, jump::kPotMinDissipation));
+    return;
+  }
+  require_in_range(name + ".dissipation", spec.dissipation, 0.0, 1.0);
+}
+
+template <int dim>
 HeapFront<dim>::HeapFront(const HeapSpec<dim>& spec)
-    : after_(spec.side == HeapSpec<dim>::Side::kAfter), s0_(spec.s0), point_(spec.point) {
+    : after_(spec.side == HeapSpec<dim>::Side::kAfter), s0_(spec.s0), point_(spec.point), pot_(spec.pot) {
   this->dissipation = spec.dissipation;
   this->expected_s0 = spec.s0;
   if (spec.plane_normal) {
@@ -225,6 +241,13 @@ typename HeapFront<dim>::End HeapFront<dim>::end(const StringModel<dim>& model) 
 
 template <int dim>
 void HeapFront<dim>::initialize(const StringModel<dim>& model) {
+  if (pot_ && !on_plane_) {  // a pinned pot's mouth: the tangent at the front of the initial string
+    const End e = end(model);
+    const int links = model.arcs()[static_cast<std::size_t>(e.arc)].num_links();
+    const HeapGeometry<dim> geo = heap_geometry<dim>(model.x(), model.v(), false, point_, normal_, last_direction_,
+                                                     last_curvature_, e.node, after_, links, this->m_.h);
+    pot_direction_ = -geo.e;
+  }
   if (!on_plane_) return;
   const End e = end(model);
   if (model.arcs()[static_cast<std::size_t>(e.arc)].num_links() == 0) {
@@ -287,15 +310,16 @@ void HeapFront<dim>::evaluate(const StringModel<dim>& model, FrontState<dim>& s,
   // The jump conditions: the arc's end tension (on the − side of the front when the heap holds s > s0),
   // the internal shock at the contact, the reaction of the heap's support and the power exchanged
   // with the heap. The end node carries the partial link, so its mass changes at λ w: d(½ m v²)/dt
-  // gains ½ λ w |v|², and the front force τ e works at τ e·v. The shock dissipates f λ |w|³; the rest
-  // is exchanged with the heap (−½ λ w³ for a string moving along itself, as the paper's W*).
+  // gains ½ λ w |v|², and the front force τ e works at τ e·v. The shock dissipates f λ |w|³ (none for a pot's
+  // f < 0, jump::heap_shock_power); the rest is exchanged with the heap (−½ λ w³ for a string moving along
+  // itself, as the paper's W*; −(½ + f) λ w³ for a pot's f < 0).
   // Momentum: the heap is at rest, so the supports give d(m v)/dt − (other forces) = τ e + λ w v.
   const double tau = jump::end_tension(this->dissipation, lambda, s.s0_dot, after_ ? -1 : +1);
   s.l_minus = after_ ? l : 0;
   s.l_plus = after_ ? 0 : l;
   s.tension_minus = after_ ? tau : 0;
   s.tension_plus = after_ ? 0 : tau;
-  s.power_shock = jump::shock_power(this->dissipation, lambda, s.s0_dot, 1);
+  s.power_shock = jump::heap_shock_power(this->dissipation, lambda, s.s0_dot);  // 0 for a pot's f < 0
   s.power_heap = jump::heap_power<dim>(tau, e, v_end, lambda, w, s.power_shock);
   s.reaction = jump::heap_reaction<dim>(tau, e, v_end, lambda, w);
   s.heap = true;
@@ -377,9 +401,13 @@ EventAction HeapFront<dim>::cross(StringModel<dim>& model, const FrontState<dim>
     const double h = this->m_.h;
     const HeapGeometry<dim> geo = heap_geometry<dim>(x, v, on_plane_, point_, normal_, last_direction_,
                                                      last_curvature_, e.node, after_, arc.num_links(), h);
+    // A pinned pot's node comes out through its mouth instead: on the line from the pot point along the mouth,
+    // (l − h) from it, moving along it at w (docs/shocks.md, "A pot": the string leaving a pot that pushes
+    // needs its direction there as well as its point).
     const double at = after_ ? h : -h;
-    x.col(e.outer) = geo.curve.position(at);
-    v.col(e.outer) = geo.curve.velocity(at);
+    const bool mouth = pot_ && !on_plane_;
+    x.col(e.outer) = mouth ? Vec<dim>(point_ + (geo.l - h) * pot_direction_) : geo.curve.position(at);
+    v.col(e.outer) = mouth ? Vec<dim>(geo.w * pot_direction_) : geo.curve.velocity(at);
     (after_ ? arc.last : arc.first) = e.outer;
   }
   model.rebuild();
@@ -389,5 +417,7 @@ EventAction HeapFront<dim>::cross(StringModel<dim>& model, const FrontState<dim>
 
 template class HeapFront<2>;
 template class HeapFront<3>;
+template void check_heap_dissipation<2>(const HeapSpec<2>&, const std::string&);
+template void check_heap_dissipation<3>(const HeapSpec<3>&, const std::string&);
 
 }  // namespace chainsim

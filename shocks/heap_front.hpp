@@ -14,13 +14,22 @@ struct HeapSpec {
   Side side = Side::kAfter;  ///< kAfter: the heap holds s > s0 (string runs into it at its end, e.g.
                              ///< falling chain); kBefore: it holds s < s0 (feeds the string, sliding chain)
   Vec<dim> point = Vec<dim>::Zero();  ///< x0 (m)
-  double dissipation = 0;             ///< f of the internal shock at x0, in [0, 1]
+  double dissipation = 0;             ///< f of the internal shock at x0, in [0, 1]; a pot: [−½, 1]
   double s0 = 0;                      ///< initial material coordinate of the front (m), in (0, ℓ)
   /// Unset: the front is pinned at `point` (a hole or an edge the string runs through). Set: the
   /// heap lies on the smooth plane through `point` with this normal (pointing to the string's side),
   /// and the contact slides along the plane where the string meets it (a table under a falling chain).
   std::optional<Vec<dim>> plane_normal;
+  /// A pot (side kBefore only): a heap that may push the string out, f < 0 (the chain fountain's pot).
+  /// It draws material at τ = (1 + f) λ v² and loses (½ + f) λ v³ ≥ 0 (jump::heap_shock_power). A pinned pot
+  /// has a mouth: the nodes it gives out leave along the direction the initial string leaves its point in.
+  bool pot = false;
 };
+
+/// Throws InputError unless the heap's f is allowed: 0 ≤ f ≤ 1, or −½ ≤ f ≤ 1 for a pot, which must
+/// be a start heap (side kBefore). `name` prefixes the message ("heap").
+template <int dim>
+void check_heap_dissipation(const HeapSpec<dim>& spec, const std::string& name = "heap");
 
 template <int dim>
 class HeapFront final : public FrontKind<dim> {
@@ -70,6 +79,8 @@ class HeapFront final : public FrontKind<dim> {
   Vec<dim> last_curvature_ = Vec<dim>::Zero();  ///< on a plane, once the arc has one full link left:
                                                 ///< the second derivative x'' its end keeps
   Vec<dim> partial_mid_ = Vec<dim>::Zero();     ///< the midpoint of the string from the end node to the front
+  bool pot_ = false;
+  Vec<dim> pot_direction_ = Vec<dim>::Zero();   ///< a pinned pot: the direction the string leaves it in (unit)
 };
 
 }  // namespace chainsim

@@ -8,7 +8,8 @@
 /// Conventions. s is the material coordinate; "+" is the side of larger s, "−" the side of smaller
 /// s; [ψ] = ψ⁺ − ψ⁻. ṡ0 is the speed of the front in the material (m/s); t± the unit tangents,
 /// v± the velocities, τ± the tensions on the two sides; λ the linear density; f ∈ [0, 1] the
-/// shock's dissipation parameter (`dissipation`).
+/// shock's dissipation parameter (`dissipation`; a pot, a start heap that pushes, has −½ ≤ f < 0:
+/// heap_shock_power).
 ///
 ///   kinematic compatibility   v0 = v⁺ + ṡ0 t⁺ = v⁻ + ṡ0 t⁻        ⇔  [v] = −ṡ0 [t]
 ///   momentum balance          [τ t] + F0 + λ ṡ0 [v] = 0            (F0: force concentrated at x0)
@@ -116,6 +117,26 @@ inline double end_tension(double dissipation, double density, double s0_dot, int
 /// moving at ṡ0 (−Σ dissipation_rate).
 inline double shock_power(double dissipation, double density, double s0_dot, int shocks) {
   return -shocks * dissipation * density * std::abs(s0_dot) * s0_dot * s0_dot;
+}
+
+/// The lowest f a heap's contact may have: a pot (a start heap that pushes the string out, f < 0;
+/// Biggins & Warner's chain fountain) draws material at τ = (1 + f) λ v² < λ v², and loses
+/// (½ + f) λ v³ in all (pot_dissipation_rate), which must not be negative.
+inline constexpr double kPotMinDissipation = -0.5;
+
+/// W_s of the internal shock at a heap's contact (W): shock_power with k = 1 for f ≥ 0. A pot's f < 0
+/// is no internal shock (that would be D < 0, energy made at a point): its contact books no shock
+/// power, and heap_power then books its whole exchange, −(½ + f) λ v³ ≤ 0 for a string moving along
+/// itself.
+inline double heap_shock_power(double dissipation, double density, double s0_dot) {
+  return dissipation >= 0 ? shock_power(dissipation, density, s0_dot, 1) : 0.0;
+}
+
+/// (½ + f) λ |v|³ (W): the power a heap's contact loses in all (internal and external shock) while it
+/// gives out a string moving along itself at speed v, drawn at τ = (1 + f) λ v² (end_tension);
+/// ≥ 0 for f ≥ −½. (A string running into a heap loses (f − ½) λ |v|³: the falling chain's f ≥ ½.)
+inline double pot_dissipation_rate(double dissipation, double density, double speed) {
+  return (0.5 + dissipation) * density * std::abs(speed) * speed * speed;
 }
 
 /// R = τ e + λ w v_k: the force the support of a quiescent heap exerts on the string (N). `tangent`

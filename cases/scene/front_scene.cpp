@@ -140,6 +140,7 @@ FrontScene<dim> build_front_scene(const SceneSpec& spec) {
     hs.side = start ? HeapSpec<dim>::Side::kBefore : HeapSpec<dim>::Side::kAfter;
     hs.point = point;
     hs.dissipation = heap.dissipation;
+    hs.pot = heap.pot;
     hs.s0 = heap.s0;
     if (heap.on_plane) hs.plane_normal = *plane_normal;
     heaps.push_back(hs);
@@ -249,6 +250,7 @@ FrontScene<dim> build_front_scene(const SceneSpec& spec) {
       f["s0"] = heap.s0;
       f["point"] = to_array<dim>(dynamic_cast<const HeapFront<dim>&>(front).point());
       f["on_plane"] = heap.on_plane;
+      if (heap.pot) f["pot"] = true;
       if (heap.on_plane) f["plane_normal"] = to_array<dim>(*plane_normal);
     }
     d["fronts"].push_back(f);

@@ -1,6 +1,7 @@
 // [effects.*]: gravity, drag, heaps, fold and plane, each existing only if its section is written
 // (parse_sections.hpp).
 #include "cases/scene/parse_sections.hpp"
+#include "shocks/jump_conditions.hpp"
 
 namespace chainsim::scene_parse {
 
@@ -11,7 +12,7 @@ void parse_heaps(const Section& effects, Context& ctx) {
   auto& heaps = ctx.spec.effects.heaps;
   const auto tables = table_array(effects, "heap", "heap");
   for (std::size_t k = 0; k < tables.size(); ++k) {
-    Section h(*tables[k], fmt::format("effects.heap[{}]", k), ctx, {"side", "s0", "f", "point", "on_plane"});
+    Section h(*tables[k], fmt::format("effects.heap[{}]", k), ctx, {"side", "s0", "f", "point", "on_plane", "pot"});
     if (!h.has("side")) h.missing("side", "\"start\" (the heap holds s < s0 and feeds the string) or \"end\" (it holds s > s0)");
     if (!h.has("s0")) h.missing("s0", "m, the material coordinate of the front at t = 0");
     if (!h.has("point")) h.missing("point", "m, the hole or edge the front sits at, or the contact point on the plane at t = 0");
@@ -23,7 +24,22 @@ void parse_heaps(const Section& effects, Context& ctx) {
                                    "string; allowed at most one heap per side",
                                    k, heap.side, j));
     heap.s0 = *h.number("s0");
-    heap.dissipation = h.number_in("f", 0.0, 0.0, 1.0);
+    // f: 0 <= f <= 1; a pot (a start heap that pushes the string out) also -1/2 <= f < 0 (docs/model.md §5).
+    heap.pot = h.boolean("pot").value_or(false);
+    if (heap.pot && heap.side != "start")
+      h.fail("pot", fmt::format("effects.heap[{}].pot = true on side = \"{}\": a pot feeds the string; allowed only "
+                                "for side = \"start\"",
+                                k, heap.side));
+    const double f = h.number("f").value_or(0.0), lowest = jump::kPotMinDissipation;
+    if (heap.pot && !(f >= lowest && f <= 1))
+      h.fail("f", fmt::format("effects.heap[{}].f = {} is out of range: allowed {} <= f <= 1 for a pot (it loses "
+                              "(1/2 + f) lambda v^3, which must not be negative)",
+                              k, h.text("f"), lowest));
+    if (!heap.pot && f < 0 && f >= lowest)
+      h.fail("f", fmt::format("effects.heap[{}].f = {} is out of range: allowed 0 <= f <= 1; a heap that pushes the "
+                              "string out (f < 0, down to {}) must be a pot: side = \"start\" with pot = true",
+                              k, h.text("f"), lowest));
+    heap.dissipation = heap.pot ? f : h.number_in("f", 0.0, 0.0, 1.0);
     heap.point = h.vector("point");
     heap.on_plane = h.boolean("on_plane").value_or(false);
     heaps.push_back(heap);

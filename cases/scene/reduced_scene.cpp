@@ -132,6 +132,8 @@ ReducedSetup match(const SceneSpec& spec) {
       setup.problem = Problem::kSliding;
       if (heap.on_plane)
         refuse("needs the sliding chain's heap at a hole: on_plane = false (the front pinned at the heap point)");
+      if (heap.pot)
+        refuse("has no pot: the reduced sliding chain draws from a heap with 0 <= f <= 1 (effects.heap[0].pot = true)");
       if (spec.end.kind != "free")
         refuse(fmt::format("needs the sliding chain's lower end free: ends.end = \"{}\"", spec.end.kind));
       if (!spec.stop.fronts.empty())

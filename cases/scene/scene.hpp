@@ -20,7 +20,7 @@
 ///     [velocity] kind = rest | uniform | tangential | nodes
 ///     [ends]     start, end = "free" | "fixed" | { kind = "loaded", … } | { kind = "driven", … }
 ///     [effects.gravity] g (m/s²)          [effects.drag] coefficient (1/s)
-///     [[effects.heap]] side = start | end, s0 (m), f, point (m), on_plane
+///     [[effects.heap]] side = start | end, s0 (m), f, point (m), on_plane, pot
 ///     [effects.fold]   s0 (m), f          [effects.plane] point (m), normal (the table of a heap)
 ///     [solver]   method, rtol, atol, max_step, initial_step, max_steps, stabilization_time, backend,
 ///                slack = stop | warn | ignore (check_slack = true | false: its older form),
@@ -60,7 +60,8 @@ struct EndSpec {
 struct HeapEntry {
   std::string side;            ///< "start": the heap holds s < s0 (feeds the string); "end": s > s0
   double s0 = 0;               ///< material coordinate of the front at t = 0 (m)
-  double dissipation = 0;      ///< f, in [0, 1]
+  double dissipation = 0;      ///< f, in [0, 1]; a pot: [−½, 1]
+  bool pot = false;            ///< a start heap that may push the string out (f < 0): the chain fountain's pot
   std::vector<double> point;   ///< hole / edge / contact point at t = 0 (m)
   bool on_plane = false;       ///< the heap lies on [effects.plane] and its contact slides along it
   /// "heap_start" or "heap_end": the name of its front in [[stop.front]] and in the outputs.

@@ -76,8 +76,10 @@ json effects_json(const SceneSpec::Effects& fx) {
   if (fx.drag) j["drag"] = {{"coefficient", *fx.drag}};
   if (!fx.heaps.empty()) {
     j["heap"] = json::array();
-    for (const HeapEntry& h : fx.heaps)
+    for (const HeapEntry& h : fx.heaps) {
       j["heap"].push_back({{"side", h.side}, {"s0", h.s0}, {"f", h.dissipation}, {"point", h.point}, {"on_plane", h.on_plane}});
+      if (h.pot) j["heap"].back()["pot"] = true;
+    }
   }
   if (fx.fold) j["fold"] = {{"s0", fx.fold->s0}, {"f", fx.fold->dissipation}};
   if (fx.plane) j["plane"] = {{"point", fx.plane->point}, {"normal", fx.plane->normal}};

@@ -101,3 +101,29 @@ TEST_CASE("a running fold's state is the jump conditions at that state: folded c
              WithinAbs(jump::tension_jump(f, lam, s.s0_dot, jump_v.squaredNorm()), 1e-12 * scale));
   CHECK_THAT(s.power_shock, WithinAbs(-jump::dissipation_rate(f, lam, sd, jump_v.squaredNorm()), 1e-12 * scale * sd));
 }
+
+TEST_CASE("a running pot's state is the jump conditions at that state: a sliding chain drawn out of a pot",
+          "[unit][shocks][fountain]") {
+  // The sliding chain whose heap is a pot that pushes (f = −0.3): τ = (1 + f) λ ẏ² = 0.7 λ ẏ² at the hole, the
+  // pot's support pushes the string out with f λ ẏ² e_y (down, into the hole), no internal shock is booked and the
+  // heap's exchange is the whole loss −(½ + f) λ |ẏ|³ (docs/model.md §4.5). The string hangs straight below the
+  // pot's mouth, so every node comes out on it.
+  const Vec<2> ey(0.0, 1.0);
+  const Running run(test::edit(test::kSlidingBase, "f = 0.5", "f = -0.3\npot = true"), 0.2);
+  const FrontKind<2>& front = run.tracker->fronts()[0];
+  const FrontState<2>& s = run.tracker->front_state(0);
+  REQUIRE(front.dissipation == -0.3);
+  const ArcRange& arc = run.model().arcs()[static_cast<std::size_t>(front.arc_plus)];
+  const Vec<2> v_end = run.model().v().col(arc.first);
+  const double lam = run.lambda, f = front.dissipation;
+  CHECK(s.tension_plus == jump::end_tension(f, lam, s.s0_dot, +1));
+  CHECK(s.power_shock == 0.0);
+  CHECK(s.power_heap == jump::heap_power<2>(s.tension_plus, s.direction, v_end, lam, s.inflow, 0.0));
+  const double ydot = v_end.dot(ey), y2 = ydot * ydot, scale = lam * y2;
+  CAPTURE(ydot, s.tension_plus, s.power_heap);
+  REQUIRE(ydot < -0.5);
+  CHECK(std::abs(v_end.x()) <= 1e-12 * std::abs(ydot));
+  CHECK_THAT(s.tension_plus, WithinAbs((1 + f) * lam * y2, 1e-12 * scale));
+  CHECK_THAT((s.reaction - f * lam * y2 * ey).norm(), WithinAbs(0.0, 1e-12 * scale));
+  CHECK_THAT(s.power_heap, WithinAbs(-(0.5 + f) * lam * std::abs(ydot) * y2, 1e-12 * scale * std::abs(ydot)));
+}

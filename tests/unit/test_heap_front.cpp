@@ -144,3 +144,28 @@ TEST_CASE("heap front: a string moving along itself meets the paper's external s
       CHECK((front.position - Vec<2>::Zero()).norm() < 1e-14);
     }
 }
+
+TEST_CASE("a heap's f: 0 <= f <= 1, and -1/2 <= f <= 1 for a pot, which only a start heap may be", "[unit][shocks][fountain]") {
+  HeapSpec<2> heap;
+  heap.side = HeapSpec<2>::Side::kBefore;
+  for (double f : {0.0, 0.5, 1.0}) {
+    heap.dissipation = f;
+    CHECK_NOTHROW(check_heap_dissipation(heap));
+  }
+  heap.dissipation = -0.2;
+  CHECK_THROWS_WITH(check_heap_dissipation(heap), "heap.dissipation = -0.2 is out of range: allowed 0 <= dissipation <= 1");
+  heap.pot = true;
+  for (double f : {-0.5, -0.2, 0.0, 1.0}) {
+    heap.dissipation = f;
+    CHECK_NOTHROW(check_heap_dissipation(heap));
+  }
+  heap.dissipation = -0.6;
+  CHECK_THROWS_WITH(check_heap_dissipation(heap),
+                    "heap.dissipation = -0.6 is out of range: allowed -0.5 <= dissipation <= 1 for a pot (it loses (1/2 + f) "
+                    "lambda v^3, which must not be negative)");
+  heap.dissipation = 0.5;
+  heap.side = HeapSpec<2>::Side::kAfter;
+  CHECK_THROWS_WITH(check_heap_dissipation(heap),
+                    "heap.pot = true on a heap the string runs into: a pot feeds the string; allowed only for a start "
+                    "heap (side before s0)");
+}

@@ -203,3 +203,31 @@ TEST_CASE("heap reaction and power at the table and the hole: the concentrated f
     CHECK_THAT(heap_power<3>(tau, t, v * t, lam, -v, w_s), WithinAbs(heap_power(true, tau, lam, v) - w_s, kExact));
   }
 }
+
+TEST_CASE("a pot (f < 0) pushes the string out: T = (1 + f) lambda v^2, loss (1/2 + f) lambda v^3, no internal shock",
+          "[unit][shocks][fountain]") {
+  // A string drawn out of a pot at speed v along t (the fountain's first leg, any direction): ṡ0 = −v, the arc
+  // gains material at w = v, e (from the arc into the heap) = −t, the end moves at v t. By hand: the tension
+  // (1 + f) λ v² (less than λ v²: the pot pushes with −f λ v², Biggins & Warner's α λ v²); the pot's support takes
+  // the momentum flux λ v² t less that tension; the string gains K at ½ λ v³ per unit time from new material and
+  // loses τ v at its end, so the pot's whole exchange is −(½ + f) λ v³ (the sliding chain's K̇ + V̇ at the hole).
+  const double lam = 0.7, v = 2.3;
+  const V3 t = V3(0.2, 0.9, -0.1).normalized();
+  for (double f : {-0.5, -0.2, 0.0, 0.4}) {
+    INFO("f = " << f);
+    const double tau = end_tension(f, lam, -v, +1);
+    CHECK_THAT(tau, WithinAbs((1 + f) * lam * v * v, kExact));
+    const double w_s = heap_shock_power(f, lam, -v);
+    // f < 0 is no internal shock (it would dissipate −f λ v³ < 0): none is booked; f >= 0 books −f λ v³.
+    CHECK_THAT(w_s, WithinAbs(f < 0 ? 0.0 : -f * lam * v * v * v, kExact));
+    const double w_heap = heap_power<3>(tau, V3(-t), V3(v * t), lam, v, w_s);
+    CHECK_THAT(w_s + w_heap, WithinAbs(-(0.5 + f) * lam * v * v * v, kExact));
+    CHECK_THAT(pot_dissipation_rate(f, lam, v), WithinAbs((0.5 + f) * lam * v * v * v, kExact));
+    CHECK(w_s <= 0);
+    CHECK(w_heap <= 0);  // both ledgers are losses, down to f = −½ (none there)
+    // The pot's reaction: the momentum flux λ v² t the string takes away, less the tension that pulls it out.
+    const V3 R = heap_reaction<3>(tau, V3(-t), V3(v * t), lam, v);
+    CHECK_THAT((R - (-f) * lam * v * v * t).norm(), WithinAbs(0.0, kExact));
+  }
+  CHECK(kPotMinDissipation == -0.5);
+}

@@ -286,7 +286,15 @@ TEST_CASE("bad scenes with fronts, and scenes the reduced model does not fit, ar
   auto reduced = [](const std::string& text) { return edit(text, "model = \"string\"", "model = \"reduced\""); };
   const BadScene cases[] = {
       {"typo in a heap's key", edit(F, "side = \"end\"", "sid = \"end\""),
-       "s.toml:15:1: unknown key 'sid' in effects.heap[0]; valid keys: side, s0, f, point, on_plane (did you mean 'side'?)"},
+       "s.toml:15:1: unknown key 'sid' in effects.heap[0]; valid keys: side, s0, f, point, on_plane, pot (did you mean 'side'?)"},
+      {"a heap that pushes but is no pot", edit(S, "f = 0.5", "f = -0.2"), 
+       "s.toml:17:5: effects.heap[0].f = -0.2 is out of range: allowed 0 <= f <= 1; a heap that pushes the string out (f < 0, down to -0.5) must be a pot: side = \"start\" with pot = true"},
+      {"a pot below f = -1/2", edit(S, "f = 0.5", "f = -0.6\npot = true"), 
+       "s.toml:17:5: effects.heap[0].f = -0.6 is out of range: allowed -0.5 <= f <= 1 for a pot (it loses (1/2 + f) lambda v^3, which must not be negative)"},
+      {"a pot the string runs into", edit(F, "f = 0.5", "f = 0.5\npot = true"), 
+       "s.toml:18:7: effects.heap[0].pot = true on side = \"end\": a pot feeds the string; allowed only for side = \"start\""},
+      {"a pot in a reduced scene", reduced(edit(S, "f = 0.5", "f = -0.2\npot = true")), 
+       "s.toml:1:9: model = \"reduced\" has no pot: the reduced sliding chain draws from a heap with 0 <= f <= 1 (effects.heap[0].pot = true)"},
       {"a heap's f above one", edit(F, "f = 0.5", "f = 1.5"),
        "s.toml:17:5: effects.heap[0].f = 1.5 is out of range: allowed 0 <= f <= 1"},
       {"a heap on neither side", edit(F, "side = \"end\"", "side = \"top\""),
