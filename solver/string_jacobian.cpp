@@ -260,7 +260,7 @@ bool StringModel<dim>::jacobian_times(const Eigen::Ref<const Eigen::VectorXd>& v
 
 template <int dim>
 bool StringModel<dim>::newton_solver_exact() const {
-  if (module_ || !system_) return false;
+  if (module_ || !system_ || quadratic_) return false;
   for (const auto& force : forces_)
     if (!dynamic_cast<const Gravity<dim>*>(force.get()) && !dynamic_cast<const EndLoad<dim>*>(force.get())) return false;
   return true;

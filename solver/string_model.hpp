@@ -51,6 +51,8 @@ namespace chainsim {
 
 template <int dim>
 class StringJacobian;
+template <int dim>
+class QuadraticString;
 
 /// What a run does when the tension goes negative beyond round-off (slack: an inextensible string
 /// cannot push, so the model no longer applies): stop with a NumericalError, record the first
@@ -78,6 +80,10 @@ struct StringModelOptions {
   SlackPolicy slack = SlackPolicy::kIgnore;
   /// Slack means T_j < −slack_tolerance · max_k |T_k| (relative, so round-off is not slack).
   double slack_tolerance = 1e-8;
+  /// The discretization: "links" (lumped masses, one tension per link, order 2) or "quadratic"
+  /// (quadratic elements, consistent mass, tension at the Gauss points, order 4 for smooth arcs:
+  /// quadratic_string.hpp; open strings without fronts only).
+  std::string elements = "links";
   void validate() const;
 };
 
@@ -103,7 +109,7 @@ class StringModel final : public OdeSystem {
   /// matching energies; without one, plain absolute tolerances (empty).
   Eigen::VectorXd state_scale() const override;
   /// Implicit methods: the exact Newton systems of the string (string_jacobian.hpp), O(N) each.
-  bool has_newton_solver() const override { return system_ != nullptr; }
+  bool has_newton_solver() const override { return system_ != nullptr && !quadratic_; }
   void newton_setup(double t, const Eigen::Ref<const Eigen::VectorXd>& y, bool relinearize, double gamma) override;
   void newton_solve(const Eigen::Ref<const Eigen::VectorXd>& r, Eigen::Ref<Eigen::VectorXd> z) override;
   /// No module and only state-independent applied forces (gravity, end loads): the linearisation
@@ -204,7 +210,9 @@ class StringModel final : public OdeSystem {
   double beta() const { return beta_; }
   TensionSystem& tension_system() { return *system_; }
   bool has_tension_system() const { return system_ != nullptr; }
-  long tension_solves() const { return solves_ + (system_ ? system_->num_solves() : 0); }
+  long tension_solves() const;
+  /// The quadratic elements (StringModelOptions::elements = "quadratic"), or null.
+  const QuadraticString<dim>* quadratic() const { return quadratic_.get(); }
   /// Tensions (per tension unknown) and accelerations of the last evaluation (rhs or snapshot).
   const Eigen::VectorXd& tensions() const { return system_->solution(); }
   const Points<dim>& accelerations() const { return a_; }
@@ -271,6 +279,10 @@ class StringModel final : public OdeSystem {
   void for_each_link(Visit&& visit) const;
   friend class StringJacobian<dim>;
   std::shared_ptr<StringJacobian<dim>> jacobian_;  // built by the first newton_setup()
+  std::shared_ptr<QuadraticString<dim>> quadratic_;  // elements = "quadratic"
+  /// β² = 1/τ_b², capped where its response to the round-off of the coordinates would exceed the
+  /// physical accelerations (needs x_max_).
+  double capped_beta2() const;
 
   Chain<dim> chain_;
   std::vector<std::unique_ptr<Force<dim>>> forces_;
