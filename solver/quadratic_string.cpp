@@ -30,7 +30,6 @@ void BlockTridiagonal<K>::resize(int blocks) {
   lower.resize(n);
   diag.resize(n);
   upper.resize(n);
-  lu_.resize(n);
   y_.resize(n);
 }
 
@@ -43,13 +42,51 @@ void BlockTridiagonal<K>::set_zero() {
   }
 }
 
+namespace {
+/// Inverts a small fixed-size matrix in place by Gauss–Jordan elimination with partial pivoting.
+/// Eigen's LU of a 6×6 or 8×8 block goes through its general (blocked, dynamic-size) triangular
+/// kernels, which cost several times the arithmetic at this size; these loops unroll. Returns false
+/// if a pivot is zero or not finite (a singular block).
+template <int K>
+bool invert_in_place(Eigen::Matrix<double, K, K>& A) {
+  int perm[K];
+  for (int i = 0; i < K; ++i) perm[i] = i;
+  for (int c = 0; c < K; ++c) {
+    int p = c;
+    for (int r = c + 1; r < K; ++r)
+      if (std::abs(A(r, c)) > std::abs(A(p, c))) p = r;
+    if (!(std::abs(A(p, c)) > 0) || !std::isfinite(A(p, c))) return false;
+    if (p != c) {
+      A.row(p).swap(A.row(c));
+      std::swap(perm[p], perm[c]);
+    }
+    const double inv = 1.0 / A(c, c);
+    A(c, c) = 1.0;
+    A.row(c) *= inv;
+    for (int r = 0; r < K; ++r) {
+      if (r == c) continue;
+      const double f = A(r, c);
+      if (f == 0) continue;
+      A(r, c) = 0.0;
+      A.row(r) -= f * A.row(c);
+    }
+  }
+  // The rows were exchanged: the inverse of the original has its columns exchanged back.
+  Eigen::Matrix<double, K, K> out;
+  for (int i = 0; i < K; ++i) out.col(perm[i]) = A.col(i);
+  A = out;
+  return true;
+}
+}  // namespace
+
 template <int K>
 void BlockTridiagonal<K>::factor() {
   const std::size_t n = diag.size();
+  singular_ = false;
   for (std::size_t i = 0; i < n; ++i) {
     if (i > 0) diag[i].noalias() -= lower[i] * y_[i - 1];
-    lu_[i].compute(diag[i]);
-    if (i + 1 < n) y_[i].noalias() = lu_[i].solve(upper[i]);
+    if (!invert_in_place<K>(diag[i])) singular_ = true;  // diag[i] holds the pivot block's inverse
+    if (i + 1 < n) y_[i].noalias() = diag[i] * upper[i];
   }
 }
 
@@ -59,7 +96,7 @@ void BlockTridiagonal<K>::solve(std::vector<Column>& rhs) const {
   Column z;
   for (std::size_t i = 0; i < n; ++i) {
     if (i > 0) rhs[i].noalias() -= lower[i] * rhs[i - 1];
-    z = lu_[i].solve(rhs[i]);
+    z.noalias() = diag[i] * rhs[i];
     rhs[i] = z;
   }
   for (std::size_t i = n - 1; i-- > 0;) rhs[i].noalias() -= y_[i] * rhs[i + 1];
@@ -168,6 +205,7 @@ void QuadraticString<dim>::solve(const Points<dim>& f, const Eigen::VectorXd& r,
     work_[static_cast<std::size_t>(block_of_node(a))].template segment<dim>(offset_of_node(a)) = f.col(a);
   for (int e = 0; e < num_elements_; ++e)
     for (int k = 0; k < 2; ++k) work_[static_cast<std::size_t>(e + 1)][2 * dim + k] = r[2 * e + k];
+  if (solver_.singular()) throw RecoverableError("the quadratic elements' tension system is singular (a Gauss point with x' = 0?)");
   solver_.solve(work_);
   ++solves_;
   for (int a = 0; a < num_nodes_; ++a)

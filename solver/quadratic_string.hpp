@@ -24,8 +24,8 @@
 /// B_ek,a = N_a'(ξ_k) x'_ekᵀ; a prescribed node's momentum rows are replaced by a = a_path(t) (its
 /// reaction is not an unknown). α = β = 1/τ_b: Baumgarte's stabilisation of c_ek, as on the links.
 /// Ordered by element ([a_2e−1, a_2e, T_e−1,0, T_e−1,1] per element, node 0 first), the matrix is block
-/// tridiagonal with blocks of 2·dim+2: the solve is a block Thomas algorithm with Eigen's LU of each
-/// block, O(E).
+/// tridiagonal with blocks of 2·dim+2: the solve is a block Thomas algorithm (pivot blocks inverted
+/// with partial pivoting), O(E).
 ///
 /// StringModel (string_model.hpp) runs it when StringModelOptions::elements = "quadratic": the state,
 /// the forces (evaluated with the masses Σ_b M_ab, so that gravity is the consistent load M g), the
@@ -35,7 +35,6 @@
 #include <vector>
 
 #include <Eigen/Core>
-#include <Eigen/LU>
 
 #include "mesh/chain.hpp"
 #include "forces.hpp"
@@ -43,8 +42,8 @@
 namespace chainsim {
 
 /// A block-tridiagonal system with K×K blocks: row block i couples to blocks i−1 (lower), i (diag),
-/// i+1 (upper). factor() eliminates forward with Eigen's partial-pivoting LU of each pivot block;
-/// solve() then costs O(number of blocks).
+/// i+1 (upper). factor() eliminates forward (block Thomas), inverting each pivot block with partial
+/// pivoting; solve() then costs O(number of blocks), in fixed-size Eigen products.
 template <int K>
 class BlockTridiagonal {
  public:
@@ -53,16 +52,18 @@ class BlockTridiagonal {
   void resize(int blocks);
   int blocks() const { return static_cast<int>(diag.size()); }
   void set_zero();
-  /// Factors the current blocks (overwrites diag with the pivot blocks).
+  /// Factors the current blocks (overwrites diag with the inverses of the pivot blocks).
   void factor();
+  /// A pivot block of the last factor() was singular.
+  bool singular() const { return singular_; }
   /// Solves in place: rhs holds blocks() columns of K values.
   void solve(std::vector<Column>& rhs) const;
 
   std::vector<Block> lower, diag, upper;
 
  private:
-  std::vector<Eigen::PartialPivLU<Block>> lu_;
-  std::vector<Block> y_;  // lu_i⁻¹ upper_i
+  std::vector<Block> y_;  // (pivot block i)⁻¹ upper_i
+  bool singular_ = false;
 };
 
 template <int dim>
