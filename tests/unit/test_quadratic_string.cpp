@@ -1,0 +1,65 @@
+// Quadratic elements (solver/quadratic_string.hpp) at single states, against independent references:
+// the block-tridiagonal solve against Eigen's dense LU, and the hanging chain's tension λ g (ℓ − s),
+// which the elements (tension linear per element, at the Gauss points) must give exactly.
+#include <random>
+
+#include <Eigen/Dense>
+#include <catch2/catch.hpp>
+
+#include "../problems/string_test_support.hpp"
+#include "solver/quadratic_string.hpp"
+
+using namespace chainsim;
+using namespace chainsim::testing;
+
+TEST_CASE("BlockTridiagonal solves as a dense LU does", "[unit][quadratic]") {
+  constexpr int K = 6;
+  const int blocks = 7, n = K * blocks;
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  BlockTridiagonal<K> bt;
+  bt.resize(blocks);
+  Eigen::MatrixXd dense = Eigen::MatrixXd::Zero(n, n);
+  for (int i = 0; i < blocks; ++i) {
+    for (int r = 0; r < K; ++r)
+      for (int c = 0; c < K; ++c) {
+        // Saddle-like blocks: zero diagonal entries in the last rows need the pivoting.
+        bt.diag[i](r, c) = (r >= 4 && c >= 4) ? 0.0 : u(rng) + (r == c ? 4.0 : 0.0);
+        bt.lower[i](r, c) = i > 0 ? u(rng) : 0.0;
+        bt.upper[i](r, c) = i + 1 < blocks ? u(rng) : 0.0;
+      }
+    dense.block(K * i, K * i, K, K) = bt.diag[i];
+    if (i > 0) dense.block(K * i, K * (i - 1), K, K) = bt.lower[i];
+    if (i + 1 < blocks) dense.block(K * i, K * (i + 1), K, K) = bt.upper[i];
+  }
+  Eigen::VectorXd b(n);
+  for (int k = 0; k < n; ++k) b[k] = u(rng);
+  const Eigen::VectorXd exact = dense.partialPivLu().solve(b);
+  std::vector<BlockTridiagonal<K>::Column> rhs(static_cast<std::size_t>(blocks));
+  for (int i = 0; i < blocks; ++i) rhs[static_cast<std::size_t>(i)] = b.segment<K>(K * i);
+  bt.factor();
+  REQUIRE_FALSE(bt.singular());
+  bt.solve(rhs);
+  for (int i = 0; i < blocks; ++i)
+    CHECK((rhs[static_cast<std::size_t>(i)] - exact.segment<K>(K * i)).cwiseAbs().maxCoeff() < 1e-12 * exact.cwiseAbs().maxCoeff());
+}
+
+TEST_CASE("quadratic elements: a chain hanging at rest has the tension lambda g (l - s) at every Gauss point",
+          "[unit][quadratic]") {
+  for (int elements : {1, 3, 10}) {
+    auto model = hanging_chain(2 * elements, 1.0, [](double) { return 0.0; }, 0.1, 0.0, "quadratic");
+    const Eigen::VectorXd y = model->state_from_chain();
+    const auto snap = model->snapshot(0.0, y);
+    const QuadraticString<2>& q = *model->quadratic();
+    for (int e = 0; e < elements; ++e)
+      for (int k = 0; k < 2; ++k)
+        CHECK(std::abs(q.tensions()[2 * e + k] - kG * (1.0 - q.gauss_coordinate(e, k))) < 1e-12 * kG);
+    // tension.csv's values: the element's linear tension at each link's midpoint.
+    for (int j = 0; j < 2 * elements; ++j)
+      CHECK(std::abs(snap.tension[j] - kG * (1.0 - model->chain().link_midpoint(j))) < 1e-12 * kG);
+    // At rest: no acceleration, the support carries the weight λ g ℓ.
+    CHECK(snap.a.cwiseAbs().maxCoeff() < 1e-12 * kG);
+    CHECK(std::abs(snap.end_reactions[0].y() - kG) < 1e-12 * kG);
+    CHECK(std::abs(snap.moving_mass - 1.0) < 1e-14);
+  }
+}
