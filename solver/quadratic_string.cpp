@@ -24,8 +24,8 @@ constexpr double kRoundoffUlps = 64;
 
 // --- BlockTridiagonal ---------------------------------------------------------------------------
 
-template <int K>
-void BlockTridiagonal<K>::resize(int blocks) {
+template <int K, int O, int W>
+void BlockTridiagonal<K, O, W>::resize(int blocks) {
   const auto n = static_cast<std::size_t>(blocks);
   lower.resize(n);
   diag.resize(n);
@@ -33,8 +33,8 @@ void BlockTridiagonal<K>::resize(int blocks) {
   y_.resize(n);
 }
 
-template <int K>
-void BlockTridiagonal<K>::set_zero() {
+template <int K, int O, int W>
+void BlockTridiagonal<K, O, W>::set_zero() {
   for (std::size_t i = 0; i < diag.size(); ++i) {
     lower[i].setZero();
     diag[i].setZero();
@@ -79,23 +79,23 @@ bool invert_in_place(Eigen::Matrix<double, K, K>& A) {
 }
 }  // namespace
 
-template <int K>
-void BlockTridiagonal<K>::factor() {
+template <int K, int O, int W>
+void BlockTridiagonal<K, O, W>::factor() {
   const std::size_t n = diag.size();
   singular_ = false;
   for (std::size_t i = 0; i < n; ++i) {
-    if (i > 0) diag[i].noalias() -= lower[i] * y_[i - 1];
+    if (i > 0) diag[i].noalias() -= lower[i].template middleCols<W>(O) * y_[i - 1].template middleRows<W>(O);
     if (!invert_in_place<K>(diag[i])) singular_ = true;  // diag[i] holds the pivot block's inverse
-    if (i + 1 < n) y_[i].noalias() = diag[i] * upper[i];
+    if (i + 1 < n) y_[i].noalias() = diag[i].template middleCols<W>(O) * upper[i].template middleRows<W>(O);
   }
 }
 
-template <int K>
-void BlockTridiagonal<K>::solve(std::vector<Column>& rhs) const {
+template <int K, int O, int W>
+void BlockTridiagonal<K, O, W>::solve(std::vector<Column>& rhs) const {
   const std::size_t n = diag.size();
   Column z;
   for (std::size_t i = 0; i < n; ++i) {
-    if (i > 0) rhs[i].noalias() -= lower[i] * rhs[i - 1];
+    if (i > 0) rhs[i].noalias() -= lower[i].template middleCols<W>(O) * rhs[i - 1].template segment<W>(O);
     z.noalias() = diag[i] * rhs[i];
     rhs[i] = z;
   }
@@ -103,7 +103,8 @@ void BlockTridiagonal<K>::solve(std::vector<Column>& rhs) const {
 }
 
 template class BlockTridiagonal<6>;
-template class BlockTridiagonal<8>;
+template class BlockTridiagonal<6, 2, 2>;
+template class BlockTridiagonal<8, 3, 3>;
 
 // --- QuadraticString ----------------------------------------------------------------------------
 
@@ -159,11 +160,12 @@ template <int dim>
 void QuadraticString<dim>::assemble_and_factor(const Points<dim>& x) {
   solver_.set_zero();
   // Entry (row block I) × (column block J), J − I ∈ {−1, 0, 1}.
-  auto block = [&](int I, int J) -> typename BlockTridiagonal<kBlock>::Block& {
+  auto block = [&](int I, int J) -> typename Blocks::Block& {
     const auto i = static_cast<std::size_t>(I);
     return J == I ? solver_.diag[i] : (J < I ? solver_.lower[i] : solver_.upper[i]);
   };
-  for (int r = dim; r < kBlock; ++r) solver_.diag[0](r, r) = 1.0;  // block 0 holds node 0 only
+  for (int r = 0; r < kBlock; ++r)  // block 0 holds node 0 only, at offset dim
+    if (r < dim || r >= 2 * dim) solver_.diag[0](r, r) = 1.0;
   for (int e = 0; e < num_elements_; ++e) {
     const double h = h_[static_cast<std::size_t>(e)];
     const int tb = e + 1;  // the block of the element's tensions

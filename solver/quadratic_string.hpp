@@ -23,7 +23,8 @@
 ///     [ B  0  ] [ T ] = [ −(h/2) (|v'_k|² + 2α x'_k·v'_k + β² (|x'_k|² − 1)/2)      ],
 /// B_ek,a = N_a'(ξ_k) x'_ekᵀ; a prescribed node's momentum rows are replaced by a = a_path(t) (its
 /// reaction is not an unknown). α = β = 1/τ_b: Baumgarte's stabilisation of c_ek, as on the links.
-/// Ordered by element ([a_2e−1, a_2e, T_e−1,0, T_e−1,1] per element, node 0 first), the matrix is block
+/// Ordered by element ([a_2e−1, a_2e, T_e−1,0, T_e−1,1] per element, node 0 first, at the place of
+/// a_2e), the matrix is block
 /// tridiagonal with blocks of 2·dim+2: the solve is a block Thomas algorithm (pivot blocks inverted
 /// with partial pivoting), O(E).
 ///
@@ -42,9 +43,11 @@
 namespace chainsim {
 
 /// A block-tridiagonal system with K×K blocks: row block i couples to blocks i−1 (lower), i (diag),
-/// i+1 (upper). factor() eliminates forward (block Thomas), inverting each pivot block with partial
+/// i+1 (upper), the neighbours only through the W unknowns at offset O of each block (a lower block
+/// is zero outside its columns O..O+W−1, an upper block outside its rows O..O+W−1; W = K: any
+/// coupling). factor() eliminates forward (block Thomas), inverting each pivot block with partial
 /// pivoting; solve() then costs O(number of blocks), in fixed-size Eigen products.
-template <int K>
+template <int K, int O = 0, int W = K>
 class BlockTridiagonal {
  public:
   using Block = Eigen::Matrix<double, K, K>;
@@ -112,12 +115,14 @@ class QuadraticString {
   long solves() const { return solves_; }
 
  private:
-  using Column = typename BlockTridiagonal<kBlock>::Column;
+  /// Neighbouring elements share one node, the last of a block (offset dim): the coupling window.
+  using Blocks = BlockTridiagonal<kBlock, dim, dim>;
+  using Column = typename Blocks::Column;
   /// The saddle-point matrix at x (mass, constraint gradients, prescribed rows) into solver_, factored.
   void assemble_and_factor(const Points<dim>& x);
   /// Block and offset of node a's rows / columns.
   int block_of_node(int a) const { return (a + 1) / 2; }
-  int offset_of_node(int a) const { return a == 0 ? 0 : (a % 2 == 1 ? 0 : dim); }
+  int offset_of_node(int a) const { return a % 2 == 1 ? 0 : dim; }
   /// x' (per unit s) at Gauss point k of element e.
   Vec<dim> derivative(const Points<dim>& x, int e, int k) const;
   /// Solves [M Bᵀ; B 0] [d; μ] = [f; r] at the last factorisation (f per node, r per Gauss point).
@@ -130,7 +135,7 @@ class QuadraticString {
   std::vector<double> h_;
   double h_min_ = 0;
   Eigen::VectorXd mass_row_;
-  BlockTridiagonal<kBlock> solver_;
+  Blocks solver_;
   std::vector<Column> work_;
   Points<dim> a_, rhs_, tension_force_, inertia_;
   Eigen::VectorXd tension_, r_;

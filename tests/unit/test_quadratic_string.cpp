@@ -17,21 +17,25 @@
 using namespace chainsim;
 using namespace chainsim::testing;
 
-TEST_CASE("BlockTridiagonal solves as a dense LU does", "[unit][quadratic]") {
-  constexpr int K = 6;
-  const int blocks = 7, n = K * blocks;
+namespace {
+/// A random block-tridiagonal system with saddle-like blocks (zero diagonal entries in the last rows,
+/// which need the pivoting), its neighbours coupled through the window O..O+W−1, solved by
+/// BlockTridiagonal and by Eigen's dense LU.
+template <int K, int O, int W>
+void check_against_dense(int blocks) {
+  const int n = K * blocks;
   std::mt19937 rng(5);
   std::uniform_real_distribution<double> u(-1.0, 1.0);
-  BlockTridiagonal<K> bt;
+  BlockTridiagonal<K, O, W> bt;
   bt.resize(blocks);
+  bt.set_zero();
   Eigen::MatrixXd dense = Eigen::MatrixXd::Zero(n, n);
   for (int i = 0; i < blocks; ++i) {
     for (int r = 0; r < K; ++r)
       for (int c = 0; c < K; ++c) {
-        // Saddle-like blocks: zero diagonal entries in the last rows need the pivoting.
-        bt.diag[i](r, c) = (r >= 4 && c >= 4) ? 0.0 : u(rng) + (r == c ? 4.0 : 0.0);
-        bt.lower[i](r, c) = i > 0 ? u(rng) : 0.0;
-        bt.upper[i](r, c) = i + 1 < blocks ? u(rng) : 0.0;
+        bt.diag[i](r, c) = (r >= K - 2 && c >= K - 2) ? 0.0 : u(rng) + (r == c ? 4.0 : 0.0);
+        if (i > 0 && c >= O && c < O + W) bt.lower[i](r, c) = u(rng);
+        if (i + 1 < blocks && r >= O && r < O + W) bt.upper[i](r, c) = u(rng);
       }
     dense.block(K * i, K * i, K, K) = bt.diag[i];
     if (i > 0) dense.block(K * i, K * (i - 1), K, K) = bt.lower[i];
@@ -40,13 +44,21 @@ TEST_CASE("BlockTridiagonal solves as a dense LU does", "[unit][quadratic]") {
   Eigen::VectorXd b(n);
   for (int k = 0; k < n; ++k) b[k] = u(rng);
   const Eigen::VectorXd exact = dense.partialPivLu().solve(b);
-  std::vector<BlockTridiagonal<K>::Column> rhs(static_cast<std::size_t>(blocks));
-  for (int i = 0; i < blocks; ++i) rhs[static_cast<std::size_t>(i)] = b.segment<K>(K * i);
+  std::vector<typename BlockTridiagonal<K, O, W>::Column> rhs(static_cast<std::size_t>(blocks));
+  for (int i = 0; i < blocks; ++i) rhs[static_cast<std::size_t>(i)] = b.template segment<K>(K * i);
   bt.factor();
   REQUIRE_FALSE(bt.singular());
   bt.solve(rhs);
   for (int i = 0; i < blocks; ++i)
-    CHECK((rhs[static_cast<std::size_t>(i)] - exact.segment<K>(K * i)).cwiseAbs().maxCoeff() < 1e-12 * exact.cwiseAbs().maxCoeff());
+    CHECK((rhs[static_cast<std::size_t>(i)] - exact.template segment<K>(K * i)).cwiseAbs().maxCoeff() <
+          1e-12 * exact.cwiseAbs().maxCoeff());
+}
+}  // namespace
+
+TEST_CASE("BlockTridiagonal solves as a dense LU does", "[unit][quadratic]") {
+  check_against_dense<6, 0, 6>(7);
+  check_against_dense<6, 2, 2>(9);  // the 2D quadratic elements' layout
+  check_against_dense<8, 3, 3>(5);  // the 3D one
 }
 
 TEST_CASE("quadratic elements: a chain hanging at rest has the tension lambda g (l - s) at every Gauss point",
