@@ -467,7 +467,10 @@ Integrator::~Integrator() = default;
 
 std::string Integrator::resolve_method(const std::string& method, const OdeSystem& system) {
   if (method != "auto") return method;
-  const bool stiff = system.explicit_stiffness() >= kAutoImplicitStiffness && system.num_events() == 0;
+  // Implicit only where the system solves its own Newton systems (O(N)): ARKODE's dense difference-
+  // quotient Jacobian is O(N³) per set-up (quadratic elements, string_model.hpp).
+  const bool stiff = system.explicit_stiffness() >= kAutoImplicitStiffness && system.num_events() == 0 &&
+                     system.has_newton_solver();
   return stiff ? kAutoImplicit : kAutoExplicit;
 }
 

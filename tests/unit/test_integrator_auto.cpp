@@ -28,3 +28,13 @@ TEST_CASE("method = auto: implicit from 50 links on, explicit below", "[unit][in
   CHECK(stats.method == "ARKODE_ARK436L2SA_DIRK_6_3_4");
   CHECK(stats.lin_solves > 0);  // the string's own Newton solver was used
 }
+
+TEST_CASE("method = auto: explicit with quadratic elements, whose implicit path is not O(N)",
+          "[unit][integrator][implicit][quadratic]") {
+  // Quadratic elements have no Newton solver of their own (ARKODE's dense difference-quotient
+  // Jacobian would be O(N³) per set-up): auto keeps them explicit however stiff.
+  auto quadratic = hanging_chain(100, 1.0, [](double) { return 0.0; }, 0.03, 0.0, "quadratic");
+  CHECK(quadratic->explicit_stiffness() == Approx(100));
+  CHECK_FALSE(quadratic->has_newton_solver());
+  CHECK(Integrator::resolve_method("auto", *quadratic) == kAutoExplicit);
+}
