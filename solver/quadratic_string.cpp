@@ -16,6 +16,9 @@ const double kGauss[2] = {-1.0 / std::sqrt(3.0), 1.0 / std::sqrt(3.0)};
 inline double shape_derivative(int a, double xi) { return a == 0 ? xi - 0.5 : (a == 1 ? -2.0 * xi : xi + 0.5); }
 /// Consistent mass of an element of unit λh: ∫ N_a N_b ds / h.
 const double kMass[3][3] = {{4.0 / 30, 2.0 / 30, -1.0 / 30}, {2.0 / 30, 16.0 / 30, 2.0 / 30}, {-1.0 / 30, 2.0 / 30, 4.0 / 30}};
+const char* const kSingularMessage =
+    "the quadratic elements' tension system is singular: the string cannot move as its constraints require (taut "
+    "between prescribed points, folded onto itself, or a Gauss point with x' = 0)";
 /// Newton iterations of the projection.
 constexpr int kMaxProjection = 60;
 /// Round-off of the coordinates, in ulps of max |x| / h_min (as StringModel's projection).
@@ -43,12 +46,24 @@ void BlockTridiagonal<K, O, W>::set_zero() {
 }
 
 namespace {
-/// Inverts a small fixed-size matrix in place by Gauss–Jordan elimination with partial pivoting.
-/// Eigen's LU of a 6×6 or 8×8 block goes through its general (blocked, dynamic-size) triangular
-/// kernels, which cost several times the arithmetic at this size; these loops unroll. Returns false
-/// if a pivot is zero or not finite (a singular block).
+/// Inverts a small fixed-size matrix in place by Gauss–Jordan elimination with partial pivoting, after
+/// scaling its rows and then its columns to a largest entry of 1 (the blocks mix masses, kg, with
+/// constraint gradients, 1). Eigen's LU of a 6×6 or 8×8 block goes through its general (blocked,
+/// dynamic-size) triangular kernels, which cost several times the arithmetic at this size; these
+/// loops unroll. Returns false for a singular block: a zero or non-finite pivot, or an inverse of the
+/// scaled block beyond 1/kSingularBlock (its condition number, to a factor of K).
+constexpr double kSingularBlock = 1e-13;
 template <int K>
 bool invert_in_place(Eigen::Matrix<double, K, K>& A) {
+  Eigen::Matrix<double, K, 1> row_scale, col_scale;
+  for (int i = 0; i < K; ++i) {
+    const double m = A.row(i).cwiseAbs().maxCoeff();
+    if (!(m > 0) || !std::isfinite(m)) return false;
+    row_scale[i] = 1.0 / m;
+  }
+  A = row_scale.asDiagonal() * A;
+  for (int j = 0; j < K; ++j) col_scale[j] = 1.0 / A.col(j).cwiseAbs().maxCoeff();
+  A = A * col_scale.asDiagonal();
   int perm[K];
   for (int i = 0; i < K; ++i) perm[i] = i;
   for (int c = 0; c < K; ++c) {
@@ -71,10 +86,12 @@ bool invert_in_place(Eigen::Matrix<double, K, K>& A) {
       A.row(r) -= f * A.row(c);
     }
   }
-  // The rows were exchanged: the inverse of the original has its columns exchanged back.
+  if (!(A.cwiseAbs().maxCoeff() < 1.0 / kSingularBlock)) return false;
+  // The rows were exchanged: the inverse has its columns exchanged back; then the scalings undone,
+  // A⁻¹ = C (R A C)⁻¹ R.
   Eigen::Matrix<double, K, K> out;
   for (int i = 0; i < K; ++i) out.col(perm[i]) = A.col(i);
-  A = out;
+  A = col_scale.asDiagonal() * out * row_scale.asDiagonal();
   return true;
 }
 }  // namespace
@@ -207,7 +224,7 @@ void QuadraticString<dim>::solve(const Points<dim>& f, const Eigen::VectorXd& r,
     work_[static_cast<std::size_t>(block_of_node(a))].template segment<dim>(offset_of_node(a)) = f.col(a);
   for (int e = 0; e < num_elements_; ++e)
     for (int k = 0; k < 2; ++k) work_[static_cast<std::size_t>(e + 1)][2 * dim + k] = r[2 * e + k];
-  if (solver_.singular()) throw RecoverableError("the quadratic elements' tension system is singular (a Gauss point with x' = 0?)");
+  if (solver_.singular()) throw RecoverableError(kSingularMessage);
   solver_.solve(work_);
   ++solves_;
   for (int a = 0; a < num_nodes_; ++a)
@@ -216,7 +233,7 @@ void QuadraticString<dim>::solve(const Points<dim>& f, const Eigen::VectorXd& r,
     for (int e = 0; e < num_elements_; ++e)
       for (int k = 0; k < 2; ++k) (*mu)[2 * e + k] = work_[static_cast<std::size_t>(e + 1)][2 * dim + k];
   if (!d.allFinite() || (mu && !mu->allFinite()))
-    throw RecoverableError("the quadratic elements' tension system is singular (a Gauss point with x' = 0?)");
+    throw RecoverableError(kSingularMessage);
 }
 
 template <int dim>

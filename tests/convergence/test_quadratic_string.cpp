@@ -135,6 +135,14 @@ TEST_CASE("quadratic elements: refused where they do not apply, at the key", "[u
   CHECK_THAT(even, Contains("q.toml:5") && Contains("string.elements") && Contains("20 nodes") && Contains("odd"));
   const std::string bad = message(std::regex_replace(base, std::regex("\"quadratic\""), "\"cubic\""));
   CHECK_THAT(bad, Contains("q.toml:5") && Contains("string.elements") && Contains("cubic") && Contains("quadratic"));
+  // One element between fixed ends 1 − 1e-6 m apart (hanging_chain.toml's line): nearly taut, its two
+  // Gauss-point constraints nearly dependent, the tensions undetermined (the links refuse the same
+  // string at their singular tension system).
+  std::string nearly_taut = std::regex_replace(base, std::regex("nodes = 21"), "nodes = 3");
+  nearly_taut = std::regex_replace(nearly_taut, std::regex("\\[1\\.0, 0\\.0\\]"), "[0.04998, -0.99875]");
+  const std::string taut = message(
+      std::regex_replace(nearly_taut, std::regex("start = \"fixed\""), "start = \"fixed\"\nend = \"fixed\""));
+  CHECK_THAT(taut, Contains("q.toml:11") && Contains("singular") && Contains("taut"));  // at ends.end
   std::ifstream file(std::string(CHAINSIM_SOURCE_DIR) + "/cases/scenes/falling_chain.toml");
   std::stringstream falling;
   falling << file.rdbuf();
