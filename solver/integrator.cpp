@@ -467,10 +467,7 @@ Integrator::~Integrator() = default;
 
 std::string Integrator::resolve_method(const std::string& method, const OdeSystem& system) {
   if (method != "auto") return method;
-  // Implicit only where the system solves its own Newton systems (O(N)): ARKODE's dense difference-
-  // quotient Jacobian is O(N³) per set-up (quadratic elements, string_model.hpp).
-  const bool stiff = system.explicit_stiffness() >= kAutoImplicitStiffness && system.num_events() == 0 &&
-                     system.has_newton_solver();
+  const bool stiff = system.explicit_stiffness() >= kAutoImplicitStiffness && system.num_events() == 0;
   return stiff ? kAutoImplicit : kAutoExplicit;
 }
 

@@ -78,8 +78,8 @@ struct IntegratorOptions {
   /// short aliases listed by method_aliases(): "erk8" (Fehlberg 13-7-8, default), "erk6" (Verner
   /// 8-5-6), "erk5" (Dormand–Prince 7-4-5), "erk4" (Zonneveld 5-3-4), "erk3" (Bogacki–Shampine),
   /// "dirk5" (Kvaerno 7-4-5), "dirk4" (ARK 4-3-6 DIRK), "dirk3" (ARK 3-2-4 DIRK), "dirk2" (SDIRK 2-1-2),
-  /// or "auto": kAutoImplicit when OdeSystem::explicit_stiffness() >= Integrator::kAutoImplicitStiffness,
-  /// the system has no event functions and solves its own Newton systems, kAutoExplicit otherwise.
+  /// or "auto": kAutoImplicit when OdeSystem::explicit_stiffness() >= Integrator::kAutoImplicitStiffness
+  /// and the system has no event functions, kAutoExplicit otherwise.
   std::string method = "erk8";
   double rtol = 1e-10;   ///< relative tolerance, in [1e-14, 1e-2]
   double atol = 1e-12;   ///< absolute tolerance relative to OdeSystem::state_scale(), > 0

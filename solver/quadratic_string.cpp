@@ -154,7 +154,8 @@ QuadraticString<dim>::QuadraticString(const Chain<dim>& chain, const std::vector
   for (int e = 0; e < num_elements_; ++e)
     for (int a = 0; a < 3; ++a)
       for (int b = 0; b < 3; ++b) mass_row_[2 * e + a] += density_ * h_[static_cast<std::size_t>(e)] * kMass[a][b];
-  solver_.resize(num_elements_ + 1);
+  blocks_.resize(num_elements_ + 1);
+  newton_.resize(num_elements_ + 1);
   work_.resize(static_cast<std::size_t>(num_elements_ + 1));
   for (Points<dim>* p : {&a_, &rhs_, &tension_force_, &inertia_}) *p = Points<dim>::Zero(dim, n);
   tension_ = Eigen::VectorXd::Zero(2 * num_elements_);
@@ -174,26 +175,31 @@ double QuadraticString<dim>::gauss_coordinate(int e, int k) const {
 }
 
 template <int dim>
-void QuadraticString<dim>::assemble_and_factor(const Points<dim>& x) {
-  solver_.set_zero();
+void QuadraticString<dim>::assemble_and_factor(const Points<dim>& x, double gamma) {
+  Blocks& sys = gamma > 0 ? newton_ : blocks_;  // a Newton system is kept across right-hand sides
+  sys.set_zero();
   // Entry (row block I) × (column block J), J − I ∈ {−1, 0, 1}.
   auto block = [&](int I, int J) -> typename Blocks::Block& {
     const auto i = static_cast<std::size_t>(I);
-    return J == I ? solver_.diag[i] : (J < I ? solver_.lower[i] : solver_.upper[i]);
+    return J == I ? sys.diag[i] : (J < I ? sys.lower[i] : sys.upper[i]);
   };
   for (int r = 0; r < kBlock; ++r)  // block 0 holds node 0 only, at offset dim
-    if (r < dim || r >= 2 * dim) solver_.diag[0](r, r) = 1.0;
+    if (r < dim || r >= 2 * dim) sys.diag[0](r, r) = 1.0;
   for (int e = 0; e < num_elements_; ++e) {
     const double h = h_[static_cast<std::size_t>(e)];
     const int tb = e + 1;  // the block of the element's tensions
     for (int k = 0; k < 2; ++k) {
+      const int g = 2 * e + k;
       const Vec<dim> d = derivative(x, e, k);
+      // The constraint row's vector: x' (B), plus γ² (2α v' + β² x' + a') + γ (2 v' + 2α x') in a
+      // Newton system (−γ² C_x − γ C_v).
+      const Vec<dim> row = gamma > 0 ? Vec<dim>(d + gamma * gamma * cx_lin_.col(g) + gamma * cv_lin_.col(g)) : d;
       for (int a = 0; a < 3; ++a) {
         const int node = 2 * e + a, nb = block_of_node(node), no = offset_of_node(node);
-        const Vec<dim> col = shape_derivative(a, kGauss[k]) * d;
+        const double dn = shape_derivative(a, kGauss[k]);
         // Constraint row (e, k): B_ek,a a_a;  momentum rows of a free node: + B_ek,aᵀ T_ek.
-        block(tb, nb).block(2 * dim + k, no, 1, dim) += col.transpose();
-        if (!prescribed_[static_cast<std::size_t>(node)]) block(nb, tb).block(no, 2 * dim + k, dim, 1) += col;
+        block(tb, nb).block(2 * dim + k, no, 1, dim) += dn * row.transpose();
+        if (!prescribed_[static_cast<std::size_t>(node)]) block(nb, tb).block(no, 2 * dim + k, dim, 1) += dn * d;
       }
     }
     for (int a = 0; a < 3; ++a) {
@@ -201,31 +207,38 @@ void QuadraticString<dim>::assemble_and_factor(const Points<dim>& x) {
       if (prescribed_[static_cast<std::size_t>(na)]) continue;
       for (int b = 0; b < 3; ++b) {
         const int nb = 2 * e + b;
+        double m = density_ * h * kMass[a][b];
+        if (gamma > 0)  // + γ² K_T
+          for (int k = 0; k < 2; ++k)
+            m += gamma * gamma * t_lin_[2 * e + k] * shape_derivative(a, kGauss[k]) * shape_derivative(b, kGauss[k]) *
+                 (2.0 / h);
         block(block_of_node(na), block_of_node(nb))
             .block(offset_of_node(na), offset_of_node(nb), dim, dim)
             .diagonal()
-            .array() += density_ * h * kMass[a][b];
+            .array() += m;
       }
     }
   }
   for (int a = 0; a < num_nodes_; ++a)
     if (prescribed_[static_cast<std::size_t>(a)])
-      solver_.diag[static_cast<std::size_t>(block_of_node(a))]
+      sys.diag[static_cast<std::size_t>(block_of_node(a))]
           .block(offset_of_node(a), offset_of_node(a), dim, dim)
           .diagonal()
           .array() += 1.0;
-  solver_.factor();
+  sys.factor();
 }
 
 template <int dim>
-void QuadraticString<dim>::solve(const Points<dim>& f, const Eigen::VectorXd& r, Points<dim>& d, Eigen::VectorXd* mu) {
+void QuadraticString<dim>::solve(const Points<dim>& f, const Eigen::VectorXd& r, Points<dim>& d, Eigen::VectorXd* mu,
+                                 bool newton) {
+  const Blocks& sys = newton ? newton_ : blocks_;
   for (auto& w : work_) w.setZero();
   for (int a = 0; a < num_nodes_; ++a)
     work_[static_cast<std::size_t>(block_of_node(a))].template segment<dim>(offset_of_node(a)) = f.col(a);
   for (int e = 0; e < num_elements_; ++e)
     for (int k = 0; k < 2; ++k) work_[static_cast<std::size_t>(e + 1)][2 * dim + k] = r[2 * e + k];
-  if (solver_.singular()) throw RecoverableError(kSingularMessage);
-  solver_.solve(work_);
+  if (sys.singular()) throw RecoverableError(kSingularMessage);
+  sys.solve(work_);
   ++solves_;
   for (int a = 0; a < num_nodes_; ++a)
     d.col(a) = work_[static_cast<std::size_t>(block_of_node(a))].template segment<dim>(offset_of_node(a));
@@ -262,6 +275,60 @@ void QuadraticString<dim>::evaluate(const Points<dim>& x, const Points<dim>& v, 
     for (int a = 0; a < 3; ++a)
       for (int b = 0; b < 3; ++b) inertia_.col(2 * e + a) += density_ * h * kMass[a][b] * a_.col(2 * e + b);
   }
+}
+
+template <int dim>
+void QuadraticString<dim>::linearize(const Points<dim>& x, const Points<dim>& v, double alpha, double beta2) {
+  const int ng = 2 * num_elements_;
+  for (Points<dim>* p : {&dx_lin_, &cx_lin_, &cv_lin_}) p->resize(dim, ng);
+  t_lin_ = tension_;
+  for (int e = 0; e < num_elements_; ++e)
+    for (int k = 0; k < 2; ++k) {
+      const int g = 2 * e + k;
+      const Vec<dim> dx = derivative(x, e, k), dv = derivative(v, e, k), da = derivative(a_, e, k);
+      dx_lin_.col(g) = dx;
+      cx_lin_.col(g) = 2 * alpha * dv + beta2 * dx + da;
+      cv_lin_.col(g) = 2 * dv + 2 * alpha * dx;
+    }
+  xl_ = x;
+}
+
+template <int dim>
+void QuadraticString<dim>::newton_factor(double gamma) {
+  gamma_ = gamma;
+  assemble_and_factor(xl_, gamma);
+}
+
+template <int dim>
+void QuadraticString<dim>::newton_solve(const Points<dim>& rx, const Points<dim>& rv, Points<dim>& zv) {
+  const double gamma = gamma_;
+  rhs_.setZero();
+  for (int e = 0; e < num_elements_; ++e) {
+    const double h = h_[static_cast<std::size_t>(e)];
+    for (int a = 0; a < 3; ++a) {
+      const int na = 2 * e + a;
+      if (prescribed_[static_cast<std::size_t>(na)]) continue;
+      for (int b = 0; b < 3; ++b) {
+        const int nb = 2 * e + b;
+        double kt = 0;
+        for (int k = 0; k < 2; ++k)
+          kt += t_lin_[2 * e + k] * shape_derivative(a, kGauss[k]) * shape_derivative(b, kGauss[k]) * (2.0 / h);
+        rhs_.col(na) += density_ * h * kMass[a][b] * rv.col(nb) - gamma * kt * rx.col(nb);  // M r_v − γ K_T r_x
+      }
+    }
+    for (int k = 0; k < 2; ++k) {
+      const int g = 2 * e + k;
+      double rk = 0;  // B r_v + γ C_x r_x
+      for (int b = 0; b < 3; ++b) {
+        const int nb = 2 * e + b;
+        if (prescribed_[static_cast<std::size_t>(nb)]) continue;
+        rk += shape_derivative(b, kGauss[k]) * (dx_lin_.col(g).dot(rv.col(nb)) - gamma * cx_lin_.col(g).dot(rx.col(nb)));
+      }
+      r_[g] = rk;
+    }
+  }
+  zv.resize(dim, num_nodes_);
+  solve(rhs_, r_, zv, nullptr, true);
 }
 
 template <int dim>

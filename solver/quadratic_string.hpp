@@ -114,19 +114,36 @@ class QuadraticString {
   Vec<dim> position_at(const Points<dim>& x, double s) const;
   long solves() const { return solves_; }
 
+  // --- Newton systems of implicit methods -----------------------------------------------------
+  /// Keeps the linearisation at the last evaluate() (its x', v', a' and T at the Gauss points, α, β²).
+  void linearize(const Points<dim>& x, const Points<dim>& v, double alpha, double beta2);
+  /// Factors the Newton system of a stage, (I − γ J) z = r, as the saddle-point system in (z_v, γ δT)
+  ///     [ M + γ² K_T           Bᵀ ] [ z_v  ]   [ M r_v − γ K_T r_x    ]
+  ///     [ B − γ² C_x − γ C_v   0  ] [ γ δT ] = [ B r_v + γ C_x r_x    ],   z_x = r_x + γ z_v,
+  /// K_T = Σ_ek T_ek N_a' N_b' (2/h) I (the tensions' stiffness), C_x, C_v the derivatives of the
+  /// constraint rows' right-hand side less (δB) a: the same block-tridiagonal structure, O(N).
+  void newton_factor(double gamma);
+  /// z_v of the factored Newton system for r_x, r_v (all nodes; the prescribed ones' are ignored).
+  void newton_solve(const Points<dim>& rx, const Points<dim>& rv, Points<dim>& zv);
+  /// γ of the last newton_factor().
+  double newton_gamma() const { return gamma_; }
+
  private:
   /// Neighbouring elements share one node, the last of a block (offset dim): the coupling window.
   using Blocks = BlockTridiagonal<kBlock, dim, dim>;
   using Column = typename Blocks::Column;
-  /// The saddle-point matrix at x (mass, constraint gradients, prescribed rows) into solver_, factored.
-  void assemble_and_factor(const Points<dim>& x);
+  /// The saddle-point matrix at x (mass, constraint gradients, prescribed rows) into blocks_, factored;
+  /// with γ > 0, the Newton system's into newton_ (newton_factor, at the linearisation's state).
+  void assemble_and_factor(const Points<dim>& x, double gamma = 0);
   /// Block and offset of node a's rows / columns.
   int block_of_node(int a) const { return (a + 1) / 2; }
   int offset_of_node(int a) const { return a % 2 == 1 ? 0 : dim; }
   /// x' (per unit s) at Gauss point k of element e.
   Vec<dim> derivative(const Points<dim>& x, int e, int k) const;
-  /// Solves [M Bᵀ; B 0] [d; μ] = [f; r] at the last factorisation (f per node, r per Gauss point).
-  void solve(const Points<dim>& f, const Eigen::VectorXd& r, Points<dim>& d, Eigen::VectorXd* mu);
+  /// Solves [M Bᵀ; B 0] [d; μ] = [f; r] at the last factorisation (f per node, r per Gauss point), or
+  /// the Newton system's.
+  void solve(const Points<dim>& f, const Eigen::VectorXd& r, Points<dim>& d, Eigen::VectorXd* mu,
+             bool newton = false);
 
   double density_ = 0;
   std::vector<double> s_;  // node coordinates
@@ -135,11 +152,16 @@ class QuadraticString {
   std::vector<double> h_;
   double h_min_ = 0;
   Eigen::VectorXd mass_row_;
-  Blocks solver_;
+  Blocks blocks_, newton_;
   std::vector<Column> work_;
   Points<dim> a_, rhs_, tension_force_, inertia_;
   Eigen::VectorXd tension_, r_;
   long solves_ = 0;
+  // The linearisation (Newton systems): per Gauss point 2e + k, x', and the constraint rows' extra
+  // terms γ² (2α v' + β² x' + a') + γ (2 v' + 2α x') as their two vectors; T; γ.
+  Points<dim> xl_, dx_lin_, cx_lin_, cv_lin_;  // xl_: the positions
+  Eigen::VectorXd t_lin_;
+  double gamma_ = 0;
 };
 
 }  // namespace chainsim

@@ -109,7 +109,7 @@ class StringModel final : public OdeSystem {
   /// matching energies; without one, plain absolute tolerances (empty).
   Eigen::VectorXd state_scale() const override;
   /// Implicit methods: the exact Newton systems of the string (string_jacobian.hpp), O(N) each.
-  bool has_newton_solver() const override { return system_ != nullptr && !quadratic_; }
+  bool has_newton_solver() const override { return system_ != nullptr; }
   void newton_setup(double t, const Eigen::Ref<const Eigen::VectorXd>& y, bool relinearize, double gamma) override;
   void newton_solve(const Eigen::Ref<const Eigen::VectorXd>& r, Eigen::Ref<Eigen::VectorXd> z) override;
   /// No module and only state-independent applied forces (gravity, end loads): the linearisation

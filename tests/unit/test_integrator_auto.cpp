@@ -29,12 +29,24 @@ TEST_CASE("method = auto: implicit from 50 links on, explicit below", "[unit][in
   CHECK(stats.lin_solves > 0);  // the string's own Newton solver was used
 }
 
-TEST_CASE("method = auto: explicit with quadratic elements, whose implicit path is not O(N)",
+TEST_CASE("method = auto: implicit from 50 links on with quadratic elements too, on their own Newton solver",
           "[unit][integrator][implicit][quadratic]") {
-  // Quadratic elements have no Newton solver of their own (ARKODE's dense difference-quotient
-  // Jacobian would be O(N³) per set-up): auto keeps them explicit however stiff.
-  auto quadratic = hanging_chain(100, 1.0, [](double) { return 0.0; }, 0.03, 0.0, "quadratic");
-  CHECK(quadratic->explicit_stiffness() == Approx(100));
-  CHECK_FALSE(quadratic->has_newton_solver());
-  CHECK(Integrator::resolve_method("auto", *quadratic) == kAutoExplicit);
+  // Quadratic elements solve their Newton systems themselves (O(N), quadratic_string.hpp): auto treats
+  // them as the links, by the stiffness ℓ / h_min.
+  auto tilted = [](double sigma) { return 1e-3 * sigma; };
+  auto quadratic = hanging_chain(50, 1.0, tilted, 0.03, 0.0, "quadratic");
+  auto coarse = hanging_chain(48, 1.0, tilted, 0.03, 0.0, "quadratic");
+  CHECK(quadratic->explicit_stiffness() == Approx(50));
+  REQUIRE(quadratic->has_newton_solver());
+  CHECK(quadratic->newton_solver_exact());
+  CHECK(Integrator::resolve_method("auto", *coarse) == kAutoExplicit);
+  CHECK(Integrator::resolve_method("auto", *quadratic) == kAutoImplicit);
+  IntegratorOptions options;
+  options.method = "auto";
+  Integrator integrator(*quadratic, 0.0, quadratic->state_from_chain(), options);
+  integrator.advance(0.01);
+  const IntegratorStats stats = integrator.stats();
+  CHECK(stats.implicit);
+  CHECK(stats.lin_solves > 0);  // the elements' own Newton solver was used
+  CHECK(stats.nonlin_conv_fails == 0);
 }
