@@ -295,6 +295,7 @@ void QuadraticString<dim>::linearize(const Points<dim>& x, const Points<dim>& v,
 
 template <int dim>
 void QuadraticString<dim>::newton_factor(double gamma) {
+  if (xl_.cols() != num_nodes_) throw RecoverableError("the quadratic elements have no linearisation yet");
   gamma_ = gamma;
   assemble_and_factor(xl_, gamma);
 }
