@@ -44,6 +44,9 @@ inline constexpr Integration kReduced{"erk8", 1e-13, 1e-15};
 inline constexpr long kMaxSteps = 500000;
 /// Tension backend (StringModelOptions::backend, [solver] backend).
 inline constexpr const char* kBackend = "auto";
+/// The discretization (StringModelOptions::elements, [string] elements): "links" (order 2) until the
+/// quadratic elements carry fronts and closed strings (docs/work-precision.md).
+inline constexpr const char* kElements = "links";
 /// Slack means T_j < −kSlackTolerance · (tension scale) ([solver] slack_tolerance).
 inline constexpr double kSlackTolerance = 1e-8;
 /// A scene checks slack and stops at it ([solver] slack = "stop"): a scene's result past a slack

@@ -1,5 +1,6 @@
 // The exact linearisation of the string and its Newton systems: see string_jacobian.hpp.
 #include "string_jacobian.hpp"
+#include "quadratic_string.hpp"
 
 #include <cmath>
 #include <vector>
@@ -234,6 +235,15 @@ void StringJacobian<dim>::solve(const Eigen::Ref<const Eigen::VectorXd>& r, Eige
 template <int dim>
 void StringModel<dim>::newton_setup(double t, const Eigen::Ref<const Eigen::VectorXd>& y, bool relinearize,
                                     double gamma) {
+  if (quadratic_) {  // the elements' own Newton systems (quadratic_string.hpp)
+    if (relinearize) {
+      unpack_state(t, y);
+      evaluate_current(t);
+      quadratic_->linearize(x_, v_, alpha_, beta2_);
+    }
+    quadratic_->newton_factor(gamma);
+    return;
+  }
   if (!jacobian_) jacobian_ = std::make_shared<StringJacobian<dim>>(*this);
   const bool stale = jacobian_->velocity_unknowns() != dim * num_free_ ||
                      jacobian_->tension_unknowns() != (system_ ? system_->size() : 0);
@@ -246,6 +256,26 @@ void StringModel<dim>::newton_setup(double t, const Eigen::Ref<const Eigen::Vect
 
 template <int dim>
 void StringModel<dim>::newton_solve(const Eigen::Ref<const Eigen::VectorXd>& r, Eigen::Ref<Eigen::VectorXd> z) {
+  if (quadratic_) {
+    const int nv = dim * num_free_;
+    Points<dim> rx = Points<dim>::Zero(dim, chain_.num_nodes()), rv = rx, zv;
+    for (int i = 0; i < chain_.num_nodes(); ++i) {
+      const int k = slot_[i];
+      if (k < 0) continue;
+      rx.col(i) = r.template segment<dim>(dim * k);
+      rv.col(i) = r.template segment<dim>(nv + dim * k);
+    }
+    quadratic_->newton_solve(rx, rv, zv);
+    const double gamma = quadratic_->newton_gamma();
+    for (int i = 0; i < chain_.num_nodes(); ++i) {
+      const int k = slot_[i];
+      if (k < 0) continue;
+      z.template segment<dim>(nv + dim * k) = zv.col(i);
+      z.template segment<dim>(dim * k) = rx.col(i) + gamma * zv.col(i);
+    }
+    z.tail(r.size() - 2 * nv) = r.tail(r.size() - 2 * nv);  // the ledgers: identity rows
+    return;
+  }
   CHAINSIM_VERIFY(jacobian_ && jacobian_->velocity_unknowns() == dim * num_free_,
                   "newton_setup() comes before newton_solve()");
   jacobian_->solve(r, z);

@@ -8,6 +8,7 @@
 #include <fmt/format.h>
 
 #include "mesh/errors.hpp"
+#include "quadratic_string.hpp"
 
 namespace chainsim {
 
@@ -47,6 +48,9 @@ void StringModelOptions::validate() const {
   require_in_range("solver.stabilization_time", stabilization_time, 0.0, INFINITY);
   require_in_range("solver.slack_tolerance", slack_tolerance, 0.0, 1.0);
   if (backend != "auto") make_tension_backend(backend);  // throws InputError for an unknown name
+  if (elements != "links" && elements != "quadratic")
+    throw InputError(fmt::format("string.elements = \"{}\" is not allowed; valid values: \"links\", \"quadratic\"",
+                                 elements));
 }
 
 template <int dim>
@@ -99,6 +103,12 @@ StringModel<dim>::StringModel(Chain<dim> chain, std::vector<std::unique_ptr<Forc
                                    "use more nodes",
                                    j, chain_.link_start(j), chain_.link_end(j)));
   if (options_.stabilization_time > 0) alpha_ = beta_ = 1.0 / options_.stabilization_time;
+  if (options_.elements == "quadratic") {
+    if (module_)
+      throw InputError("string.elements = \"quadratic\" does not meet fronts (heaps, folds): use elements = \"links\" "
+                       "for a scene with fronts");
+    quadratic_ = std::make_shared<QuadraticString<dim>>(chain_, prescribed_);
+  }
   // 3. Workspace, the state, then slots, masses and the tension system.
   for (Points<dim>* p : {&a_, &force_, &force_nc_, &module_force_, &tension_force_, &b_, &reaction_})
     *p = Points<dim>::Zero(dim, n);
@@ -146,6 +156,7 @@ void StringModel<dim>::rebuild() {
     arc_links.push_back(arc.num_links());
     arc_closed.push_back(arc.closed);
   }
+  if (quadratic_) base_mass_ = quadratic_->mass_rows();  // the consistent load M g, momentum 1ᵀ M v
   if (system_) solves_ += system_->num_solves();
   system_ = arc_links.empty() ? nullptr : std::make_unique<TensionSystem>(arc_links, arc_closed, options_.backend);
   m_ = base_mass_;
@@ -211,6 +222,25 @@ void StringModel<dim>::links() {
 }
 
 template <int dim>
+double StringModel<dim>::capped_beta2() const {
+  // The position term β² C of the drift control turns the round-off of the link lengths (the
+  // constraint tolerance δ) into accelerations β² δ h. It may not exceed kDriftRoundoff of the
+  // physical acceleration scale (physical_scales().tension / λℓ: weight, loads, drivers, speeds),
+  // so β² is capped there: a string with none of them (at rest without weight or load) gets no
+  // position term and no artificial tension, however short τ_b (β² = 1/τ_b² turned its round-off
+  // into T = −1.5e165 N with τ_b = 1e-91 s). Ordinary runs are far below the cap (falling chain:
+  // β² δ h = 1.7e-10 m/s² against 1e-5 m/s²) and keep β² = 1/τ_b².
+  const double a_physical = physical_scales().tension / (chain_.density() * chain_.length());
+  const double h_ref = std::isfinite(h_min_) ? h_min_ : chain_.length();
+  return std::min(beta_ * beta_, kDriftRoundoff * a_physical / (constraint_tolerance() * h_ref));
+}
+
+template <int dim>
+long StringModel<dim>::tension_solves() const {
+  return solves_ + (system_ ? system_->num_solves() : 0) + (quadratic_ ? quadratic_->solves() : 0);
+}
+
+template <int dim>
 double StringModel<dim>::constraint_tolerance() const {
   return std::max(kProjectionTolerance, kRoundoffUlps * std::numeric_limits<double>::epsilon() * x_max_ / h_min_);
 }
@@ -266,21 +296,16 @@ double StringModel<dim>::evaluate_current(double t) {
   }
   // 2. Link geometry and the tension system.
   tension_force_.setZero();
-  if (system_) {
+  if (quadratic_) {
+    x_max_ = x_.cwiseAbs().maxCoeff();
+    beta2_ = capped_beta2();
+    quadratic_->evaluate(x_, v_, force_, force_nc_, b_, alpha_, beta2_);
+    tension_force_ = quadratic_->tension_forces();
+  } else if (system_) {
     links();
     system_->zero();
     assemble_matrix();
-    // The position term β² C of the drift control turns the round-off of the link lengths (the
-    // constraint tolerance δ) into accelerations β² δ h. It may not exceed kDriftRoundoff of the
-    // physical acceleration scale (physical_scales().tension / λℓ: weight, loads, drivers, speeds),
-    // so β² is capped there: a string with none of them (at rest without weight or load) gets no
-    // position term and no artificial tension, however short τ_b (β² = 1/τ_b² turned its round-off
-    // into T = −1.5e165 N with τ_b = 1e-91 s). Ordinary runs are far below the cap (falling chain:
-    // β² δ h = 1.7e-10 m/s² against 1e-5 m/s²) and keep β² = 1/τ_b².
-    const double tolerance = constraint_tolerance();
-    const double a_physical = physical_scales().tension / (chain_.density() * chain_.length());
-    const double h_ref = std::isfinite(h_min_) ? h_min_ : chain_.length();
-    beta2_ = std::min(beta_ * beta_, kDriftRoundoff * a_physical / (tolerance * h_ref));
+    beta2_ = capped_beta2();  // the drift control's position term, capped (capped_beta2)
     for_each_link([&](int j, int u, int) {
       const int a = chain_.link_start(j), b = chain_.link_end(j);
       const double h = chain_.link_length(j), l = l_[j];
@@ -299,12 +324,12 @@ double StringModel<dim>::evaluate_current(double t) {
   for (int i = 0; i < n; ++i) {
     if (arc_of_[i] < 0) continue;
     if (path_of_[i] < 0) {
-      a_.col(i) = b_.col(i) + w_[i] * tension_force_.col(i);
+      a_.col(i) = quadratic_ ? Vec<dim>(quadratic_->accelerations().col(i)) : Vec<dim>(b_.col(i) + w_[i] * tension_force_.col(i));
       power += force_nc_.col(i).dot(v_.col(i));
     } else {
       a_.col(i) = b_.col(i);
       // the support's reaction R_i = m a − F − T − (module force); drag on it is applied work too
-      reaction_.col(i) = m_[i] * a_.col(i) - force_.col(i) - force_nc_.col(i) - tension_force_.col(i) -
+      reaction_.col(i) = (quadratic_ ? Vec<dim>(quadratic_->inertia().col(i)) : Vec<dim>(m_[i] * a_.col(i))) - force_.col(i) - force_nc_.col(i) - tension_force_.col(i) -
                          module_force_.col(i);
       power += (reaction_.col(i) + force_nc_.col(i)).dot(v_.col(i));
     }
@@ -360,6 +385,7 @@ void StringModel<dim>::project(double t) {
     x_.col(p.node) = p.path->position(t);
     v_.col(p.node) = p.path->velocity(t);
   }
+  if (quadratic_) return quadratic_->project(t, x_, v_);
   // Newton's method for g_j(x) = |Δx_j| − h_j = 0 along δx = W Gᵀ ν: the matrix is the tension
   // matrix A = −G W Gᵀ, so A ν = g gives the smallest mass-weighted correction.
   auto correct = [&](Points<dim>& target, const Eigen::VectorXd& nu) {
@@ -474,6 +500,7 @@ Eigen::VectorXd StringModel<dim>::state_from_chain() const {
 
 template <int dim>
 double StringModel<dim>::kinetic_energy() const {
+  if (quadratic_) return quadratic_->kinetic_energy(v_);
   double K = 0;
   for (int i = 0; i < chain_.num_nodes(); ++i)
     if (in_arc(i)) K += 0.5 * m_[i] * v_.col(i).squaredNorm();
@@ -515,7 +542,9 @@ typename StringModel<dim>::Snapshot StringModel<dim>::snapshot(double t, const E
   s.v = v_;
   s.a = a_;
   s.tension = Eigen::VectorXd::Constant(chain_.num_links(), std::numeric_limits<double>::quiet_NaN());
-  if (system_) {
+  if (quadratic_) {
+    s.tension = quadratic_->link_tensions();
+  } else if (system_) {
     const Eigen::VectorXd& T = system_->solution();
     for_each_link([&](int j, int u, int) { s.tension[j] = T[u]; });
   }
@@ -526,10 +555,15 @@ typename StringModel<dim>::Snapshot StringModel<dim>::snapshot(double t, const E
   for (int i = 0; i < chain_.num_nodes(); ++i)
     if (in_arc(i)) s.moving_mass += m_[i];
   s.work = y[work_index()];
-  for_each_link([&](int j, int, int) {
-    s.max_violation = std::max(s.max_violation, std::abs(l_[j] - chain_.link_length(j)) / chain_.link_length(j));
-    s.max_rate_violation = std::max(s.max_rate_violation, std::abs(e_.col(j).dot(dv_.col(j))));
-  });
+  if (quadratic_) {
+    s.max_violation = quadratic_->max_constraint_violation(x_);
+    s.max_rate_violation = quadratic_->max_rate_violation(x_, v_);
+  } else {
+    for_each_link([&](int j, int, int) {
+      s.max_violation = std::max(s.max_violation, std::abs(l_[j] - chain_.link_length(j)) / chain_.link_length(j));
+      s.max_rate_violation = std::max(s.max_rate_violation, std::abs(e_.col(j).dot(dv_.col(j))));
+    });
+  }
   s.support = support_reaction();
   for (const auto& p : prescribed_) {
     s.end_reactions.push_back(reaction_.col(p.node));
@@ -557,6 +591,11 @@ typename StringModel<dim>::Snapshot StringModel<dim>::snapshot(double t, const E
 
 template <int dim>
 double StringModel<dim>::max_constraint_violation(double t, const Eigen::Ref<const Eigen::VectorXd>& y) const {
+  if (quadratic_) {
+    Points<dim> x, v;
+    unpack(t, y, x, v);
+    return quadratic_->max_constraint_violation(x);
+  }
   auto position = [&](int i) -> Vec<dim> {
     const int k = slot_[i];
     if (k >= 0) return y.template segment<dim>(dim * k);
@@ -593,7 +632,7 @@ std::optional<SlackReport> StringModel<dim>::find_slack(double t, const Eigen::R
   if (!system_) return std::nullopt;
   unpack_state(t, y);
   evaluate_current(t);
-  const Eigen::VectorXd& T = system_->solution();
+  const Eigen::VectorXd T = quadratic_ ? quadratic_->link_tensions() : system_->solution();
   // A string with no weight, load, speed or driver has zero exact tension: whatever the solve gives
   // is round-off, never slack.
   const double physical = physical_scales().tension;

@@ -51,6 +51,8 @@ namespace chainsim {
 
 template <int dim>
 class StringJacobian;
+template <int dim>
+class QuadraticString;
 
 /// SlackPolicy (defaults.hpp): what a run does at a slack link.
 /// "stop", "warn", "ignore".
@@ -75,6 +77,10 @@ struct StringModelOptions {
   SlackPolicy slack = defaults::kLibrarySlack;
   /// Slack means T_j < −slack_tolerance · max_k |T_k| (relative, so round-off is not slack).
   double slack_tolerance = defaults::kSlackTolerance;
+  /// The discretization: "links" (lumped masses, one tension per link, order 2) or "quadratic"
+  /// (quadratic elements, consistent mass, tension at the Gauss points, order 4 for smooth arcs:
+  /// quadratic_string.hpp; open strings without fronts only).
+  std::string elements = defaults::kElements;
   void validate() const;
 };
 
@@ -202,7 +208,9 @@ class StringModel final : public OdeSystem {
   double beta() const { return beta_; }
   TensionSystem& tension_system() { return *system_; }
   bool has_tension_system() const { return system_ != nullptr; }
-  long tension_solves() const { return solves_ + (system_ ? system_->num_solves() : 0); }
+  long tension_solves() const;
+  /// The quadratic elements (StringModelOptions::elements = "quadratic"), or null.
+  const QuadraticString<dim>* quadratic() const { return quadratic_.get(); }
   /// Tensions (per tension unknown) and accelerations of the last evaluation (rhs or snapshot).
   const Eigen::VectorXd& tensions() const { return system_->solution(); }
   const Points<dim>& accelerations() const { return a_; }
@@ -271,6 +279,10 @@ class StringModel final : public OdeSystem {
   void for_each_link(Visit&& visit) const;
   friend class StringJacobian<dim>;
   std::shared_ptr<StringJacobian<dim>> jacobian_;  // built by the first newton_setup()
+  std::shared_ptr<QuadraticString<dim>> quadratic_;  // elements = "quadratic"
+  /// β² = 1/τ_b², capped where its response to the round-off of the coordinates would exceed the
+  /// physical accelerations (needs x_max_).
+  double capped_beta2() const;
 
   Chain<dim> chain_;
   std::vector<std::unique_ptr<Force<dim>>> forces_;

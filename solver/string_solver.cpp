@@ -205,7 +205,9 @@ void StringSolver<dim>::describe_model() {
   summary_.root_functions = model_.num_events();
   summary_.tension_unknowns = model_.has_tension_system() ? model_.tension_system().size() : 0;
   summary_.stabilization_time = model_.options().stabilization_time;
-  summary_.tension_backend = model_.has_tension_system() ? model_.tension_system().backend_name() : "none";
+  summary_.tension_backend = model_.quadratic()             ? "quadratic elements (block tridiagonal)"
+                             : model_.has_tension_system() ? model_.tension_system().backend_name()
+                                                           : "none";
   summary_.t_end = options_.t_end;
   summary_.slack_policy = model_.options().slack;
   const char* axes[] = {"x", "y", "z"};

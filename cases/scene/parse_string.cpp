@@ -60,7 +60,7 @@ EndSpec parse_end(const Section& ends, const std::string& key, Context& ctx) {
 
 void parse_string(const Section& top, Context& ctx) {
   SceneSpec& spec = ctx.spec;
-  Section s(subtable(top, "string"), "string", ctx, {"length", "density", "nodes", "link_length", "closed", "dimension"});
+  Section s(subtable(top, "string"), "string", ctx, {"length", "density", "nodes", "link_length", "closed", "dimension", "elements"});
   spec.length = s.positive("length");
   spec.density = s.positive("density").value_or(spec.density);
   if (auto n = s.integer_in("nodes", 2, kMaxNodes)) spec.nodes = static_cast<int>(*n);
@@ -70,6 +70,7 @@ void parse_string(const Section& top, Context& ctx) {
                                       "one of them",
                                       s.text("link_length"), s.text("nodes")));
   spec.closed = s.boolean("closed");
+  spec.elements = s.choice("elements", {"links", "quadratic"}, defaults::kElements);
   if (auto d = s.integer("dimension")) {
     if (*d != 2 && *d != 3) s.fail("dimension", fmt::format("string.dimension = {} is not allowed; valid values: 2, 3", *d));
     spec.dimension = static_cast<int>(*d);

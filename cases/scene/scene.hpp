@@ -15,7 +15,8 @@
 ///                        offending key.
 /// The keys, their units, defaults and ranges are documented in docs/scenes.md. In short:
 ///
-///     [string]   length (m), density (kg/m), nodes | link_length (m), closed, dimension (2 | 3)
+///     [string]   length (m), density (kg/m), nodes | link_length (m), closed, dimension (2 | 3),
+///                elements (links | quadratic)
 ///     [shape]    kind = polyline | points | arc | circle | catenary, and that kind's keys
 ///     [velocity] kind = rest | uniform | tangential | nodes
 ///     [ends]     start, end = "free" | "fixed" | { kind = "loaded", … } | { kind = "driven", … }
@@ -115,6 +116,7 @@ struct SceneSpec {
   std::optional<int> nodes;           ///< default 41 (unless link_length is given)
   std::optional<double> link_length;  ///< m; target material length of a link (instead of nodes)
   std::optional<bool> closed;         ///< default: true for a circle, else false
+  std::string elements = defaults::kElements;     ///< "links" (order 2) | "quadratic" (order 4: StringModelOptions::elements)
   // [shape]
   struct Shape {
     std::string kind;

@@ -160,6 +160,21 @@ SceneParts<dim> build_scene_parts(const SceneSpec& spec) {
   const int links = link_count(spec, length, closed);
   Chain<dim> chain =
       at_key(spec, "shape", [&] { return discretize(*curve, length, spec.density, links, closed, sh.length_tolerance); });
+  if (spec.elements == "quadratic") {  // what quadratic elements hold (solver/quadratic_string.hpp)
+    std::string why;
+    if (spec.has_fronts())
+      why = "the scene has a front (a heap or a fold), which quadratic elements do not meet";
+    else if (closed)
+      why = "the string is closed; quadratic elements hold open strings only";
+    else if (chain.num_nodes() % 2 == 0)
+      why = fmt::format("the string has {} nodes; quadratic elements need an odd number (two per element, plus one)",
+                        chain.num_nodes());
+    if (!why.empty())
+      fail_at(spec, "string.elements", fmt::format("string.elements = \"quadratic\" is not allowed here: {}; allowed: "
+                                                   "\"links\" (any string), \"quadratic\" (an open string without "
+                                                   "fronts, an odd number of nodes)",
+                                                   why));
+  }
   const auto& vel = spec.velocity;
   if (vel.kind == "uniform") set_uniform_velocity(chain, as_vec<dim>(spec, vel.value, "velocity.value"));
   if (vel.kind == "tangential") at_key(spec, "velocity.speed", [&] { set_tangential_velocity(chain, vel.speed); });
@@ -256,6 +271,7 @@ SceneParts<dim> build_scene_parts(const SceneSpec& spec) {
   StringModelOptions mo;
   mo.stabilization_time = so.stabilization_time.value_or(defaults::kSceneStabilizationFraction * t_char);
   mo.backend = so.backend;
+  mo.elements = spec.elements;
   mo.slack = so.slack == "warn" ? SlackPolicy::kWarn : so.slack == "ignore" ? SlackPolicy::kIgnore : SlackPolicy::kStop;
   mo.slack_tolerance = so.slack_tolerance;
   StringSolverOptions run;

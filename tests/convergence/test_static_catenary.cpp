@@ -50,7 +50,7 @@ Catenary reference(double d, double dy, double length) {
   return cat;
 }
 
-double relaxed_error(int links) {
+double relaxed_error(int links, const std::string& elements = "links") {
   const double length = 1.0;
   const Vec<2> p0(0.0, 0.0), p1(0.8, 0.2);
   // The V: apex at x = 0.4 below the chord, with legs adding up to ℓ (bisection on its height).
@@ -70,6 +70,7 @@ double relaxed_error(int links) {
                                          {links, std::make_shared<FixedPoint<2>>(p1)}};
   StringModelOptions mo;
   mo.stabilization_time = 0.03;
+  mo.elements = elements;
   StringModel<2> model(std::move(chain), std::move(forces), ends, mo);
   model.make_consistent(0.0);
   IntegratorOptions io;
@@ -96,4 +97,15 @@ TEST_CASE("a damped string relaxes to the catenary, at second order in the mesh 
   const auto rates = rate_table("static catenary: max node distance to y = a cosh((x - x_m)/a) + c (m)", "links",
                                 links, error);
   for (double r : rates) CHECK(r > kOrder - kRateMargin);
+}
+
+TEST_CASE("with quadratic elements the damped string relaxes to the catenary at fourth order",
+          "[convergence][string][quadratic]") {
+  // The same rest state with [string] elements = "quadratic" (two links per element): a smooth arc.
+  const std::vector<int> links = {4, 8, 16, 32};
+  std::vector<double> error;
+  for (int n : links) error.push_back(relaxed_error(n, "quadratic"));
+  const auto rates = rate_table("static catenary, quadratic elements: max node distance to the catenary (m)", "links",
+                                links, error);
+  for (double r : rates) CHECK(r > 4.0 - 0.2);
 }

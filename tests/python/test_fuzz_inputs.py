@@ -71,7 +71,7 @@ values = st.one_of(numbers, text, vectors, st.none(),
                    st.sampled_from([1j, object(), b"bytes", {1, 2}]))
 
 # The scene keys (docs/scenes.md), and keys that are not any.
-SCENE_KEYS = ["model", "string.length", "string.density", "string.nodes", "string.link_length", "string.closed",
+SCENE_KEYS = ["model", "string.length", "string.density", "string.nodes", "string.link_length", "string.closed", "string.elements",
               "string.dimension", "shape.kind", "shape.points", "shape.length_tolerance", "velocity.kind",
               "velocity.value", "ends.start", "ends.end", "effects.gravity.g", "effects.drag.coefficient",
               "effects.heap[0].f", "effects.heap[0].s0", "effects.heap[0].point", "effects.heap[0].side",

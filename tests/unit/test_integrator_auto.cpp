@@ -51,3 +51,25 @@ TEST_CASE("the method is checked where it enters and where it is loaded, not at 
   run.integrator.rtol = 1.0;
   CHECK_THROWS_WITH(run.validate(), Catch::Contains("rtol"));
 }
+
+TEST_CASE("method = auto: implicit from 50 links on with quadratic elements too, on their own Newton solver",
+          "[unit][integrator][implicit][quadratic]") {
+  // Quadratic elements solve their Newton systems themselves (O(N), quadratic_string.hpp): auto treats
+  // them as the links, by the stiffness ℓ / h_min.
+  auto tilted = [](double sigma) { return 1e-3 * sigma; };
+  auto quadratic = hanging_chain(50, 1.0, tilted, 0.03, 0.0, "quadratic");
+  auto coarse = hanging_chain(48, 1.0, tilted, 0.03, 0.0, "quadratic");
+  CHECK(quadratic->explicit_stiffness() == Approx(50));
+  REQUIRE(quadratic->has_newton_solver());
+  CHECK(quadratic->newton_solver_exact());
+  CHECK(Integrator::resolve_method("auto", *coarse) == kAutoExplicit);
+  CHECK(Integrator::resolve_method("auto", *quadratic) == kAutoImplicit);
+  IntegratorOptions options;
+  options.method = "auto";
+  Integrator integrator(*quadratic, 0.0, quadratic->state_from_chain(), options);
+  integrator.advance(0.01);
+  const IntegratorStats stats = integrator.stats();
+  CHECK(stats.implicit);
+  CHECK(stats.lin_solves > 0);  // the elements' own Newton solver was used
+  CHECK(stats.nonlin_conv_fails == 0);
+}

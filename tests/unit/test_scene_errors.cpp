@@ -56,7 +56,7 @@ TEST_CASE("bad scenes are refused with the location, the key, the value and what
   const BadScene cases[] = {
       {"typo in a key",
        edit(kBase, "length = 1.0", "lenght = 1.0"),
-       "s.toml:2:1: unknown key 'lenght' in [string]; valid keys: length, density, nodes, link_length, closed, dimension (did you mean 'length'?)"},
+       "s.toml:2:1: unknown key 'lenght' in [string]; valid keys: length, density, nodes, link_length, closed, dimension, elements (did you mean 'length'?)"},
       {"a section of the old format",
        edit(kBase, "[effects.gravity]", "[gravity]"),
        "s.toml:13:2: unknown section [gravity]; valid sections: string, shape, velocity, ends, effects, solver, output, stop; valid top-level keys: model; gravity is now written [effects.gravity]"},

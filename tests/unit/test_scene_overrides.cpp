@@ -81,7 +81,7 @@ TEST_CASE("overrides (--set) are checked as the file is, and located at the argu
   const Bad cases[] = {
       {&F, {"effects.heap[0].f=1.5"}, "--set effects.heap[0].f=1.5: effects.heap[0].f = 1.5 is out of range: allowed 0 <= f <= 1"},
       {&H, {"string.nodez=21"},
-       "--set string.nodez=21: unknown key 'nodez' in [string]; valid keys: length, density, nodes, link_length, closed, dimension (did you mean 'nodes'?)"},
+       "--set string.nodez=21: unknown key 'nodez' in [string]; valid keys: length, density, nodes, link_length, closed, dimension, elements (did you mean 'nodes'?)"},
       {&H, {"strin.nodes=21"},
        "--set strin.nodes=21: unknown section [strin]; valid sections: string, shape, velocity, ends, effects, solver, output, stop; valid top-level keys: model (did you mean [string]?)"},
       {&H, {"effects.gravty.g=[0.0, -1.0]"},
@@ -127,7 +127,7 @@ TEST_CASE("overrides (--set) are checked as the file is, and located at the argu
       {&H, {"string.nodes=1", "string.nodes=5", "solver.rtol=1.0", "string.density=-1"},
        "--set string.density=-1: string.density = -1 is out of range: allowed density > 0"},
       {&H, {"string.nodez=1", "string.lenght=1"},
-       "--set string.nodez=1: unknown key 'nodez' in [string]; valid keys: length, density, nodes, link_length, closed, dimension (did you mean 'nodes'?)"},
+       "--set string.nodez=1: unknown key 'nodez' in [string]; valid keys: length, density, nodes, link_length, closed, dimension, elements (did you mean 'nodes'?)"},
   };
   for (const Bad& c : cases) {
     std::string args;
