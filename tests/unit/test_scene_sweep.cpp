@@ -123,7 +123,7 @@ TEST_CASE("a sweep refuses, before any run, two grid keys that set one scene key
   }
 }
 
-TEST_CASE("a sweep point run by another runner (the Python module's that keeps the run); the points ended counted",
+TEST_CASE("a sweep point run by another runner (the Python module's that keeps the run) and the points ended counted",
           "[unit][sweep]") {
   const SweepScene falling{kFallingBase, "falling.toml", {}, std::nullopt};
   // The runner gets the point's scene with its overrides applied (f is the front's key), and its summary makes
