@@ -18,6 +18,7 @@ import csv
 import json
 import math
 import os
+import re
 import sys
 import time
 
@@ -35,6 +36,8 @@ REDUCED_KEYS = ("f", "eta0", "eps", "force", "length", "density", "gravity")
 REDUCED_SOLVER_KEYS = ("t_max", "method", "rtol", "atol", "max_step", "max_steps")  # fixed= only
 # Default bounds of the parameters chainsim knows (the ranges the scene format and `chainsim reduced` allow).
 KNOWN_BOUNDS = {"f": (0.0, 1.0), "eta0": (0.0, 1.0), "t_offset": (-np.inf, np.inf)}
+# A pot (a start heap that pushes, docs/model.md) may have -1/2 <= f < 0: its loss (1/2 + f) lambda v^3 >= 0.
+POT_MIN_F = -0.5
 # Columns whose time derivative is another column of the same series: the model is interpolated between its
 # steps by cubic Hermite polynomials there (error ~ h^4), linearly elsewhere.
 TIME_DERIVATIVE = {"y": "ydot", "ydot": "yddot"}
@@ -244,6 +247,25 @@ def _scene_key(scene, key):
     return "effects.fold.f" if "fold" in effects else "effects.heap[0].f"
 
 
+def _allowed_range(target, name):
+    """The range the scene format allows for a free parameter, or None where it states none.
+
+    ``f`` and ``eta0`` of the reduced models are in [0, 1]. On a scene, a front's dissipation is in [0, 1],
+    except a pot's (a start heap declared ``pot = true``), which may push: -1/2 <= f <= 1 (docs/scenes.md)."""
+    if isinstance(target, str) or name not in KNOWN_BOUNDS and not name.endswith(".f"):
+        return KNOWN_BOUNDS.get(name)
+    if name == "t_offset":
+        return KNOWN_BOUNDS[name]
+    key = _scene_key(target, name)
+    match = re.fullmatch(r"effects\.heap\[(\d+)\]\.f", key)
+    if match:
+        heaps = target.effective.get("effects", {}).get("heap", [])
+        k = int(match.group(1))
+        if k < len(heaps) and heaps[k].get("pot", False):
+            return (POT_MIN_F, 1.0)
+    return KNOWN_BOUNDS["f"] if key.endswith(".f") else KNOWN_BOUNDS.get(name)
+
+
 def _run_model(target, settings):
     """Runs the model with `settings` (parameter and per-series values, t_offset removed)."""
     from . import Scene, reduced
@@ -371,18 +393,19 @@ class _Problem:
         self.names, self.x0, self.lo, self.hi, self.owner, self.base = [], [], [], [], [], []
         bounds = dict(bounds or {})
         for name, spec in free.items():
+            allowed = _allowed_range(target, name)
             if isinstance(spec, (tuple, list)):
                 if len(spec) != 3:
                     raise _error(f"free parameter {name} = {spec!r}: allowed a start value or (start, lower, upper)")
                 start, lo, hi = (float(v) for v in spec)
             else:
                 start = float(spec)
-                lo, hi = bounds.get(name, KNOWN_BOUNDS.get(name, (-np.inf, np.inf)))
+                lo, hi = bounds.get(name, allowed or (-np.inf, np.inf))
             lo, hi = float(lo), float(hi)
             if name in bounds and isinstance(spec, (tuple, list)):
                 raise _error(f"free parameter {name}: bounds given twice (in free= and in bounds=)")
-            if name in KNOWN_BOUNDS:
-                klo, khi = KNOWN_BOUNDS[name]
+            if allowed is not None:
+                klo, khi = allowed
                 if lo < klo or hi > khi:
                     raise _error(f"free parameter {name}: bounds [{lo}, {hi}] are out of range: allowed "
                                  f"{klo} <= {name} <= {khi}")
@@ -699,7 +722,7 @@ def fit(target, data, free=None, *, bounds=None, per_run=(), fixed=None, profile
     free : dict, optional
         {name: start} or {name: (start, lower, upper)}: f, the reduced model's keywords (eta0, eps, force, length,
         density, gravity) or the scene's dotted keys, and t_offset (the release time on the data's clock).
-        Default {"f": 0.5}. f is bounded to [0, 1], eta0 to [0, 1].
+        Default {"f": 0.5}. f is bounded to [0, 1] (a pot's f to [-1/2, 1]), eta0 to [0, 1].
     bounds : dict, optional
         {name: (lower, upper)} for parameters given by their start value only.
     per_run : sequence of str, optional
@@ -997,7 +1020,7 @@ def _parser():
                    "(default: the column sigma if present, else estimated from the residuals)")
     p.add_argument("--free", action="append", default=[], metavar="NAME=START[:LOWER:UPPER]",
                    help="a free parameter and its start value (default f=0.5); bounds default to the allowed range "
-                   "(f, eta0 in [0, 1]), else unbounded")
+                   "(f, eta0 in [0, 1]; a pot's f in [-0.5, 1]), else unbounded")
     p.add_argument("--per-run", action="append", default=[], metavar="NAME",
                    help="fit this free parameter once per data file (e.g. t_offset of each drop)")
     p.add_argument("--set", action="append", default=[], metavar="KEY=VALUE", help="a fixed key for every run")

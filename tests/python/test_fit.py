@@ -265,6 +265,19 @@ def test_bad_csv_files_are_refused_with_the_file_line_column_and_value(tmp_path)
         chainsim.Data.from_csv(path)
 
 
+def test_a_pots_f_is_free_down_to_minus_one_half():
+    """The default bounds of a scene's front dissipation are the scene format's: a pot's f in [-1/2, 1]."""
+    from chainsim.fitting import _allowed_range
+    fountain = chainsim.Scene.from_file(os.path.join(SCENES, "chain_fountain.toml"))
+    assert _allowed_range(fountain, "effects.heap[0].f") == (-0.5, 1.0)
+    assert _allowed_range(fountain, "effects.heap[1].f") == (0.0, 1.0)
+    falling = chainsim.Scene.from_file(os.path.join(SCENES, "falling_chain.toml"))
+    assert _allowed_range(falling, "f") == (0.0, 1.0)
+    assert _allowed_range(falling, "t_offset") == (-np.inf, np.inf)
+    assert _allowed_range(falling, "string.length") is None
+    assert _allowed_range("falling", "eta0") == (0.0, 1.0)
+
+
 def test_bad_fits_are_refused_with_the_reason():
     t, y = truth(n=20)
     data = noisy(t, y, 0.005, seed=1)
@@ -282,6 +295,13 @@ def test_bad_fits_are_refused_with_the_reason():
         (dict(target="falling", data=data, free={"f": 0.5}, fixed={"eps": 2.0}), "eps"),
         (dict(target=os.path.join(SCENES, "falling_chain.toml"), data=data, free={"f": 0.5},
               fixed={"string.nodes": 1}), "--set string.nodes=1: string.nodes = 1 is out of range"),
+        # A pot's f may push (-1/2 <= f <= 1, docs/model.md), the floor heap's may not (0 <= f <= 1).
+        (dict(target=os.path.join(SCENES, "chain_fountain.toml"), data=data,
+              free={"effects.heap[0].f": (-0.2, -0.7, 1.0)}),
+         "free parameter effects.heap[0].f: bounds [-0.7, 1.0] are out of range: allowed -0.5 <= effects.heap[0].f <= 1.0"),
+        (dict(target=os.path.join(SCENES, "chain_fountain.toml"), data=data,
+              free={"effects.heap[1].f": (0.5, -0.1, 1.0)}),
+         "free parameter effects.heap[1].f: bounds [-0.1, 1.0] are out of range: allowed 0.0 <= effects.heap[1].f <= 1.0"),
     ]
     for kwargs, message in refusals:
         with pytest.raises(chainsim.ChainsimInputError) as e:
