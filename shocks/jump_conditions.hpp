@@ -156,4 +156,50 @@ double heap_power(double tension, const Vector<dim>& tangent, const Vector<dim>&
   return tension * tangent.dot(end_velocity) + 0.5 * density * inflow * end_velocity.squaredNorm() - shock_power;
 }
 
+// --- A front pinned in space (an edge, a peg): v0 = 0 ---------------------------------------------
+// Material flows through a point fixed in space, turning from t⁻ to t⁺. With v0 = 0, v± = −ṡ0 t±, so
+// [v] = −ṡ0 [t] and |[v]|² = ṡ0² |[t]|²; the tension jumps by [τ] = −½ f λ sgn(ṡ0) ṡ0² |[t]|², and the
+// obstacle must supply F0 = −[τ t] + λ ṡ0² [t] (docs/model.md §8). It can only push: F0 must lie in
+// its normal cone, spanned by the outward normals n∓ of the obstacle's faces at the point (pinned_cone).
+
+/// τ⁺ at a pinned front, from τ⁻, the tangents on the two sides and the speed ṡ0 (N).
+template <int dim>
+double pinned_tension_plus(double tension_minus, const Vector<dim>& t_minus, const Vector<dim>& t_plus,
+                           double dissipation, double density, double s0_dot) {
+  return tension_minus + tension_jump(dissipation, density, s0_dot, s0_dot * s0_dot * (t_plus - t_minus).squaredNorm());
+}
+
+/// D = ½ f λ |ṡ0|³ |[t]|² (W): the power a pinned front's kink dissipates (W_s = −D).
+template <int dim>
+double pinned_dissipation_rate(const Vector<dim>& t_minus, const Vector<dim>& t_plus, double dissipation,
+                               double density, double s0_dot) {
+  return dissipation_rate(dissipation, density, s0_dot, s0_dot * s0_dot * (t_plus - t_minus).squaredNorm());
+}
+
+/// F0 = −[τ t] + λ ṡ0² [t]: the force the obstacle exerts on the string at a pinned front (N); it is
+/// required_force with v± = −ṡ0 t±.
+template <int dim>
+Vector<dim> pinned_reaction(const Vector<dim>& t_minus, const Vector<dim>& t_plus, double tension_minus,
+                            double tension_plus, double density, double s0_dot) {
+  return -(tension_plus * t_plus - tension_minus * t_minus) + density * s0_dot * s0_dot * (t_plus - t_minus);
+}
+
+/// The outward normal of the obstacle's face that the string on the side of tangent `t_side` lies on,
+/// when the string turns by [t] = t⁺ − t⁻ ≠ 0 over the obstacle: the unit vector normal to t_side on
+/// the side away from the bend (the obstacle lies where [t] points).
+template <int dim>
+Vector<dim> face_normal(const Vector<dim>& t_side, const Vector<dim>& jump_t) {
+  const Vector<dim> n = -(jump_t - jump_t.dot(t_side) * t_side);
+  return n / n.norm();
+}
+
+/// The coordinates (α, β) of F in the normal cone spanned by the faces' outward normals n⁻, n⁺
+/// (F = α n⁻ + β n⁺ + a part normal to both, which a 3D edge's line carries): F lies in the cone while
+/// both are ≥ 0; min(α, β) is the margin whose zero is lift-off. n⁻ and n⁺ must not be parallel.
+template <int dim>
+Eigen::Vector2d pinned_cone(const Vector<dim>& force, const Vector<dim>& n_minus, const Vector<dim>& n_plus) {
+  const double c = n_minus.dot(n_plus), fm = force.dot(n_minus), fp = force.dot(n_plus), det = 1 - c * c;
+  return Eigen::Vector2d((fm - c * fp) / det, (fp - c * fm) / det);
+}
+
 }  // namespace chainsim::jump

@@ -244,6 +244,9 @@ void StringModel<dim>::newton_setup(double t, const Eigen::Ref<const Eigen::Vect
     quadratic_->newton_factor(gamma);
     return;
   }
+  if (!bends_.empty())
+    throw InputError("an implicit method cannot run a string bent over an edge (its linearisation is not written): "
+                     "choose an explicit method");
   if (!jacobian_) jacobian_ = std::make_shared<StringJacobian<dim>>(*this);
   const bool stale = jacobian_->velocity_unknowns() != dim * num_free_ ||
                      jacobian_->tension_unknowns() != (system_ ? system_->size() : 0);

@@ -219,6 +219,65 @@ void StringModel<dim>::links() {
     e_.col(j) = dx_.col(j) / l;
     x_max_ = std::max({x_max_, x_.col(a).cwiseAbs().maxCoeff(), x_.col(b).cwiseAbs().maxCoeff()});
   });
+  if (!bends_.empty()) bend_links();
+}
+
+template <int dim>
+void StringModel<dim>::bend_link(int link, const Vec<dim>& point) {
+  if (quadratic_) throw InputError("a link bent over a point (an edge) needs link elements ([string] elements = \"links\")");
+  if (link < 0 || link >= chain_.num_links()) throw InputError(fmt::format("bend_link: no link {}", link));
+  for (Bend& b : bends_)
+    if (b.link == link) {
+      b.point = point;
+      return;
+    }
+  Bend bend;
+  bend.link = link;
+  bend.point = point;
+  bends_.push_back(bend);
+}
+
+template <int dim>
+void StringModel<dim>::bend_links() {
+  for (Bend& bend : bends_) {
+    const int j = bend.link, a = chain_.link_start(j), b = chain_.link_end(j);
+    const Vec<dim> to_a = bend.point - x_.col(a), from_b = x_.col(b) - bend.point;
+    bend.l_minus = to_a.norm();
+    bend.l_plus = from_b.norm();
+    const double floor = kCollapsedLink * chain_.link_length(j);
+    if (!(bend.l_minus > floor) || !(bend.l_plus > floor) || !std::isfinite(bend.l_minus + bend.l_plus))
+      throw RecoverableError(fmt::format("link {} has reached the point it is bent over ({:g} and {:g} m from it)", j,
+                                         bend.l_minus, bend.l_plus));
+    l_[j] = bend.l_minus + bend.l_plus;
+    e_.col(j) = to_a / bend.l_minus;
+    bend.e_plus = from_b / bend.l_plus;
+  }
+}
+
+template <int dim>
+double StringModel<dim>::bend_rate(const Bend& bend) const {
+  const int a = chain_.link_start(bend.link), b = chain_.link_end(bend.link);
+  return bend.e_plus.dot(v_.col(b)) - e_.col(bend.link).dot(v_.col(a));
+}
+
+template <int dim>
+void StringModel<dim>::bend_couplings() {
+  // The coupling of a bent link with the next link goes through its end node b, along e⁺.
+  for_each_link([&](int j, int u, int next) {
+    if (next < 0) return;
+    for (const Bend& bend : bends_)
+      if (bend.link == j) system_->set_coupling(u, w_[chain_.link_end(j)] * bend.e_plus.dot(e_.col(next)));
+  });
+}
+
+template <int dim>
+Vec<dim> StringModel<dim>::bend_reaction() const {
+  Vec<dim> r = Vec<dim>::Zero();
+  for (const Bend& bend : bends_) {
+    const int u = link_unknown_[static_cast<std::size_t>(bend.link)];
+    if (u >= 0) r += system_->solution()[u] * (e_.col(bend.link) - bend.e_plus);
+  }
+  return r;
 }
 
 template <int dim>
@@ -254,6 +313,7 @@ void StringModel<dim>::assemble_matrix() {
     system_->add_diagonal(u, -(w_[a] + w_[b]));
     if (next >= 0) system_->set_coupling(u, w_[b] * e_.col(j).dot(e_.col(next)));
   });
+  if (!bends_.empty()) bend_couplings();
 }
 
 template <int dim>
@@ -312,11 +372,27 @@ double StringModel<dim>::evaluate_current(double t) {
       const double stab = 2 * alpha_ * dx_.col(j).dot(dv_.col(j)) + beta2_ * 0.5 * (l * l - h * h);
       system_->rhs(u) = -dv_.col(j).squaredNorm() / l - e_.col(j).dot(b_.col(b) - b_.col(a)) - stab / l;
     });
+    for (const Bend& bend : bends_) {
+      // d²(l⁻ + l⁺)/dt² = e⁺·a_b − e⁻·a_a + |v_b⊥e⁺|²/l⁺ + |v_a⊥e⁻|²/l⁻ = 0, with the same drift control.
+      const int j = bend.link, u = link_unknown_[static_cast<std::size_t>(j)];
+      if (u < 0) continue;
+      const int a = chain_.link_start(j), b = chain_.link_end(j);
+      const Vec<dim> em = e_.col(j), ep = bend.e_plus;
+      const Vec<dim> va = v_.col(a) - em * em.dot(v_.col(a)), vb = v_.col(b) - ep * ep.dot(v_.col(b));
+      const double h = chain_.link_length(j), l = l_[j];
+      const double stab = 2 * alpha_ * bend_rate(bend) + beta2_ * 0.5 * (l * l - h * h) / l;
+      system_->rhs(u) = -va.squaredNorm() / bend.l_minus - vb.squaredNorm() / bend.l_plus -
+                        (ep.dot(b_.col(b)) - em.dot(b_.col(a))) - stab;
+    }
     const Eigen::VectorXd& T = system_->solve(t);
     for_each_link([&](int j, int u, int) {
       tension_force_.col(chain_.link_start(j)) += T[u] * e_.col(j);
       tension_force_.col(chain_.link_end(j)) -= T[u] * e_.col(j);
     });
+    for (const Bend& bend : bends_) {
+      const int u = link_unknown_[static_cast<std::size_t>(bend.link)];
+      if (u >= 0) tension_force_.col(chain_.link_end(bend.link)) += T[u] * (e_.col(bend.link) - bend.e_plus);
+    }
   }
   // 3. Accelerations, the supports' reactions and the power of everything not booked in V.
   double power = 0;
@@ -394,6 +470,10 @@ void StringModel<dim>::project(double t) {
       target.col(a) -= w_[a] * nu[u] * e_.col(j);
       target.col(b) += w_[b] * nu[u] * e_.col(j);
     });
+    for (const Bend& bend : bends_) {
+      const int u = link_unknown_[static_cast<std::size_t>(bend.link)];
+      if (u >= 0) target.col(chain_.link_end(bend.link)) += w_[chain_.link_end(bend.link)] * nu[u] * (bend.e_plus - e_.col(bend.link));
+    }
   };
   double violation = 0, previous = INFINITY, roundoff = 0;
   for (int iteration = 0;; ++iteration) {
@@ -423,6 +503,10 @@ void StringModel<dim>::project(double t) {
   system_->zero();
   assemble_matrix();
   for_each_link([&](int j, int u, int) { system_->rhs(u) = e_.col(j).dot(dv_.col(j)); });
+  for (const Bend& bend : bends_) {
+    const int u = link_unknown_[static_cast<std::size_t>(bend.link)];
+    if (u >= 0) system_->rhs(u) = bend_rate(bend);
+  }
   correct(v_, system_->solve(t));
 }
 
@@ -561,8 +645,10 @@ typename StringModel<dim>::Snapshot StringModel<dim>::snapshot(double t, const E
   } else {
     for_each_link([&](int j, int, int) {
       s.max_violation = std::max(s.max_violation, std::abs(l_[j] - chain_.link_length(j)) / chain_.link_length(j));
-      s.max_rate_violation = std::max(s.max_rate_violation, std::abs(e_.col(j).dot(dv_.col(j))));
+      const bool bent = std::any_of(bends_.begin(), bends_.end(), [j](const Bend& b) { return b.link == j; });
+      if (!bent) s.max_rate_violation = std::max(s.max_rate_violation, std::abs(e_.col(j).dot(dv_.col(j))));
     });
+    for (const Bend& bend : bends_) s.max_rate_violation = std::max(s.max_rate_violation, std::abs(bend_rate(bend)));
   }
   s.support = support_reaction();
   for (const auto& p : prescribed_) {

@@ -213,6 +213,17 @@ class StringModel final : public OdeSystem {
   const QuadraticString<dim>* quadratic() const { return quadratic_.get(); }
   /// Tensions (per tension unknown) and accelerations of the last evaluation (rhs or snapshot).
   const Eigen::VectorXd& tensions() const { return system_->solution(); }
+  /// Bends link `link` over a point fixed in space (an edge or a peg, docs/model.md §8): its
+  /// constraint becomes |point − x_a| + |x_b − point| = h (a = its start node, b = its end node), its
+  /// tension pulls node a along e⁻ = (point − x_a)/l⁻ and node b along −e⁺ = −(x_b − point)/l⁺, and
+  /// the point takes the difference: the string runs over it, its tension a multiplier of the same
+  /// tension system. Link elements only; implicit methods refuse a bent link (its linearisation is not
+  /// written). Replaces any earlier bend of the same link.
+  void bend_link(int link, const Vec<dim>& point);
+  /// Straightens every bent link.
+  void clear_bends() { bends_.clear(); }
+  /// The force the points of the bent links exert on the string after an evaluation (N): Σ T (e⁻ − e⁺).
+  Vec<dim> bend_reaction() const;
   const Points<dim>& accelerations() const { return a_; }
   /// The sum of the uniform fields the forces declare (Force::uniform_field; gravity's g, zero
   /// without one): the weight per unit mass in the physical scales, and what the module books for
@@ -298,6 +309,18 @@ class StringModel final : public OdeSystem {
   std::vector<int> slot_;        // node -> index among free nodes, or -1 (prescribed or in no arc)
   std::vector<int> path_of_;     // node -> index into prescribed_, or -1
   std::vector<int> link_unknown_;  // link -> tension unknown, or -1 (in no arc)
+  /// A link bent over a fixed point (bend_link): the point, and after links() the partial lengths
+  /// and the unit vector e⁺ at the end node (e_ holds e⁻, the one at the start node).
+  struct Bend {
+    int link = -1;
+    Vec<dim> point = Vec<dim>::Zero();
+    Vec<dim> e_plus = Vec<dim>::Zero();
+    double l_minus = 0, l_plus = 0;
+  };
+  std::vector<Bend> bends_;
+  void bend_links();               // links(): the bent links' lengths and directions
+  void bend_couplings();           // assemble_matrix(): their couplings at the end node
+  double bend_rate(const Bend& bend) const;  // d(l⁻ + l⁺)/dt
   Eigen::VectorXd base_mass_;    // lumped masses of the arcs' links
   Eigen::VectorXd m_;            // current masses (base + module)
   Eigen::VectorXd w_;            // 1/m_i for free nodes, 0 otherwise

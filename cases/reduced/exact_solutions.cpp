@@ -278,4 +278,82 @@ double sliding_eta(double f, double xi, double eta0) {
   return solve_for_eta([&](double eta) { return sliding_xi(f, eta, eta0); }, xi, eta0, 0.0, 1.0, fall_time);
 }
 
+// @sect{A chain sliding off a table over an edge}
+// With u = ẋ², ℓ ẍ = g x − f u becomes u_x + (2f/ℓ) u = 2 g x/ℓ, integrating factor e^(2fx/ℓ); with
+// u(x0) = 0 this is the header's form. ψ1 and ψ2 are evaluated from their series below z = 0.1
+// (z + expm1(−z) loses digits there). The time t = ∫ dx/√u with x = x0 + w² is
+// t = ∫_0^√(x−x0) 2 dw / √(g (2 Δ ψ2 + 2 X0 ψ1)): a bounded, smooth integrand for x0 > 0.
+
+namespace {
+
+void check_edge(double f, double x0, double ell, double g) {
+  check_dissipation(f);
+  require_in_range("ell", ell, 0.0, 1e100, Bound::kOpen, Bound::kClosed);
+  require_in_range("g", g, 0.0, 1e100, Bound::kOpen, Bound::kClosed);
+  require_in_range("x0", x0, 0.0, ell, Bound::kOpen, Bound::kOpen);
+}
+
+double psi1(double z) {
+  if (z < 0.1) return 1 - z / 2 * (1 - z / 3 * (1 - z / 4 * (1 - z / 5 * (1 - z / 6 * (1 - z / 7 * (1 - z / 8))))));
+  return -std::expm1(-z) / z;
+}
+
+double psi2(double z) {
+  if (z < 0.1)
+    return 0.5 * (1 - z / 3 * (1 - z / 4 * (1 - z / 5 * (1 - z / 6 * (1 - z / 7 * (1 - z / 8 * (1 - z / 9)))))));
+  return (z + std::expm1(-z)) / (z * z);
+}
+
+/// ẋ² / w² with w² = x − x0: g (2 Δ ψ2 + 2 X0 ψ1), Δ = w²/ℓ.
+double edge_speed_squared_over_w2(double f, double w2, double x0, double ell, double g) {
+  const double d = w2 / ell, z = 2 * f * d;
+  return g * (2 * d * psi2(z) + 2 * (x0 / ell) * psi1(z));
+}
+
+}  // namespace
+
+double edge_speed_squared(double f, double x, double x0, double ell, double g) {
+  check_edge(f, x0, ell, g);
+  require_in_range("x", x, x0, ell);
+  return (x - x0) * edge_speed_squared_over_w2(f, x - x0, x0, ell, g);
+}
+
+double edge_acceleration(double f, double x, double x0, double ell, double g) {
+  return (g * x - f * edge_speed_squared(f, x, x0, ell, g)) / ell;
+}
+
+double edge_time(double f, double x, double x0, double ell, double g) {
+  check_edge(f, x0, ell, g);
+  require_in_range("x", x, x0, ell);
+  const double w_end = std::sqrt(x - x0);
+  if (w_end == 0.0) return 0.0;
+  auto integrand = [&](double t, double /*tc*/) {
+    const double w = w_end * t;
+    return 2 / std::sqrt(edge_speed_squared_over_w2(f, w * w, x0, ell, g));
+  };
+  return w_end * integrate_unit_interval(integrand, "the edge's 1/sqrt(u)");
+}
+
+double edge_x(double f, double t, double x0, double ell, double g) {
+  const double t_end = edge_time(f, ell, x0, ell, g);
+  require_in_range("t", t, 0.0, t_end);
+  return solve_for_eta([&](double x) { return edge_time(f, x, x0, ell, g); }, t, x0, 0.0, ell, t_end);
+}
+
+double edge_lift_off_x(double f, double x0, double ell, double g) {
+  check_edge(f, x0, ell, g);
+  // g x (ℓ − x) − ẋ² (ℓ + f (ℓ − x)): g x0 (ℓ − x0) > 0 at x0, −ẋ² ℓ < 0 at ℓ.
+  auto margin = [&](double x) {
+    return g * x * (ell - x) - edge_speed_squared(f, x, x0, ell, g) * (ell + f * (ell - x));
+  };
+  auto narrow_enough = [](double a, double b) {
+    return std::abs(b - a) <= kRootTolerance * std::max(std::abs(a), std::abs(b));
+  };
+  std::uintmax_t iterations = kMaxRootIterations;
+  const std::pair<double, double> bracket =
+      boost::math::tools::toms748_solve(margin, x0, ell, margin(x0), margin(ell), narrow_enough, iterations);
+  CHAINSIM_VERIFY(iterations < kMaxRootIterations, "TOMS 748 did not bracket the lift-off point to 1e-14");
+  return 0.5 * (bracket.first + bracket.second);
+}
+
 }  // namespace chainsim::exact

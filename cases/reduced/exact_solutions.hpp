@@ -117,4 +117,26 @@ double folded_eta(double f, double xi, double eta0 = 0.0);
 /// 0 <= xi <= sliding_fall_time(f, eta0). For η0 = 0 this is the closed form ξ²/(3+2f).
 double sliding_eta(double f, double xi, double eta0);
 
+// ---------------------------------------------------------------------------------------------------
+// A chain sliding off a smooth table over a sharp edge (docs/model.md §8), physical units: length ℓ (m),
+// gravity g (m/s²), x (m) the hanging length, released at rest from x0 ∈ (0, ℓ); f ∈ [0, 1] the edge's
+// dissipation. Energy with the kink's loss f λ ẋ³ gives ℓ ẍ = g x − f ẋ², and with X = x/ℓ,
+// Δ = X − X0, z = 2 f Δ:
+//   ẋ² = g ℓ (2 X0 Δ ψ1(z) + 2 Δ² ψ2(z)),   ψ1(z) = (1 − e^−z)/z,  ψ2(z) = (z − 1 + e^−z)/z²
+// (f = 0: ẋ² = (g/ℓ)(x² − x0²), x = x0 cosh(√(g/ℓ) t)). The table part is pulled by
+// τ⁻ = λ (ℓ − x) ẍ, the hanging part by τ⁺ = τ⁻ + f λ ẋ²; the edge pushes while τ⁻ ≥ λ ẋ², and the
+// chain lifts off where ẋ² (ℓ + f (ℓ − x)) = g x (ℓ − x) (f = 0: x* = (ℓ + √(ℓ² + 8 x0²))/4).
+// ---------------------------------------------------------------------------------------------------
+
+/// ẋ² (m²/s²) at hanging length x ∈ [x0, ℓ]. Ranges: 0 ≤ f ≤ 1, ℓ > 0, g > 0, 0 < x0 < ℓ.
+double edge_speed_squared(double f, double x, double x0, double ell, double g);
+/// ẍ (m/s²) at hanging length x: (g x − f ẋ²)/ℓ.
+double edge_acceleration(double f, double x, double x0, double ell, double g);
+/// t(x) = ∫_x0^x dx/ẋ (s), x ∈ [x0, ℓ].
+double edge_time(double f, double x, double x0, double ell, double g);
+/// x(t) (m), 0 ≤ t ≤ edge_time(f, ℓ, …).
+double edge_x(double f, double t, double x0, double ell, double g);
+/// The hanging length x* ∈ (x0, ℓ) at which the chain lifts off the edge (τ⁻ = λ ẋ²).
+double edge_lift_off_x(double f, double x0, double ell, double g);
+
 }  // namespace chainsim::exact

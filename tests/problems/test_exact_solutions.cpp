@@ -398,3 +398,87 @@ TEST_CASE("bad arguments throw InputError naming the argument, its value and the
   require_input_error([] { return exact::folded_eta(0.5, -0.5); }, "xi = -0.5", "0 <= xi <= ");
   require_input_error([] { return exact::sliding_eta(0.5, 3.0, 0.0); }, "xi = 3", "0 <= xi <= ");
 }
+
+// --- The chain sliding off a table over an edge (docs/model.md §8) -----------------------------------
+
+namespace {
+/// ℓ ẍ = g x − f ẋ², integrated by classical RK4 with step dt from rest at x0 (independent of the
+/// first integral and the quadrature): calls visit(t, x, ẋ) after every step until x reaches ℓ.
+template <class Visit>
+void integrate_edge_ode(double f, double x0, double ell, double g, double dt, const Visit& visit) {
+  auto rhs = [&](double x, double v) { return (g * x - f * v * v) / ell; };
+  double t = 0, x = x0, v = 0;
+  while (x < ell) {
+    const double k1x = v, k1v = rhs(x, v);
+    const double k2x = v + 0.5 * dt * k1v, k2v = rhs(x + 0.5 * dt * k1x, v + 0.5 * dt * k1v);
+    const double k3x = v + 0.5 * dt * k2v, k3v = rhs(x + 0.5 * dt * k2x, v + 0.5 * dt * k2v);
+    const double k4x = v + dt * k3v, k4v = rhs(x + dt * k3x, v + dt * k3v);
+    x += dt / 6 * (k1x + 2 * k2x + 2 * k3x + k4x);
+    v += dt / 6 * (k1v + 2 * k2v + 2 * k3v + k4v);
+    t += dt;
+    visit(t, x, v);
+  }
+}
+}  // namespace
+
+TEST_CASE("chain off a table edge, f = 0: x0 cosh(sqrt(g/l) t), lift-off at (l + sqrt(l^2 + 8 x0^2))/4",
+          "[problems][exact][edge]") {
+  using namespace chainsim::exact;
+  const double ell = 1.7, g = 9.81;
+  for (double x0 : {0.05, 0.3, 1.0}) {
+    CAPTURE(x0);
+    const double w = std::sqrt(g / ell);
+    for (double x : {x0, 0.5 * (x0 + ell), ell}) {
+      CHECK_THAT(edge_speed_squared(0, x, x0, ell, g), WithinRel(g / ell * (x * x - x0 * x0), 1e-14));
+      CHECK_THAT(edge_time(0, x, x0, ell, g), WithinAbs(std::acosh(x / x0) / w, 1e-13));
+    }
+    for (double t : {0.1, 0.4}) {
+      if (x0 * std::cosh(w * t) < ell) CHECK_THAT(edge_x(0, t, x0, ell, g), WithinRel(x0 * std::cosh(w * t), 1e-13));
+    }
+    CHECK_THAT(edge_lift_off_x(0, x0, ell, g), WithinRel((ell + std::sqrt(ell * ell + 8 * x0 * x0)) / 4, 1e-13));
+  }
+}
+
+TEST_CASE("chain off a table edge, f > 0: the first integral and the quadrature against RK4 of l x'' = g x - f x'^2",
+          "[problems][exact][edge]") {
+  using namespace chainsim::exact;
+  const double ell = 1.7, g = 9.81, lam = 0.8;
+  for (double f : {0.2, 0.7, 1.0}) {
+    for (double x0 : {0.1, 0.5}) {
+      CAPTURE(f, x0);
+      const double xs = edge_lift_off_x(f, x0, ell, g);
+      const double ts = edge_time(f, xs, x0, ell, g);
+      // RK4 at dt = 2e-4 (error ~1e-13 here): x(t) (every 50th step) and ẋ² against the reference; the lift-off
+      // (τ⁻ = λ(ℓ − x)ẍ falls to λẋ²) located by linear interpolation of the margin between steps.
+      double max_x = 0, max_u = 0, t_prev = 0, m_prev = g * x0 * (ell - x0) / ell, t_lift = -1;
+      long step = 0;
+      integrate_edge_ode(f, x0, ell, g, 2e-4, [&](double t, double x, double v) {
+        if (x >= ell) return;
+        if (++step % 50 == 0) max_x = std::max(max_x, std::abs(edge_x(f, t, x0, ell, g) - x));
+        max_u = std::max(max_u, std::abs(edge_speed_squared(f, x, x0, ell, g) - v * v));
+        const double m = (ell - x) * (g * x - f * v * v) / ell - v * v;
+        if (t_lift < 0 && m <= 0) t_lift = t_prev + (t - t_prev) * m_prev / (m_prev - m);
+        t_prev = t;
+        m_prev = m;
+      });
+      CHECK(max_x < 1e-10);
+      CHECK(max_u < 1e-9);
+      CHECK_THAT(t_lift, WithinAbs(ts, 1e-6));  // linear interpolation: O(dt²) in the root
+      // At x*: the tension at the edge on the table side equals λẋ² (the margin's zero), and f > 0
+      // lifts off earlier in x than f = 0 (the kink's loss slows the chain, its tension jump
+      // raises τ⁺ and not τ⁻ — ẍ is smaller, so τ⁻ meets λẋ² sooner).
+      const double u = edge_speed_squared(f, xs, x0, ell, g);
+      CHECK_THAT(lam * (ell - xs) * edge_acceleration(f, xs, x0, ell, g), WithinRel(lam * u, 1e-12));
+      CHECK(xs < edge_lift_off_x(0, x0, ell, g));
+      // Energy: ½ λ ℓ ẋ² − ½ λ g (x² − x0²) = −∫ f λ ẋ³ dt = −f λ ∫_x0^x ẋ² dx (Simpson, 2000 panels).
+      const int n = 2000;
+      double integral = 0;
+      for (int i = 0; i <= n; ++i) {
+        const double x = x0 + (xs - x0) * i / n;
+        integral += (i == 0 || i == n ? 1 : (i % 2 ? 4 : 2)) * edge_speed_squared(f, x, x0, ell, g);
+      }
+      integral *= (xs - x0) / (3 * n);
+      CHECK_THAT(0.5 * lam * ell * u - 0.5 * lam * g * (xs * xs - x0 * x0), WithinAbs(-f * lam * integral, 1e-12));
+    }
+  }
+}

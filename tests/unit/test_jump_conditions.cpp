@@ -231,3 +231,90 @@ TEST_CASE("a pot (f < 0) pushes the string out: T = (1 + f) lambda v^2, loss (1/
   }
   CHECK(kPotMinDissipation == -0.5);
 }
+
+TEST_CASE("pinned front (an edge): the chain sliding off a table, F0 in the normal cone while tau >= lambda v^2",
+          "[unit][shocks][edge]") {
+  // s from the far end on the table (t⁻ = e_x, towards the edge at the origin) to the hanging end
+  // (t⁺ = −e_y). The chain moves at speed v > 0: v⁻ = v e_x, v⁺ = −v e_y, ṡ0 = −v (the edge moves
+  // back through the material). The table part (length ℓ − x) is pulled by τ⁻ = λ (ℓ − x) ẍ; the
+  // hanging part (length x) obeys λ x ẍ = λ g x − τ⁺ (docs/model.md §8).
+  const double lam = 0.9, g = 9.81, ell = 2.0, x = 0.7;
+  for (double f : {0.0, 0.35, 1.0}) {
+    for (double v : {0.4, 2.6}) {
+      CAPTURE(f, v);
+      const double s0dot = -v;
+      const double xdd = (g * x - f * v * v) / ell;  // the reduced equation ℓ ẍ = g x − f ẋ²
+      const double tm = lam * (ell - x) * xdd;
+      const double tp = pinned_tension_plus<2>(tm, ex, -ey, f, lam, s0dot);
+      // The hanging part's momentum balance with this τ⁺ gives the same ẍ: [τ] = f λ v².
+      CHECK_THAT(tp - tm, WithinAbs(f * lam * v * v, kExact));
+      CHECK_THAT(lam * x * xdd, WithinAbs(lam * g * x - tp, kExact));
+      Side<2> minus{ex, v * ex, tm};
+      Side<2> plus{-ey, -v * ey, tp};
+      CHECK_THAT(compatibility_residual(minus, plus, s0dot), WithinAbs(0.0, kExact));
+      CHECK_THAT(front_velocity(plus, s0dot).norm(), WithinAbs(0.0, kExact));  // pinned: v0 = 0
+      const V2 F0 = pinned_reaction<2>(ex, -ey, tm, tp, lam, s0dot);
+      CHECK_THAT((F0 - required_force(minus, plus, lam, s0dot)).norm(), WithinAbs(0.0, kExact));
+      CHECK_THAT((F0 - V2(tm - lam * v * v, tp - lam * v * v)).norm(), WithinAbs(0.0, kExact));
+      // The faces: the table's top (normal e_y) under the − side, its side (normal e_x) under the + side.
+      const V2 jt = -ey - ex;
+      const V2 nm = face_normal<2>(ex, jt), np = face_normal<2>(-ey, jt);
+      CHECK_THAT((nm - ey).norm(), WithinAbs(0.0, kExact));
+      CHECK_THAT((np - ex).norm(), WithinAbs(0.0, kExact));
+      const Eigen::Vector2d ab = pinned_cone<2>(F0, nm, np);
+      CHECK_THAT(ab[0], WithinAbs(tp - lam * v * v, kExact));
+      CHECK_THAT(ab[1], WithinAbs(tm - lam * v * v, kExact));
+      // The kink dissipates D = f λ v³ = −ṡ0 [τ] (the power the tensions feed into the front).
+      const double D = pinned_dissipation_rate<2>(ex, -ey, f, lam, s0dot);
+      CHECK_THAT(D, WithinAbs(f * lam * v * v * v, kExact));
+      CHECK_THAT(D, WithinAbs(-s0dot * (tp - tm), kExact));
+    }
+  }
+  // f = 0, released at rest from x0: ẋ² = (g/ℓ)(x² − x0²), and the margin τ⁻ − λ ẋ² vanishes at
+  // x* = (ℓ + √(ℓ² + 8 x0²))/4 (the issue's closed form).
+  const double x0 = 0.3, xs = (ell + std::sqrt(ell * ell + 8 * x0 * x0)) / 4;
+  const double v2 = g / ell * (xs * xs - x0 * x0);
+  const double tm = lam * (ell - xs) * g * xs / ell;
+  const V2 F0 = pinned_reaction<2>(ex, -ey, tm, tm, lam, -std::sqrt(v2));
+  // With f = 0 the tension is continuous (τ⁺ = τ⁻): both faces let go at once.
+  CHECK_THAT(pinned_cone<2>(F0, ey, ex)[1], WithinAbs(0.0, 1e-12));
+  CHECK_THAT(pinned_cone<2>(F0, ey, ex)[0], WithinAbs(0.0, 1e-12));
+}
+
+TEST_CASE("pinned front at any angle, in 3D and with s reversed: the momentum balance holds, the cone is A >= B cos",
+          "[unit][shocks][edge]") {
+  const double lam = 1.4, f = 0.6;
+  for (double theta : {0.3, 1.2, 2.5}) {
+    for (double s0dot : {-1.3, 0.8}) {
+      CAPTURE(theta, s0dot);
+      const V3 tm(1, 0, 0), tp(std::cos(theta), -std::sin(theta), 0);
+      const double taum = 2.1;
+      const double taup = pinned_tension_plus<3>(taum, tm, tp, f, lam, s0dot);
+      Side<3> minus{tm, -s0dot * tm, taum};
+      Side<3> plus{tp, -s0dot * tp, taup};
+      const V3 F0 = pinned_reaction<3>(tm, tp, taum, taup, lam, s0dot);
+      CHECK_THAT(momentum_residual(minus, plus, F0, lam, s0dot).norm(), WithinAbs(0.0, kExact));
+      const double jv2 = (plus.velocity - minus.velocity).squaredNorm();
+      CHECK_THAT(taup - taum, WithinAbs(tension_jump(f, lam, s0dot, jv2), kExact));
+      CHECK_THAT(pinned_dissipation_rate<3>(tm, tp, f, lam, s0dot), WithinAbs(dissipation_rate(f, lam, s0dot, jv2), kExact));
+      // F0 = A t⁻ − B t⁺ with A = τ⁻ − λṡ0², B = τ⁺ − λṡ0²; it is in the cone of the faces' normals
+      // iff F0·t⁻ ≥ 0 and F0·t⁺ ≤ 0 (the polar of the wedge's tangent cone {−t⁻, t⁺}).
+      const V3 jt = tp - tm;
+      const V3 nm = face_normal<3>(tm, jt), np = face_normal<3>(tp, jt);
+      CHECK_THAT(nm.dot(tm), WithinAbs(0.0, kExact));
+      CHECK(nm.dot(jt) < 0);
+      const Eigen::Vector2d ab = pinned_cone<3>(F0, nm, np);
+      CHECK_THAT((ab[0] * nm + ab[1] * np - F0).norm(), WithinAbs(0.0, 1e-12));
+      CHECK(std::signbit(ab[1]) == std::signbit(F0.dot(tm)));
+      CHECK(std::signbit(ab[0]) == std::signbit(-F0.dot(tp)));
+      // Reversed orientation: t → −t, the sides swap, ṡ0 → −ṡ0 ([t] is unchanged): the same
+      // reaction, the cone's coordinates swapped.
+      const V3 F0r = pinned_reaction<3>(V3(-tp), V3(-tm), taup, taum, lam, -s0dot);
+      CHECK_THAT((F0r - F0).norm(), WithinAbs(0.0, kExact));
+      CHECK_THAT(pinned_tension_plus<3>(taup, V3(-tp), V3(-tm), f, lam, -s0dot), WithinAbs(taum, kExact));
+      const Eigen::Vector2d abr = pinned_cone<3>(F0r, face_normal<3>(V3(-tp), jt), face_normal<3>(V3(-tm), jt));
+      CHECK_THAT(abr[0], WithinAbs(ab[1], 1e-12));
+      CHECK_THAT(abr[1], WithinAbs(ab[0], 1e-12));
+    }
+  }
+}
