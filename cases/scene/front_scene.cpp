@@ -14,6 +14,7 @@
 #include <fmt/format.h>
 
 #include "cases/scene/scene_build.hpp"
+#include "cases/scene/scene_front_keys.hpp"
 #include "mesh/errors.hpp"
 #include "solver/output.hpp"
 #include "solver/string_solver.hpp"
@@ -75,10 +76,8 @@ FrontScene<dim> build_front_scene(const SceneSpec& spec) {
   const Chain<dim>& chain = parts.chain;
 
   // 2. What a string with fronts cannot have.
-  if (chain.closed())
-    fail_at(spec, first_front,
-            fmt::format("{} on a closed string: fronts are tracked on open strings only (string.closed = true)",
-                        fx.heaps.empty() ? "[effects.fold]" : "[[effects.heap]]"));
+  const SceneFrontKeys keys(spec);
+  check_open_string(chain.closed(), !fx.heaps.empty(), keys);
   if (chain.num_links() < 2) {
     const std::string key = spec.link_length ? "string.link_length" : "string.nodes";
     fail_at(spec, key,
@@ -88,11 +87,7 @@ FrontScene<dim> build_front_scene(const SceneSpec& spec) {
   for (std::size_t k = 0; k < fx.heaps.size(); ++k) {
     const HeapEntry& heap = fx.heaps[k];
     const EndSpec& end = heap.side == "start" ? spec.start : spec.end;
-    if (end.kind != "free")
-      fail_at(spec, "ends." + heap.side,
-              fmt::format("ends.{} = \"{}\" is inside the heap of effects.heap[{}] (side = \"{}\", s0 = {:g} m): an "
-                          "end held by a heap cannot be fixed, loaded or driven",
-                          heap.side, end.kind, k, heap.side, heap.s0));
+    check_end_free(k, heap.side == "end", heap.s0, end.kind == "free" ? "" : fmt::format("\"{}\"", end.kind), keys);
   }
 
   // 3. Heaps: s0 inside the string, the shape through the heap point at s0, the point on its plane.
@@ -102,22 +97,14 @@ FrontScene<dim> build_front_scene(const SceneSpec& spec) {
   if (fx.plane) {
     plane_point = as_vec<dim>(spec, fx.plane->point, "effects.plane.point");
     const Vec<dim> n = as_vec<dim>(spec, fx.plane->normal, "effects.plane.normal");
-    if (n.isZero(0.0))
-      fail_at(spec, "effects.plane.normal",
-              fmt::format("effects.plane.normal = {} is zero: a plane needs a normal", text_of(spec, "effects.plane.normal")));
+    check_plane_normal(n, show<dim>(n), keys);
     plane_normal = n.stableNormalized();  // [0, 1e300] too: its norm overflows, its direction does not
   }
   for (std::size_t k = 0; k < fx.heaps.size(); ++k) {
     const HeapEntry& heap = fx.heaps[k];
     const std::string key = fmt::format("effects.heap[{}]", k);
     const bool start = heap.side == "start";
-    const bool inside = start ? (heap.s0 >= 0 && heap.s0 < ell) : (heap.s0 > 0 && heap.s0 <= ell * (1 + 1e-12));
-    if (!inside)
-      fail_at(spec, key + ".s0",
-              fmt::format("{}.s0 = {} is outside the string: allowed {} for side = \"{}\" (the string is {} m long)",
-                          key, text_of(spec, key + ".s0"),
-                          start ? fmt::format("0 <= s0 < {}", ell) : fmt::format("0 < s0 <= {}", ell), heap.side,
-                          ell));
+    check_heap_s0(k, !start, heap.s0, ell, keys);
     const Vec<dim> point = as_vec<dim>(spec, heap.point, key + ".point");
     const Vec<dim> on_shape = parts.curve->point(heap.s0);
     const double miss = (point - on_shape).norm();
@@ -165,13 +152,9 @@ FrontScene<dim> build_front_scene(const SceneSpec& spec) {
   if (fx.fold) {
     const double s0 = fx.fold->s0;
     const std::string key = "effects.fold.s0";
-    const bool start_heap = std::any_of(fx.heaps.begin(), fx.heaps.end(), [](const HeapEntry& e) { return e.side == "start"; });
-    const bool end_heap = std::any_of(fx.heaps.begin(), fx.heaps.end(), [](const HeapEntry& e) { return e.side == "end"; });
-    if (!((start_heap ? s0 > s_lo : s0 >= 0) && s0 < s_hi))
-      fail_at(spec, key,
-              fmt::format("effects.fold.s0 = {} is {}: allowed {} {} s0 < {}", text_of(spec, key),
-                          start_heap || end_heap ? "not between the heaps" : "outside the string", s_lo,
-                          start_heap ? "<" : "<=", s_hi));
+    std::optional<double> start_heap, end_heap;
+    for (const HeapEntry& e : fx.heaps) (e.side == "start" ? start_heap : end_heap) = e.s0;
+    check_fold_s0(s0, ell, start_heap, end_heap, keys);
     const double d = kTangentStep * ell;
     if (s0 - d > 0 && s0 + d < ell) {
       const Vec<dim> before = parts.curve->point(s0) - parts.curve->point(s0 - d);
