@@ -66,12 +66,18 @@ std::string name_fronts(const std::string& reason, const std::vector<std::string
 
 template <int dim>
 FrontScene<dim> build_front_scene(const SceneSpec& spec) {
+  CHAINSIM_VERIFY(spec.has_fronts(), "a scene without fronts has no front description");
+  return build_string_scene<dim>(spec);
+}
+
+template <int dim>
+std::unique_ptr<StringModel<dim>> build_front_model(const SceneSpec& spec, scene_build::SceneParts<dim>& parts,
+                                                    StringScene<dim>& scene) {
   CHAINSIM_VERIFY(spec.has_fronts(), "a scene without fronts runs on StringModel (build_string_scene)");
   const auto& fx = spec.effects;
   const std::string first_front = fx.heaps.empty() ? "effects.fold" : "effects.heap[0]";
 
-  // 1. The string, its forces and ends.
-  scene_build::SceneParts<dim> parts = scene_build::build_scene_parts<dim>(spec);
+  // 1. The string, its forces and ends (build_string_scene built them).
   const double ell = parts.length;
   const Chain<dim>& chain = parts.chain;
 
@@ -190,22 +196,12 @@ FrontScene<dim> build_front_scene(const SceneSpec& spec) {
   }
 
   // 6. The model (the front tracker's own layout checks, located at the fronts) and the run options.
-  FrontScene<dim> scene;
   scene.front_names = names;
-  scene.characteristic_time = parts.characteristic_time;
   nlohmann::json& d = scene.description;
-  d["model"] = "string";
-  d["dimension"] = dim;
-  d["nodes"] = chain.num_nodes();
-  d["links"] = chain.num_links();
-  d["effects"] = nlohmann::json::array();
-  for (const auto& force : parts.forces) d["effects"].push_back(force->name());
-  d["prescribed"] = nlohmann::json::array();
-  for (const auto& p : parts.prescribed) d["prescribed"].push_back(fmt::format("node {}: {}", p.node, p.path->description()));
   const StringModelOptions mo = parts.model;
   const std::string fit_key = fold && heaps.empty() ? "effects.fold.s0" : first_front;
   // Located at the front and naming it: the tracker's messages speak of "the heap's plane", "the fold".
-  scene.model = at_key(spec, fit_key, [&] {
+  std::unique_ptr<StringModel<dim>> model = at_key(spec, fit_key, [&] {
     try {
       return std::make_unique<StringModel<dim>>(make_front_model<dim>(std::move(parts.chain), std::move(parts.forces),
                                                                       std::move(parts.prescribed), heaps, fold,
@@ -217,7 +213,7 @@ FrontScene<dim> build_front_scene(const SceneSpec& spec) {
       throw InputError(fmt::format("{}: {}", fit_key, e.what()));
     }
   });
-  const FrontTracker<dim>& tracker = *front_tracker(*scene.model);
+  const FrontTracker<dim>& tracker = *front_tracker(*model);
   d["fronts"] = nlohmann::json::array();
   for (std::size_t k = 0; k < names.size(); ++k) {
     const auto& front = tracker.fronts()[k];
@@ -239,22 +235,18 @@ FrontScene<dim> build_front_scene(const SceneSpec& spec) {
     d["fronts"].push_back(f);
   }
   d["num_fronts"] = names.size();
-  d["root_functions"] = scene.model->num_events();
   d["stop_events"] = nlohmann::json::array();
   for (const auto& stop : options.stop_at)
     d["stop_events"].push_back({{"front", names[static_cast<std::size_t>(stop.front)]}, {"s0", stop.s}});
-  d["stabilization_time"] = mo.stabilization_time;
-
-  scene.output = spec.output.select;
-  scene.solver = parts.solver;
   scene.solver.record_steps = true;
-  return scene;
+  return model;
 }
 
 template <int dim>
 nlohmann::json front_summary(const FrontScene<dim>& scene, const RunSummary& run) {
   nlohmann::json j = to_json(run);
   j.update(scene.description);
+  if (!scene.has_fronts()) return j;
   j["t_end"] = scene.solver.t_end;
   j["stop_reason"] = name_fronts(run.stop_reason, scene.front_names);
   nlohmann::json final_s0 = nlohmann::json::object();
@@ -275,6 +267,10 @@ RunSummary run_front_scene(const SceneSpec& spec) {
   return solver.summary();
 }
 
+template std::unique_ptr<StringModel<2>> build_front_model<2>(const SceneSpec&, scene_build::SceneParts<2>&,
+                                                               StringScene<2>&);
+template std::unique_ptr<StringModel<3>> build_front_model<3>(const SceneSpec&, scene_build::SceneParts<3>&,
+                                                               StringScene<3>&);
 template FrontScene<2> build_front_scene<2>(const SceneSpec&);
 template FrontScene<3> build_front_scene<3>(const SceneSpec&);
 template nlohmann::json front_summary<2>(const FrontScene<2>&, const RunSummary&);
