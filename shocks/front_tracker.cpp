@@ -8,6 +8,7 @@
 #include <fmt/format.h>
 
 #include "mesh/errors.hpp"
+#include "shocks/front_checks.hpp"
 
 namespace chainsim {
 
@@ -27,24 +28,22 @@ template <int dim>
 std::vector<std::unique_ptr<FrontKind<dim>>> FrontTracker<dim>::make_fronts(double ell) {
   const HeapSpec<dim>* before = nullptr;
   const HeapSpec<dim>* after = nullptr;
-  for (auto& heap : heap_specs_) {
+  for (std::size_t k = 0; k < heap_specs_.size(); ++k) {
+    HeapSpec<dim>& heap = heap_specs_[k];
+    const bool at_end = heap.side == HeapSpec<dim>::Side::kAfter;
     check_heap_dissipation(heap);
+    check_heap_s0(k, at_end, heap.s0, ell);
     if (std::abs(heap.s0 - ell) <= 1e-12 * ell) heap.s0 = ell;  // ℓ is a sum of link lengths
     if (std::abs(heap.s0) <= 1e-12 * ell) heap.s0 = 0;
-    if (heap.side == HeapSpec<dim>::Side::kAfter)
-      require_in_range("heap.s0", heap.s0, 0.0, ell, Bound::kOpen, Bound::kClosed);
-    else
-      require_in_range("heap.s0", heap.s0, 0.0, ell, Bound::kClosed, Bound::kOpen);
-    auto& slot = heap.side == HeapSpec<dim>::Side::kBefore ? before : after;
-    if (slot) throw InputError("at most one heap on each side of the string");
+    auto& slot = at_end ? after : before;
+    check_one_heap_per_side(k, at_end, slot ? std::optional<std::size_t>(slot - heap_specs_.data()) : std::nullopt);
     slot = &heap;
   }
   const std::optional<FoldSpec>& fold = fold_spec_;
   if (fold) {
-    require_in_range("fold.dissipation", fold->dissipation, 0.0, 1.0);
-    require_in_range("fold.s0", fold->s0, 0.0, ell, Bound::kClosed, Bound::kOpen);
-    if ((before && fold->s0 <= before->s0) || (after && fold->s0 >= after->s0))
-      throw InputError("the fold must lie between the heaps");
+    check_fold_dissipation(fold->dissipation);
+    check_fold_s0(fold->s0, ell, before ? std::optional<double>(before->s0) : std::nullopt,
+                  after ? std::optional<double>(after->s0) : std::nullopt);
   }
   if (before && after && after->s0 - before->s0 < 2 * material_.h)
     throw InputError("the heaps are less than two links apart: use more nodes");
@@ -57,7 +56,7 @@ std::vector<std::unique_ptr<FrontKind<dim>>> FrontTracker<dim>::make_fronts(doub
 
 template <int dim>
 std::vector<ArcRange> FrontTracker<dim>::initial_arcs(const Chain<dim>& chain) {
-  if (chain.closed()) throw InputError("fronts are tracked on open strings only");
+  check_open_string(chain.closed(), !heap_specs_.empty());
   const int L = chain.num_links();
   const double h = chain.link_length(0);
   for (int j = 1; j < L; ++j)
@@ -284,6 +283,18 @@ StringModel<dim> make_front_model(Chain<dim> chain, std::vector<std::unique_ptr<
                                   std::vector<PrescribedNode<dim>> prescribed, std::vector<HeapSpec<dim>> heaps,
                                   std::optional<FoldSpec> fold, const FrontOptions& fronts,
                                   const StringModelOptions& options) {
+  // An end on a heap's side is inside the heap: neither prescribed nor loaded.
+  auto held = [&](int node) -> std::string {
+    for (const auto& p : prescribed)
+      if (p.node == node) return "prescribed";
+    for (const auto& force : forces)
+      if (const auto* load = dynamic_cast<const EndLoad<dim>*>(force.get()); load && load->node() == node) return "loaded";
+    return "";
+  };
+  for (std::size_t k = 0; k < heaps.size(); ++k) {
+    const bool at_end = heaps[k].side == HeapSpec<dim>::Side::kAfter;
+    check_end_free(k, at_end, heaps[k].s0, held(at_end ? chain.num_nodes() - 1 : 0));
+  }
   return StringModel<dim>(std::move(chain), std::move(forces), std::move(prescribed), options,
                           std::make_unique<FrontTracker<dim>>(std::move(heaps), fold, fronts));
 }

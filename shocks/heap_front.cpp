@@ -176,18 +176,7 @@ HeapGeometry<dim> heap_geometry(const Points<dim>& x, const Points<dim>& v, bool
 
 template <int dim>
 void check_heap_dissipation(const HeapSpec<dim>& spec, const std::string& name) {
-  if (spec.pot && spec.side != HeapSpec<dim>::Side::kBefore)
-    throw InputError(fmt::format("{}.pot = true on a heap the string runs into: a pot feeds the string; allowed "
-                                 "only for a start heap (side before s0)",
-                                 name));
-  if (spec.pot) {
-    if (!(spec.dissipation >= jump::kPotMinDissipation && spec.dissipation <= 1))
-      throw InputError(fmt::format("{}.dissipation = {} is out of range: allowed {} <= dissipation <= 1 for a pot (it "
-                                   "loses (1/2 + f) lambda v^3, which must not be negative)",
-                                   name, spec.dissipation, jump::kPotMinDissipation));
-    return;
-  }
-  require_in_range(name + ".dissipation", spec.dissipation, 0.0, 1.0);
+  check_heap_dissipation(0, spec.side == HeapSpec<dim>::Side::kAfter, spec.pot, spec.dissipation, FrontKeys(name));
 }
 
 template <int dim>
@@ -217,9 +206,11 @@ void HeapFront<dim>::cut(FrontLayout& layout) {
   this->arc_minus = after_ ? layout.arc : -1;
   this->arc_plus = after_ ? -1 : layout.arc;
   if (on_plane_) {
+    std::string shown = "[";
+    for (int d = 0; d < dim; ++d) shown += fmt::format("{}{}", d ? ", " : "", normal_[d]);
+    check_plane_normal(normal_, shown + "]");
     const double norm = normal_.norm();
-    if (!(norm > 0) || !std::isfinite(norm)) throw InputError("the normal of a heap's plane must be a nonzero vector");
-    normal_ = normal_ / norm;
+    normal_ = std::isfinite(norm) ? Vec<dim>(normal_ / norm) : Vec<dim>(normal_.stableNormalized());
     // An arc with no full link next to the heap takes the direction of its partial link from the
     // initial shape (initialize()).
   }

@@ -3,6 +3,7 @@
 /// A heap front (front_kind.hpp): a quiescent heap, pinned at a point or lying on a plane, holding
 /// the material on one side of the front (front_tracker.hpp has the physics, docs/shocks.md the
 /// numerics).
+#include "shocks/front_checks.hpp"
 #include "shocks/front_kind.hpp"
 
 namespace chainsim {

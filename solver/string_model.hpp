@@ -207,6 +207,7 @@ class StringModel final : public OdeSystem {
   double alpha() const { return alpha_; }
   double beta() const { return beta_; }
   TensionSystem& tension_system() { return *system_; }
+  const TensionSystem& tension_system() const { return *system_; }
   bool has_tension_system() const { return system_ != nullptr; }
   long tension_solves() const;
   /// The quadratic elements (StringModelOptions::elements = "quadratic"), or null.

@@ -76,6 +76,16 @@ void StringSolverOptions::check_output_budget(int nodes, int dim, bool fronts, c
                                  asks, e.disk_bytes / 1e6, select.max_megabytes));
 }
 
+nlohmann::json model_json(const RunSummary& s) {
+  nlohmann::json j = {{"dimension", s.dimension}, {"nodes", s.nodes}, {"links", s.links}};
+  j["effects"] = s.effects;
+  j["prescribed"] = s.prescribed;
+  j["root_functions"] = s.root_functions;
+  j["tension_unknowns"] = s.tension_unknowns;
+  j["stabilization_time"] = s.stabilization_time;
+  return j;
+}
+
 nlohmann::json to_json(const RunSummary& s) {
   nlohmann::json j = {{"status", s.status},
                       {"stop_reason", s.stop_reason},
@@ -97,15 +107,8 @@ nlohmann::json to_json(const RunSummary& s) {
                       {"tension_backend", s.tension_backend},
                       {"frames", s.frames},
                       {"samples", s.samples.size()},
-                      {"dimension", s.dimension},
-                      {"nodes", s.nodes},
-                      {"links", s.links},
-                      {"effects", s.effects},
-                      {"prescribed", s.prescribed},
-                      {"root_functions", s.root_functions},
-                      {"tension_unknowns", s.tension_unknowns},
-                      {"stabilization_time", s.stabilization_time},
                       {"stats", to_json(s.stats)}};
+  j.update(model_json(s));
   nlohmann::json slack = {{"policy", to_string(s.slack_policy)}, {"detected", s.slack.has_value()}};
   if (s.slack)
     slack.update({{"t", s.slack->t},
@@ -191,36 +194,41 @@ StringSolver<dim>::StringSolver(StringModel<dim>& model, const StringSolverOptio
 }
 
 template <int dim>
-void StringSolver<dim>::describe_model() {
+void describe_model(const StringModel<dim>& model, RunSummary& summary) {
   // What the model holds, read back from it (not from the scene that asked for it).
-  const auto& chain = model_.chain();
-  summary_.dimension = dim;
-  summary_.nodes = chain.num_nodes();
-  summary_.links = chain.num_links();
-  summary_.effects.clear();
-  for (const auto& force : model_.forces()) summary_.effects.push_back(force->name());
-  summary_.prescribed.clear();
-  for (const auto& p : model_.prescribed())
-    summary_.prescribed.push_back(fmt::format("node {}: {}", p.node, p.path->description()));
-  summary_.root_functions = model_.num_events();
-  summary_.tension_unknowns = model_.has_tension_system() ? model_.tension_system().size() : 0;
-  summary_.stabilization_time = model_.options().stabilization_time;
-  summary_.tension_backend = model_.quadratic()             ? "quadratic elements (block tridiagonal)"
-                             : model_.has_tension_system() ? model_.tension_system().backend_name()
-                                                           : "none";
-  summary_.t_end = options_.t_end;
-  summary_.slack_policy = model_.options().slack;
+  const auto& chain = model.chain();
+  summary.dimension = dim;
+  summary.nodes = chain.num_nodes();
+  summary.links = chain.num_links();
+  summary.effects.clear();
+  for (const auto& force : model.forces()) summary.effects.push_back(force->name());
+  summary.prescribed.clear();
+  for (const auto& p : model.prescribed())
+    summary.prescribed.push_back(fmt::format("node {}: {}", p.node, p.path->description()));
+  summary.root_functions = model.num_events();
+  summary.tension_unknowns = model.has_tension_system() ? model.tension_system().size() : 0;
+  summary.stabilization_time = model.options().stabilization_time;
+  summary.tension_backend = model.quadratic()             ? "quadratic elements (block tridiagonal)"
+                            : model.has_tension_system() ? model.tension_system().backend_name()
+                                                         : "none";
+  summary.slack_policy = model.options().slack;
   const char* axes[] = {"x", "y", "z"};
-  summary_.force_columns.clear();
-  for (const auto& p : model_.prescribed()) {
-    for (int d = 0; d < dim; ++d) summary_.force_columns.push_back(fmt::format("R_node{}_{}", p.node, axes[d]));
-    summary_.force_columns.push_back(fmt::format("T_node{}", p.node));
+  summary.force_columns.clear();
+  for (const auto& p : model.prescribed()) {
+    for (int d = 0; d < dim; ++d) summary.force_columns.push_back(fmt::format("R_node{}_{}", p.node, axes[d]));
+    summary.force_columns.push_back(fmt::format("T_node{}", p.node));
   }
-  const int fronts = model_.module() ? model_.module()->num_fronts() : 0;
-  summary_.ledger_terms = model_.module() ? model_.module()->ledger_terms() : std::vector<LedgerTerm>{};
-  term_names_ = std::make_shared<const std::vector<LedgerTerm>>(summary_.ledger_terms);
+  const int fronts = model.module() ? model.module()->num_fronts() : 0;
+  summary.ledger_terms = model.module() ? model.module()->ledger_terms() : std::vector<LedgerTerm>{};
   for (int k = 0; k < fronts; ++k)
-    for (int d = 0; d < dim; ++d) summary_.force_columns.push_back(fmt::format("R_front{}_{}", k, axes[d]));
+    for (int d = 0; d < dim; ++d) summary.force_columns.push_back(fmt::format("R_front{}_{}", k, axes[d]));
+}
+
+template <int dim>
+void StringSolver<dim>::describe_model() {
+  chainsim::describe_model(model_, summary_);
+  summary_.t_end = options_.t_end;
+  term_names_ = std::make_shared<const std::vector<LedgerTerm>>(summary_.ledger_terms);
 }
 
 template <int dim>
@@ -596,5 +604,7 @@ void StringSolver<dim>::write_outputs(const std::filesystem::path& dir, const Ou
 
 template class StringSolver<2>;
 template class StringSolver<3>;
+template void describe_model<2>(const StringModel<2>&, RunSummary&);
+template void describe_model<3>(const StringModel<3>&, RunSummary&);
 
 }  // namespace chainsim

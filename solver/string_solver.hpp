@@ -177,6 +177,14 @@ struct RunSummary {
 /// description (dimension, nodes, links, effects, prescribed, root functions, tension unknowns,
 /// stabilization time, backend) and ARKODE's statistics.
 nlohmann::json to_json(const RunSummary& summary);
+/// The model's part of the summary (to_json has it too): dimension, nodes, links, effects, prescribed,
+/// root_functions, tension_unknowns, stabilization_time. A scene's description (cases/scene) is it.
+nlohmann::json model_json(const RunSummary& summary);
+/// Fills the model's fields of `summary` (those of model_json, the tension backend, the slack
+/// policy, the force columns, the ledger terms), read back from the model: the one description of
+/// a model, used by StringSolver and by the scenes.
+template <int dim>
+void describe_model(const StringModel<dim>& model, RunSummary& summary);
 /// The samples as a table (columns t, s0_k, s0dot_k, front_k_x.., K, V, W_applied, the module's energy
 /// terms, energy_residual, momentum_residual, support_x.., moving_mass, the module's other terms,
 /// max_violation, moving_nodes; front tracking's terms: shocks/front_tracker.hpp).

@@ -14,6 +14,7 @@
 #include <fmt/format.h>
 
 #include "cases/scene/scene_build.hpp"
+#include "cases/scene/scene_front_keys.hpp"
 #include "mesh/errors.hpp"
 #include "solver/output.hpp"
 #include "solver/string_solver.hpp"
@@ -65,20 +66,24 @@ std::string name_fronts(const std::string& reason, const std::vector<std::string
 
 template <int dim>
 FrontScene<dim> build_front_scene(const SceneSpec& spec) {
+  CHAINSIM_VERIFY(spec.has_fronts(), "a scene without fronts has no front description");
+  return build_string_scene<dim>(spec);
+}
+
+template <int dim>
+std::unique_ptr<StringModel<dim>> build_front_model(const SceneSpec& spec, scene_build::SceneParts<dim>& parts,
+                                                    StringScene<dim>& scene) {
   CHAINSIM_VERIFY(spec.has_fronts(), "a scene without fronts runs on StringModel (build_string_scene)");
   const auto& fx = spec.effects;
   const std::string first_front = fx.heaps.empty() ? "effects.fold" : "effects.heap[0]";
 
-  // 1. The string, its forces and ends.
-  scene_build::SceneParts<dim> parts = scene_build::build_scene_parts<dim>(spec);
+  // 1. The string, its forces and ends (build_string_scene built them).
   const double ell = parts.length;
   const Chain<dim>& chain = parts.chain;
 
   // 2. What a string with fronts cannot have.
-  if (chain.closed())
-    fail_at(spec, first_front,
-            fmt::format("{} on a closed string: fronts are tracked on open strings only (string.closed = true)",
-                        fx.heaps.empty() ? "[effects.fold]" : "[[effects.heap]]"));
+  const SceneFrontKeys keys(spec);
+  check_open_string(chain.closed(), !fx.heaps.empty(), keys);
   if (chain.num_links() < 2) {
     const std::string key = spec.link_length ? "string.link_length" : "string.nodes";
     fail_at(spec, key,
@@ -88,11 +93,7 @@ FrontScene<dim> build_front_scene(const SceneSpec& spec) {
   for (std::size_t k = 0; k < fx.heaps.size(); ++k) {
     const HeapEntry& heap = fx.heaps[k];
     const EndSpec& end = heap.side == "start" ? spec.start : spec.end;
-    if (end.kind != "free")
-      fail_at(spec, "ends." + heap.side,
-              fmt::format("ends.{} = \"{}\" is inside the heap of effects.heap[{}] (side = \"{}\", s0 = {:g} m): an "
-                          "end held by a heap cannot be fixed, loaded or driven",
-                          heap.side, end.kind, k, heap.side, heap.s0));
+    check_end_free(k, heap.side == "end", heap.s0, end.kind == "free" ? "" : fmt::format("\"{}\"", end.kind), keys);
   }
 
   // 3. Heaps: s0 inside the string, the shape through the heap point at s0, the point on its plane.
@@ -102,22 +103,14 @@ FrontScene<dim> build_front_scene(const SceneSpec& spec) {
   if (fx.plane) {
     plane_point = as_vec<dim>(spec, fx.plane->point, "effects.plane.point");
     const Vec<dim> n = as_vec<dim>(spec, fx.plane->normal, "effects.plane.normal");
-    if (n.isZero(0.0))
-      fail_at(spec, "effects.plane.normal",
-              fmt::format("effects.plane.normal = {} is zero: a plane needs a normal", text_of(spec, "effects.plane.normal")));
+    check_plane_normal(n, show<dim>(n), keys);
     plane_normal = n.stableNormalized();  // [0, 1e300] too: its norm overflows, its direction does not
   }
   for (std::size_t k = 0; k < fx.heaps.size(); ++k) {
     const HeapEntry& heap = fx.heaps[k];
     const std::string key = fmt::format("effects.heap[{}]", k);
     const bool start = heap.side == "start";
-    const bool inside = start ? (heap.s0 >= 0 && heap.s0 < ell) : (heap.s0 > 0 && heap.s0 <= ell * (1 + 1e-12));
-    if (!inside)
-      fail_at(spec, key + ".s0",
-              fmt::format("{}.s0 = {} is outside the string: allowed {} for side = \"{}\" (the string is {} m long)",
-                          key, text_of(spec, key + ".s0"),
-                          start ? fmt::format("0 <= s0 < {}", ell) : fmt::format("0 < s0 <= {}", ell), heap.side,
-                          ell));
+    check_heap_s0(k, !start, heap.s0, ell, keys);
     const Vec<dim> point = as_vec<dim>(spec, heap.point, key + ".point");
     const Vec<dim> on_shape = parts.curve->point(heap.s0);
     const double miss = (point - on_shape).norm();
@@ -165,13 +158,9 @@ FrontScene<dim> build_front_scene(const SceneSpec& spec) {
   if (fx.fold) {
     const double s0 = fx.fold->s0;
     const std::string key = "effects.fold.s0";
-    const bool start_heap = std::any_of(fx.heaps.begin(), fx.heaps.end(), [](const HeapEntry& e) { return e.side == "start"; });
-    const bool end_heap = std::any_of(fx.heaps.begin(), fx.heaps.end(), [](const HeapEntry& e) { return e.side == "end"; });
-    if (!((start_heap ? s0 > s_lo : s0 >= 0) && s0 < s_hi))
-      fail_at(spec, key,
-              fmt::format("effects.fold.s0 = {} is {}: allowed {} {} s0 < {}", text_of(spec, key),
-                          start_heap || end_heap ? "not between the heaps" : "outside the string", s_lo,
-                          start_heap ? "<" : "<=", s_hi));
+    std::optional<double> start_heap, end_heap;
+    for (const HeapEntry& e : fx.heaps) (e.side == "start" ? start_heap : end_heap) = e.s0;
+    check_fold_s0(s0, ell, start_heap, end_heap, keys);
     const double d = kTangentStep * ell;
     if (s0 - d > 0 && s0 + d < ell) {
       const Vec<dim> before = parts.curve->point(s0) - parts.curve->point(s0 - d);
@@ -207,22 +196,12 @@ FrontScene<dim> build_front_scene(const SceneSpec& spec) {
   }
 
   // 6. The model (the front tracker's own layout checks, located at the fronts) and the run options.
-  FrontScene<dim> scene;
   scene.front_names = names;
-  scene.characteristic_time = parts.characteristic_time;
   nlohmann::json& d = scene.description;
-  d["model"] = "string";
-  d["dimension"] = dim;
-  d["nodes"] = chain.num_nodes();
-  d["links"] = chain.num_links();
-  d["effects"] = nlohmann::json::array();
-  for (const auto& force : parts.forces) d["effects"].push_back(force->name());
-  d["prescribed"] = nlohmann::json::array();
-  for (const auto& p : parts.prescribed) d["prescribed"].push_back(fmt::format("node {}: {}", p.node, p.path->description()));
   const StringModelOptions mo = parts.model;
   const std::string fit_key = fold && heaps.empty() ? "effects.fold.s0" : first_front;
   // Located at the front and naming it: the tracker's messages speak of "the heap's plane", "the fold".
-  scene.model = at_key(spec, fit_key, [&] {
+  std::unique_ptr<StringModel<dim>> model = at_key(spec, fit_key, [&] {
     try {
       return std::make_unique<StringModel<dim>>(make_front_model<dim>(std::move(parts.chain), std::move(parts.forces),
                                                                       std::move(parts.prescribed), heaps, fold,
@@ -234,7 +213,7 @@ FrontScene<dim> build_front_scene(const SceneSpec& spec) {
       throw InputError(fmt::format("{}: {}", fit_key, e.what()));
     }
   });
-  const FrontTracker<dim>& tracker = *front_tracker(*scene.model);
+  const FrontTracker<dim>& tracker = *front_tracker(*model);
   d["fronts"] = nlohmann::json::array();
   for (std::size_t k = 0; k < names.size(); ++k) {
     const auto& front = tracker.fronts()[k];
@@ -256,22 +235,18 @@ FrontScene<dim> build_front_scene(const SceneSpec& spec) {
     d["fronts"].push_back(f);
   }
   d["num_fronts"] = names.size();
-  d["root_functions"] = scene.model->num_events();
   d["stop_events"] = nlohmann::json::array();
   for (const auto& stop : options.stop_at)
     d["stop_events"].push_back({{"front", names[static_cast<std::size_t>(stop.front)]}, {"s0", stop.s}});
-  d["stabilization_time"] = mo.stabilization_time;
-
-  scene.output = spec.output.select;
-  scene.solver = parts.solver;
   scene.solver.record_steps = true;
-  return scene;
+  return model;
 }
 
 template <int dim>
 nlohmann::json front_summary(const FrontScene<dim>& scene, const RunSummary& run) {
   nlohmann::json j = to_json(run);
   j.update(scene.description);
+  if (!scene.has_fronts()) return j;
   j["t_end"] = scene.solver.t_end;
   j["stop_reason"] = name_fronts(run.stop_reason, scene.front_names);
   nlohmann::json final_s0 = nlohmann::json::object();
@@ -292,6 +267,10 @@ RunSummary run_front_scene(const SceneSpec& spec) {
   return solver.summary();
 }
 
+template std::unique_ptr<StringModel<2>> build_front_model<2>(const SceneSpec&, scene_build::SceneParts<2>&,
+                                                               StringScene<2>&);
+template std::unique_ptr<StringModel<3>> build_front_model<3>(const SceneSpec&, scene_build::SceneParts<3>&,
+                                                               StringScene<3>&);
 template FrontScene<2> build_front_scene<2>(const SceneSpec&);
 template FrontScene<3> build_front_scene<3>(const SceneSpec&);
 template nlohmann::json front_summary<2>(const FrontScene<2>&, const RunSummary&);

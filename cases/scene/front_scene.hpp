@@ -30,28 +30,30 @@
 
 namespace chainsim {
 
-/// A scene with fronts, ready to run.
+/// A scene with fronts, ready to run: the one scene type (scene.hpp), its fronts described.
 template <int dim>
-struct FrontScene {
-  std::unique_ptr<StringModel<dim>> model;
-  StringSolverOptions solver;  ///< record_steps on: series.csv
-  OutputSelection output;
-  std::vector<std::string> front_names;  ///< "heap_start", "fold", "heap_end": those built, in order of s
-  /// What was built, read back from the model: dimension, nodes, links, effects, prescribed, fronts
-  /// (name, kind, side, f, s0, point, on_plane, plane_normal), num_fronts, root_functions (2 per
-  /// front + stop events), stop_events, stabilization_time.
-  nlohmann::json description;
-  double characteristic_time = 0;  ///< t_char (s), as for a string scene
-};
+using FrontScene = StringScene<dim>;
 
-/// Builds the model of a scene with fronts (spec.has_fronts(), dim = spec.dimension) with exactly
-/// the effects it declares. Throws InputError naming the file:line:column of the key at fault.
+namespace scene_build {
+template <int dim>
+struct SceneParts;
+}
+
+/// The fronts' part of build_string_scene (scene.hpp), for a scene with fronts: checks the fronts
+/// against the string, builds the model with front tracking from `parts` (moved from), sets
+/// scene.front_names, the fronts' description (fronts, num_fronts, stop_events) and record_steps.
+template <int dim>
+std::unique_ptr<StringModel<dim>> build_front_model(const SceneSpec& spec, scene_build::SceneParts<dim>& parts,
+                                                    StringScene<dim>& scene);
+
+/// Builds the model of a scene with fronts (spec.has_fronts(), dim = spec.dimension): build_string_scene.
 template <int dim>
 FrontScene<dim> build_front_scene(const SceneSpec& spec);
 
-/// The run's summary: to_json(run), the scene's description, "model": "string", "t_end" (the
-/// scene's end time), "fronts_final" (each front's s0 at the stop, m) and a stop_reason that names
-/// the fronts ("the heap_end front reached s0 = 0.01 m", "the heap has run empty", "t_end reached").
+/// The run's summary (any scene, with or without fronts): to_json(run) and the scene's description;
+/// with fronts also "t_end" (the scene's end time), "fronts_final_s0" (each front's s0 at the stop, m)
+/// and a stop_reason that names the fronts ("the heap_end front reached s0 = 0.01 m", "the heap has
+/// run empty", "t_end reached").
 template <int dim>
 nlohmann::json front_summary(const FrontScene<dim>& scene, const RunSummary& run);
 

@@ -1,7 +1,7 @@
 // [effects.*]: gravity, drag, heaps, fold and plane, each existing only if its section is written
 // (parse_sections.hpp).
 #include "cases/scene/parse_sections.hpp"
-#include "shocks/jump_conditions.hpp"
+#include "cases/scene/scene_front_keys.hpp"
 
 namespace chainsim::scene_parse {
 
@@ -18,28 +18,16 @@ void parse_heaps(const Section& effects, Context& ctx) {
     if (!h.has("point")) h.missing("point", "m, the hole or edge the front sits at, or the contact point on the plane at t = 0");
     HeapEntry heap;
     heap.side = h.choice("side", {"start", "end"}, "");
+    const SceneFrontKeys keys(ctx.spec);
+    std::optional<std::size_t> other;
     for (std::size_t j = 0; j < heaps.size(); ++j)
-      if (heaps[j].side == heap.side)
-        h.fail("side", fmt::format("effects.heap[{}].side = \"{}\": effects.heap[{}] already holds that side of the "
-                                   "string; allowed at most one heap per side",
-                                   k, heap.side, j));
+      if (heaps[j].side == heap.side) other = j;
+    check_one_heap_per_side(k, heap.side == "end", other, keys);
     heap.s0 = *h.number("s0");
     // f: 0 <= f <= 1; a pot (a start heap that pushes the string out) also -1/2 <= f < 0 (docs/model.md §5).
     heap.pot = h.boolean("pot").value_or(false);
-    if (heap.pot && heap.side != "start")
-      h.fail("pot", fmt::format("effects.heap[{}].pot = true on side = \"{}\": a pot feeds the string; allowed only "
-                                "for side = \"start\"",
-                                k, heap.side));
-    const double f = h.number("f").value_or(0.0), lowest = jump::kPotMinDissipation;
-    if (heap.pot && !(f >= lowest && f <= 1))
-      h.fail("f", fmt::format("effects.heap[{}].f = {} is out of range: allowed {} <= f <= 1 for a pot (it loses "
-                              "(1/2 + f) lambda v^3, which must not be negative)",
-                              k, h.text("f"), lowest));
-    if (!heap.pot && f < 0 && f >= lowest)
-      h.fail("f", fmt::format("effects.heap[{}].f = {} is out of range: allowed 0 <= f <= 1; a heap that pushes the "
-                              "string out (f < 0, down to {}) must be a pot: side = \"start\" with pot = true",
-                              k, h.text("f"), lowest));
-    heap.dissipation = heap.pot ? f : h.number_in("f", 0.0, 0.0, 1.0);
+    heap.dissipation = h.number("f").value_or(0.0);
+    check_heap_dissipation(k, heap.side == "end", heap.pot, heap.dissipation, keys);
     heap.point = h.vector("point");
     heap.on_plane = h.boolean("on_plane").value_or(false);
     heaps.push_back(heap);
@@ -67,7 +55,8 @@ void parse_effects(const Section& top, Context& ctx) {
   if (s.has("fold")) {
     Section f(subtable(s, "fold"), "effects.fold", ctx, {"s0", "f"});
     if (!f.has("s0")) f.missing("s0", "m, the material coordinate of the fold at t = 0");
-    fx.fold = FoldEntry{*f.number("s0"), f.number_in("f", 0.0, 0.0, 1.0)};
+    fx.fold = FoldEntry{*f.number("s0"), f.number("f").value_or(0.0)};
+    check_fold_dissipation(fx.fold->dissipation, SceneFrontKeys(ctx.spec));
   }
   if (s.has("plane")) {
     Section p(subtable(s, "plane"), "effects.plane", ctx, {"point", "normal"});

@@ -41,6 +41,8 @@
 #include <string_view>
 #include <vector>
 
+#include <nlohmann/json.hpp>
+
 #include "solver/string_model.hpp"
 #include "solver/string_solver.hpp"
 
@@ -202,17 +204,25 @@ SceneSpec parse_scene_text(std::string_view text, const std::string& source, con
 /// given, not at the file's line. Throws InputError.
 void replace_t_end(SceneSpec& spec, double t_end, const std::string& origin);
 
-/// A scene ready to run.
+/// A scene ready to run, with or without fronts (one builder: build_string_scene).
 template <int dim>
 struct StringScene {
   std::unique_ptr<StringModel<dim>> model;  ///< already projected onto the constraints at t = 0
-  StringSolverOptions solver;
+  StringSolverOptions solver;  ///< with fronts, record_steps on: series.csv
   OutputSelection output;
   double characteristic_time = 0;  ///< t_char used for the default stabilization time (s)
+  std::vector<std::string> front_names;  ///< "heap_start", "fold", "heap_end": those built, in order of s
+  /// What was built, read back from the model: "model": "string", the model's part of the summary
+  /// (model_json: dimension, nodes, links, effects, prescribed, root_functions (2 per front + stop
+  /// events), tension_unknowns, stabilization_time), fronts (name, kind, side, f, s0, point, on_plane,
+  /// plane_normal, pot; [] without fronts), num_fronts and, with fronts, stop_events.
+  nlohmann::json description;
+  bool has_fronts() const { return !front_names.empty(); }
 };
 
 /// Builds the model of a parsed scene (dim must equal spec.dimension) with exactly the effects the
-/// scene declares, checks it physically and projects its initial state onto the constraints.
+/// scene declares, and its fronts when it declares a heap or a fold (front_scene.hpp), checks it
+/// physically and projects its initial state onto the constraints.
 /// Default Baumgarte time: τ_b = 0.1 t_char with t_char the shortest of sqrt(ℓ/|g|) (gravity),
 /// ℓ/v (v the largest initial speed or the speed of an end driven along a line) and 2π/ω (shaken or
 /// periodically loaded ends); t_end only when the scene has none of these.

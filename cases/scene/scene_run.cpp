@@ -6,19 +6,8 @@
 namespace chainsim {
 
 template <int dim>
-SceneRun<dim>::SceneRun(const SceneSpec& spec) {
-  if (spec.has_fronts()) {
-    fronts_ = std::make_unique<FrontScene<dim>>(build_front_scene<dim>(spec));
-    model_ = std::move(fronts_->model);
-    options_ = fronts_->solver;
-    output_ = fronts_->output;
-  } else {
-    StringScene<dim> scene = build_string_scene<dim>(spec);
-    model_ = std::move(scene.model);
-    options_ = scene.solver;
-    output_ = scene.output;
-  }
-  solver_ = std::make_unique<StringSolver<dim>>(*model_, options_);
+SceneRun<dim>::SceneRun(const SceneSpec& spec) : scene_(build_string_scene<dim>(spec)) {
+  solver_ = std::make_unique<StringSolver<dim>>(*scene_.model, scene_.solver);
 }
 
 template <int dim>
@@ -46,17 +35,12 @@ std::optional<NumericalError> SceneRun<dim>::run(const std::function<void(double
 
 template <int dim>
 nlohmann::json SceneRun<dim>::description() const {
-  return fronts_ ? fronts_->description : nlohmann::json();
+  return scene_.has_fronts() ? scene_.description : nlohmann::json();
 }
 
 template <int dim>
 nlohmann::json SceneRun<dim>::summary() const {
-  if (fronts_) return front_summary(*fronts_, solver_->summary());
-  nlohmann::json j = to_json(solver_->summary());
-  j["model"] = "string";
-  j["fronts"] = nlohmann::json::array();  // none built: no fronts, no root functions
-  j["num_fronts"] = 0;
-  return j;
+  return front_summary(scene_, solver_->summary());
 }
 
 template <int dim>
@@ -66,7 +50,7 @@ void SceneRun<dim>::write(const std::filesystem::path& dir, const nlohmann::json
 
 template <int dim>
 void SceneRun<dim>::write(const RunDirectory& dir, const nlohmann::json& summary) const {
-  solver_->write_outputs(dir.path(), output_, &summary);
+  solver_->write_outputs(dir.path(), scene_.output, &summary);
 }
 
 template class SceneRun<2>;

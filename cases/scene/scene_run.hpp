@@ -1,7 +1,7 @@
 #pragma once
 /// @file scene_run.hpp
 /// One run of a string scene (with or without fronts), exactly as `chainsim run` does it: the model
-/// built and checked (build_string_scene, or build_front_scene when the scene has a heap or a fold),
+/// built and checked (build_string_scene, with the fronts when the scene has a heap or a fold),
 /// the one runner (StringSolver), the summary that becomes stats.json, and the run directory
 /// (StringSolver::write_outputs). `chainsim run`, `chainsim sweep` and the Python module
 /// (python/chainsim) all run scenes through this class, so they give the same numbers.
@@ -19,9 +19,6 @@
 namespace chainsim {
 
 template <int dim>
-struct FrontScene;
-
-template <int dim>
 class SceneRun {
  public:
   /// Builds the model of `spec` (spec.model = "string", dim = spec.dimension) and checks it.
@@ -37,15 +34,15 @@ class SceneRun {
   std::optional<NumericalError> run(const std::function<void(double)>& on_step = {});
 
   const StringSolver<dim>& solver() const { return *solver_; }
-  const StringModel<dim>& model() const { return *model_; }
-  const StringSolverOptions& solver_options() const { return options_; }
-  const OutputSelection& output() const { return output_; }
-  bool has_fronts() const { return fronts_ != nullptr; }
+  const StringModel<dim>& model() const { return *scene_.model; }
+  const StringSolverOptions& solver_options() const { return scene_.solver; }
+  const OutputSelection& output() const { return scene_.output; }
+  bool has_fronts() const { return scene_.has_fronts(); }
   /// With fronts: what was built (front_scene.hpp's description: fronts, stop events); else null.
   nlohmann::json description() const;
 
-  /// The run's summary as stats.json holds it: to_json(summary) with "model": "string" and no fronts,
-  /// or front_summary() for a scene with fronts.
+  /// The run's summary as stats.json holds it: front_summary() (to_json(summary) and the scene's
+  /// description; "model": "string", and "fronts": [] without fronts).
   nlohmann::json summary() const;
   /// Writes the run directory (the scene's [output] selection; stats.json = `summary`, last), after
   /// removing what any chainsim command wrote there before, holding its lock meanwhile (RunDirectory:
@@ -55,10 +52,7 @@ class SceneRun {
   void write(const RunDirectory& dir, const nlohmann::json& summary) const;
 
  private:
-  std::unique_ptr<StringModel<dim>> model_;
-  StringSolverOptions options_;
-  OutputSelection output_;
-  std::unique_ptr<FrontScene<dim>> fronts_;  ///< the front scene's description (its model moved out)
+  StringScene<dim> scene_;  ///< the model, its options and description (build_string_scene)
   std::unique_ptr<StringSolver<dim>> solver_;
 };
 
