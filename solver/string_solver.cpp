@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <future>
 
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
@@ -470,62 +471,10 @@ void StringSolver<dim>::write_outputs(const std::filesystem::path& dir, const Ou
   const auto& chain = model_.chain();
   const int L = chain.num_links();
   const bool fronts = model_.module() != nullptr;
-  // 2. CSV files, streamed from the frames (a row at a time: nothing but the frames in memory).
-  if (select.csv) {
-    const char* axes[] = {"x", "y", "z"};
-    std::vector<std::string> columns = {"t", "node"};
-    if (fronts) columns.emplace_back("s");
-    for (int d = 0; d < dim; ++d) columns.emplace_back(axes[d]);
-    for (int d = 0; d < dim; ++d) columns.push_back(std::string("v") + axes[d]);
-    std::vector<double> row;
-    if (select.nodes) {
-      CsvWriter nodes(dir / "nodes.csv", columns);
-      for (const auto& f : frames_)
-        for (int i : f.moving) {
-          row = {f.t, static_cast<double>(i)};
-          if (fronts) row.push_back(chain.node_coordinate(i));
-          for (int d = 0; d < dim; ++d) row.push_back(f.x(d, i));
-          for (int d = 0; d < dim; ++d) row.push_back(f.v(d, i));
-          nodes.row(row);
-        }
-      nodes.commit();
-    }
-    if (select.tension) {
-      CsvWriter tension(dir / "tension.csv", {"t", "link", "s_mid", "T"});
-      for (const auto& f : frames_)
-        for (int j = 0; j < L; ++j)
-          if (!std::isnan(f.tension[j])) tension.row({f.t, static_cast<double>(j), chain.link_midpoint(j), f.tension[j]});
-      tension.commit();
-    }
-    if (select.energy) {
-      std::vector<std::string> energy_columns = {"t", "K", "V", "W_applied", "drift"};
-      const std::vector<LedgerTerm>& terms = summary_.ledger_terms;
-      for (const LedgerTerm& term : terms)
-        if (term.energy()) energy_columns.push_back(term.name);
-      CsvWriter energy(dir / "energy.csv", energy_columns);
-      for (const auto& f : frames_) {
-        row = {f.t, f.kinetic, f.potential, f.work, f.drift};
-        for (std::size_t k = 0; k < terms.size(); ++k)
-          if (terms[k].energy()) row.push_back(f.terms.values[k]);
-        energy.row(row);
-      }
-      energy.commit();
-      if (!summary_.samples.empty()) samples_table(summary_).write(dir / "series.csv");
-    }
-    if (select.forces && !summary_.force_columns.empty()) {
-      std::vector<std::string> force_columns = {"t"};
-      force_columns.insert(force_columns.end(), summary_.force_columns.begin(), summary_.force_columns.end());
-      CsvWriter forces(dir / "forces.csv", force_columns);
-      for (const auto& f : frames_) {
-        row = {f.t};
-        row.insert(row.end(), f.forces.begin(), f.forces.end());
-        forces.row(row);
-      }
-      forces.commit();
-    }
-  }
-  // 3. ParaView frames (the moving nodes, a line cell per link of an arc), then their index.
-  if (select.vtk) {
+  // 2. ParaView frames (the moving nodes, a line cell per link of an arc), then their index: on a
+  //    second thread while this one writes the CSV files (both only read the frames; each file is its
+  //    own AtomicFile), so that the run's outputs cost the longer of the two, not their sum.
+  auto write_frames = [&]() {
     ensure_directory(dir / "frames");
     std::vector<PvdEntry> index;
     const VtkEncoding encoding = select.vtk_ascii ? VtkEncoding::kAscii : VtkEncoding::kBinary;
@@ -589,7 +538,64 @@ void StringSolver<dim>::write_outputs(const std::filesystem::path& dir, const Ou
       index.push_back({f.t, "frames/" + fronts_name, 1});
     }
     write_pvd(dir / "string.pvd", index);
+  };
+  std::future<void> frames_written;
+  if (select.vtk) frames_written = std::async(std::launch::async, write_frames);
+  // 3. CSV files, streamed from the frames (a row at a time: nothing but the frames in memory).
+  if (select.csv) {
+    const char* axes[] = {"x", "y", "z"};
+    std::vector<std::string> columns = {"t", "node"};
+    if (fronts) columns.emplace_back("s");
+    for (int d = 0; d < dim; ++d) columns.emplace_back(axes[d]);
+    for (int d = 0; d < dim; ++d) columns.push_back(std::string("v") + axes[d]);
+    std::vector<double> row;
+    if (select.nodes) {
+      CsvWriter nodes(dir / "nodes.csv", columns);
+      for (const auto& f : frames_)
+        for (int i : f.moving) {
+          row = {f.t, static_cast<double>(i)};
+          if (fronts) row.push_back(chain.node_coordinate(i));
+          for (int d = 0; d < dim; ++d) row.push_back(f.x(d, i));
+          for (int d = 0; d < dim; ++d) row.push_back(f.v(d, i));
+          nodes.row(row);
+        }
+      nodes.commit();
+    }
+    if (select.tension) {
+      CsvWriter tension(dir / "tension.csv", {"t", "link", "s_mid", "T"});
+      for (const auto& f : frames_)
+        for (int j = 0; j < L; ++j)
+          if (!std::isnan(f.tension[j])) tension.row({f.t, static_cast<double>(j), chain.link_midpoint(j), f.tension[j]});
+      tension.commit();
+    }
+    if (select.energy) {
+      std::vector<std::string> energy_columns = {"t", "K", "V", "W_applied", "drift"};
+      const std::vector<LedgerTerm>& terms = summary_.ledger_terms;
+      for (const LedgerTerm& term : terms)
+        if (term.energy()) energy_columns.push_back(term.name);
+      CsvWriter energy(dir / "energy.csv", energy_columns);
+      for (const auto& f : frames_) {
+        row = {f.t, f.kinetic, f.potential, f.work, f.drift};
+        for (std::size_t k = 0; k < terms.size(); ++k)
+          if (terms[k].energy()) row.push_back(f.terms.values[k]);
+        energy.row(row);
+      }
+      energy.commit();
+      if (!summary_.samples.empty()) samples_table(summary_).write(dir / "series.csv");
+    }
+    if (select.forces && !summary_.force_columns.empty()) {
+      std::vector<std::string> force_columns = {"t"};
+      force_columns.insert(force_columns.end(), summary_.force_columns.begin(), summary_.force_columns.end());
+      CsvWriter forces(dir / "forces.csv", force_columns);
+      for (const auto& f : frames_) {
+        row = {f.t};
+        row.insert(row.end(), f.forces.begin(), f.forces.end());
+        forces.row(row);
+      }
+      forces.commit();
+    }
   }
+  if (frames_written.valid()) frames_written.get();  // rethrows the frames' error, if any
   // 4. stats.json, last.
   if (select.stats) write_json(dir / "stats.json", summary ? *summary : to_json(summary_));
 }
