@@ -282,6 +282,7 @@ void StringSolver<dim>::record_frame(double t, const Eigen::VectorXd& y) {
   f.max_violation = snap.max_violation;
   f.forces = measured_forces(snap);
   f.fronts = snap.fronts;
+  f.moving.reserve(static_cast<std::size_t>(model_.chain().num_nodes()));  // not grown by doubling
   for (int i = 0; i < model_.chain().num_nodes(); ++i)
     if (model_.in_arc(i)) f.moving.push_back(i);
   f.x = std::move(snap.x);
@@ -345,25 +346,29 @@ const RunSummary& StringSolver<dim>::run() {
     if (integrator) {
       summary_.stats = integrator->stats();
       summary_.t_stop = integrator->time();
-      final_state_ = integrator->state();
+      final_state_ = integrator->take_state();  // a copy would add a state's bytes at the run's peak
     }
   };
   try {
     // 1. A consistent initial state.
     model_.make_consistent(t0);
-    Eigen::VectorXd y0 = model_.state_from_chain();
-    // An impulsive start: the energy the jump of the velocities gave is the drivers' work at t = 0.
-    const auto& impulsive = model_.impulsive_start();
-    summary_.impulsive_start = impulsive.detected();
-    summary_.impulsive_speed_change = impulsive.max_speed_change;
-    if (summary_.impulsive_start) {
-      summary_.impulsive_energy = impulsive.kinetic_energy;
-      y0[model_.work_index()] = impulsive.kinetic_energy;
+    {
+      // The initial state lives only until the integrator holds its own copy (a state's bytes per
+      // node for the whole run otherwise).
+      Eigen::VectorXd y0 = model_.state_from_chain();
+      // An impulsive start: the energy the jump of the velocities gave is the drivers' work at t = 0.
+      const auto& impulsive = model_.impulsive_start();
+      summary_.impulsive_start = impulsive.detected();
+      summary_.impulsive_speed_change = impulsive.max_speed_change;
+      if (summary_.impulsive_start) {
+        summary_.impulsive_energy = impulsive.kinetic_energy;
+        y0[model_.work_index()] = impulsive.kinetic_energy;
+      }
+      integrator = std::make_unique<Integrator>(model_, t0, y0, options_.integrator);
+      record_frame(t0, y0);
+      if (options_.record_steps) record_sample(t0, y0);
+      check_slack(t0, y0);
     }
-    integrator = std::make_unique<Integrator>(model_, t0, y0, options_.integrator);
-    record_frame(t0, y0);
-    if (options_.record_steps) record_sample(t0, y0);
-    check_slack(t0, y0);
     // 2. Step by step to each output time: constraints (and slack) are checked at accepted steps,
     //    root functions acted on where they vanish.
     // At least one: a t_end far below the output interval is still integrated to (the last frame is t_end).

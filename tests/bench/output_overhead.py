@@ -10,6 +10,8 @@ default (nodes, tension, energy, forces as CSV; a ParaView frame each; stats.jso
 directory each time. The binaries run in turn, `repeat` times each, so that they see the same machine.
 For each binary: the medians of the whole process's wall time, its CPU time (user + system, all
 threads), the run's own `wall_s` (the solver, from stats.json) and their difference (the overhead).
+With --python, the same run by chainsim.Scene(...).run() in this process (PYTHONPATH=build/python): the
+median of its time (scene parsing, the run, the arrays copied into numpy; no files) beside the CLI's.
 The same run by hand: /usr/bin/time -v build/chainsim run docs/data/hanging_chain_mode1.toml --out DIR
 --set string.nodes=251 --set solver.method=dirk4 --set solver.rtol=1e-6 --set solver.atol=1e-10
 --set stop.t_end=5.0 --set output.interval=0.01 --quiet
@@ -48,13 +50,25 @@ def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("binaries", nargs="+")
     parser.add_argument("--repeat", type=int, default=7)
+    parser.add_argument("--python", action="store_true", help="also time chainsim.Scene(...).run()")
     a = parser.parse_args()
     runs = {b: [] for b in a.binaries}
+    scene = None
+    if a.python:
+        import chainsim
+        scene = chainsim.Scene.from_file(SCENE).set(**{k: float(v) if "." in v or "e" in v else (int(v) if v.isdigit() else v)
+                                                       for k, v in (x.split("=") for x in SETTINGS)})
+        runs["chainsim.Scene(...).run()"] = []
     with tempfile.TemporaryDirectory() as tmp:
         out = os.path.join(tmp, "run")
         for _ in range(a.repeat):
             for b in a.binaries:
                 runs[b].append(one_run(b, out))
+            if scene is not None:
+                t0 = time.perf_counter()
+                result = scene.run()
+                wall = time.perf_counter() - t0
+                runs["chainsim.Scene(...).run()"].append((wall, wall, result.summary["wall_s"]))
     print(f"{'binary':40s} {'wall ms':>9s} {'cpu ms':>9s} {'solver ms':>10s} {'overhead ms':>12s}")
     for b, rs in runs.items():
         wall, cpu, solver = (statistics.median(x) * 1e3 for x in zip(*rs))
