@@ -19,6 +19,14 @@
 
 extern char** environ;
 
+#if defined(__SANITIZE_ADDRESS__)
+#define CHAINSIM_TEST_ASAN 1
+#elif defined(__has_feature)
+#if __has_feature(address_sanitizer)
+#define CHAINSIM_TEST_ASAN 1
+#endif
+#endif
+
 namespace {
 
 struct Measured {
@@ -65,7 +73,7 @@ int stages_of(const std::string& table) {
 
 TEST_CASE("peak memory per node stays within a bound of the explicit integrator's own vectors",
           "[memory][string]") {
-#if defined(__SANITIZE_ADDRESS__)
+#if defined(CHAINSIM_TEST_ASAN)
   SUCCEED("not measured under AddressSanitizer (its shadow memory is most of the peak)");
 #else
   const auto dir = chainsim::test::temp_dir("memory_per_node");
