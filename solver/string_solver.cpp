@@ -126,6 +126,7 @@ nlohmann::json to_json(const RunSummary& s) {
         s.impulsive_speed_change, s.impulsive_energy);
   j["impulsive_start"] = impulsive;
   if (!s.error.empty()) j["error"] = s.error;
+  if (!s.tolerance_warning.empty()) j["tolerance_warning"] = s.tolerance_warning;
   return j;
 }
 
@@ -269,6 +270,29 @@ void StringSolver<dim>::book(double t, const typename StringModel<dim>::Snapshot
 }
 
 template <int dim>
+void StringSolver<dim>::check_tolerance() {
+  // The motion's size: the largest displacement of a node from its initial position over the frames
+  // (a small oscillation about a rest shape moves by about twice its amplitude).
+  if (frames_.size() < 2) return;
+  const Points<dim>& x0 = frames_.front().x;
+  double size = 0;
+  for (std::size_t k = 1; k < frames_.size(); ++k)
+    if (frames_[k].x.cols() == x0.cols())
+      for (Eigen::Index i = 0; i < x0.cols(); ++i)  // no temporary: this runs at the run's memory peak
+        size = std::max(size, (frames_[k].x.col(i) - x0.col(i)).cwiseAbs().maxCoeff());
+  // The absolute tolerance on a position: atol, times the state's scale of positions when it has one.
+  const Eigen::VectorXd scale = model_.state_scale();
+  const double position_scale = scale.size() > 0 ? scale[0] : 1.0;
+  const double atol = options_.integrator.atol * position_scale, rtol = options_.integrator.rtol;
+  if (!(size > 0) || atol <= rtol * size) return;
+  summary_.tolerance_warning = fmt::format(
+      "atol = {:.3g} m on positions is {:.3g} of the motion's size ({:.3g} m, the largest displacement of a node "
+      "over the frames), coarser than rtol = {:.3g}: the run resolves the motion only to about atol; set "
+      "solver.atol <= {:.3g}",
+      atol, atol / size, size, rtol, rtol * size / position_scale);
+}
+
+template <int dim>
 void StringSolver<dim>::record_frame(double t, const Eigen::VectorXd& y) {
   auto snap = model_.snapshot(t, y);
   book(t, snap);
@@ -347,7 +371,9 @@ const RunSummary& StringSolver<dim>::run() {
       summary_.stats = integrator->stats();
       summary_.t_stop = integrator->time();
       final_state_ = integrator->take_state();  // a copy would add a state's bytes at the run's peak
+      integrator.reset();  // its vectors freed before anything else is computed
     }
+    check_tolerance();
   };
   try {
     // 1. A consistent initial state.
@@ -452,7 +478,7 @@ const RunSummary& StringSolver<dim>::run() {
   } catch (const RecoverableError& e) {
     // Only a trial stage may be retried: at an accepted state the model cannot go on.
     finish("failed");
-    const double t = integrator ? integrator->time() : t0;
+    const double t = summary_.t_stop;  // the integrator's time (t0 if it was never made), set by finish()
     summary_.error = fmt::format("the string degenerated at t = {:.9g} s: {}", t, e.what());
     throw NumericalError(summary_.error, t);
   } catch (const Error& e) {
