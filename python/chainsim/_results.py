@@ -69,6 +69,8 @@ class Result:
         A run without or with fronts (default: from `fronts`).
     path : str, optional
         The run directory it was read from, if any.
+    _arrays : dict, optional
+        ``run.arrays()`` when the caller has them already (internal: the frames are copied once).
 
     Attributes
     ----------
