@@ -182,6 +182,9 @@ class Integrator {
   /// Current time and state of the integrator.
   double time() const { return t_; }
   const Eigen::VectorXd& state() const { return y_; }
+  /// The current state, moved out: for a caller that is done with the integrator (state() is empty
+  /// afterwards), so that keeping the final state costs no second copy beside the integrator's vectors.
+  Eigen::VectorXd take_state() { return std::move(y_); }
 
   /// After Outcome::kEvent: for each event function, +1/-1 if it crossed zero increasing/decreasing, else 0.
   /// The event's time and state are polished to the method's accuracy (not the interpolant's):

@@ -39,9 +39,10 @@ class AtomicFile {
   bool committed_ = false;
 };
 
-/// A CSV file written row by row through an AtomicFile (nothing held in memory): the header at
-/// construction, then rows of numbers, each optionally led by a text label; commit() publishes it.
-/// significant_digits = 0: the shortest text that reads back to the same double.
+/// A CSV file written row by row through an AtomicFile (nothing held in memory but a buffer of
+/// kFlushBytes): the header at construction, then rows of numbers, each optionally led by a text
+/// label; commit() publishes it. significant_digits = 0: the shortest text that reads back to the
+/// same double (an integer below 10^15 as its digits, the same text by a faster path).
 class CsvWriter {
  public:
   CsvWriter(const std::filesystem::path& path, const std::vector<std::string>& columns,
@@ -49,14 +50,27 @@ class CsvWriter {
   /// Appends a row; it must have one value per column.
   void row(const double* values, std::size_t count, const std::string* label = nullptr);
   void row(const std::vector<double>& values) { row(values.data(), values.size()); }
-  void commit() { file_.commit(); }
+  void commit() {
+    flush();
+    file_.commit();
+  }
+
+  /// The size of the formatted rows written to the file at once.
+  static constexpr std::size_t kFlushBytes = 1u << 20;
 
  private:
+  /// Writes the buffered rows to the file (at kFlushBytes and at commit()).
+  void flush();
+
   AtomicFile file_;
   std::size_t columns_;
   bool labelled_;
   int digits_;
-  std::string line_;
+  std::string buffer_;  ///< formatted rows not yet written: one write per kFlushBytes
+  /// The first column's last value and its text: a frame's time repeats on each of its rows.
+  double first_value_ = 0;
+  std::string first_text_;
+  bool first_known_ = false;
 };
 
 /// A CSV table built in memory and written atomically: one header row, then numeric rows, each

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <future>
 
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
@@ -128,6 +129,7 @@ nlohmann::json to_json(const RunSummary& s) {
         s.impulsive_speed_change, s.impulsive_energy);
   j["impulsive_start"] = impulsive;
   if (!s.error.empty()) j["error"] = s.error;
+  if (!s.tolerance_warning.empty()) j["tolerance_warning"] = s.tolerance_warning;
   return j;
 }
 
@@ -276,6 +278,29 @@ void StringSolver<dim>::book(double t, const typename StringModel<dim>::Snapshot
 }
 
 template <int dim>
+void StringSolver<dim>::check_tolerance() {
+  // The motion's size: the largest displacement of a node from its initial position over the frames
+  // (a small oscillation about a rest shape moves by about twice its amplitude).
+  if (frames_.size() < 2) return;
+  const Points<dim>& x0 = frames_.front().x;
+  double size = 0;
+  for (std::size_t k = 1; k < frames_.size(); ++k)
+    if (frames_[k].x.cols() == x0.cols())
+      for (Eigen::Index i = 0; i < x0.cols(); ++i)  // no temporary: this runs at the run's memory peak
+        size = std::max(size, (frames_[k].x.col(i) - x0.col(i)).cwiseAbs().maxCoeff());
+  // The absolute tolerance on a position: atol, times the state's scale of positions when it has one.
+  const Eigen::VectorXd scale = model_.state_scale();
+  const double position_scale = scale.size() > 0 ? scale[0] : 1.0;
+  const double atol = options_.integrator.atol * position_scale, rtol = options_.integrator.rtol;
+  if (!(size > 0) || atol <= rtol * size) return;
+  summary_.tolerance_warning = fmt::format(
+      "atol = {:.3g} m on positions is {:.3g} of the motion's size ({:.3g} m, the largest displacement of a node "
+      "over the frames), coarser than rtol = {:.3g}: the run resolves the motion only to about atol; set "
+      "solver.atol <= {:.3g}",
+      atol, atol / size, size, rtol, rtol * size / position_scale);
+}
+
+template <int dim>
 void StringSolver<dim>::record_frame(double t, const Eigen::VectorXd& y) {
   auto snap = model_.snapshot(t, y);
   book(t, snap);
@@ -289,6 +314,7 @@ void StringSolver<dim>::record_frame(double t, const Eigen::VectorXd& y) {
   f.max_violation = snap.max_violation;
   f.forces = measured_forces(snap);
   f.fronts = snap.fronts;
+  f.moving.reserve(static_cast<std::size_t>(model_.chain().num_nodes()));  // not grown by doubling
   for (int i = 0; i < model_.chain().num_nodes(); ++i)
     if (model_.in_arc(i)) f.moving.push_back(i);
   f.x = std::move(snap.x);
@@ -352,25 +378,31 @@ const RunSummary& StringSolver<dim>::run() {
     if (integrator) {
       summary_.stats = integrator->stats();
       summary_.t_stop = integrator->time();
-      final_state_ = integrator->state();
+      final_state_ = integrator->take_state();  // a copy would add a state's bytes at the run's peak
+      integrator.reset();  // its vectors freed before anything else is computed
     }
+    check_tolerance();
   };
   try {
     // 1. A consistent initial state.
     model_.make_consistent(t0);
-    Eigen::VectorXd y0 = model_.state_from_chain();
-    // An impulsive start: the energy the jump of the velocities gave is the drivers' work at t = 0.
-    const auto& impulsive = model_.impulsive_start();
-    summary_.impulsive_start = impulsive.detected();
-    summary_.impulsive_speed_change = impulsive.max_speed_change;
-    if (summary_.impulsive_start) {
-      summary_.impulsive_energy = impulsive.kinetic_energy;
-      y0[model_.work_index()] = impulsive.kinetic_energy;
+    {
+      // The initial state lives only until the integrator holds its own copy (a state's bytes per
+      // node for the whole run otherwise).
+      Eigen::VectorXd y0 = model_.state_from_chain();
+      // An impulsive start: the energy the jump of the velocities gave is the drivers' work at t = 0.
+      const auto& impulsive = model_.impulsive_start();
+      summary_.impulsive_start = impulsive.detected();
+      summary_.impulsive_speed_change = impulsive.max_speed_change;
+      if (summary_.impulsive_start) {
+        summary_.impulsive_energy = impulsive.kinetic_energy;
+        y0[model_.work_index()] = impulsive.kinetic_energy;
+      }
+      integrator = std::make_unique<Integrator>(model_, t0, y0, options_.integrator);
+      record_frame(t0, y0);
+      if (options_.record_steps) record_sample(t0, y0);
+      check_slack(t0, y0);
     }
-    integrator = std::make_unique<Integrator>(model_, t0, y0, options_.integrator);
-    record_frame(t0, y0);
-    if (options_.record_steps) record_sample(t0, y0);
-    check_slack(t0, y0);
     // 2. Step by step to each output time: constraints (and slack) are checked at accepted steps,
     //    root functions acted on where they vanish.
     // At least one: a t_end far below the output interval is still integrated to (the last frame is t_end).
@@ -454,7 +486,7 @@ const RunSummary& StringSolver<dim>::run() {
   } catch (const RecoverableError& e) {
     // Only a trial stage may be retried: at an accepted state the model cannot go on.
     finish("failed");
-    const double t = integrator ? integrator->time() : t0;
+    const double t = summary_.t_stop;  // the integrator's time (t0 if it was never made), set by finish()
     summary_.error = fmt::format("the string degenerated at t = {:.9g} s: {}", t, e.what());
     throw NumericalError(summary_.error, t);
   } catch (const Error& e) {
@@ -478,62 +510,10 @@ void StringSolver<dim>::write_outputs(const std::filesystem::path& dir, const Ou
   const auto& chain = model_.chain();
   const int L = chain.num_links();
   const bool fronts = model_.module() != nullptr;
-  // 2. CSV files, streamed from the frames (a row at a time: nothing but the frames in memory).
-  if (select.csv) {
-    const char* axes[] = {"x", "y", "z"};
-    std::vector<std::string> columns = {"t", "node"};
-    if (fronts) columns.emplace_back("s");
-    for (int d = 0; d < dim; ++d) columns.emplace_back(axes[d]);
-    for (int d = 0; d < dim; ++d) columns.push_back(std::string("v") + axes[d]);
-    std::vector<double> row;
-    if (select.nodes) {
-      CsvWriter nodes(dir / "nodes.csv", columns);
-      for (const auto& f : frames_)
-        for (int i : f.moving) {
-          row = {f.t, static_cast<double>(i)};
-          if (fronts) row.push_back(chain.node_coordinate(i));
-          for (int d = 0; d < dim; ++d) row.push_back(f.x(d, i));
-          for (int d = 0; d < dim; ++d) row.push_back(f.v(d, i));
-          nodes.row(row);
-        }
-      nodes.commit();
-    }
-    if (select.tension) {
-      CsvWriter tension(dir / "tension.csv", {"t", "link", "s_mid", "T"});
-      for (const auto& f : frames_)
-        for (int j = 0; j < L; ++j)
-          if (!std::isnan(f.tension[j])) tension.row({f.t, static_cast<double>(j), chain.link_midpoint(j), f.tension[j]});
-      tension.commit();
-    }
-    if (select.energy) {
-      std::vector<std::string> energy_columns = {"t", "K", "V", "W_applied", "drift"};
-      const std::vector<LedgerTerm>& terms = summary_.ledger_terms;
-      for (const LedgerTerm& term : terms)
-        if (term.energy()) energy_columns.push_back(term.name);
-      CsvWriter energy(dir / "energy.csv", energy_columns);
-      for (const auto& f : frames_) {
-        row = {f.t, f.kinetic, f.potential, f.work, f.drift};
-        for (std::size_t k = 0; k < terms.size(); ++k)
-          if (terms[k].energy()) row.push_back(f.terms.values[k]);
-        energy.row(row);
-      }
-      energy.commit();
-      if (!summary_.samples.empty()) samples_table(summary_).write(dir / "series.csv");
-    }
-    if (select.forces && !summary_.force_columns.empty()) {
-      std::vector<std::string> force_columns = {"t"};
-      force_columns.insert(force_columns.end(), summary_.force_columns.begin(), summary_.force_columns.end());
-      CsvWriter forces(dir / "forces.csv", force_columns);
-      for (const auto& f : frames_) {
-        row = {f.t};
-        row.insert(row.end(), f.forces.begin(), f.forces.end());
-        forces.row(row);
-      }
-      forces.commit();
-    }
-  }
-  // 3. ParaView frames (the moving nodes, a line cell per link of an arc), then their index.
-  if (select.vtk) {
+  // 2. ParaView frames (the moving nodes, a line cell per link of an arc), then their index: on a
+  //    second thread while this one writes the CSV files (both only read the frames; each file is its
+  //    own AtomicFile), so that the run's outputs cost the longer of the two, not their sum.
+  auto write_frames = [&]() {
     ensure_directory(dir / "frames");
     std::vector<PvdEntry> index;
     const VtkEncoding encoding = select.vtk_ascii ? VtkEncoding::kAscii : VtkEncoding::kBinary;
@@ -597,7 +577,64 @@ void StringSolver<dim>::write_outputs(const std::filesystem::path& dir, const Ou
       index.push_back({f.t, "frames/" + fronts_name, 1});
     }
     write_pvd(dir / "string.pvd", index);
+  };
+  std::future<void> frames_written;
+  if (select.vtk) frames_written = std::async(std::launch::async, write_frames);
+  // 3. CSV files, streamed from the frames (a row at a time: nothing but the frames in memory).
+  if (select.csv) {
+    const char* axes[] = {"x", "y", "z"};
+    std::vector<std::string> columns = {"t", "node"};
+    if (fronts) columns.emplace_back("s");
+    for (int d = 0; d < dim; ++d) columns.emplace_back(axes[d]);
+    for (int d = 0; d < dim; ++d) columns.push_back(std::string("v") + axes[d]);
+    std::vector<double> row;
+    if (select.nodes) {
+      CsvWriter nodes(dir / "nodes.csv", columns);
+      for (const auto& f : frames_)
+        for (int i : f.moving) {
+          row = {f.t, static_cast<double>(i)};
+          if (fronts) row.push_back(chain.node_coordinate(i));
+          for (int d = 0; d < dim; ++d) row.push_back(f.x(d, i));
+          for (int d = 0; d < dim; ++d) row.push_back(f.v(d, i));
+          nodes.row(row);
+        }
+      nodes.commit();
+    }
+    if (select.tension) {
+      CsvWriter tension(dir / "tension.csv", {"t", "link", "s_mid", "T"});
+      for (const auto& f : frames_)
+        for (int j = 0; j < L; ++j)
+          if (!std::isnan(f.tension[j])) tension.row({f.t, static_cast<double>(j), chain.link_midpoint(j), f.tension[j]});
+      tension.commit();
+    }
+    if (select.energy) {
+      std::vector<std::string> energy_columns = {"t", "K", "V", "W_applied", "drift"};
+      const std::vector<LedgerTerm>& terms = summary_.ledger_terms;
+      for (const LedgerTerm& term : terms)
+        if (term.energy()) energy_columns.push_back(term.name);
+      CsvWriter energy(dir / "energy.csv", energy_columns);
+      for (const auto& f : frames_) {
+        row = {f.t, f.kinetic, f.potential, f.work, f.drift};
+        for (std::size_t k = 0; k < terms.size(); ++k)
+          if (terms[k].energy()) row.push_back(f.terms.values[k]);
+        energy.row(row);
+      }
+      energy.commit();
+      if (!summary_.samples.empty()) samples_table(summary_).write(dir / "series.csv");
+    }
+    if (select.forces && !summary_.force_columns.empty()) {
+      std::vector<std::string> force_columns = {"t"};
+      force_columns.insert(force_columns.end(), summary_.force_columns.begin(), summary_.force_columns.end());
+      CsvWriter forces(dir / "forces.csv", force_columns);
+      for (const auto& f : frames_) {
+        row = {f.t};
+        row.insert(row.end(), f.forces.begin(), f.forces.end());
+        forces.row(row);
+      }
+      forces.commit();
+    }
   }
+  if (frames_written.valid()) frames_written.get();  // rethrows the frames' error, if any
   // 4. stats.json, last.
   if (select.stats) write_json(dir / "stats.json", summary ? *summary : to_json(summary_));
 }

@@ -117,6 +117,10 @@ struct RunSummary {
   std::string status = "not run";  ///< "completed" (t_end), "stopped" (a stop event), "interrupted"
                                    ///< (Ctrl-C, interrupt.hpp) or "failed"
   std::string error;               ///< the failure's message
+  /// Set when the absolute tolerance is coarser than rtol times the motion's size (the largest
+  /// displacement of a node from its initial position over the frames): the run resolves the motion
+  /// only to about atol, whatever rtol says ("" otherwise).
+  std::string tolerance_warning;
   std::string stop_reason;         ///< "t_end" when completed
   double t_end = 0;                ///< the end time asked for (s)
   double t_stop = 0;               ///< the time reached (s)
@@ -217,6 +221,8 @@ class StringSolver {
 
  private:
   void record_frame(double t, const Eigen::VectorXd& y);
+  /// Sets summary().tolerance_warning when atol is coarser than rtol times the motion's size.
+  void check_tolerance();
   void record_sample(double t, const Eigen::VectorXd& y);
   void check_slack(double t, const Eigen::VectorXd& y);
   void book(double t, const typename StringModel<dim>::Snapshot& snap);

@@ -135,6 +135,7 @@ int run_string_scene(const SceneSpec& spec, const std::filesystem::path& dir, bo
                        s.slack ? s.slack->message()
                                : s.slack_policy == SlackPolicy::kIgnore ? "not checked" : "none at any accepted step",
                        to_string(s.slack_policy));
+    if (!s.tolerance_warning.empty()) out << fmt::format("warning    {}\n", s.tolerance_warning);
     out << fmt::format("outputs    {}: {}\n", dir.string(), output_files(dir));
   }
   if (failure) throw *failure;

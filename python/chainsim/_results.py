@@ -69,6 +69,8 @@ class Result:
         A run without or with fronts (default: from `fronts`).
     path : str, optional
         The run directory it was read from, if any.
+    _arrays : dict, optional
+        ``run.arrays()`` when the caller has them already (internal: the frames are copied once).
 
     Attributes
     ----------
@@ -97,11 +99,12 @@ class Result:
     def __init__(self, run: Optional[_core.Run] = None, *, summary: Optional[Dict[str, Any]] = None,
                  nodes: Optional[Arrays] = None, tension: Optional[Arrays] = None, energy: Optional[Arrays] = None,
                  forces: Optional[Arrays] = None, fronts: Optional[Arrays] = None, series: Optional[Arrays] = None,
-                 kind: Optional[str] = None, path: Optional[str] = None) -> None:
+                 kind: Optional[str] = None, path: Optional[str] = None,
+                 _arrays: Optional[Dict[str, Arrays]] = None) -> None:
         self._run = run
         if run is not None:
             summary = json.loads(run.summary())
-            arrays = run.arrays()
+            arrays = run.arrays() if _arrays is None else _arrays  # result_of_run has them already
             nodes, tension, energy = arrays.get("nodes"), arrays.get("tension"), arrays.get("energy")
             forces, fronts, series = arrays.get("forces"), arrays.get("fronts"), arrays.get("series")
         self.summary: Dict[str, Any] = summary or {}
@@ -566,7 +569,7 @@ def result_of_run(run: _core.Run) -> Union[Result, ReducedResult]:
     arrays = run.arrays()
     if "nodes" not in arrays:
         return ReducedResult(arrays["series"], json.loads(run.summary()))
-    return Result(run)
+    return Result(run, _arrays=arrays)  # one copy of the frames into numpy, not two
 
 
 def read_directory(directory: PathLike) -> Union[Result, ReducedResult, Comparison]:

@@ -4,6 +4,8 @@
 // command may have written there, stray temporary files included, and never another file.
 #include <filesystem>
 #include <fstream>
+#include <cmath>
+#include <iterator>
 #include <set>
 #include <string>
 
@@ -148,4 +150,37 @@ TEST_CASE("JSON text replaces bytes that are not UTF-8 instead of failing", "[un
   const std::string text = json_text(j);
   CHECK(text == "{\"ok\":\"caf\xc3\xa9\",\"out\":\"d\xef\xbf\xbd\"}");
   CHECK(nlohmann::json::parse(text)["out"] == "d\xef\xbf\xbd");
+}
+
+TEST_CASE("CSV numbers are written as fmt's shortest text, whatever path formats them", "[unit][output]") {
+  // The writer formats integers and a repeated first column by faster paths: the text must stay the
+  // one fmt::format("{}") (or "{:.Ng}") gives, byte for byte, across the rows and a buffer flush.
+  const auto dir = temp_dir("csv_number_text");
+  std::vector<double> values = {0.0, -0.0, 1.0, -1.0, 7.0, 250.0, 1e6, 123456789012345.0, 999999999999999.0,
+                                1e15, -1e15, 1e16, 3e17, 0.5, -2.5, 0.1, 1.0 / 3.0, 5e-324, 2.2250738585072014e-308,
+                                1e-5, 1e-4, 6.02214076e23, std::nan(""), INFINITY, -INFINITY, 4503599627370496.5,
+                                9007199254740993.0, -123.0};
+  const std::size_t rows = 3 * CsvWriter::kFlushBytes / (values.size() * 8) + 7;  // past a few flushes
+  for (const int digits : {0, 6}) {
+    const auto path = dir / fmt::format("numbers_{}.csv", digits);
+    std::string expected = "t,a,b\n";
+    {
+      CsvWriter csv(path, {"t", "a", "b"}, "", digits);
+      for (std::size_t r = 0; r < rows; ++r) {
+        const double t = values[(r / 5) % values.size()];  // the first column repeats, as a frame's time
+        const double a = values[r % values.size()], b = values[(r * 7 + 3) % values.size()];
+        csv.row({t, a, b});
+        const double row[] = {t, a, b};
+        for (int j = 0; j < 3; ++j) {
+          expected += digits ? fmt::format("{:.{}g}", row[j], digits) : fmt::format("{}", row[j]);
+          expected += j == 2 ? '\n' : ',';
+        }
+      }
+      csv.commit();
+    }
+    std::ifstream in(path, std::ios::binary);
+    const std::string written((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    REQUIRE(written.size() == expected.size());
+    CHECK(written == expected);
+  }
 }
