@@ -142,20 +142,20 @@ double LedgerValues::operator[](const std::string& name) const {
 
 CsvTable samples_table(const RunSummary& run) {
   std::vector<std::string> cols = {"t"};
-  const std::size_t nf = run.samples.empty() ? 0 : run.samples.front().s0.size();
-  const std::size_t dim = run.samples.empty() ? 0 : run.samples.front().support.size();
+  const std::size_t nf = run.samples.empty() ? 0 : run.samples.front().fronts.size();
+  const auto dim = static_cast<Eigen::Index>(run.samples.empty() ? 0 : run.dimension);
   const char* axes[] = {"x", "y", "z"};
   const std::vector<LedgerTerm>& terms = run.ledger_terms;
   for (std::size_t k = 0; k < nf; ++k) {
     cols.push_back("s0_" + std::to_string(k));
     cols.push_back("s0dot_" + std::to_string(k));
-    for (std::size_t d = 0; d < dim; ++d) cols.push_back("front_" + std::to_string(k) + "_" + axes[d]);
+    for (Eigen::Index d = 0; d < dim; ++d) cols.push_back("front_" + std::to_string(k) + "_" + axes[d]);
   }
   for (const char* c : {"K", "V", "W_applied"}) cols.emplace_back(c);
   for (const LedgerTerm& term : terms)
     if (term.energy()) cols.push_back(term.name);
   for (const char* c : {"energy_residual", "momentum_residual"}) cols.emplace_back(c);
-  for (std::size_t d = 0; d < dim; ++d) cols.push_back(std::string("support_") + axes[d]);
+  for (Eigen::Index d = 0; d < dim; ++d) cols.push_back(std::string("support_") + axes[d]);
   cols.emplace_back("moving_mass");
   for (const LedgerTerm& term : terms)
     if (!term.energy()) cols.push_back(term.name);
@@ -164,16 +164,16 @@ CsvTable samples_table(const RunSummary& run) {
   CsvTable table(cols);
   for (const StepSample& s : run.samples) {
     std::vector<double> row = {s.t};
-    for (std::size_t k = 0; k < nf; ++k) {
-      row.push_back(s.s0[k]);
-      row.push_back(s.s0_dot[k]);
-      for (std::size_t d = 0; d < dim; ++d) row.push_back(s.position[k * dim + d]);
+    for (const FrontValues& front : s.fronts) {
+      row.push_back(front.s0);
+      row.push_back(front.s0_dot);
+      for (Eigen::Index d = 0; d < dim; ++d) row.push_back(front.position[d]);
     }
-    for (double v : {s.kinetic, s.potential, s.w_applied}) row.push_back(v);
+    for (double v : {s.kinetic, s.potential, s.work}) row.push_back(v);
     for (std::size_t k = 0; k < terms.size(); ++k)
       if (terms[k].energy()) row.push_back(s.terms.values[k]);
-    for (double v : {s.energy_residual, s.momentum_residual}) row.push_back(v);
-    for (double v : s.support) row.push_back(v);
+    for (double v : {s.drift, s.momentum_residual}) row.push_back(v);
+    for (Eigen::Index d = 0; d < dim; ++d) row.push_back(s.support[d]);
     row.push_back(s.moving_mass);
     for (std::size_t k = 0; k < terms.size(); ++k)
       if (!terms[k].energy()) row.push_back(s.terms.values[k]);
@@ -301,19 +301,38 @@ void StringSolver<dim>::check_tolerance() {
 }
 
 template <int dim>
+void StringSolver<dim>::fill_record(double t, const typename StringModel<dim>::Snapshot& snap,
+                                    RunRecord& record) const {
+  record.t = t;
+  record.kinetic = snap.kinetic;
+  record.potential = snap.potential;
+  record.work = snap.work;
+  record.terms = {term_names_, snap.terms};
+  record.drift = summary_.final_energy_drift;  // book() has just set it for this snapshot
+  record.momentum_residual = snap.has_momentum_ledger ? (snap.momentum - p0_ - snap.impulse).norm() : 0.0;
+  record.support.template head<dim>() = snap.support;
+  record.moving_mass = snap.moving_mass;
+  record.max_violation = snap.max_violation;
+  record.moving_nodes = model_.num_moving_nodes();
+  record.forces = measured_forces(snap);
+  record.fronts.clear();
+  record.fronts.reserve(snap.fronts.size());
+  for (const FrontRecord<dim>& front : snap.fronts) {
+    FrontValues& r = record.fronts.emplace_back();
+    r.s0 = front.s0;
+    r.s0_dot = front.s0_dot;
+    r.position.template head<dim>() = front.position;
+    r.reaction.template head<dim>() = front.reaction;
+    r.fields = front.fields;
+  }
+}
+
+template <int dim>
 void StringSolver<dim>::record_frame(double t, const Eigen::VectorXd& y) {
   auto snap = model_.snapshot(t, y);
   book(t, snap);
   Frame<dim> f;
-  f.t = t;
-  f.kinetic = snap.kinetic;
-  f.potential = snap.potential;
-  f.work = snap.work;
-  f.terms = {term_names_, snap.terms};
-  f.drift = summary_.final_energy_drift;
-  f.max_violation = snap.max_violation;
-  f.forces = measured_forces(snap);
-  f.fronts = snap.fronts;
+  fill_record(t, snap, f);
   f.moving.reserve(static_cast<std::size_t>(model_.chain().num_nodes()));  // not grown by doubling
   for (int i = 0; i < model_.chain().num_nodes(); ++i)
     if (model_.in_arc(i)) f.moving.push_back(i);
@@ -328,25 +347,7 @@ template <int dim>
 void StringSolver<dim>::record_sample(double t, const Eigen::VectorXd& y) {
   const auto snap = model_.snapshot(t, y);
   book(t, snap);
-  StepSample s;
-  s.t = t;
-  for (const auto& f : snap.fronts) {
-    s.s0.push_back(f.s0);
-    s.s0_dot.push_back(f.s0_dot);
-    for (int d = 0; d < dim; ++d) s.position.push_back(f.position[d]);
-  }
-  s.kinetic = snap.kinetic;
-  s.potential = snap.potential;
-  s.w_applied = snap.work;
-  s.terms = {term_names_, snap.terms};
-  s.energy_residual = summary_.final_energy_drift;
-  s.momentum_residual = snap.has_momentum_ledger ? (snap.momentum - p0_ - snap.impulse).norm() : 0.0;
-  for (int d = 0; d < dim; ++d) s.support.push_back(snap.support[d]);
-  s.moving_mass = snap.moving_mass;
-  s.max_violation = snap.max_violation;
-  s.moving_nodes = model_.num_moving_nodes();
-  s.forces = measured_forces(snap);
-  summary_.samples.push_back(std::move(s));
+  fill_record(t, snap, summary_.samples.emplace_back());
 }
 
 template <int dim>
@@ -556,13 +557,13 @@ void StringSolver<dim>::write_outputs(const std::filesystem::path& dir, const Ou
       points.points = Eigen::Matrix3Xd::Zero(3, nf);
       Eigen::MatrixXd s0(1, nf), s0_dot(1, nf);
       for (Eigen::Index q = 0; q < nf; ++q) {
-        const FrontRecord<dim>& front = f.fronts[static_cast<std::size_t>(q)];
-        points.points.col(q).head(dim) = front.position;
+        const FrontValues& front = f.fronts[static_cast<std::size_t>(q)];
+        points.points.col(q).head(dim) = front.position.head(dim);
         s0(0, q) = front.s0;
         s0_dot(0, q) = front.s0_dot;
       }
       points.point_data = {{"s0", s0}, {"s0_dot", s0_dot}};
-      std::size_t offset = 0;  // of the field in FrontRecord::fields
+      std::size_t offset = 0;  // of the field in FrontValues::fields
       for (const FrontField& field : front_fields) {
         Eigen::MatrixXd values = Eigen::MatrixXd::Zero(field.vector ? 3 : 1, nf);
         const int components = field.vector ? dim : 1;

@@ -80,36 +80,46 @@ struct LedgerValues {
   double operator[](const std::string& name) const;
 };
 
-/// One recorded output time.
-template <int dim>
-struct Frame {
+/// A front in a record: the module's FrontRecord<dim> held without the dimension (z = 0 in 2D), so
+/// that one record type serves runs in 2 and 3 dimensions.
+struct FrontValues {
+  double s0 = 0;      ///< material coordinate of the front (m)
+  double s0_dot = 0;  ///< its speed in the material (m/s)
+  Eigen::Vector3d position = Eigen::Vector3d::Zero();  ///< x0 (m; dim components)
+  Eigen::Vector3d reaction = Eigen::Vector3d::Zero();  ///< the force of its support on the string (N)
+  std::vector<double> fields;  ///< the module's front_fields() values (FrontRecord::fields)
+};
+
+/// The state of a run at a recorded time, the one record type for frames (Frame, at the output
+/// times) and steps (RunSummary::samples: after every accepted step, crossing and the stop, when
+/// StringSolverOptions::record_steps). A new ledger quantity is a field here, filled in one place
+/// (StringSolver::make_record), and written by the outputs that list it.
+struct RunRecord {
   double t = 0;
-  Points<dim> x, v;
-  Eigen::VectorXd tension;   ///< per link; NaN for a link in no arc
-  std::vector<int> moving;   ///< the nodes in an arc (all of them without a module)
-  double kinetic = 0, potential = 0, work = 0;
-  double drift = 0;          ///< the energy ledger's residual (J), see the file comment
-  LedgerValues terms;        ///< the module's ledger terms (their energies are energy.csv's last columns)
-  double max_violation = 0;
-  std::vector<double> forces;  ///< the forces people measure, in the order of force_columns()
-  std::vector<FrontRecord<dim>> fronts;  ///< with a module that has fronts
+  double kinetic = 0, potential = 0, work = 0;  ///< K, V, W_applied (J)
+  LedgerValues terms;  ///< the module's ledger terms (energy.csv's and series.csv's last columns)
+  /// The energy ledger's residual in joules: K + V − K0 − V0 − W_applied − the module's energy terms
+  /// (energy.csv's drift and series.csv's energy_residual; the summary's energy_residual is relative,
+  /// energy_residual_abs J).
+  double drift = 0;
+  double momentum_residual = 0;  ///< |p − p0 − impulse| (N s); 0 without a momentum ledger
+  Eigen::Vector3d support = Eigen::Vector3d::Zero();  ///< force of all supports on the system (N; dim components)
+  double moving_mass = 0;    ///< Σ m_i over the nodes in an arc (kg)
+  double max_violation = 0;  ///< max_j | |Δx_j| − h_j | / h_j over the links of the arcs
+  int moving_nodes = 0;      ///< nodes in an arc
+  std::vector<double> forces;  ///< the forces people measure, in the order of RunSummary::force_columns
+  std::vector<FrontValues> fronts;  ///< with a module that has fronts
 };
 
 /// One accepted step (or crossing, or the stop) of a run that records its steps.
-struct StepSample {
-  double t = 0;
-  std::vector<double> s0, s0_dot;  ///< per front (m, m/s)
-  std::vector<double> position;    ///< per front, its point x0 (dim components, m)
-  double kinetic = 0, potential = 0, w_applied = 0;
-  LedgerValues terms;              ///< the module's ledger terms (columns of series.csv)
-  /// The energy ledger's residual in joules: K + V − K0 − V0 − W_applied − the module's energy terms
-  /// (series.csv's energy_residual; the summary's energy_residual is relative, energy_residual_abs J).
-  double energy_residual = 0;
-  double momentum_residual = 0;    ///< |p − p0 − impulse| (N s); 0 without a momentum ledger
-  std::vector<double> support;     ///< force of all supports on the system (N), dim components
-  double moving_mass = 0, max_violation = 0;
-  int moving_nodes = 0;
-  std::vector<double> forces;  ///< in the order of RunSummary::force_columns
+using StepSample = RunRecord;
+
+/// One recorded output time: the record and the nodes.
+template <int dim>
+struct Frame : RunRecord {
+  Points<dim> x, v;
+  Eigen::VectorXd tension;   ///< per link; NaN for a link in no arc
+  std::vector<int> moving;   ///< the nodes in an arc (all of them without a module)
 };
 
 /// What a run did.
@@ -228,6 +238,8 @@ class StringSolver {
   void book(double t, const typename StringModel<dim>::Snapshot& snap);
   void describe_model();
   std::vector<double> measured_forces(const typename StringModel<dim>::Snapshot& snap) const;
+  /// Fills what every record holds (RunRecord) from the snapshot at t, after book().
+  void fill_record(double t, const typename StringModel<dim>::Snapshot& snap, RunRecord& record) const;
 
   StringModel<dim>& model_;
   StringSolverOptions options_;

@@ -155,7 +155,7 @@ StringCaseRun solve_string_case(const StringCaseSetup& setup) {
   out.frames = solver.frames();
   // η, dη/dt and P per sample.
   for (const StepSample& s : out.run.samples) {
-    const double s0 = s.s0[0], sd = s.s0_dot[0];
+    const double s0 = s.fronts[0].s0, sd = s.fronts[0].s0_dot;
     double eta = s0 / ell, eta_dot = sd / ell;
     if (setup.problem == Problem::kSliding) {
       eta = (ell - s0) / ell;

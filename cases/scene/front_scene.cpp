@@ -251,7 +251,7 @@ nlohmann::json front_summary(const FrontScene<dim>& scene, const RunSummary& run
   j["stop_reason"] = name_fronts(run.stop_reason, scene.front_names);
   nlohmann::json final_s0 = nlohmann::json::object();
   if (!run.samples.empty())
-    for (std::size_t k = 0; k < scene.front_names.size(); ++k) final_s0[scene.front_names[k]] = run.samples.back().s0[k];
+    for (std::size_t k = 0; k < scene.front_names.size(); ++k) final_s0[scene.front_names[k]] = run.samples.back().fronts[k].s0;
   j["fronts_final_s0"] = final_s0;
   return j;
 }

@@ -69,9 +69,10 @@ FountainRun run_fountain(const std::vector<std::string>& overrides, const Steady
   r.run = solver.summary();
   for (const StepSample& s : r.run.samples) {
     r.t.push_back(s.t);
-    r.pot_speed.push_back(std::abs(s.s0_dot[0]));
-    r.floor_x.push_back(s.position[2]);
-    for (double sd : s.s0_dot) r.speed_error = std::max(r.speed_error, std::abs(std::abs(sd) - reference.v));
+    r.pot_speed.push_back(std::abs(s.fronts[0].s0_dot));
+    r.floor_x.push_back(s.fronts[1].position[0]);
+    for (const FrontValues& front : s.fronts)
+      r.speed_error = std::max(r.speed_error, std::abs(std::abs(front.s0_dot) - reference.v));
   }
   r.speed = r.pot_speed.back();
   const StringModel<2>& model = *scene.model;

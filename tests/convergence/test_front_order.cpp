@@ -37,7 +37,7 @@ double s0_at(const RunSummary& run, double t) {
   const double dt = b.t - a.t, u = (t - a.t) / dt;
   const double h00 = 2 * u * u * u - 3 * u * u + 1, h10 = u * u * u - 2 * u * u + u;
   const double h01 = -2 * u * u * u + 3 * u * u, h11 = u * u * u - u * u;
-  return h00 * a.s0[0] + h10 * dt * a.s0_dot[0] + h01 * b.s0[0] + h11 * dt * b.s0_dot[0];
+  return h00 * a.fronts[0].s0 + h10 * dt * a.fronts[0].s0_dot + h01 * b.fronts[0].s0 + h11 * dt * b.fronts[0].s0_dot;
 }
 
 double max_abs_diff(const std::vector<double>& a, const std::vector<double>& b) {

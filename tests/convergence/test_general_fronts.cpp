@@ -108,12 +108,12 @@ TEST_CASE("a tilted falling chain slides its contact along the table as its thre
       const double t_stop_err = std::abs(run.run.t_stop - ref.back()[0]) / ref.back()[0];
       double err_s0 = 0, err_x = 0;
       for (const StepSample& sample : run.run.samples) {
-        err_s0 = std::max(err_s0, std::abs(sample.s0[0] - at(ref, sample.t, 1)) / ell);
-        err_x = std::max(err_x, std::abs(sample.position[0] - at(ref, sample.t, 2)) / ell);
-        CHECK(std::abs(sample.position[1]) < 1e-12);  // the contact stays on the table
+        err_s0 = std::max(err_s0, std::abs(sample.fronts[0].s0 - at(ref, sample.t, 1)) / ell);
+        err_x = std::max(err_x, std::abs(sample.fronts[0].position[0] - at(ref, sample.t, 2)) / ell);
+        CHECK(std::abs(sample.fronts[0].position[1]) < 1e-12);  // the contact stays on the table
         CHECK(sample.moving_mass + sample.terms["heap_mass"] == Approx(setup.chain.density * ell).epsilon(1e-12));
       }
-      const double moved = std::abs(run.run.samples.back().position[0]) / ell;
+      const double moved = std::abs(run.run.samples.back().fronts[0].position[0]) / ell;
       std::printf("  %.2f  %5d  %.3e       %.3e      %.3e          %.4f           %.1e  %.1e\n", f, nodes, t_stop_err,
                   err_s0, err_x, moved, run.run.relative_energy_residual(), run.run.relative_momentum_residual());
       // The scheme is exact for a straight chain (all nodes move alike), so the errors sit at the
@@ -152,7 +152,7 @@ TEST_CASE("a curved falling chain with f = 1 falls freely and lays its heap wher
     double err = 0;
     for (const StepSample& sample : run.run.samples) {
       const double sigma = R * (std::asin(g * sample.t * sample.t / (2 * R) + std::sin(t_rad)) - t_rad);
-      err = std::max(err, std::abs(sample.s0[0] - (ell - sigma)) / ell);
+      err = std::max(err, std::abs(sample.fronts[0].s0 - (ell - sigma)) / ell);
     }
     errors.push_back(err);
     remesh.push_back(std::abs(run.run.samples.back().terms["W_remesh"]));
@@ -182,7 +182,7 @@ TEST_CASE("a curved falling chain with f < 1 converges under refinement with clo
     energy.push_back(run.run.relative_energy_residual());
     std::printf("  nodes %4d  t_stop/t0 = %.9f  energy %.2e  momentum %.1e  contact x/l = %.4f\n", nodes,
                 t_stop.back(), energy.back(), run.run.relative_momentum_residual(),
-                run.run.samples.back().position[0]);
+                run.run.samples.back().fronts[0].position[0]);
     CHECK(run.run.relative_momentum_residual() < 1e-8);
   }
   const double d1 = std::abs(t_stop[1] - t_stop[0]), d2 = std::abs(t_stop[2] - t_stop[1]);

@@ -33,7 +33,7 @@ void require_agrees_with_reduced(const Comparison& c, int nodes, double t_stop_t
   for (const StepSample& sample : c.string.run.samples) {
     REQUIRE(std::isfinite(sample.kinetic));
     REQUIRE(std::isfinite(sample.potential));
-    REQUIRE(std::isfinite(sample.energy_residual));
+    REQUIRE(std::isfinite(sample.drift));
     REQUIRE(sample.moving_mass + sample.terms["heap_mass"] == Approx(1.0).epsilon(1e-12));
   }
 }

@@ -121,9 +121,9 @@ TEST_CASE("the folded chain's fixed end reports the fold's tension while the fol
     // The fold strictly inside the first link: its arc A has no full link. The row at the crossing
     // (s0 = h up to the root's round-off, recorded after node 1 joined arc A) reports link 0's
     // tension, on the other side of the fold's jump.
-    if (sample.s0[0] < 0.01 * (1 - 1e-9)) {
+    if (sample.fronts[0].s0 < 0.01 * (1 - 1e-9)) {
       ++on_fold;
-      const double sd = sample.s0_dot[0];
+      const double sd = sample.fronts[0].s0_dot;
       CHECK(T == Approx(1.0 * sd * sd * (1 + 0.5)).epsilon(1e-9).margin(1e-12));
     }
   }

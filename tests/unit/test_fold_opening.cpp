@@ -69,7 +69,7 @@ TEST_CASE("a fold whose arms swing apart stops the run when they are 20 degrees 
   CHECK(run.status == "stopped");
   CHECK(run.stop_reason.find("has opened: its arms leave it 20 degrees from antiparallel") != std::string::npos);
   REQUIRE(!run.samples.empty());
-  CHECK(run.samples.back().s0[0] < 0.99);
+  CHECK(run.samples.back().fronts[0].s0 < 0.99);
   // The fold's forces carry the momentum flux of the material it moves (exact), and its energy
   // balance is W_s = −2 f λ |ṡ0|³ up to the bounded O(h²) term of V (midpoints vs lumped masses).
   CHECK(run.relative_momentum_residual() < 1e-12);

@@ -237,7 +237,7 @@ TEST_CASE("the canonical scenes on the string solver agree with chainsim compare
     // η(t) at every sample against the quadrature's η(ξ).
     double worst = 0;
     for (const StepSample& s : run.samples) {
-      const double eta = c.problem == Problem::kSliding ? 1.0 - s.s0[0] : s.s0[0];
+      const double eta = c.problem == Problem::kSliding ? 1.0 - s.fronts[0].s0 : s.fronts[0].s0;
       const double xi = std::min(s.t / kT0, c.exact_t_stop);
       worst = std::max(worst, std::abs(eta - c.exact_eta(xi)));
     }
@@ -385,14 +385,14 @@ TEST_CASE("a tilted falling chain with f = 1 falls freely while its contact slid
   double worst_s0 = 0, worst_x = 0;
   for (const StepSample& s : run.samples) {
     const double L = 1.0 - kG * s.t * s.t / (2 * std::cos(theta));
-    worst_s0 = std::max(worst_s0, std::abs(s.s0[0] - L));
-    worst_x = std::max(worst_x, std::abs(s.position[0] - std::sin(theta) * (1 - L)));
+    worst_s0 = std::max(worst_s0, std::abs(s.fronts[0].s0 - L));
+    worst_x = std::max(worst_x, std::abs(s.fronts[0].position[0] - std::sin(theta) * (1 - L)));
   }
   // The straight chain is exact on the mesh (docs/shocks.md) and free fall is exact for the
   // integrator: measured 2.4e-15 m in L and 1.7e-15 m in x, round-off. Bound: 1e-12 m.
   CHECK(worst_s0 < 1e-12);
   CHECK(worst_x < 1e-12);
-  CHECK(run.samples.back().position[0] > 0.4);  // it slid about 0.42 m along the table
+  CHECK(run.samples.back().fronts[0].position[0] > 0.4);  // it slid about 0.42 m along the table
 }
 
 TEST_CASE("chainsim run on a front scene writes its outputs, stats.json last, and says why it stopped",
