@@ -73,6 +73,8 @@ class FrontKind {
   virtual const char* name() const = 0;
   /// What the scene places at the front's material point s0, for messages ("heap point", "fold").
   virtual const char* placed() const = 0;
+  /// Whether the front holds material outside the arcs on one side (a heap's reservoir), for messages.
+  virtual bool reservoir() const { return false; }
 
   /// The material, before the layout.
   void bind(const FrontMaterial& material) { m_ = material; }

@@ -13,9 +13,16 @@
 namespace chainsim {
 
 template <int dim>
-FrontTracker<dim>::FrontTracker(std::vector<HeapSpec<dim>> heaps, std::optional<FoldSpec> fold,
-                                const FrontOptions& options)
-    : heap_specs_(std::move(heaps)), fold_spec_(fold), options_(options) {}
+FrontTracker<dim>::FrontTracker(std::vector<std::unique_ptr<FrontKind<dim>>> fronts, const FrontOptions& options)
+    : options_(options), fronts_(std::move(fronts)) {
+  CHAINSIM_VERIFY(!fronts_.empty(), "a front tracker needs a front");
+  for (std::size_t k = 1; k < fronts_.size(); ++k)
+    if (fronts_[k]->expected_s0 < fronts_[k - 1]->expected_s0)
+      throw InputError(fmt::format("the fronts must be given in order of s: the {} at s0 = {:.9g} m comes after the "
+                                   "{} at s0 = {:.9g} m",
+                                   fronts_[k]->name(), fronts_[k]->expected_s0, fronts_[k - 1]->name(),
+                                   fronts_[k - 1]->expected_s0));
+}
 
 template <int dim>
 int FrontTracker<dim>::num_checks() const {
@@ -25,27 +32,28 @@ int FrontTracker<dim>::num_checks() const {
 }
 
 template <int dim>
-std::vector<std::unique_ptr<FrontKind<dim>>> FrontTracker<dim>::make_fronts(double ell) {
+std::vector<std::unique_ptr<FrontKind<dim>>> heap_and_fold_fronts(std::vector<HeapSpec<dim>> heaps,
+                                                                  const std::optional<FoldSpec>& fold, double ell,
+                                                                  double h) {
   const HeapSpec<dim>* before = nullptr;
   const HeapSpec<dim>* after = nullptr;
-  for (std::size_t k = 0; k < heap_specs_.size(); ++k) {
-    HeapSpec<dim>& heap = heap_specs_[k];
+  for (std::size_t k = 0; k < heaps.size(); ++k) {
+    HeapSpec<dim>& heap = heaps[k];
     const bool at_end = heap.side == HeapSpec<dim>::Side::kAfter;
     check_heap_dissipation(heap);
     check_heap_s0(k, at_end, heap.s0, ell);
     if (std::abs(heap.s0 - ell) <= 1e-12 * ell) heap.s0 = ell;  // ℓ is a sum of link lengths
     if (std::abs(heap.s0) <= 1e-12 * ell) heap.s0 = 0;
     auto& slot = at_end ? after : before;
-    check_one_heap_per_side(k, at_end, slot ? std::optional<std::size_t>(slot - heap_specs_.data()) : std::nullopt);
+    check_one_heap_per_side(k, at_end, slot ? std::optional<std::size_t>(slot - heaps.data()) : std::nullopt);
     slot = &heap;
   }
-  const std::optional<FoldSpec>& fold = fold_spec_;
   if (fold) {
     check_fold_dissipation(fold->dissipation);
     check_fold_s0(fold->s0, ell, before ? std::optional<double>(before->s0) : std::nullopt,
                   after ? std::optional<double>(after->s0) : std::nullopt);
   }
-  if (before && after && after->s0 - before->s0 < 2 * material_.h)
+  if (before && after && after->s0 - before->s0 < 2 * h)
     throw InputError("the heaps are less than two links apart: use more nodes");
   std::vector<std::unique_ptr<FrontKind<dim>>> fronts;
   if (before) fronts.push_back(std::make_unique<HeapFront<dim>>(*before));
@@ -56,7 +64,8 @@ std::vector<std::unique_ptr<FrontKind<dim>>> FrontTracker<dim>::make_fronts(doub
 
 template <int dim>
 std::vector<ArcRange> FrontTracker<dim>::initial_arcs(const Chain<dim>& chain) {
-  check_open_string(chain.closed(), !heap_specs_.empty());
+  check_open_string(chain.closed(), std::any_of(fronts_.begin(), fronts_.end(),
+                                                [](const auto& front) { return front->reservoir(); }));
   const int L = chain.num_links();
   const double h = chain.link_length(0);
   for (int j = 1; j < L; ++j)
@@ -64,9 +73,7 @@ std::vector<ArcRange> FrontTracker<dim>::initial_arcs(const Chain<dim>& chain) {
       throw InputError("a string with fronts needs links of equal material length");
   if (L < 2) throw InputError(fmt::format("a string with fronts needs at least 2 links, got {}", L));
   material_ = {h, chain.density(), chain.length(), chain.num_nodes()};
-  // 1. The fronts in order of s.
-  fronts_ = make_fronts(material_.ell);
-  // 2. The arcs: the fronts bound the moving part of the material, then split it, in order of s.
+  // The arcs: the fronts bound the moving part of the material, then split it, in order of s.
   FrontLayout layout;
   layout.first = 0;
   layout.last = material_.n - 1;
@@ -280,6 +287,15 @@ EventAction FrontTracker<dim>::handle_events(StringModel<dim>& model, double t, 
 
 template <int dim>
 StringModel<dim> make_front_model(Chain<dim> chain, std::vector<std::unique_ptr<Force<dim>>> forces,
+                                  std::vector<PrescribedNode<dim>> prescribed,
+                                  std::vector<std::unique_ptr<FrontKind<dim>>> fronts, const FrontOptions& options,
+                                  const StringModelOptions& model_options) {
+  return StringModel<dim>(std::move(chain), std::move(forces), std::move(prescribed), model_options,
+                          std::make_unique<FrontTracker<dim>>(std::move(fronts), options));
+}
+
+template <int dim>
+StringModel<dim> make_front_model(Chain<dim> chain, std::vector<std::unique_ptr<Force<dim>>> forces,
                                   std::vector<PrescribedNode<dim>> prescribed, std::vector<HeapSpec<dim>> heaps,
                                   std::optional<FoldSpec> fold, const FrontOptions& fronts,
                                   const StringModelOptions& options) {
@@ -295,8 +311,12 @@ StringModel<dim> make_front_model(Chain<dim> chain, std::vector<std::unique_ptr<
     const bool at_end = heaps[k].side == HeapSpec<dim>::Side::kAfter;
     check_end_free(k, at_end, heaps[k].s0, held(at_end ? chain.num_nodes() - 1 : 0));
   }
-  return StringModel<dim>(std::move(chain), std::move(forces), std::move(prescribed), options,
-                          std::make_unique<FrontTracker<dim>>(std::move(heaps), fold, fronts));
+  check_open_string(chain.closed(), !heaps.empty());  // before the fronts' own checks
+  const double h = chain.num_links() > 0 ? chain.link_length(0) : 0.0;
+  std::vector<std::unique_ptr<FrontKind<dim>>> kinds =
+      heap_and_fold_fronts<dim>(std::move(heaps), fold, chain.length(), h);
+  return make_front_model<dim>(std::move(chain), std::move(forces), std::move(prescribed), std::move(kinds), fronts,
+                               options);
 }
 
 template class FrontTracker<2>;
@@ -307,5 +327,17 @@ template StringModel<2> make_front_model<2>(Chain<2>, std::vector<std::unique_pt
 template StringModel<3> make_front_model<3>(Chain<3>, std::vector<std::unique_ptr<Force<3>>>,
                                             std::vector<PrescribedNode<3>>, std::vector<HeapSpec<3>>,
                                             std::optional<FoldSpec>, const FrontOptions&, const StringModelOptions&);
+template StringModel<2> make_front_model<2>(Chain<2>, std::vector<std::unique_ptr<Force<2>>>,
+                                            std::vector<PrescribedNode<2>>, std::vector<std::unique_ptr<FrontKind<2>>>,
+                                            const FrontOptions&, const StringModelOptions&);
+template StringModel<3> make_front_model<3>(Chain<3>, std::vector<std::unique_ptr<Force<3>>>,
+                                            std::vector<PrescribedNode<3>>, std::vector<std::unique_ptr<FrontKind<3>>>,
+                                            const FrontOptions&, const StringModelOptions&);
+template std::vector<std::unique_ptr<FrontKind<2>>> heap_and_fold_fronts<2>(std::vector<HeapSpec<2>>,
+                                                                            const std::optional<FoldSpec>&, double,
+                                                                            double);
+template std::vector<std::unique_ptr<FrontKind<3>>> heap_and_fold_fronts<3>(std::vector<HeapSpec<3>>,
+                                                                            const std::optional<FoldSpec>&, double,
+                                                                            double);
 
 }  // namespace chainsim

@@ -102,8 +102,9 @@ class FrontTracker final : public StringModule<dim> {
     const std::vector<std::unique_ptr<FrontKind<dim>>>* fronts_;
   };
 
-  /// Heaps (at most one per side) and an optional fold, in any order; they are kept in order of s.
-  FrontTracker(std::vector<HeapSpec<dim>> heaps, std::optional<FoldSpec> fold, const FrontOptions& options);
+  /// The fronts, one FrontKind each, in order of their expected_s0 (InputError otherwise): the
+  /// tracker knows no kind, so a new kind is a new class its builder adds to this list.
+  FrontTracker(std::vector<std::unique_ptr<FrontKind<dim>>> fronts, const FrontOptions& options);
 
   Fronts fronts() const { return Fronts(fronts_); }
   /// The state front k wrote at the last evaluation.
@@ -140,11 +141,7 @@ class FrontTracker final : public StringModule<dim> {
 
  private:
   int num_checks() const;
-  /// The fronts of the specs, checked and in order of s (heap before, fold, heap after).
-  std::vector<std::unique_ptr<FrontKind<dim>>> make_fronts(double ell);
 
-  std::vector<HeapSpec<dim>> heap_specs_;
-  std::optional<FoldSpec> fold_spec_;
   FrontOptions options_;
   FrontMaterial material_;
   std::vector<std::unique_ptr<FrontKind<dim>>> fronts_;
@@ -154,8 +151,23 @@ class FrontTracker final : public StringModule<dim> {
   Vec<dim> heap_moment0_ = Vec<dim>::Zero();  // Σ held mass × its first moment at t = 0
 };
 
-/// The string with fronts: a StringModel whose module is a FrontTracker. `prescribed` nodes must
-/// lie in an arc. Throws InputError when the layout is inconsistent.
+/// Heaps (at most one per side, in any order) and an optional fold as front kinds, checked
+/// (front_checks.hpp) against a string of length `ell` and links of length `h`, in order of s (heap
+/// before, fold, heap after). A heap's s0 within 1e-12 ℓ of an end is put on it.
+template <int dim>
+std::vector<std::unique_ptr<FrontKind<dim>>> heap_and_fold_fronts(std::vector<HeapSpec<dim>> heaps,
+                                                                  const std::optional<FoldSpec>& fold, double ell,
+                                                                  double h);
+
+/// The string with fronts: a StringModel whose module is a FrontTracker of these fronts (in order of
+/// s). `prescribed` nodes must lie in an arc. Throws InputError when the layout is inconsistent.
+template <int dim>
+StringModel<dim> make_front_model(Chain<dim> chain, std::vector<std::unique_ptr<Force<dim>>> forces,
+                                  std::vector<PrescribedNode<dim>> prescribed,
+                                  std::vector<std::unique_ptr<FrontKind<dim>>> fronts, const FrontOptions& options,
+                                  const StringModelOptions& model_options = {});
+
+/// The same with heaps and a fold (heap_and_fold_fronts); a heap's held end must be free.
 template <int dim>
 StringModel<dim> make_front_model(Chain<dim> chain, std::vector<std::unique_ptr<Force<dim>>> forces,
                                   std::vector<PrescribedNode<dim>> prescribed, std::vector<HeapSpec<dim>> heaps,

@@ -40,6 +40,7 @@ class HeapFront final : public FrontKind<dim> {
 
   const char* name() const override { return "heap"; }
   const char* placed() const override { return "heap point"; }
+  bool reservoir() const override { return true; }
   bool after() const { return after_; }
   const Vec<dim>& point() const { return point_; }  ///< x0 (on a plane: a point of the plane)
   bool on_plane() const { return on_plane_; }

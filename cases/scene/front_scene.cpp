@@ -203,9 +203,11 @@ std::unique_ptr<StringModel<dim>> build_front_model(const SceneSpec& spec, scene
   // Located at the front and naming it: the tracker's messages speak of "the heap's plane", "the fold".
   std::unique_ptr<StringModel<dim>> model = at_key(spec, fit_key, [&] {
     try {
-      return std::make_unique<StringModel<dim>>(make_front_model<dim>(std::move(parts.chain), std::move(parts.forces),
-                                                                      std::move(parts.prescribed), heaps, fold,
-                                                                      options, mo));
+      // The fronts, one kind each, in order of s.
+      std::vector<std::unique_ptr<FrontKind<dim>>> kinds =
+          heap_and_fold_fronts<dim>(heaps, fold, ell, parts.chain.link_length(0));
+      return std::make_unique<StringModel<dim>>(make_front_model<dim>(
+          std::move(parts.chain), std::move(parts.forces), std::move(parts.prescribed), std::move(kinds), options, mo));
     } catch (const RecoverableError& e) {  // a degenerate front geometry found while placing the fronts
       throw InputError(fmt::format("{}: {}", fit_key, e.what()));
     } catch (const InputError& e) {
