@@ -66,7 +66,9 @@ def straight_rod(ea, np):
     youngs = 1e6
     params = inspect.signature(ea.CosseratRod.straight_rod).parameters
     kwargs = {"youngs_modulus": youngs}
-    if "nu" in params:
+    # nu (internal damping) was a required argument in early 0.3 releases and is refused (ValueError) when given in
+    # later ones, where it defaults to None: pass it only where it is required.
+    if "nu" in params and params["nu"].default is inspect.Parameter.empty:
         kwargs["nu"] = 0.0
     if "shear_modulus" in params or any(p.kind == p.VAR_KEYWORD for p in params.values()):
         kwargs["shear_modulus"] = youngs / 3.0
