@@ -85,7 +85,7 @@ atol = {atol:g}         # rtol x amplitude / length
 
 [output]
 interval = 0.02       # s: frames for the zero crossings of the modal projection
-fields = ["nodes"]
+fields = ["nodes", "stats"]  # stats.json: the run's summary and counters
 formats = ["csv"]
 
 [stop]
