@@ -101,7 +101,7 @@ def richardson(values):
     return orders, limit
 
 
-def study(binary, scene, meshes, rtol, out, grid_fraction, extra, label, turn):
+def study(binary, scene, meshes, rtol, out, grid_fraction, extra, label, turn, differences=()):
     name, folder = label, label.replace(" ", "_")
     runs = []
     for nodes in meshes:
@@ -119,6 +119,14 @@ def study(binary, scene, meshes, rtol, out, grid_fraction, extra, label, turn):
     err_t = [abs(t - t_ref) / t_ref for t in t_stop]
     err_s = [float(np.max(np.abs(p - s_ref))) for p in paths]
     orders_e = [math.log2(a / b) for a, b in zip(energy, energy[1:])]
+    if differences:
+        times = np.array(differences)
+        at = [hermite(r[2]["t"], r[2]["s0_0"], r[2]["s0dot_0"], times) for r in runs]
+        print(f"  {name}: (s0(N) - s0(2N)) / h at t = " + ", ".join(f"{t:g}" for t in times) + " s")
+        for k in range(len(runs) - 1):
+            with open(scene, "rb") as f:
+                h = float(tomllib.load(f)["string"]["length"]) / (runs[k][0] - 1)
+            print(f"    N = {runs[k][0]:5d} / {runs[k + 1][0]:5d}: " + " ".join(f"{d:9.2e}" for d in (at[k] - at[k + 1]) / h))
     result = {"scene": scene, "rtol": rtol, "nodes": meshes, "wall_s": [r[1].get("wall_s") for r in runs],
               "t_stop": t_stop, "t_stop_extrapolated": float(t_ref), "t_stop_rel_err": err_t,
               "t_stop_observed_orders": orders_t, "front_path_err": err_s, "front_path_observed_orders": orders_s,
@@ -139,6 +147,9 @@ def main():
     ap.add_argument("--nodes", default="21,41,81,161,321")
     ap.add_argument("--rtol", type=float, default=1e-11)
     ap.add_argument("--grid-fraction", type=float, default=0.95, help="front path up to this fraction of t_stop")
+    ap.add_argument("--differences", default="",
+                    help="T1,T2,...: also print (s0(N) - s0(2N)) / h at these times for each pair of successive meshes "
+                         "(h the coarser link): when a mesh's error is made")
     args = ap.parse_args()
     meshes = [int(n) for n in args.nodes.split(",")]
     results = []
@@ -147,7 +158,8 @@ def main():
         scene, _, sets = item.partition(":")
         label = label or os.path.splitext(os.path.basename(scene))[0]
         results.append(study(args.binary, scene, meshes, args.rtol, args.out, args.grid_fraction,
-                             [s for s in sets.split(";") if s], label, label in args.turn))
+                             [s for s in sets.split(";") if s], label, label in args.turn,
+                             [float(t) for t in args.differences.split(",") if t.strip()]))
     for name, r in results:
         print(f"\n{name} (rtol {r['rtol']:g}); t_stop extrapolated {r['t_stop_extrapolated']:.12f} s")
         print("  N      t_stop rel err  order   front path err  order   energy ledger  order")

@@ -104,8 +104,9 @@ InputError unknown_method(const std::string& method) {
 std::vector<std::pair<std::string, std::string>> method_aliases() {
   std::vector<std::pair<std::string, std::string>> out;
   out.emplace_back("auto", fmt::format("{} for a system as stiff as a string of {:g} links or more and without "
-                                       "root functions, else {}",
-                                       kAutoImplicit, Integrator::kAutoImplicitStiffness, kAutoExplicit));
+                                       "root functions (fronts), else {} at rtol >= {:g} and {} below",
+                                       kAutoImplicit, Integrator::kAutoImplicitStiffness, kAutoExplicitLoose,
+                                       kAutoLooseRtol, kAutoExplicit));
   for (const auto& [alias, entry] : aliases())
     out.emplace_back(alias, fmt::format("{} ({})", entry.description, entry.table));
   return out;
@@ -428,7 +429,7 @@ Integrator::Integrator(OdeSystem& system, double t0, const Eigen::VectorXd& y0,
   d.y = d.new_vector(y0.size());
   Eigen::Map<Eigen::VectorXd>(N_VGetArrayPointer(d.y), y0.size()) = y0;
 
-  d.table = table_name(resolve_method(options.method, system));
+  d.table = table_name(resolve_method(options.method, system, options.rtol));
   ARKodeButcherTable erk = nullptr, dirk = nullptr;
   load_table(d.table, erk, dirk);
   if (!erk && !dirk) throw unknown_method(options.method);
@@ -472,10 +473,11 @@ Integrator::Integrator(OdeSystem& system, double t0, const Eigen::VectorXd& y0,
 
 Integrator::~Integrator() = default;
 
-std::string Integrator::resolve_method(const std::string& method, const OdeSystem& system) {
+std::string Integrator::resolve_method(const std::string& method, const OdeSystem& system, double rtol) {
   if (method != "auto") return method;
   const bool stiff = system.explicit_stiffness() >= kAutoImplicitStiffness && system.num_events() == 0;
-  return stiff ? kAutoImplicit : kAutoExplicit;
+  if (stiff) return kAutoImplicit;
+  return rtol >= kAutoLooseRtol ? kAutoExplicitLoose : kAutoExplicit;
 }
 
 // The method, tolerance and last step, for the watchdog's messages.

@@ -293,11 +293,15 @@ void StringSolver<dim>::check_tolerance() {
   const double position_scale = scale.size() > 0 ? scale[0] : 1.0;
   const double atol = options_.integrator.atol * position_scale, rtol = options_.integrator.rtol;
   if (!(size > 0) || atol <= rtol * size) return;
+  // The advice, rounded down to two significant digits so that a run given it does not warn again
+  // (rtol × 1.9998e-5 m printed as 2e-9 did).
+  const double advice = rtol * size / position_scale;
+  const double unit = std::pow(10.0, std::floor(std::log10(advice)) - 1);
   summary_.tolerance_warning = fmt::format(
       "atol = {:.3g} m on positions is {:.3g} of the motion's size ({:.3g} m, the largest displacement of a node "
       "over the frames), coarser than rtol = {:.3g}: the run resolves the motion only to about atol; set "
-      "solver.atol <= {:.3g}",
-      atol, atol / size, size, rtol, rtol * size / position_scale);
+      "solver.atol <= {:.2g}",
+      atol, atol / size, size, rtol, std::floor(advice / unit) * unit);
 }
 
 template <int dim>

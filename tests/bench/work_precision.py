@@ -16,14 +16,19 @@ and measures every error against a reference that does not come from the run its
                             extrapolation of the finest meshes, with its observed order printed and checked;
   hanging                   the first mode of a hanging chain (cases/scenes/hanging_chain.toml started on the
                             mode shape J0(j01 sqrt(sigma/l))): the frequency from the zero crossings of the
-                            modal projection against the exact omega1 = (j01/2) sqrt(g/l).
+                            modal projection against the exact omega1 = (j01/2) sqrt(g/l);
+  hanging4                  the same on the fourth-order string ([string] elements = "quadratic"), 5 - 21 nodes.
 
 The methods are those `chainsim compare --help` lists (explicit, implicit and whatever else is added later),
 or --methods (by default all but erk6 and erk4). Wall time is the solver's own `wall_s` (the integration, not the process), median over --repeats
 runs. Writes OUT/work_precision.csv, OUT/work_precision_table.md and the figures (FIGURES/work_precision_*.png).
 
   /usr/bin/python3 tests/bench/work_precision.py [--chainsim build/chainsim] [--out results/work_precision]
-         [--figures DIR] [--methods erk8,dirk3,...] [--repeats 3] [--budget 10] [--smoke]
+         [--figures DIR] [--methods erk8,dirk3,...] [--cases hanging,hanging4,...] [--repeats 3] [--budget 10]
+         [--smoke]
+
+With `auto` among the methods the table ends with auto's wall time over the fastest method's, per setting and per
+error target.
 
 --smoke (< 30 s): one method, few runs; checks that the hanging chain's frequency error falls at order 2 in the
 link length and that a canonical run and the reduced ODE agree with the quadrature; exit 1 if not.
@@ -35,6 +40,7 @@ import math
 import os
 import platform
 import re
+import resource
 import shlex
 import statistics
 import subprocess
@@ -130,14 +136,18 @@ class Runner:
         """Runs `chainsim ARGS --out DIR --json` `repeats` times; returns (summary of the last run, walls, dir, rc)."""
         out = self.out / "runs" / tag
         walls, summary, rc = [], {}, 0
+        self.cpus = []  # the whole process's CPU time (user + system) of each repeat, from the kernel's rusage
         for _ in range(self.repeats):
             cmd = [str(self.chainsim)] + args + ["--out", str(out), "--json"]
             self.count += 1
+            before = resource.getrusage(resource.RUSAGE_CHILDREN)
             try:
                 p = subprocess.run(cmd, capture_output=True, text=True, timeout=self.budget * 3 + 60, cwd=ROOT)
             except subprocess.TimeoutExpired:
                 rc = "timeout"
                 break
+            after = resource.getrusage(resource.RUSAGE_CHILDREN)
+            self.cpus.append(after.ru_utime + after.ru_stime - before.ru_utime - before.ru_stime)
             rc = p.returncode
             try:
                 summary = json.loads(p.stdout.strip().splitlines()[0]) if p.stdout.strip() else {}
@@ -361,6 +371,19 @@ class HangingModeCase:
         return abs(math.pi / spacing - self.omega) / self.omega, float("nan")
 
 
+class QuadraticHangingModeCase(HangingModeCase):
+    """The same first mode on the fourth-order string ([string] elements = "quadratic", docs/string_solver.md):
+    the same scene file and measurement, meshes of an even number of links."""
+
+    def __init__(self, scene, amplitude=1e-5, periods=2.6):
+        super().__init__(scene, amplitude, periods)
+        self.name = "hanging4"
+        self.title = self.title.replace("first mode", "first mode, quadratic elements")
+
+    def overrides(self):
+        return dict(super().overrides(), **{"string.elements": '"quadratic"'})
+
+
 # ------------------------------------------------------------------------------------------------
 # The study
 def machine_info(chainsim):
@@ -407,6 +430,7 @@ class Study:
                "atol": atol_from(args, rtol),
                "nodes": nodes, "error": float("nan"), "error_eta": float("nan"),
                "error_P": float("nan"), "wall_s": float("nan"), "walls": ";".join(f"{w:.6g}" for w in walls),
+               "cpu_s": statistics.median(self.runner.cpus) if self.runner.cpus else float("nan"),
                "steps": stats.get("steps", ""), "rhs_evals": stats.get("rhs_evals", ""),
                "status": "ok" if rc == 0 else (f"exit {rc}" if rc != "timeout" else "timeout"),
                "why": "" if rc == 0 else str(summary.get("error", ""))[:160], "command": command_line(args)}
@@ -493,6 +517,45 @@ def best_settings(rows, case, target):
     return min(ok, key=lambda r: r["wall_s"]) if ok else None
 
 
+def auto_ratios(rows, cases):
+    return "".join(auto_ratios_by(rows, cases, key) for key in ("wall_s", "cpu_s"))
+
+
+def auto_ratios_by(rows, cases, key):
+    """How far `auto` is from the fastest method: (a) at each setting (case, mesh, rtol) that every method ran,
+    auto's median wall time over the fastest one's; (b) for each error target, auto's fastest setting that reaches
+    it over the fastest setting of any method (the same grid of meshes and tolerances)."""
+    ok = [r for r in rows if r["model"] == "string" and r["status"] == "ok"]
+    if not any(r["method"] == "auto" for r in ok):
+        return ""
+    what = {"wall_s": "the solver's wall time", "cpu_s": "the whole process's CPU time"}[key]
+    out = ["", f"`auto` against the fastest method ({what}: ratio; 1 = auto is the fastest):", ""]
+    best_settings = lambda rs, name, target: min(  # noqa: E731  (fastest by `key`)
+        (r for r in rs if r["case"] == name and r["model"] == "string" and r["status"] == "ok"
+         and r["error"] <= target), key=lambda r: r[key], default=None)
+    for case in cases:
+        mine = [r for r in ok if r["case"] == case.name]
+        per_setting = []
+        for a in (r for r in mine if r["method"] == "auto"):
+            same = [r for r in mine if r["nodes"] == a["nodes"] and r["rtol"] == a["rtol"]]
+            best = min(same, key=lambda r: r[key])
+            per_setting.append((a[key] / best[key], a, best))
+        per_target = []
+        for target in (1e-2, 1e-3, 1e-4, 1e-5, 1e-6, 1e-7, 1e-8):
+            best = best_settings(mine, case.name, target)
+            a = best_settings([r for r in mine if r["method"] == "auto"], case.name, target)
+            if best and a:
+                per_target.append((a[key] / best[key], target, a, best))
+        if per_setting:
+            worst = max(per_setting, key=lambda x: x[0])
+            out.append(f"- {case.name}: per setting worst {worst[0]:.2f} (N {worst[1]['nodes']}, rtol "
+                       f"{worst[1]['rtol']:.0e}: {worst[2]['method']} fastest), median "
+                       f"{statistics.median(x[0] for x in per_setting):.2f}; per target "
+                       + ", ".join(f"{t:.0e}: {q:.2f}" + ("" if q <= 1.5 else f" ({b['method']} rtol {b['rtol']:.0e} "
+                                                          f"N {b['nodes']})") for q, t, a, b in per_target))
+    return "\n".join(out) + "\n"
+
+
 def write_table(study, cases, info, path):
     rows = study.rows
     lines = ["| case | target error | best wall time (s) | settings | error reached | best explicit (s) | "
@@ -519,7 +582,7 @@ def write_table(study, cases, info, path):
             if ex and im:
                 cross.append(f"{case.name} {target:.0e}: implicit/explicit = {im['wall_s'] / ex['wall_s']:.2f}")
     text = "\n".join(lines) + "\n\nBest implicit over best explicit wall time (< 1: implicit faster):\n\n" + \
-        "\n".join(f"- {c}" for c in cross) + "\n"
+        "\n".join(f"- {c}" for c in cross) + "\n" + auto_ratios(rows, cases)
     path.write_text(text)
     return text
 
@@ -583,6 +646,8 @@ def main():
     ap.add_argument("--repeats", type=int, default=3, help="runs per setting; the median wall time is kept")
     ap.add_argument("--budget", type=float, default=10.0, help="wall budget of one run (s, --max-wall)")
     ap.add_argument("--smoke", action="store_true", help="a < 30 s check (CTest)")
+    ap.add_argument("--cases", default="", help="comma-separated subset of falling,folded,sliding,tilted,curved,"
+                    "hanging,hanging4 (default: all)")
     opts = ap.parse_args()
     if not opts.chainsim.exists():
         sys.exit(f"work_precision.py: {opts.chainsim} not found: build it first (cmake --build build --target chainsim)")
@@ -622,6 +687,14 @@ def main():
     curved = CurvedCase(SCENES / "curved_falling_chain.toml")
     hanging = HangingModeCase(SCENES / "hanging_chain.toml")
     hanging.write_scene(opts.out)
+    hanging4 = QuadraticHangingModeCase(SCENES / "hanging_chain.toml")
+    hanging4.scene = hanging.scene
+    chosen = {c.strip() for c in opts.cases.split(",") if c.strip()}
+    known_cases = {"falling", "folded", "sliding", "tilted", "curved", "hanging", "hanging4"}
+    if chosen - known_cases:
+        sys.exit(f"work_precision.py: --cases {','.join(sorted(chosen - known_cases))}: unknown; allowed "
+                 f"{', '.join(sorted(known_cases))}")
+    wanted = lambda name: not chosen or name in chosen  # noqa: E731
     smoke_failures = []
 
     if opts.smoke:
@@ -655,25 +728,32 @@ def main():
     else:
         rtols = [1e-3, 1e-6, 1e-9]
         floor = [m for m in methods if m[0] in ("erk8", "erk5", "dirk5")] or methods
+        canonical = [c for c in canonical if wanted(c.name)]
         for case in canonical:
             study.log(f"{case.name}: {case.title}")
             study.sweep(case, methods, rtols, [41])
             study.reduced_floor(case, floor, [1e-4, 1e-8, 1e-12])
-        study.log(f"tilted: {tilted.title}")
-        study.sweep(tilted, methods, rtols, [41])
-        study.log(f"curved: {curved.title}")
-        # Meshes with a node on the cutoff (1 cm = 1/100 of the chain: the number of links a multiple of 100): where
-        # the cutoff falls inside a link, the error has a part that depends on that fraction, and the orders
-        # observed on 161, 321, 641, 1281 nodes wander (2.44, 1.67); on these they are 1.96, 2.03, 1.96.
-        reference = study.richardson(curved, [101, 201, 401, 801, 1601], "erk8", 1e-12)
-        (opts.out / "curved_reference.json").write_text(json.dumps(reference, indent=1))
-        study.sweep(curved, methods, [1e-4, 1e-8], [21, 41, 81, 161, 321])
-        study.log(f"hanging: {hanging.title}")
-        study.sweep(hanging, methods, [1e-5, 1e-9], [11, 21, 41, 81, 161, 321], hanging.overrides())
-        cases = canonical + [tilted, curved, hanging]
+        if wanted("tilted"):
+            study.log(f"tilted: {tilted.title}")
+            study.sweep(tilted, methods, rtols, [41])
+        if wanted("curved"):
+            study.log(f"curved: {curved.title}")
+            # Meshes with a node on the cutoff (1 cm = 1/100 of the chain: the number of links a multiple of 100):
+            # where the cutoff falls inside a link, the error has a part that depends on that fraction, and the
+            # orders observed on 161, 321, 641, 1281 nodes wander (2.44, 1.67); on these they are 1.96, 2.03, 1.96.
+            reference = study.richardson(curved, [101, 201, 401, 801, 1601], "erk8", 1e-12)
+            (opts.out / "curved_reference.json").write_text(json.dumps(reference, indent=1))
+            study.sweep(curved, methods, [1e-4, 1e-8], [21, 41, 81, 161, 321])
+        if wanted("hanging"):
+            study.log(f"hanging: {hanging.title}")
+            study.sweep(hanging, methods, [1e-5, 1e-9], [11, 21, 41, 81, 161, 321], hanging.overrides())
+        if wanted("hanging4"):
+            study.log(f"hanging4: {hanging4.title}")
+            study.sweep(hanging4, methods, [1e-5, 1e-9], [5, 7, 9, 13, 17, 21], hanging4.overrides())
+        cases = canonical + [c for c in (tilted, curved, hanging, hanging4) if wanted(c.name)]
 
     fields = ["case", "model", "method", "explicit", "kind", "rtol", "atol", "nodes", "error", "error_eta", "error_P",
-              "wall_s", "walls", "steps", "rhs_evals", "status", "why", "command"]
+              "wall_s", "walls", "cpu_s", "steps", "rhs_evals", "status", "why", "command"]
     csv_path = opts.out / "work_precision.csv"
     with open(csv_path, "w", newline="") as fh:
         w = csv.DictWriter(fh, fieldnames=fields)
@@ -685,10 +765,14 @@ def main():
     if opts.smoke:
         plot(study, cases, info, figures / "work_precision_smoke.png", "chainsim work-precision (smoke)", command)
     else:
-        plot(study, canonical, info, figures / "work_precision_canonical.png",
-             "chainsim work-precision: the canonical problems (string solver; thin lines: the reduced ODE)", command)
-        plot(study, [tilted, curved, hanging], info, figures / "work_precision_scenes.png",
-             "chainsim work-precision: general scenes", command)
+        if canonical:
+            plot(study, canonical, info, figures / "work_precision_canonical.png",
+                 "chainsim work-precision: the canonical problems (string solver; thin lines: the reduced ODE)",
+                 command)
+        scenes = [c for c in cases if c not in canonical]
+        if scenes:
+            plot(study, scenes, info, figures / "work_precision_scenes.png",
+                 "chainsim work-precision: general scenes", command)
     elapsed = time.time() - start
     study.log(f"{study.runner.count} runs in {elapsed:.0f} s; load average now {os.getloadavg()[0]:.1f}; "
               f"wrote {csv_path}, {opts.out / 'work_precision_table.md'} and the figures in {figures}/")

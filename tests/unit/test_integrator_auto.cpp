@@ -73,3 +73,44 @@ TEST_CASE("method = auto: implicit from 50 links on with quadratic elements too,
   CHECK(stats.lin_solves > 0);  // the elements' own Newton solver was used
   CHECK(stats.nonlin_conv_fails == 0);
 }
+
+namespace {
+// Only what "auto" looks at: the stiffness and the root functions.
+struct StubSystem : OdeSystem {
+  StubSystem(double stiffness, int events) : stiffness_(stiffness), events_(events) {}
+  int size() const override { return 1; }
+  void rhs(double, const Eigen::Ref<const Eigen::VectorXd>&, Eigen::Ref<Eigen::VectorXd> ydot) override {
+    ydot.setZero();
+  }
+  int num_events() const override { return events_; }
+  double explicit_stiffness() const override { return stiffness_; }
+  double stiffness_;
+  int events_;
+};
+}  // namespace
+
+TEST_CASE("method = auto looks at the tolerance and the fronts: erk3 at loose rtol, erk5 at tight, explicit with "
+          "fronts", "[unit][integrator]") {
+  // Issue 24 item 4: auto chose erk8 for every front scene and every non-stiff string, which the
+  // work-precision study measured 1.5 - 2.3 times slower than erk3 at rtol 1e-3 - 1e-6 and up to 1.2 times
+  // slower than erk5 at rtol 1e-8 - 1e-9 (docs/work-precision.md, "What auto picks").
+  const StubSystem fronts(200, 2), coarse(20, 0), stiff(200, 0);
+  CHECK(Integrator::resolve_method("auto", fronts, 1e-3) == "erk3");
+  CHECK(Integrator::resolve_method("auto", fronts, 1e-6) == "erk3");
+  CHECK(Integrator::resolve_method("auto", fronts, 1e-9) == "erk5");
+  CHECK(Integrator::resolve_method("auto", coarse, 1e-5) == "erk3");
+  CHECK(Integrator::resolve_method("auto", coarse, 1e-8) == "erk5");
+  CHECK(Integrator::resolve_method("auto", stiff, 1e-5) == "dirk4");  // stiff and no fronts: implicit
+  CHECK(Integrator::resolve_method("auto", stiff, 1e-9) == "dirk4");
+  CHECK(Integrator::resolve_method("erk8", fronts, 1e-3) == "erk8");
+  // The Integrator resolves it with its own rtol: a front scene at rtol 1e-4 runs Bogacki-Shampine.
+  auto chain = hanging_chain(10, 1.0, [](double) { return 0.0; }, 0.03);
+  IntegratorOptions options;
+  options.method = "auto";
+  options.rtol = 1e-4;
+  Integrator loose(*chain, 0.0, chain->state_from_chain(), options);
+  CHECK(loose.stats().method == "ARKODE_BOGACKI_SHAMPINE_4_2_3");
+  options.rtol = 1e-9;
+  Integrator tight(*chain, 0.0, chain->state_from_chain(), options);
+  CHECK(tight.stats().method == "ARKODE_DORMAND_PRINCE_7_4_5");
+}

@@ -35,6 +35,13 @@ TEST_CASE("a run warns when atol is coarser than rtol times the motion's size", 
   CHECK_THAT(text, Catch::Matchers::Contains("atol = 1e-06 m"));
   // The size it found is the swing of the free end, 2e-5 m within the frames' sampling.
   CHECK_THAT(text, Catch::Matchers::Contains("(2e-05 m,") || Catch::Matchers::Contains("(1.99e-05 m,"));
+  // The advice is a value that does not warn again (it was rtol x 1.9998e-5 m printed as 2e-09, above it).
+  const std::string key = "set solver.atol <= ";
+  REQUIRE(text.find(key) != std::string::npos);
+  const std::string advised = text.substr(text.find(key) + key.size());
+  const auto followed = run_mode1(advised, dir / "advised");
+  INFO("advised atol " << advised);
+  CHECK_FALSE(followed.contains("tolerance_warning"));
   // atol 1e-10 m is below rtol times the swing (2e-9 m): no warning.
   const auto fine = run_mode1("1e-10", dir / "fine");
   CHECK_FALSE(fine.contains("tolerance_warning"));
