@@ -5,9 +5,14 @@
 /// unknowns ordered along the string (node, link, node, …; a closed string folded so that its last
 /// node sits beside its first) lie within a bandwidth of a few nodes whatever the number of links.
 ///
-/// The matrix is stored and factored by SUNDIALS (SUNBandMatrix and SUNLinSol_Band: LU with partial
-/// pivoting inside the band, O(n · ml · (ml + mu)) per factorisation, O(n · (2 ml + mu)) per solve);
-/// this class holds the order, the assembly into the band and the permutations of the solves.
+/// With K ≥ both bandwidths (K = 6, 8, 12 or 16), the ordered unknowns read in consecutive groups of K
+/// make a block-tridiagonal matrix (an entry within K places of the diagonal is at most one group off
+/// it), factored by the block Thomas algorithm of the quadratic elements (BlockTridiagonal,
+/// quadratic_string.hpp: fixed-size K×K blocks, each pivot block inverted with partial pivoting;
+/// the unknowns past n in the last group are identity rows): O(n K²) per factorisation, O(n K) per
+/// solve, in unrolled fixed-size products. A wider band goes to SUNDIALS (SUNBandMatrix and
+/// SUNLinSol_Band: LU with partial pivoting inside the band). This class holds the order, the
+/// assembly and the permutations of the solves.
 #include <memory>
 #include <vector>
 
@@ -29,9 +34,15 @@ class BandedLU {
   /// A(row, col) += value, in the unknowns' own numbering.
   void add(int row, int col, double value) {
     const int r = position_[static_cast<std::size_t>(row)], c = position_[static_cast<std::size_t>(col)];
-    columns_[static_cast<std::size_t>(c)][r - c] += value;
+    if (block_ > 0) {
+      const int br = r / block_, bc = c / block_;
+      blocks_[static_cast<std::size_t>(3 * br + bc - br + 1)][(c - bc * block_) * block_ + r - br * block_] += value;
+    } else {
+      columns_[static_cast<std::size_t>(c)][r - c] += value;
+    }
   }
-  /// Factors the assembled matrix. False if a pivot is exactly zero (the matrix is singular).
+  /// Factors the assembled matrix. False if it is singular (a zero pivot; with blocks, a pivot block
+  /// whose scaled inverse exceeds 1e13).
   bool factor();
   /// x = A⁻¹ b in place (`rhs` holds b on entry), with the last successful factor().
   void solve(double* rhs);
@@ -39,14 +50,17 @@ class BandedLU {
   int size() const { return static_cast<int>(position_.size()); }
   int lower_bandwidth() const { return lower_; }
   int upper_bandwidth() const { return upper_; }
+  /// The size of the blocks of the block-tridiagonal factorisation (0: SUNDIALS' band LU).
+  int block_size() const { return block_; }
   const std::vector<int>& position() const { return position_; }
 
  private:
   struct Impl;
   std::unique_ptr<Impl> impl_;
   std::vector<int> position_;
-  std::vector<double*> columns_;  // column j of the band, pointing at its diagonal entry
-  int lower_ = 0, upper_ = 0;
+  std::vector<double*> columns_;  // SUNDIALS' band: column j, pointing at its diagonal entry
+  std::vector<double*> blocks_;   // blocks: (lower, diagonal, upper) of each block row, column-major
+  int lower_ = 0, upper_ = 0, block_ = 0;
 };
 
 }  // namespace chainsim
