@@ -3,6 +3,7 @@
 #include "banded_lu.hpp"
 #include "quadratic_string.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <vector>
 
@@ -162,14 +163,10 @@ void StringJacobian<dim>::linearize(double t, const Eigen::Ref<const Eigen::Vect
       if (kb >= 0) wg.emplace_back(dim * kb + q, u, wb * e[q]);
     }
   });
-  P_.resize(nv_, nv_);
-  P_.setFromTriplets(p.begin(), p.end());
-  Qx_.resize(nt_, nv_);
-  Qx_.setFromTriplets(qx.begin(), qx.end());
-  Qv_.resize(nt_, nv_);
-  Qv_.setFromTriplets(qv.begin(), qv.end());
-  WGt_.resize(nv_, nt_);
-  WGt_.setFromTriplets(wg.begin(), wg.end());
+  bool new_pattern = assemble(P_, nv_, nv_, p, slots_[0]);
+  new_pattern |= assemble(Qx_, nt_, nv_, qx, slots_[1]);
+  new_pattern |= assemble(Qv_, nt_, nv_, qv, slots_[2]);
+  new_pattern |= assemble(WGt_, nv_, nt_, wg, slots_[3]);
   // A: the tension matrix as assembled by the model (compressed columns); factored alone only if
   // apply() needs it.
   a_values_ = m.system_->values();
@@ -179,7 +176,39 @@ void StringJacobian<dim>::linearize(double t, const Eigen::Ref<const Eigen::Vect
   exact_ = m.newton_solver_exact();
   const std::string& choice = m.options_.linear_solver;
   banded_ = choice == "banded" || (choice == "auto" && !m.module_);
-  if (banded_) order_along_string();
+  if (banded_ && (new_pattern || !band_ || band_->size() != nv_ + nt_ || ordered_slots_ != m.slot_ ||
+                  ordered_links_ != m.link_unknown_)) {
+    order_along_string();
+    ordered_slots_ = m.slot_;
+    ordered_links_ = m.link_unknown_;
+  }
+}
+
+template <int dim>
+bool StringJacobian<dim>::assemble(SpMat& out, int rows, int cols, const std::vector<Eigen::Triplet<double>>& entries,
+                                   Slots& s) {
+  bool same = out.rows() == rows && out.cols() == cols && s.rows.size() == entries.size();
+  for (std::size_t k = 0; same && k < entries.size(); ++k)
+    same = entries[k].row() == s.rows[k] && entries[k].col() == s.cols[k];
+  if (same) {  // the values into the slots, duplicates summed in the order of the entries
+    std::fill(out.valuePtr(), out.valuePtr() + out.nonZeros(), 0.0);
+    for (std::size_t k = 0; k < entries.size(); ++k) out.valuePtr()[s.slot[k]] += entries[k].value();
+    return false;
+  }
+  out.resize(rows, cols);
+  out.setFromTriplets(entries.begin(), entries.end());
+  out.makeCompressed();
+  s.rows.resize(entries.size());
+  s.cols.resize(entries.size());
+  s.slot.resize(entries.size());
+  for (std::size_t k = 0; k < entries.size(); ++k) {
+    s.rows[k] = entries[k].row();
+    s.cols[k] = entries[k].col();
+    const int* first = out.innerIndexPtr() + out.outerIndexPtr()[s.cols[k]];
+    const int* last = out.innerIndexPtr() + out.outerIndexPtr()[s.cols[k] + 1];
+    s.slot[k] = static_cast<int>(std::lower_bound(first, last, s.rows[k]) - out.innerIndexPtr());
+  }
+  return true;
 }
 
 template <int dim>

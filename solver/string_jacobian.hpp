@@ -92,6 +92,15 @@ class StringJacobian {
   void for_each_entry(double gamma, Emit&& emit) const;
   /// The string order of the augmented unknowns and its bandwidths, into band_ (linearize()).
   void order_along_string();
+  std::vector<int> ordered_slots_, ordered_links_;  // the layout band_ was ordered for
+  /// The entries' (row, column) sequence of a block and the slot of each in its compressed values.
+  struct Slots {
+    std::vector<int> rows, cols, slot;
+  };
+  Slots slots_[4];  // P, Qx, Qv, W Gᵀ
+  /// out = the (rows × cols) matrix of `entries` (duplicates summed): only the values when the
+  /// sequence of (row, column) is that of the last call, else the pattern anew (returns true).
+  static bool assemble(SpMat& out, int rows, int cols, const std::vector<Eigen::Triplet<double>>& entries, Slots& s);
   std::vector<Eigen::Triplet<double>> entries_;  // the augmented system's assembly (kept: no reallocation)
   mutable Eigen::VectorXd work_;                 // the augmented right-hand side and solution of solve()
 };
