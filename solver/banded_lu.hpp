@@ -32,14 +32,16 @@ class BandedLU {
   /// Zeroes the matrix (same order and band).
   void zero();
   /// A(row, col) += value, in the unknowns' own numbering.
-  void add(int row, int col, double value) {
+  void add(int row, int col, double value) { entry(row, col) += value; }
+  /// The storage of A(row, col), in the unknowns' own numbering: valid until the next reset(), so an
+  /// assembly whose entries come in a fixed sequence can keep the addresses.
+  double& entry(int row, int col) {
     const int r = position_[static_cast<std::size_t>(row)], c = position_[static_cast<std::size_t>(col)];
     if (block_ > 0) {
       const int br = r / block_, bc = c / block_;
-      blocks_[static_cast<std::size_t>(3 * br + bc - br + 1)][(c - bc * block_) * block_ + r - br * block_] += value;
-    } else {
-      columns_[static_cast<std::size_t>(c)][r - c] += value;
+      return blocks_[static_cast<std::size_t>(3 * br + bc - br + 1)][(c - bc * block_) * block_ + r - br * block_];
     }
+    return columns_[static_cast<std::size_t>(c)][r - c];
   }
   /// Factors the assembled matrix. False if it is singular (a zero pivot; with blocks, a pivot block
   /// whose scaled inverse exceeds 1e13).

@@ -248,6 +248,8 @@ void StringJacobian<dim>::order_along_string() {
   });
   if (!band_) band_ = std::make_unique<BandedLU>();
   band_->reset(std::move(position), lower, upper);
+  band_entries_.clear();  // the storage of each entry, in the sequence of for_each_entry
+  for_each_entry(1.0, [&](int r, int c, double) { band_entries_.push_back(&band_->entry(r, c)); });
 }
 
 template <int dim>
@@ -311,10 +313,10 @@ template <int dim>
 void StringJacobian<dim>::factor(double gamma) {
   gamma_ = gamma;
   if (banded_) {
-    BandedLU& band = *band_;
-    band.zero();
-    for_each_entry(gamma, [&](int r, int c, double v) { band.add(r, c, v); });
-    if (!band.factor()) throw RecoverableError("a Newton matrix of the string is singular");
+    band_->zero();
+    std::size_t k = 0;
+    for_each_entry(gamma, [&](int, int, double v) { *band_entries_[k++] += v; });
+    if (!band_->factor()) throw RecoverableError("a Newton matrix of the string is singular");
     return;
   }
   std::vector<Eigen::Triplet<double>>& tr = entries_;

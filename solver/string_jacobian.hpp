@@ -93,6 +93,7 @@ class StringJacobian {
   /// The string order of the augmented unknowns and its bandwidths, into band_ (linearize()).
   void order_along_string();
   std::vector<int> ordered_slots_, ordered_links_;  // the layout band_ was ordered for
+  std::vector<double*> band_entries_;                // band_'s storage of each entry of for_each_entry
   /// The entries' (row, column) sequence of a block and the slot of each in its compressed values.
   struct Slots {
     std::vector<int> rows, cols, slot;
