@@ -97,7 +97,7 @@ TEST_CASE("the banded Newton solve runs the hanging chain as KLU does", "[conver
 
 TEST_CASE("implicit steps at 10,000 links are those at 100", "[convergence][implicit][banded]") {
   // Two periods of the first mode (4 zero crossings) at rtol 1e-6: the motion sets the step. Measured
-  // 60 steps at 100 links and 82–85 at 10,000 (KLU and banded, whose round-off differs): the extra steps are set by the
+  // 60 steps at 100 links and 85 at 10,000 (82 with KLU, whose round-off differs): the extra steps are set by the
   // components whose exact values vanish to second order in the 1e-5 amplitude (the vertical motion),
   // weighted by atol = rtol × amplitude alone, which carry the round-off of accelerations of order
   // g·N (docs/string_solver.md, "Newton on fine strings"). With atol 100× larger the counts are 30
