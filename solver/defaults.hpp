@@ -44,6 +44,9 @@ inline constexpr Integration kReduced{"erk8", 1e-13, 1e-15};
 inline constexpr long kMaxSteps = 500000;
 /// Tension backend (StringModelOptions::backend, [solver] backend).
 inline constexpr const char* kBackend = "auto";
+/// Factorisation of the Newton systems of implicit methods (StringModelOptions::linear_solver,
+/// [solver] linear_solver): "auto" (banded for a string without fronts, KLU otherwise), "banded", "klu".
+inline constexpr const char* kLinearSolver = "auto";
 /// The discretization (StringModelOptions::elements, [string] elements): "links" (order 2) until the
 /// quadratic elements carry fronts and closed strings (docs/work-precision.md).
 inline constexpr const char* kElements = "links";

@@ -120,6 +120,9 @@ void BlockTridiagonal<K, O, W>::solve(std::vector<Column>& rhs) const {
 }
 
 template class BlockTridiagonal<6>;
+template class BlockTridiagonal<8>;  // 8, 12, 16: the links' Newton systems (banded_lu.hpp)
+template class BlockTridiagonal<12>;
+template class BlockTridiagonal<16>;
 template class BlockTridiagonal<6, 2, 2>;
 template class BlockTridiagonal<8, 3, 3>;
 

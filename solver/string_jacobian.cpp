@@ -1,7 +1,9 @@
 // The exact linearisation of the string and its Newton systems: see string_jacobian.hpp.
 #include "string_jacobian.hpp"
+#include "banded_lu.hpp"
 #include "quadratic_string.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <vector>
 
@@ -161,18 +163,129 @@ void StringJacobian<dim>::linearize(double t, const Eigen::Ref<const Eigen::Vect
       if (kb >= 0) wg.emplace_back(dim * kb + q, u, wb * e[q]);
     }
   });
-  P_.resize(nv_, nv_);
-  P_.setFromTriplets(p.begin(), p.end());
-  Qx_.resize(nt_, nv_);
-  Qx_.setFromTriplets(qx.begin(), qx.end());
-  Qv_.resize(nt_, nv_);
-  Qv_.setFromTriplets(qv.begin(), qv.end());
-  WGt_.resize(nv_, nt_);
-  WGt_.setFromTriplets(wg.begin(), wg.end());
-  // A: the tension matrix as assembled by the model (compressed columns).
+  bool new_pattern = assemble(P_, nv_, nv_, p, slots_[0]);
+  new_pattern |= assemble(Qx_, nt_, nv_, qx, slots_[1]);
+  new_pattern |= assemble(Qv_, nt_, nv_, qv, slots_[2]);
+  new_pattern |= assemble(WGt_, nv_, nt_, wg, slots_[3]);
+  // A: the tension matrix as assembled by the model (compressed columns); factored alone only if
+  // apply() needs it.
   a_values_ = m.system_->values();
-  a_factor_->factorize(m.system_->pattern(), a_values_);
+  const SparsePattern& a = m.system_->pattern();
+  if (a_pattern_.n != a.n || a_pattern_.col_ptr != a.col_ptr || a_pattern_.row_index != a.row_index) a_pattern_ = a;
+  a_factored_ = false;
   exact_ = m.newton_solver_exact();
+  const std::string& choice = m.options_.linear_solver;
+  banded_ = choice == "banded" || (choice == "auto" && !m.module_);
+  if (banded_ && (new_pattern || !band_ || band_->size() != nv_ + nt_ || ordered_slots_ != m.slot_ ||
+                  ordered_links_ != m.link_unknown_)) {
+    order_along_string();
+    ordered_slots_ = m.slot_;
+    ordered_links_ = m.link_unknown_;
+  }
+}
+
+template <int dim>
+bool StringJacobian<dim>::assemble(SpMat& out, int rows, int cols, const std::vector<Eigen::Triplet<double>>& entries,
+                                   Slots& s) {
+  bool same = out.rows() == rows && out.cols() == cols && s.rows.size() == entries.size();
+  for (std::size_t k = 0; same && k < entries.size(); ++k)
+    same = entries[k].row() == s.rows[k] && entries[k].col() == s.cols[k];
+  if (same) {  // the values into the slots, duplicates summed in the order of the entries
+    std::fill(out.valuePtr(), out.valuePtr() + out.nonZeros(), 0.0);
+    for (std::size_t k = 0; k < entries.size(); ++k) out.valuePtr()[s.slot[k]] += entries[k].value();
+    return false;
+  }
+  out.resize(rows, cols);
+  out.setFromTriplets(entries.begin(), entries.end());
+  out.makeCompressed();
+  s.rows.resize(entries.size());
+  s.cols.resize(entries.size());
+  s.slot.resize(entries.size());
+  for (std::size_t k = 0; k < entries.size(); ++k) {
+    s.rows[k] = entries[k].row();
+    s.cols[k] = entries[k].col();
+    const int* first = out.innerIndexPtr() + out.outerIndexPtr()[s.cols[k]];
+    const int* last = out.innerIndexPtr() + out.outerIndexPtr()[s.cols[k] + 1];
+    s.slot[k] = static_cast<int>(std::lower_bound(first, last, s.rows[k]) - out.innerIndexPtr());
+  }
+  return true;
+}
+
+template <int dim>
+void StringJacobian<dim>::order_along_string() {
+  const StringModel<dim>& m = model_;
+  const Chain<dim>& chain = m.chain_;
+  const int N = chain.num_nodes(), L = chain.num_links();
+  // Node i has the key 2i, link j (from node i) 2i + 1: along an open string, or along the arcs of
+  // one, every coupling (a node with its neighbours and its two links, a link with the nodes of its
+  // neighbours) is within a few keys. A closed string's last link couples node n−1 with node 0: its
+  // keys are folded, 0, 2n−1, 1, 2n−2, … → 0, 1, 2, 3, …, so that every coupling is within twice as many.
+  const bool fold = chain.closed() && !m.module_;
+  auto place = [&](int key) { return !fold ? key : key < N ? 2 * key : 2 * (2 * N - 1 - key) + 1; };
+  std::vector<int> start(static_cast<std::size_t>(2 * N + 1), 0);
+  for (int i = 0; i < N; ++i)
+    if (m.slot_[static_cast<std::size_t>(i)] >= 0) start[static_cast<std::size_t>(place(2 * i)) + 1] = dim;
+  for (int j = 0; j < L; ++j)
+    if (m.link_unknown_[static_cast<std::size_t>(j)] >= 0)
+      start[static_cast<std::size_t>(place(2 * chain.link_start(j) + 1)) + 1] = 1;
+  for (std::size_t k = 1; k < start.size(); ++k) start[k] += start[k - 1];
+  std::vector<int> position(static_cast<std::size_t>(nv_ + nt_), -1);
+  for (int i = 0; i < N; ++i) {
+    const int k = m.slot_[static_cast<std::size_t>(i)];
+    if (k >= 0)
+      for (int q = 0; q < dim; ++q)
+        position[static_cast<std::size_t>(dim * k + q)] = start[static_cast<std::size_t>(place(2 * i))] + q;
+  }
+  for (int j = 0; j < L; ++j) {
+    const int u = m.link_unknown_[static_cast<std::size_t>(j)];
+    if (u >= 0) position[static_cast<std::size_t>(nv_ + u)] = start[static_cast<std::size_t>(place(2 * chain.link_start(j) + 1))];
+  }
+  int lower = 0, upper = 0;
+  for_each_entry(1.0, [&](int r, int c, double) {
+    const int d = position[static_cast<std::size_t>(r)] - position[static_cast<std::size_t>(c)];
+    lower = std::max(lower, d);
+    upper = std::max(upper, -d);
+  });
+  if (!band_) band_ = std::make_unique<BandedLU>();
+  band_->reset(std::move(position), lower, upper);
+  band_entries_.clear();  // the storage of each entry, in the sequence of for_each_entry
+  for_each_entry(1.0, [&](int r, int c, double) { band_entries_.push_back(&band_->entry(r, c)); });
+}
+
+template <int dim>
+template <class Emit>
+void StringJacobian<dim>::for_each_entry(double gamma, Emit&& emit) const {
+  for (int i = 0; i < nv_; ++i) emit(i, i, 1.0);
+  auto add = [&](const SpMat& block, int row0, int col0, double scale) {
+    for (int c = 0; c < block.outerSize(); ++c)
+      for (SpMat::InnerIterator it(block, c); it; ++it)
+        emit(row0 + static_cast<int>(it.row()), col0 + static_cast<int>(it.col()), scale * it.value());
+  };
+  add(P_, 0, 0, -gamma * gamma);
+  add(WGt_, 0, nv_, gamma);
+  add(Qx_, nv_, 0, gamma);
+  add(Qv_, nv_, 0, 1.0);
+  const SparsePattern& a = a_pattern_;  // −A
+  for (int c = 0; c < a.n; ++c)
+    for (int k = a.col_ptr[static_cast<std::size_t>(c)]; k < a.col_ptr[static_cast<std::size_t>(c) + 1]; ++k)
+      emit(nv_ + a.row_index[static_cast<std::size_t>(k)], nv_ + c, -a_values_[static_cast<std::size_t>(k)]);
+}
+
+template <int dim>
+Eigen::MatrixXd StringJacobian<dim>::augmented_matrix() const {
+  Eigen::MatrixXd out = Eigen::MatrixXd::Zero(nv_ + nt_, nv_ + nt_);
+  for_each_entry(gamma_, [&](int r, int c, double v) { out(r, c) += v; });
+  return out;
+}
+
+template <int dim>
+int StringJacobian<dim>::lower_bandwidth() const {
+  return banded_ ? band_->lower_bandwidth() : 0;
+}
+
+template <int dim>
+int StringJacobian<dim>::upper_bandwidth() const {
+  return banded_ ? band_->upper_bandwidth() : 0;
 }
 
 template <int dim>
@@ -186,6 +299,10 @@ template <int dim>
 void StringJacobian<dim>::apply(const Eigen::Ref<const Eigen::VectorXd>& d, Eigen::Ref<Eigen::VectorXd> out) const {
   const auto dx = d.head(nv_), dv = d.segment(nv_, nv_);
   Eigen::VectorXd w = Qx_ * dx + Qv_ * dv;
+  if (!a_factored_) {
+    a_factor_->factorize(a_pattern_, a_values_);
+    a_factored_ = true;
+  }
   a_factor_->lu.solve(w.data());
   out.setZero();
   out.head(nv_) = dv;
@@ -195,26 +312,19 @@ void StringJacobian<dim>::apply(const Eigen::Ref<const Eigen::VectorXd>& d, Eige
 template <int dim>
 void StringJacobian<dim>::factor(double gamma) {
   gamma_ = gamma;
-  const int n = nv_ + nt_;
+  if (banded_) {
+    band_->zero();
+    std::size_t k = 0;
+    for_each_entry(gamma, [&](int, int, double v) { *band_entries_[k++] += v; });
+    if (!band_->factor()) throw RecoverableError("a Newton matrix of the string is singular");
+    return;
+  }
   std::vector<Eigen::Triplet<double>>& tr = entries_;
   tr.clear();
   tr.reserve(static_cast<std::size_t>(nv_ + P_.nonZeros() + WGt_.nonZeros() + Qx_.nonZeros() + Qv_.nonZeros()) +
              a_values_.size());
-  for (int i = 0; i < nv_; ++i) tr.emplace_back(i, i, 1.0);
-  auto add = [&](const SpMat& block, int row0, int col0, double scale) {
-    for (int c = 0; c < block.outerSize(); ++c)
-      for (SpMat::InnerIterator it(block, c); it; ++it)
-        tr.emplace_back(row0 + static_cast<int>(it.row()), col0 + static_cast<int>(it.col()), scale * it.value());
-  };
-  add(P_, 0, 0, -gamma * gamma);
-  add(WGt_, 0, nv_, gamma);
-  add(Qx_, nv_, 0, gamma);
-  add(Qv_, nv_, 0, 1.0);
-  const SparsePattern& a = a_factor_->pattern;  // −A
-  for (int c = 0; c < a.n; ++c)
-    for (int k = a.col_ptr[static_cast<std::size_t>(c)]; k < a.col_ptr[static_cast<std::size_t>(c) + 1]; ++k)
-      tr.emplace_back(nv_ + a.row_index[static_cast<std::size_t>(k)], nv_ + c, -a_values_[static_cast<std::size_t>(k)]);
-  factor_->factorize(n, tr);
+  for_each_entry(gamma, [&](int r, int c, double v) { tr.emplace_back(r, c, v); });
+  factor_->factorize(nv_ + nt_, tr);
 }
 
 template <int dim>
@@ -225,7 +335,10 @@ void StringJacobian<dim>::solve(const Eigen::Ref<const Eigen::VectorXd>& r, Eige
   sol.resize(nv_ + nt_);
   sol.head(nv_) = rv + gamma_ * (P_ * rx);
   sol.tail(nt_) = -(Qx_ * rx);
-  factor_->lu.solve(sol.data());
+  if (banded_)
+    band_->solve(sol.data());
+  else
+    factor_->lu.solve(sol.data());
   z.segment(nv_, nv_) = sol.head(nv_);
   z.head(nv_) = rx + gamma_ * sol.head(nv_);
   z.tail(r.size() - 2 * nv_) = r.tail(r.size() - 2 * nv_);

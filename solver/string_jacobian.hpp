@@ -17,7 +17,11 @@
 ///     [ I − γ² P      γ W Gᵀ ] [zv]   [ rv + γ P rx ]
 ///     [ γ Qx + Qv     −A     ] [w ] = [ −Qx rx      ]
 ///
-/// factored by KLU (klu_refactor between steps; Eigen's SparseLU when built without KLU). The ledgers (W_applied, a module's)
+/// factored in O(N): by a band LU (banded_lu.hpp) with the unknowns ordered along the string — zv of
+/// a node, then w of its link, … ; a closed string folded (0, n−1, 1, n−2, …) so that its last link
+/// is short in the order too — where every coupling is within a few nodes: a string without a module
+/// ([solver] linear_solver = "auto" or "banded"); else by KLU (klu_refactor between steps; Eigen's
+/// SparseLU when built without KLU), which "klu" asks for everywhere. The ledgers (W_applied, a module's)
 /// enter no right-hand side: their Newton rows are taken as identity. What the linearisation
 /// leaves out: velocity-dependent forces (drag), the derivative of the applied forces, and a front
 /// module's masses and loads: implicit methods use the linearisation as the preconditioner of GMRES,
@@ -28,8 +32,11 @@
 #include <Eigen/Core>
 #include <Eigen/SparseCore>
 
+#include "tension_system.hpp"
+
 namespace chainsim {
 
+class BandedLU;
 template <int dim>
 class StringModel;
 
@@ -55,6 +62,13 @@ class StringJacobian {
   void factor(double gamma);
   /// z = (I − γ J)⁻¹ r (ledger components: z = r) with the γ of the last factor().
   void solve(const Eigen::Ref<const Eigen::VectorXd>& r, Eigen::Ref<Eigen::VectorXd> z) const;
+  /// The augmented matrix of the last factor(), dense, in the unknowns (zv, w) (for tests).
+  Eigen::MatrixXd augmented_matrix() const;
+  /// True if the last linearize() chose the band LU (else KLU).
+  bool banded() const { return banded_; }
+  /// The band LU's sub- and super-diagonals in the string's order (0 when KLU factors).
+  int lower_bandwidth() const;
+  int upper_bandwidth() const;
 
   int velocity_unknowns() const { return nv_; }
   int tension_unknowns() const { return nt_; }
@@ -64,11 +78,30 @@ class StringJacobian {
   StringModel<dim>& model_;
   int nv_ = 0, nt_ = 0;  // dim · free nodes; tension unknowns
   SpMat P_, Qx_, Qv_, WGt_;
-  std::vector<double> a_values_;  // A, in the tension system's pattern (a_factor_->pattern)
+  std::vector<double> a_values_;  // A, in the tension system's pattern (a_pattern_)
+  SparsePattern a_pattern_;
   double gamma_ = 0;
   bool exact_ = false;
   struct Factor;
-  std::unique_ptr<Factor> factor_, a_factor_;  // the augmented system; A alone (for apply)
+  std::unique_ptr<Factor> factor_, a_factor_;  // the augmented system (KLU); A alone (for apply)
+  mutable bool a_factored_ = false;             // a_factor_ holds this linearisation's A (factored at apply())
+  bool banded_ = false;
+  std::unique_ptr<BandedLU> band_;              // the augmented system, banded
+  /// Calls emit(row, col, value) for every entry of the augmented matrix of γ (duplicates summed).
+  template <class Emit>
+  void for_each_entry(double gamma, Emit&& emit) const;
+  /// The string order of the augmented unknowns and its bandwidths, into band_ (linearize()).
+  void order_along_string();
+  std::vector<int> ordered_slots_, ordered_links_;  // the layout band_ was ordered for
+  std::vector<double*> band_entries_;                // band_'s storage of each entry of for_each_entry
+  /// The entries' (row, column) sequence of a block and the slot of each in its compressed values.
+  struct Slots {
+    std::vector<int> rows, cols, slot;
+  };
+  Slots slots_[4];  // P, Qx, Qv, W Gᵀ
+  /// out = the (rows × cols) matrix of `entries` (duplicates summed): only the values when the
+  /// sequence of (row, column) is that of the last call, else the pattern anew (returns true).
+  static bool assemble(SpMat& out, int rows, int cols, const std::vector<Eigen::Triplet<double>>& entries, Slots& s);
   std::vector<Eigen::Triplet<double>> entries_;  // the augmented system's assembly (kept: no reallocation)
   mutable Eigen::VectorXd work_;                 // the augmented right-hand side and solution of solve()
 };

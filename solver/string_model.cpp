@@ -48,6 +48,9 @@ void StringModelOptions::validate() const {
   require_in_range("solver.stabilization_time", stabilization_time, 0.0, INFINITY);
   require_in_range("solver.slack_tolerance", slack_tolerance, 0.0, 1.0);
   if (backend != "auto") make_tension_backend(backend);  // throws InputError for an unknown name
+  if (linear_solver != "auto" && linear_solver != "banded" && linear_solver != "klu")
+    throw InputError(fmt::format("solver.linear_solver = \"{}\" is not allowed; valid values: \"auto\", \"banded\", \"klu\"",
+                                 linear_solver));
   if (elements != "links" && elements != "quadratic")
     throw InputError(fmt::format("string.elements = \"{}\" is not allowed; valid values: \"links\", \"quadratic\"",
                                  elements));

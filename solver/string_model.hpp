@@ -73,6 +73,10 @@ struct StringModelOptions {
   double stabilization_time = defaults::kLibraryStabilizationTime;
   /// Tension solver: "auto", "tridiagonal", "klu" or "eigen" (tension_system.hpp).
   std::string backend = defaults::kBackend;
+  /// The factorisation of the implicit methods' Newton systems (string_jacobian.hpp): "banded" (a band
+  /// LU in the order along the string, O(N)), "klu" (sparse LU), or "auto": banded for a string
+  /// without a module (fronts), KLU with one.
+  std::string linear_solver = defaults::kLinearSolver;
   /// Slack (negative tension) at accepted steps: stop, warn or ignore (StringSolver).
   SlackPolicy slack = defaults::kLibrarySlack;
   /// Slack means T_j < −slack_tolerance · max_k |T_k| (relative, so round-off is not slack).

@@ -11,7 +11,7 @@ namespace chainsim::scene_parse {
 void parse_solver(const Section& top, Context& ctx) {
   auto& so = ctx.spec.solver;
   Section s(subtable(top, "solver"), "solver", ctx,
-            {"method", "rtol", "atol", "max_step", "initial_step", "max_steps", "stabilization_time", "backend",
+            {"method", "rtol", "atol", "max_step", "initial_step", "max_steps", "stabilization_time", "backend", "linear_solver",
              "check_slack", "slack_tolerance", "slack", "max_wall_s"},
             {{"t_end", "in [stop]"}, {"output_interval", "as interval in [output]"}, {"vtk", "as formats in [output]"}});
   // Each value is checked by the option struct that owns its range, one field at a time.
@@ -52,6 +52,7 @@ void parse_solver(const Section& top, Context& ctx) {
     model("stabilization_time", [&](StringModelOptions& o) { o.stabilization_time = *so.stabilization_time; });
   so.backend = s.string("backend").value_or(so.backend);
   model("backend", [&](StringModelOptions& o) { o.backend = so.backend; });
+  so.linear_solver = s.choice("linear_solver", {"auto", "banded", "klu"}, so.linear_solver);
   const std::optional<bool> check_slack = s.boolean("check_slack");
   so.slack = s.choice("slack", {"stop", "warn", "ignore"}, so.slack);
   if (s.has("check_slack") && s.has("slack"))

@@ -24,6 +24,7 @@
 ///     [[effects.heap]] side = start | end, s0 (m), f, point (m), on_plane, pot
 ///     [effects.fold]   s0 (m), f          [effects.plane] point (m), normal (the table of a heap)
 ///     [solver]   method, rtol, atol, max_step, initial_step, max_steps, stabilization_time, backend,
+///                linear_solver = auto | banded | klu,
 ///                slack = stop | warn | ignore (check_slack = true | false: its older form),
 ///                slack_tolerance, max_wall_s (s)
 ///     [output]   interval (s), fields = [nodes, tension, energy, stats], formats = [csv, vtk]
@@ -156,6 +157,8 @@ struct SceneSpec {
     /// s; default defaults::kSceneStabilizationFraction × t_char (see build_string_scene)
     std::optional<double> stabilization_time;
     std::string backend = defaults::kBackend;
+    /// Newton systems of implicit methods: "auto", "banded" or "klu" (StringModelOptions::linear_solver).
+    std::string linear_solver = defaults::kLinearSolver;
     double slack_tolerance = defaults::kSlackTolerance;
     /// What a slack link (a negative tension at an accepted step) does: "stop" (a numerical failure),
     /// "warn" (reported, the run goes on) or "ignore". The older key check_slack = true / false is

@@ -133,6 +133,7 @@ json scene_to_json(const SceneSpec& spec) {
         {"max_steps", so.max_steps},
         {"stabilization_time", or_null(so.stabilization_time)},
         {"backend", so.backend},
+        {"linear_solver", so.linear_solver},
         {"slack", so.slack},  // check_slack, its older form, is not repeated
         {"slack_tolerance", so.slack_tolerance},
         {"max_wall_s", or_null(so.max_wall_s)}}},

@@ -271,6 +271,7 @@ SceneParts<dim> build_scene_parts(const SceneSpec& spec) {
   StringModelOptions mo;
   mo.stabilization_time = so.stabilization_time.value_or(defaults::kSceneStabilizationFraction * t_char);
   mo.backend = so.backend;
+  mo.linear_solver = so.linear_solver;
   mo.elements = spec.elements;
   mo.slack = so.slack == "warn" ? SlackPolicy::kWarn : so.slack == "ignore" ? SlackPolicy::kIgnore : SlackPolicy::kStop;
   mo.slack_tolerance = so.slack_tolerance;

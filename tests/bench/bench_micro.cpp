@@ -6,6 +6,16 @@
 //                                      and solve, accelerations); counter node_time = time per node
 //   BM_TensionSolve/<backend>/<links>  the factor-and-solve alone of that chain's tension system (the
 //                                      matrix and right-hand side of the state above)
+//   BM_NewtonSetupSolve/<solver>/<links>
+//                                      one Newton set-up and solve of an implicit method on the hanging
+//                                      chain's first mode (tests/problems/string_test_support.hpp,
+//                                      amplitude 1e-5, at rest on the mode shape): StringModel::
+//                                      newton_setup (linearisation and factorisation of the augmented
+//                                      system, γ = 0.01 s) then one newton_solve; solver 0 = banded, 1 = klu
+//   BM_NewtonSolve/<solver>/<links>    one newton_solve alone, with the factorisation above
+//   BM_ImplicitStep/<solver>/<links>   dirk5 (rtol 1e-5, atol 1e-10) over one period of that mode,
+//                                      without the integrator's construction; counters steps and
+//                                      step_time = time per accepted step
 //   BM_FrontCrossing/<nodes>           one heap crossing of the falling chain (cases/scenes/
 //                                      falling_chain.toml, f = 0.5): StringModel::handle_events at the
 //                                      polished root of the first crossing (material moved into the
@@ -22,6 +32,7 @@
 
 #include <benchmark/benchmark.h>
 
+#include "../problems/string_test_support.hpp"
 #include "cases/scene/front_scene.hpp"
 #include "cases/scene/scene.hpp"
 #include "mesh/errors.hpp"
@@ -114,6 +125,70 @@ void BM_TensionSolve(benchmark::State& state) {
   state.SetLabel(kBackends[state.range(0)]);
 }
 
+const char* const kLinearSolvers[] = {"banded", "klu"};
+
+/// The hanging chain's first mode (amplitude 1e-5 of ℓ = 1 m, at rest on the mode shape) with the
+/// Newton solver of state.range(0), and its state.
+std::unique_ptr<StringModel<2>> first_mode_chain(benchmark::State& state) {
+  const double j = boost::math::cyl_bessel_j_zero(0.0, 1);
+  auto model = testing::hanging_chain(
+      static_cast<int>(state.range(1)), 1.0,
+      [&](double sigma) { return 1e-5 * boost::math::cyl_bessel_j(0, j * std::sqrt(std::max(sigma, 0.0))); },
+      0.1 / std::sqrt(testing::kG), 0.0, "links", kLinearSolvers[state.range(0)]);
+  state.SetLabel(kLinearSolvers[state.range(0)]);
+  return model;
+}
+
+void BM_NewtonSetupSolve(benchmark::State& state) {
+  auto model = first_mode_chain(state);
+  const Eigen::VectorXd y = model->state_from_chain();
+  const Eigen::VectorXd r = Eigen::VectorXd::Ones(y.size());
+  Eigen::VectorXd z(y.size());
+  for (auto _ : state) {
+    model->newton_setup(0.0, y, true, 0.01);
+    model->newton_solve(r, z);
+    benchmark::DoNotOptimize(z.data());
+    benchmark::ClobberMemory();
+  }
+}
+
+void BM_NewtonSolve(benchmark::State& state) {
+  auto model = first_mode_chain(state);
+  const Eigen::VectorXd y = model->state_from_chain();
+  const Eigen::VectorXd r = Eigen::VectorXd::Ones(y.size());
+  Eigen::VectorXd z(y.size());
+  model->newton_setup(0.0, y, true, 0.01);
+  for (auto _ : state) {
+    model->newton_solve(r, z);
+    benchmark::DoNotOptimize(z.data());
+    benchmark::ClobberMemory();
+  }
+}
+
+void BM_ImplicitStep(benchmark::State& state) {
+  auto model = first_mode_chain(state);
+  const Eigen::VectorXd y0 = model->state_from_chain();
+  IntegratorOptions io;
+  io.method = "dirk5";
+  io.rtol = 1e-5;
+  io.atol = 1e-10;
+  const double period = 4 * kPi / (boost::math::cyl_bessel_j_zero(0.0, 1) * std::sqrt(testing::kG));
+  long steps = 0;
+  for (auto _ : state) {
+    state.PauseTiming();
+    auto integrator = std::make_unique<Integrator>(*model, 0.0, y0, io);
+    state.ResumeTiming();
+    integrator->advance(period);
+    state.PauseTiming();
+    steps += integrator->stats().steps;
+    integrator.reset();
+    state.ResumeTiming();
+  }
+  state.counters["steps"] = benchmark::Counter(static_cast<double>(steps), benchmark::Counter::kAvgIterations);
+  state.counters["step_time"] =
+      benchmark::Counter(static_cast<double>(steps), benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
+}
+
 /// The falling chain of cases/scenes/falling_chain.toml with `nodes` nodes.
 FrontScene<2> falling_chain(int nodes) {
   const SceneSpec spec = parse_scene(std::string(CHAINSIM_SOURCE_DIR) + "/cases/scenes/falling_chain.toml",
@@ -166,6 +241,9 @@ void BM_FrontCrossing(benchmark::State& state) {
 
 BENCHMARK(BM_StringRhs)->ArgsProduct({{0, 1, 2}, {64, 512, 4096}});
 BENCHMARK(BM_TensionSolve)->ArgsProduct({{0, 1, 2}, {64, 512, 4096}});
+BENCHMARK(BM_NewtonSetupSolve)->ArgsProduct({{0, 1}, {250, 1000, 10000}});
+BENCHMARK(BM_NewtonSolve)->ArgsProduct({{0, 1}, {250, 1000, 10000}});
+BENCHMARK(BM_ImplicitStep)->ArgsProduct({{0, 1}, {250, 1000, 10000}})->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_FrontCrossing)->Arg(101)->Arg(1001);
 
 BENCHMARK_MAIN();

@@ -21,10 +21,12 @@ constexpr double kG = 9.81;
 /// A chain of length `length` hanging from a fixed node 0 at the origin along −y, with `links`
 /// links, density 1, lateral displacement x(s) = shape(σ) (σ = length − s: distance from the free
 /// end), at rest. Gravity (0, −g); optional linear drag; Baumgarte time tau_b; the discretization
-/// (StringModelOptions::elements: "links", or "quadratic" with an even number of links).
+/// (StringModelOptions::elements: "links", or "quadratic" with an even number of links); the
+/// factorisation of implicit methods' Newton systems (StringModelOptions::linear_solver).
 inline std::unique_ptr<StringModel<2>> hanging_chain(int links, double length, const std::function<double(double)>& shape,
                                                      double tau_b, double drag = 0,
-                                                     const std::string& elements = "links") {
+                                                     const std::string& elements = "links",
+                                                     const std::string& linear_solver = "auto") {
   Chain<2> chain = Chain<2>::uniform(1.0, length, links, false);
   for (int i = 0; i <= links; ++i) {
     const double s = length * i / links;
@@ -37,6 +39,7 @@ inline std::unique_ptr<StringModel<2>> hanging_chain(int links, double length, c
   StringModelOptions options;
   options.stabilization_time = tau_b;
   options.elements = elements;
+  options.linear_solver = linear_solver;
   auto model = std::make_unique<StringModel<2>>(std::move(chain), std::move(forces), fixed, options);
   model->make_consistent(0.0);
   return model;
@@ -102,14 +105,15 @@ struct ModeMeasurement {
 /// (u: lateral displacement), as the slope of a least-squares fit of the crossing times. 0 crossings
 /// or 1: omega = 0.
 inline ModeMeasurement measure_mode(int links, int mode, double periods, const IntegratorOptions& options,
-                                    double amplitude, const std::string& elements = "links") {
+                                    double amplitude, const std::string& elements = "links",
+                                    const std::string& linear_solver = "auto") {
   const double length = 1.0;
   const double j = boost::math::cyl_bessel_j_zero(0.0, mode);
   ModeMeasurement out;
   out.exact = 0.5 * j * std::sqrt(kG / length);
   auto phi = [&](double sigma) { return boost::math::cyl_bessel_j(0, j * std::sqrt(std::max(sigma, 0.0) / length)); };
   auto model = hanging_chain(links, length, [&](double sigma) { return amplitude * length * phi(sigma); },
-                             0.1 * std::sqrt(length / kG), 0.0, elements);
+                             0.1 * std::sqrt(length / kG), 0.0, elements, linear_solver);
   const Chain<2>& chain = model->chain();
   // Weights of the modal projection on the free nodes (state order: node 1..n-1).
   Eigen::VectorXd w(chain.num_nodes() - 1);
