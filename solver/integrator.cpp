@@ -370,6 +370,17 @@ struct Integrator::Impl {
     return v;
   }
 
+  /// The same over `data` (not owned, not freed by N_VDestroy): the Integrator's state y_, so that
+  /// ARKODE returns each step's state in place instead of into a vector of its own copied to y_
+  /// (a state's bytes less for the whole run). Its clones (ARKODE's vectors) own their data.
+  N_Vector wrap_vector(Eigen::VectorXd& data) const {
+    N_Vector v = N_VMake_Serial(static_cast<sunindextype>(data.size()), data.data(), ctx);
+    if (!v) throw Error("N_VMake_Serial failed");
+    N_VEnableFusedOps_Serial(v, SUNTRUE);
+    use_eigen_kernels(v);
+    return v;
+  }
+
   static int rhs(sunrealtype t, N_Vector y, N_Vector ydot, void* data) {
     auto* self = static_cast<Impl*>(data);
     const long n = N_VGetLength(y);
@@ -426,8 +437,7 @@ Integrator::Integrator(OdeSystem& system, double t0, const Eigen::VectorXd& y0,
   CHAINSIM_VERIFY(y0.size() == system.size(), "initial state has the wrong length");
   Impl& d = *impl_;
   if (SUNContext_Create(nullptr, &d.ctx) != 0) throw Error("SUNContext_Create failed");
-  d.y = d.new_vector(y0.size());
-  Eigen::Map<Eigen::VectorXd>(N_VGetArrayPointer(d.y), y0.size()) = y0;
+  d.y = d.wrap_vector(y_);  // y_ = y0: ARKODE reads the initial state from it and returns states into it
 
   d.table = table_name(resolve_method(options.method, system, options.rtol));
   ARKodeButcherTable erk = nullptr, dirk = nullptr;
@@ -528,7 +538,7 @@ int Integrator::evolve(double t_target, bool one_step) {
                                      flag_name(flag), d.last_error.empty() ? "" : ": ", d.last_error, diagnosis()),
                          tret);
   t_ = flag == ARK_TSTOP_RETURN ? t_target : tret;
-  y_ = Eigen::Map<Eigen::VectorXd>(N_VGetArrayPointer(d.y), N_VGetLength(d.y));
+  CHAINSIM_VERIFY(N_VGetArrayPointer(d.y) == y_.data(), "ARKODE returns the state in y_");
   return flag;
 }
 
@@ -699,19 +709,19 @@ Eigen::VectorXd Integrator::interpolate(double t, int k) const {
 void Integrator::restart(double t, const Eigen::VectorXd& y) {
   Impl& d = *impl_;
   CHAINSIM_VERIFY(y.size() == N_VGetLength(d.y), "restart() keeps the state length; use resize()");
-  Eigen::Map<Eigen::VectorXd>(N_VGetArrayPointer(d.y), y.size()) = y;
+  y_ = y;  // the same length: the same storage, which d.y wraps
   d.check(ARKStepReset(d.mem, t, d.y), "ARKStepReset");
   d.check(ARKStepSetInitStep(d.mem, d.h_resume), "ARKStepSetInitStep");  // 0: ARKODE's estimate
   d.h_resume = 0;
   t_ = t;
-  y_ = y;
 }
 
 void Integrator::resize(double t, const Eigen::VectorXd& y) {
   Impl& d = *impl_;
   CHAINSIM_VERIFY(y.size() == d.system.size(), "resize() needs the system to report the new size");
-  N_Vector ynew = d.new_vector(y.size());
-  Eigen::Map<Eigen::VectorXd>(N_VGetArrayPointer(ynew), y.size()) = y;
+  Eigen::VectorXd old = y;  // (y may be state() itself)
+  std::swap(old, y_);        // d.y wraps the old state until ARKODE has moved to the new one
+  N_Vector ynew = d.wrap_vector(y_);
   const int flag = ARKStepResize(d.mem, ynew, 1.0, t, nullptr, nullptr);
   N_VDestroy(d.y);
   d.y = ynew;
@@ -721,7 +731,6 @@ void Integrator::resize(double t, const Eigen::VectorXd& y) {
   d.apply_tolerances();
   if (d.implicit) d.attach_linear_solver();
   t_ = t;
-  y_ = y;
 }
 
 double Integrator::last_step() const {

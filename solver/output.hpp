@@ -66,7 +66,11 @@ class CsvWriter {
   std::size_t columns_;
   bool labelled_;
   int digits_;
-  std::string buffer_;  ///< formatted rows not yet written: one write per kFlushBytes
+  /// Formatted rows not yet written (the first used_ bytes): one write per kFlushBytes. The numbers
+  /// are formatted straight into it (fmt::format_to on a char pointer), never through a stream or a
+  /// growing string.
+  std::vector<char> buffer_;
+  std::size_t used_ = 0;
   /// The first column's last value and its text: a frame's time repeats on each of its rows.
   double first_value_ = 0;
   std::string first_text_;

@@ -113,8 +113,11 @@ StringModel<dim>::StringModel(Chain<dim> chain, std::vector<std::unique_ptr<Forc
     quadratic_ = std::make_shared<QuadraticString<dim>>(chain_, prescribed_);
   }
   // 3. Workspace, the state, then slots, masses and the tension system.
-  for (Points<dim>* p : {&a_, &force_, &force_nc_, &module_force_, &tension_force_, &b_, &reaction_})
-    *p = Points<dim>::Zero(dim, n);
+  for (Points<dim>* p : {&a_, &force_, &force_nc_, &tension_force_, &b_}) *p = Points<dim>::Zero(dim, n);
+  // Per node only where they exist: the module's forces with a module, the reactions at the
+  // prescribed nodes (column k for prescribed_[k]): 32 bytes per 2D node less for a plain string.
+  module_force_ = Points<dim>::Zero(dim, module_ ? n : 0);
+  reaction_ = Points<dim>::Zero(dim, static_cast<Eigen::Index>(prescribed_.size()));
   for (Points<dim>* p : {&dx_, &dv_, &e_}) *p = Points<dim>::Zero(dim, L);
   l_ = Eigen::VectorXd::Zero(L);
   x_ = chain_.positions();
@@ -408,11 +411,13 @@ double StringModel<dim>::evaluate_current(double t) {
     } else {
       a_.col(i) = b_.col(i);
       // the support's reaction R_i = m a − F − T − (module force); drag on it is applied work too
-      reaction_.col(i) = (quadratic_ ? Vec<dim>(quadratic_->inertia().col(i)) : Vec<dim>(m_[i] * a_.col(i))) - force_.col(i) - force_nc_.col(i) - tension_force_.col(i) -
-                         module_force_.col(i);
-      power += (reaction_.col(i) + force_nc_.col(i)).dot(v_.col(i));
+      auto reaction = reaction_.col(path_of_[i]);
+      reaction = (quadratic_ ? Vec<dim>(quadratic_->inertia().col(i)) : Vec<dim>(m_[i] * a_.col(i))) - force_.col(i) - force_nc_.col(i) - tension_force_.col(i);
+      if (module_) reaction -= module_force_.col(i);
+      power += (reaction + force_nc_.col(i)).dot(v_.col(i));
     }
-    if (module_) external_ += force_.col(i) + force_nc_.col(i) + reaction_.col(i);
+    if (module_)
+      external_ += force_.col(i) + force_nc_.col(i) + (path_of_[i] >= 0 ? Vec<dim>(reaction_.col(path_of_[i])) : Vec<dim>::Zero());
   }
   return power;
 }
@@ -605,7 +610,7 @@ Vec<dim> StringModel<dim>::momentum() const {
 template <int dim>
 Vec<dim> StringModel<dim>::support_reaction() const {
   Vec<dim> r = Vec<dim>::Zero();
-  for (const auto& p : prescribed_) r += reaction_.col(p.node);
+  for (Eigen::Index k = 0; k < reaction_.cols(); ++k) r += reaction_.col(k);
   return r;
 }
 
@@ -627,7 +632,6 @@ typename StringModel<dim>::Snapshot StringModel<dim>::snapshot(double t, const E
   s.power = evaluate_current(t);
   s.x = x_;
   s.v = v_;
-  s.a = a_;
   s.tension = Eigen::VectorXd::Constant(chain_.num_links(), std::numeric_limits<double>::quiet_NaN());
   if (quadratic_) {
     s.tension = quadratic_->link_tensions();
@@ -655,7 +659,7 @@ typename StringModel<dim>::Snapshot StringModel<dim>::snapshot(double t, const E
   }
   s.support = support_reaction();
   for (const auto& p : prescribed_) {
-    s.end_reactions.push_back(reaction_.col(p.node));
+    s.end_reactions.push_back(reaction_.col(path_of_[static_cast<std::size_t>(p.node)]));
     double T = std::numeric_limits<double>::quiet_NaN();
     for_each_link([&](int j, int, int) {
       if (chain_.link_start(j) == p.node || chain_.link_end(j) == p.node) T = s.tension[j];

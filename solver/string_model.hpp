@@ -152,7 +152,8 @@ class StringModel final : public OdeSystem {
   /// Everything at one state (one tension solve).
   struct Snapshot : ModuleLedger<dim> {
     double t = 0;
-    Points<dim> x, v, a;            ///< positions, velocities, accelerations of all nodes
+    Points<dim> x, v;               ///< positions and velocities of all nodes (the accelerations:
+                                    ///< accelerations(), set by the snapshot's evaluation)
     Eigen::VectorXd tension;        ///< T_j (N) of every link; NaN for a link in no arc
     double kinetic = 0;             ///< K (J)
     double potential = 0;           ///< V (J)

@@ -585,7 +585,8 @@ void StringSolver<dim>::write_outputs(const std::filesystem::path& dir, const Ou
   };
   std::future<void> frames_written;
   if (select.vtk) frames_written = std::async(std::launch::async, write_frames);
-  // 3. CSV files, streamed from the frames (a row at a time: nothing but the frames in memory).
+  // 3. CSV files, streamed from the frames (a row at a time: nothing but the frames in memory);
+  //    nodes.csv on a third thread.
   if (select.csv) {
     const char* axes[] = {"x", "y", "z"};
     std::vector<std::string> columns = {"t", "node"};
@@ -593,18 +594,23 @@ void StringSolver<dim>::write_outputs(const std::filesystem::path& dir, const Ou
     for (int d = 0; d < dim; ++d) columns.emplace_back(axes[d]);
     for (int d = 0; d < dim; ++d) columns.push_back(std::string("v") + axes[d]);
     std::vector<double> row;
-    if (select.nodes) {
+    // nodes.csv, the largest file (half the numbers), on a thread of its own while this one writes
+    // the others: the CSV files cost the longer of the two, not their sum.
+    auto write_nodes = [&]() {
       CsvWriter nodes(dir / "nodes.csv", columns);
+      std::vector<double> node_row;
       for (const auto& f : frames_)
         for (int i : f.moving) {
-          row = {f.t, static_cast<double>(i)};
-          if (fronts) row.push_back(chain.node_coordinate(i));
-          for (int d = 0; d < dim; ++d) row.push_back(f.x(d, i));
-          for (int d = 0; d < dim; ++d) row.push_back(f.v(d, i));
-          nodes.row(row);
+          node_row = {f.t, static_cast<double>(i)};
+          if (fronts) node_row.push_back(chain.node_coordinate(i));
+          for (int d = 0; d < dim; ++d) node_row.push_back(f.x(d, i));
+          for (int d = 0; d < dim; ++d) node_row.push_back(f.v(d, i));
+          nodes.row(node_row);
         }
       nodes.commit();
-    }
+    };
+    std::future<void> nodes_written;  // after what it reads: an error below waits for it, then frees them
+    if (select.nodes) nodes_written = std::async(std::launch::async, write_nodes);
     if (select.tension) {
       CsvWriter tension(dir / "tension.csv", {"t", "link", "s_mid", "T"});
       for (const auto& f : frames_)
@@ -638,6 +644,7 @@ void StringSolver<dim>::write_outputs(const std::filesystem::path& dir, const Ou
       }
       forces.commit();
     }
+    if (nodes_written.valid()) nodes_written.get();  // rethrows its error, if any
   }
   if (frames_written.valid()) frames_written.get();  // rethrows the frames' error, if any
   // 4. stats.json, last.

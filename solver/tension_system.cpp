@@ -60,12 +60,15 @@ class TridiagonalBackend final : public TensionBackend {
       throw InputError(
           "the tridiagonal tension backend solves arcs only; this system has entries coupling arcs: "
           "use backend = \"klu\" or \"eigen\"");
-    const int max_links = arcs.empty() ? 0 : std::max_element(arcs.begin(), arcs.end(), [](auto& a, auto& b) {
-                                               return a.num_links < b.num_links;
-                                             })->num_links;
-    cp_.resize(static_cast<std::size_t>(max_links));
-    z_.resize(static_cast<std::size_t>(max_links));
-    bb_.resize(static_cast<std::size_t>(max_links));
+    // Workspace for the longest arc; the cyclic solve's two vectors only for the closed arcs.
+    std::size_t max_links = 0, max_closed = 0;
+    for (const ArcBlock& arc : arcs) {
+      max_links = std::max(max_links, static_cast<std::size_t>(arc.num_links));
+      if (arc.closed && arc.num_links >= 3) max_closed = std::max(max_closed, static_cast<std::size_t>(arc.num_links));
+    }
+    cp_.resize(max_links);
+    z_.resize(max_closed);
+    bb_.resize(max_closed);
   }
 
   SolveStatus factor_solve(const double* values, double* rhs) override {
@@ -374,6 +377,7 @@ TensionSystem::TensionSystem(const std::vector<int>& arc_links, const std::vecto
   entries.erase(std::unique(entries.begin(), entries.end()), entries.end());
   pattern_.n = n;
   pattern_.col_ptr.assign(static_cast<std::size_t>(n) + 1, 0);
+  pattern_.row_index.reserve(entries.size());  // exactly: not grown by doubling (up to 4 bytes per entry spare)
   for (auto [r, c] : entries) {
     ++pattern_.col_ptr[static_cast<std::size_t>(c) + 1];
     pattern_.row_index.push_back(r);

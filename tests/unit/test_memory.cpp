@@ -90,9 +90,14 @@ TEST_CASE("peak memory per node stays within a bound of the explicit integrator'
     INFO(method << " (" << large.method << ", " << stages << " stages): " << per_node
                 << " bytes per node, integrator's vectors " << integrator_per_node << " -> ratio "
                 << per_node / integrator_per_node);
-    // Measured 1.71 (erk4) and 1.57 (erk8); the issue's target is 1.5 (not reached: the string model's
-    // twelve workspace arrays, 192 bytes per node, are the largest rest; docs/stability.md).
-    CHECK(per_node <= 1.75 * integrator_per_node);
+    // Measured 1.535 (erk4) and 1.446 (erk8), 1.71 and 1.57 before ARKODE returned its state into
+    // the Integrator's own (no second copy), the string kept the module's forces and the supports'
+    // reactions only where they exist, the snapshot stopped copying the accelerations and the
+    // tridiagonal tension backend its cyclic workspace for open strings (docs/stability.md). The
+    // issue's target, 1.5, holds for erk8; erk4 (fewer stages, so the string's own arrays weigh more)
+    // is bounded at 1.6.
+    const double bound = method == "erk8" ? 1.5 : 1.6;
+    CHECK(per_node <= bound * integrator_per_node);
   }
 #endif
 }

@@ -5,7 +5,10 @@
 #include <filesystem>
 #include <fstream>
 #include <cmath>
+#include <cstdlib>
+#include <cstring>
 #include <iterator>
+#include <random>
 #include <set>
 #include <string>
 
@@ -152,6 +155,51 @@ TEST_CASE("JSON text replaces bytes that are not UTF-8 instead of failing", "[un
   CHECK(nlohmann::json::parse(text)["out"] == "d\xef\xbf\xbd");
 }
 
+TEST_CASE("CSV numbers over the whole double range are fmt's shortest text and read back exactly", "[unit][output]") {
+  // The writer lays out the shortest digits itself (fmt's "{}" rules): every finite double, random bit
+  // patterns and the edges of fmt's switch between plain and exponent notation (1e-5, 1e16), must give
+  // fmt::format("{}")'s text, and that text must read back (strtod) to the same bits.
+  std::vector<double> values;
+  std::mt19937_64 random(20261126);
+  for (int k = 0; k < 60000; ++k) {
+    std::uint64_t bits = random();
+    double v = 0;
+    std::memcpy(&v, &bits, sizeof v);
+    if (std::isfinite(v)) values.push_back(v);
+  }
+  std::uniform_real_distribution<double> unit(-1.0, 1.0);
+  for (int k = 0; k < 40000; ++k) values.push_back(unit(random) * std::pow(10.0, (k % 44) - 22));  // typical sizes
+  for (const double edge : {1e-5, 1e-4, 1e15, 1e16, 1e17, 1e100, 1e-100, 1e300, 1e-300, 0.1, 123.456, 5e-324,
+                            1.7976931348623157e308, 9007199254740993.0, 1e15 + 0.5, 0.000123456789012345})
+    for (const double v : {edge, std::nextafter(edge, 0.0), std::nextafter(edge, 1e308)})
+      for (const double signed_v : {v, -v}) values.push_back(signed_v);
+  const auto dir = temp_dir("csv_number_range");
+  const auto path = dir / "range.csv";
+  std::string expected = "t,a\n";
+  {
+    CsvWriter csv(path, {"t", "a"});
+    for (const double v : values) {
+      csv.row({0.0, v});  // the second column: the writer's general path
+      expected += "0," + fmt::format("{}", v) + "\n";
+    }
+    csv.commit();
+  }
+  std::ifstream in(path, std::ios::binary);
+  const std::string written((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  REQUIRE(written.size() == expected.size());
+  CHECK(written == expected);
+  // Read back: every value's text gives its bits.
+  std::size_t at = written.find('\n') + 1, bad = 0;  // the first row
+  for (const double v : values) {
+    at += 2;  // past "0,": the row's second column
+    const std::size_t line_end = written.find('\n', at);
+    const double back = std::strtod(written.substr(at, line_end - at).c_str(), nullptr);
+    if (std::memcmp(&back, &v, sizeof v) != 0) ++bad;
+    at = line_end + 1;
+  }
+  CHECK(bad == 0);
+}
+
 TEST_CASE("CSV numbers are written as fmt's shortest text, whatever path formats them", "[unit][output]") {
   // The writer formats integers and a repeated first column by faster paths: the text must stay the
   // one fmt::format("{}") (or "{:.Ng}") gives, byte for byte, across the rows and a buffer flush.
@@ -161,7 +209,7 @@ TEST_CASE("CSV numbers are written as fmt's shortest text, whatever path formats
                                 1e-5, 1e-4, 6.02214076e23, std::nan(""), INFINITY, -INFINITY, 4503599627370496.5,
                                 9007199254740993.0, -123.0};
   const std::size_t rows = 3 * CsvWriter::kFlushBytes / (values.size() * 8) + 7;  // past a few flushes
-  for (const int digits : {0, 6}) {
+  for (const int digits : {0, 6, 17, 40}) {
     const auto path = dir / fmt::format("numbers_{}.csv", digits);
     std::string expected = "t,a,b\n";
     {
