@@ -352,7 +352,8 @@ void StringSolver<dim>::record_sample(double t, const Eigen::VectorXd& y) {
 template <int dim>
 void StringSolver<dim>::check_slack(double t, const Eigen::VectorXd& y) {
   const SlackPolicy policy = model_.options().slack;
-  if (policy == SlackPolicy::kIgnore || (policy == SlackPolicy::kWarn && summary_.slack)) return;
+  if (policy == SlackPolicy::kIgnore || policy == SlackPolicy::kAllow || (policy == SlackPolicy::kWarn && summary_.slack))
+    return;
   const std::optional<SlackReport> slack = model_.find_slack(t, y);
   if (!slack) return;
   summary_.slack = slack;
@@ -414,6 +415,7 @@ const RunSummary& StringSolver<dim>::run() {
       summary_.max_constraint_violation =
           std::max(summary_.max_constraint_violation, model_.max_constraint_violation(t, y));
       check_slack(t, y);
+      model_.accept_step(t, y);  // slack = allow: the links released at this step go slack
       if (on_step) on_step(t, y);
       if (options_.record_steps) record_sample(t, y);
     };
