@@ -817,6 +817,22 @@ double StringModel<dim>::slack_gap() const {
 template <int dim>
 void StringModel<dim>::accept_step(double t, const Eigen::Ref<const Eigen::VectorXd>& y) {
   if (!allows_slack() || !system_) return;
+  if (num_slack_ > 0) {
+    // A slack link past its length at an accepted step is a snap the root function missed: refuse to
+    // go on with a string longer than its material (the one root function would stay negative).
+    unpack_state(t, y);
+    for (int j = 0; j < chain_.num_links(); ++j) {
+      if (!link_slack(j)) continue;
+      const double h = chain_.link_length(j);
+      const double gap = (h - (x_.col(chain_.link_end(j)) - x_.col(chain_.link_start(j))).norm()) / h +
+                         slack_offset_[static_cast<std::size_t>(j)];
+      if (gap < -kSlackGap)
+        throw NumericalError(fmt::format("at t = {:.9g} s slack link {} (s = {:.6g} m) is {:.3g} of its length past "
+                                         "it: its snap taut was not located",
+                                         t, j, chain_.link_midpoint(j), -gap),
+                             t);
+    }
+  }
   const long calls = system_->complementarity_stats().calls_with_release;
   if (calls == released_calls_) return;  // no evaluation since the last accepted step released a link
   unpack_state(t, y);
@@ -840,7 +856,24 @@ typename StringModel<dim>::SnapResult StringModel<dim>::snap(double t) {
       set_slack(j, false);
       ++result.caught;
     }
-  if (result.caught == 0) return result;
+  if (result.caught == 0) {
+    // The root was located on ARKODE's interpolant; the state of the step recomputed to the event
+    // differs from it by the integration error, so the link may be a little short of its length:
+    // catch the nearest slack link if it is within kSnapWindow plus that error (kCatchWindow).
+    int nearest = -1;
+    double nearest_gap = INFINITY;
+    for (int j = 0; j < L; ++j) {
+      if (!link_slack(j)) continue;
+      const double gap = (chain_.link_length(j) - l_[j]) / chain_.link_length(j) + slack_offset_[static_cast<std::size_t>(j)];
+      if (gap < nearest_gap) {
+        nearest_gap = gap;
+        nearest = j;
+      }
+    }
+    if (nearest < 0 || !(nearest_gap < kCatchWindow)) return result;
+    set_slack(nearest, false);
+    ++result.caught;
+  }
   // 2. The impulse problem on the taut links: w = −(1 + e) u⁻ − A P ≥ 0, P ≥ 0, P w = 0 (the
   //    tension matrix A: a link's rate of lengthening changes by (A P)_j).
   const double e = options_.snap_restitution;
@@ -875,9 +908,12 @@ typename StringModel<dim>::SnapResult StringModel<dim>::snap(double t) {
   for_each_link([&](int j, int u, int) {
     const double u_after = e_.col(j).dot(dv_.col(j));
     result.dissipated += 0.5 * P[u] * (u_before[j] + u_after);
-    if (!link_slack(j) && u_after < -kSlackGap * u_scale) {
+    if (!link_slack(j) && u_after < -kSeparation * u_scale) {
       set_slack(j, true);
-      slack_offset_[static_cast<std::size_t>(j)] = std::max(0.0, (l_[j] - chain_.link_length(j)) / chain_.link_length(j));
+      // Its root function starts at +kSlackGap, never at zero: ARKODE deactivates a root function that
+      // is zero at a restart, and would miss the link's return to its length if it came at once.
+      slack_offset_[static_cast<std::size_t>(j)] =
+          std::max(0.0, (l_[j] - chain_.link_length(j)) / chain_.link_length(j)) + kSlackGap;
     }
   });
   return result;

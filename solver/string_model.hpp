@@ -222,8 +222,17 @@ class StringModel final : public OdeSystem {
   /// that are shorter than (1 − kSlackGap) h_j and shortening become slack (one tension solve, only
   /// after steps whose evaluations released a link).
   void accept_step(double t, const Eigen::Ref<const Eigen::VectorXd>& y);
-  static constexpr double kSlackGap = 1e-9;
-  static constexpr double kSnapWindow = 1e-10;
+  /// A released link goes slack once shorter than (1 − kSlackGap) h; a link that goes slack at a snap
+  /// starts with its root function at +kSlackGap.
+  static constexpr double kSlackGap = 2e-7;
+  /// At a snap the slack links within kSnapWindow of their length are caught; if none is (the state
+  /// recomputed to the event is a little short of the located root), the nearest one within
+  /// kCatchWindow.
+  static constexpr double kSnapWindow = 1e-7;
+  static constexpr double kCatchWindow = 1e-5;
+  /// After a snap, a taut link goes slack when it separates faster than this share of the largest
+  /// approach speed of the snap (slower, it stays taut and the tension solve releases it if it must).
+  static constexpr double kSeparation = 1e-6;
 
   // --- access -------------------------------------------------------------------------------
   const Chain<dim>& chain() const { return chain_; }

@@ -412,10 +412,10 @@ const RunSummary& StringSolver<dim>::run() {
     auto output_time = [&](long k) { return std::min(options_.t_end, k * options_.output_interval); };
     // At every accepted step: the constraints, slack, the caller's hook and the step record.
     auto after_step = [&](double t, const Eigen::VectorXd& y) {
+      model_.accept_step(t, y);  // slack = allow: the links released at this step go slack
       summary_.max_constraint_violation =
           std::max(summary_.max_constraint_violation, model_.max_constraint_violation(t, y));
       check_slack(t, y);
-      model_.accept_step(t, y);  // slack = allow: the links released at this step go slack
       if (on_step) on_step(t, y);
       if (options_.record_steps) record_sample(t, y);
     };
