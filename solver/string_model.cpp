@@ -817,32 +817,23 @@ double StringModel<dim>::slack_gap() const {
 template <int dim>
 void StringModel<dim>::accept_step(double t, const Eigen::Ref<const Eigen::VectorXd>& y) {
   if (!allows_slack() || !system_) return;
-  if (num_slack_ > 0) {
-    // A slack link past its length at an accepted step is a snap the root function missed: refuse to
-    // go on with a string longer than its material (the one root function would stay negative).
-    unpack_state(t, y);
-    for (int j = 0; j < chain_.num_links(); ++j) {
-      if (!link_slack(j)) continue;
-      const double h = chain_.link_length(j);
-      const double gap = (h - (x_.col(chain_.link_end(j)) - x_.col(chain_.link_start(j))).norm()) / h +
-                         slack_offset_[static_cast<std::size_t>(j)];
-      if (gap < -kSlackGap)
-        throw NumericalError(fmt::format("at t = {:.9g} s slack link {} (s = {:.6g} m) is {:.3g} of its length past "
-                                         "it: its snap taut was not located",
-                                         t, j, chain_.link_midpoint(j), -gap),
-                             t);
+  // A taut link shorter than (1 − kSlackGap) h is slack: the tension solve released it during the step
+  // (a taut link's length is held to the integration tolerance, far below kSlackGap). A slack link past
+  // its length is a snap the root function missed: refuse to go on with a string longer than its
+  // material (the one root function would stay negative). O(N), no tension solve.
+  unpack_state(t, y);
+  for (int j = 0; j < chain_.num_links(); ++j) {
+    const double h = chain_.link_length(j);
+    const double gap = (h - (x_.col(chain_.link_end(j)) - x_.col(chain_.link_start(j))).norm()) / h;
+    if (!link_slack(j)) {
+      if (gap > kSlackGap) set_slack(j, true);
+    } else if (gap + slack_offset_[static_cast<std::size_t>(j)] < -kSlackGap) {
+      throw NumericalError(fmt::format("at t = {:.9g} s slack link {} (s = {:.6g} m) is {:.3g} of its length past it: "
+                                       "its snap taut was not located",
+                                       t, j, chain_.link_midpoint(j), -(gap + slack_offset_[static_cast<std::size_t>(j)])),
+                           t);
     }
   }
-  const long calls = system_->complementarity_stats().calls_with_release;
-  if (calls == released_calls_) return;  // no evaluation since the last accepted step released a link
-  unpack_state(t, y);
-  evaluate_current(t);
-  released_calls_ = system_->complementarity_stats().calls_with_release;
-  for_each_link([&](int j, int u, int) {
-    if (link_slack(j) || !system_->excluded(u)) return;
-    const double h = chain_.link_length(j);
-    if (l_[j] < (1 - kSlackGap) * h && e_.col(j).dot(dv_.col(j)) < 0) set_slack(j, true);
-  });
 }
 
 template <int dim>

@@ -218,9 +218,9 @@ class StringModel final : public OdeSystem {
   /// solve the complementarity problem u⁺ = u⁻ + A P ≤ −e u⁻, P (u⁺ + e u⁻) = 0 (u: rate of
   /// lengthening); the velocities jump, and links that separate afterwards go slack.
   SnapResult snap(double t);
-  /// At an accepted step (t, y): the taut links the complementarity problem released (T = 0) and
-  /// that are shorter than (1 − kSlackGap) h_j and shortening become slack (one tension solve, only
-  /// after steps whose evaluations released a link).
+  /// At an accepted step (t, y): the taut links shorter than (1 − kSlackGap) h_j (released by the
+  /// complementarity problem during the step) become slack; a slack link past its length (a snap not
+  /// located) throws NumericalError. O(N), no tension solve.
   void accept_step(double t, const Eigen::Ref<const Eigen::VectorXd>& y);
   /// A released link goes slack once shorter than (1 − kSlackGap) h; a link that goes slack at a snap
   /// starts with its root function at +kSlackGap.
@@ -392,7 +392,6 @@ class StringModel final : public OdeSystem {
   std::vector<char> slack_;            // per link: slack (slack = allow)
   std::vector<double> slack_offset_;   // per link: its root function's offset
   int num_slack_ = 0;
-  long released_calls_ = 0;            // complementarity solves that released a link, at the last accept_step
 };
 
 template <int dim>
