@@ -392,3 +392,13 @@ TEST_CASE("slack: the swinging U converges under mesh refinement at t = 1 s", "[
   for (std::size_t k = 1; k < differences.size(); ++k) CHECK(differences[k] < differences[k - 1]);
   CHECK(differences.back() < 0.01);
 }
+
+TEST_CASE("slack: allow is refused with fronts and with quadratic elements, located at the key", "[slack]") {
+  const std::filesystem::path scenes = std::filesystem::path(CHAINSIM_SOURCE_DIR) / "cases" / "scenes";
+  const SceneSpec folded = parse_scene(scenes / "folded_chain.toml", {"solver.slack=allow"});
+  CHECK_THROWS_WITH(build_string_scene<2>(folded),
+                    Catch::Matchers::Contains("solver.slack = \"allow\" does not meet fronts (heaps, folds) yet"));
+  const SceneSpec quadratic =
+      parse_scene(scenes / "swinging_u.toml", {"string.elements=quadratic", "string.nodes=101"});
+  CHECK_THROWS_WITH(build_string_scene<2>(quadratic), Catch::Matchers::Contains("needs link elements"));
+}
