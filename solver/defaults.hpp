@@ -9,8 +9,9 @@ namespace chainsim {
 
 /// What a run does when the tension goes negative beyond round-off (slack: an inextensible string
 /// cannot push, so the model no longer applies): stop with a NumericalError, record the first
-/// occurrence and go on, or not check at all.
-enum class SlackPolicy { kStop, kWarn, kIgnore };
+/// occurrence and go on, or not check at all; or allow it: links are unilateral, a slack link flies
+/// freely and snaps taut with an impulse (docs/model.md "Slack and snap-taut").
+enum class SlackPolicy { kStop, kWarn, kIgnore, kAllow };
 
 namespace defaults {
 

@@ -122,6 +122,8 @@ void IntegratorOptions::validate_method() const {
   if (!(method == "auto" || listed(table, kErkTables) || listed(table, kDirkTables))) throw unknown_method(method);
 }
 
+bool IntegratorOptions::implicit_method() const { return listed(table_name(method), kDirkTables); }
+
 void IntegratorOptions::validate_numbers() const {
   require_in_range("rtol", rtol, 1e-14, 1e-2);
   // atol is relative to the state scale: above 1e-2 a component may err by more than 1% of its natural

@@ -101,6 +101,8 @@ struct IntegratorOptions {
   void validate() const;
   /// `method` names a known method (an alias, "auto" or an ARKODE_* table): throws InputError.
   void validate_method() const;
+  /// The method is an implicit (DIRK) table or alias ("auto" is not: with root functions it is explicit).
+  bool implicit_method() const;
   /// The tolerances, step limits and budgets: throws InputError naming the field.
   void validate_numbers() const;
 };

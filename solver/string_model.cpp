@@ -9,6 +9,7 @@
 
 #include "mesh/errors.hpp"
 #include "quadratic_string.hpp"
+#include "slack_module.hpp"
 
 namespace chainsim {
 
@@ -31,6 +32,7 @@ const char* to_string(SlackPolicy policy) {
   switch (policy) {
     case SlackPolicy::kStop: return "stop";
     case SlackPolicy::kWarn: return "warn";
+    case SlackPolicy::kAllow: return "allow";
     case SlackPolicy::kIgnore: break;
   }
   return "ignore";
@@ -47,6 +49,7 @@ std::string SlackReport::message() const {
 void StringModelOptions::validate() const {
   require_in_range("solver.stabilization_time", stabilization_time, 0.0, INFINITY);
   require_in_range("solver.slack_tolerance", slack_tolerance, 0.0, 1.0);
+  require_in_range("solver.snap_restitution", snap_restitution, 0.0, 1.0);
   if (backend != "auto") make_tension_backend(backend);  // throws InputError for an unknown name
   if (linear_solver != "auto" && linear_solver != "banded" && linear_solver != "klu")
     throw InputError(fmt::format("solver.linear_solver = \"{}\" is not allowed; valid values: \"auto\", \"banded\", \"klu\"",
@@ -67,6 +70,18 @@ StringModel<dim>::StringModel(Chain<dim> chain, std::vector<std::unique_ptr<Forc
       module_(std::move(module)) {
   options_.validate();
   const int n = chain_.num_nodes(), L = chain_.num_links();
+  if (allows_slack()) {
+    // Unilateral links: a module of their own (the snap root function, W_snap, the momentum ledger).
+    if (module_)
+      throw InputError("solver.slack = \"allow\" does not meet fronts (heaps, folds) yet: a scene with fronts takes "
+                       "slack = \"stop\", \"warn\" or \"ignore\"");
+    if (options_.elements == "quadratic")
+      throw InputError("solver.slack = \"allow\" needs link elements: string.elements = \"quadratic\" has no "
+                       "tension per link to release");
+    module_ = make_slack_module<dim>();
+    slack_.assign(static_cast<std::size_t>(L), 0);
+    slack_offset_.assign(static_cast<std::size_t>(L), 0.0);
+  }
   // 1. The arcs: the whole string, or the module's layout.
   if (module_) {
     arcs_ = module_->initial_arcs(chain_);
@@ -231,6 +246,7 @@ void StringModel<dim>::links() {
 template <int dim>
 void StringModel<dim>::bend_link(int link, const Vec<dim>& point) {
   if (quadratic_) throw InputError("a link bent over a point (an edge) needs link elements ([string] elements = \"links\")");
+  if (allows_slack()) throw InputError("a link bent over a point (an edge) does not meet solver.slack = \"allow\"");
   if (link < 0 || link >= chain_.num_links()) throw InputError(fmt::format("bend_link: no link {}", link));
   for (Bend& b : bends_)
     if (b.link == link) {
@@ -390,7 +406,7 @@ double StringModel<dim>::evaluate_current(double t) {
       system_->rhs(u) = -va.squaredNorm() / bend.l_minus - vb.squaredNorm() / bend.l_plus -
                         (ep.dot(b_.col(b)) - em.dot(b_.col(a))) - stab;
     }
-    const Eigen::VectorXd& T = system_->solve(t);
+    const Eigen::VectorXd& T = solve_tensions(t);
     for_each_link([&](int j, int u, int) {
       tension_force_.col(chain_.link_start(j)) += T[u] * e_.col(j);
       tension_force_.col(chain_.link_end(j)) -= T[u] * e_.col(j);
@@ -472,17 +488,7 @@ void StringModel<dim>::project(double t) {
   if (quadratic_) return quadratic_->project(t, x_, v_);
   // Newton's method for g_j(x) = |Δx_j| − h_j = 0 along δx = W Gᵀ ν: the matrix is the tension
   // matrix A = −G W Gᵀ, so A ν = g gives the smallest mass-weighted correction.
-  auto correct = [&](Points<dim>& target, const Eigen::VectorXd& nu) {
-    for_each_link([&](int j, int u, int) {
-      const int a = chain_.link_start(j), b = chain_.link_end(j);
-      target.col(a) -= w_[a] * nu[u] * e_.col(j);
-      target.col(b) += w_[b] * nu[u] * e_.col(j);
-    });
-    for (const Bend& bend : bends_) {
-      const int u = link_unknown_[static_cast<std::size_t>(bend.link)];
-      if (u >= 0) target.col(chain_.link_end(bend.link)) += w_[chain_.link_end(bend.link)] * nu[u] * (bend.e_plus - e_.col(bend.link));
-    }
-  };
+  auto correct = [&](Points<dim>& target, const Eigen::VectorXd& nu) { add_link_responses(target, nu); };
   double violation = 0, previous = INFINITY, roundoff = 0;
   for (int iteration = 0;; ++iteration) {
     links();
@@ -490,7 +496,7 @@ void StringModel<dim>::project(double t) {
     roundoff = tolerance;
     violation = 0;
     for_each_link([&](int j, int, int) {
-      violation = std::max(violation, std::abs(l_[j] - chain_.link_length(j)) / chain_.link_length(j));
+      if (!link_slack(j)) violation = std::max(violation, std::abs(l_[j] - chain_.link_length(j)) / chain_.link_length(j));
     });
     // Converged; or stalled at a few times the round-off level (Newton no longer halves it).
     if (violation <= tolerance || (violation < 1e3 * tolerance && violation > 0.5 * previous)) break;
@@ -504,6 +510,7 @@ void StringModel<dim>::project(double t) {
     system_->zero();
     assemble_matrix();
     for_each_link([&](int j, int u, int) { system_->rhs(u) = l_[j] - chain_.link_length(j); });
+    exclude_slack_links();
     correct(x_, system_->solve(t));
   }
   // Velocities: one linear projection onto e_j·Δv_j = 0.
@@ -515,6 +522,7 @@ void StringModel<dim>::project(double t) {
     const int u = link_unknown_[static_cast<std::size_t>(bend.link)];
     if (u >= 0) system_->rhs(u) = bend_rate(bend);
   }
+  exclude_slack_links();
   correct(v_, system_->solve(t));
 }
 
@@ -534,6 +542,11 @@ double StringModel<dim>::make_consistent(double t0) {
     x_.col(p.node) = p.path->position(t0);
     v_.col(p.node) = p.path->velocity(t0);
   }
+  for (int j = 0; j < chain_.num_links(); ++j)
+    if (link_slack(j) && !((x_.col(chain_.link_end(j)) - x_.col(chain_.link_start(j))).norm() <
+                           (1 - kSlackGap) * chain_.link_length(j)))
+      throw InputError(fmt::format("link {} is declared slack but is not shorter than its length {:g} m",
+                                   j, chain_.link_length(j)));
   const Points<dim> x_start = x_, v_start = v_;
   double K_start = 0;
   try {
@@ -651,6 +664,7 @@ typename StringModel<dim>::Snapshot StringModel<dim>::snapshot(double t, const E
     s.max_rate_violation = quadratic_->max_rate_violation(x_, v_);
   } else {
     for_each_link([&](int j, int, int) {
+      if (link_slack(j)) return;
       s.max_violation = std::max(s.max_violation, std::abs(l_[j] - chain_.link_length(j)) / chain_.link_length(j));
       const bool bent = std::any_of(bends_.begin(), bends_.end(), [j](const Bend& b) { return b.link == j; });
       if (!bent) s.max_rate_violation = std::max(s.max_rate_violation, std::abs(e_.col(j).dot(dv_.col(j))));
@@ -696,6 +710,7 @@ double StringModel<dim>::max_constraint_violation(double t, const Eigen::Ref<con
   };
   double worst = 0;
   for_each_link([&](int j, int, int) {
+    if (link_slack(j)) return;
     const double h = chain_.link_length(j);
     const double l = (position(chain_.link_end(j)) - position(chain_.link_start(j))).norm();
     worst = std::max(worst, std::abs(l - h) / h);
@@ -749,6 +764,157 @@ EventAction StringModel<dim>::handle_events(double t, Eigen::VectorXd& y, const 
   const EventAction action = module_->handle_events(*this, t, ledgers.tail(num_ledgers_), found);
   if (action.kind == EventAction::Kind::kTransfer) y = pack(ledgers);
   return action;
+}
+
+template <int dim>
+void StringModel<dim>::add_link_responses(Points<dim>& target, const Eigen::VectorXd& nu) const {
+  for_each_link([&](int j, int u, int) {
+    const int a = chain_.link_start(j), b = chain_.link_end(j);
+    target.col(a) -= w_[a] * nu[u] * e_.col(j);
+    target.col(b) += w_[b] * nu[u] * e_.col(j);
+  });
+  for (const Bend& bend : bends_) {
+    const int u = link_unknown_[static_cast<std::size_t>(bend.link)];
+    if (u >= 0) target.col(chain_.link_end(bend.link)) += w_[chain_.link_end(bend.link)] * nu[u] * (bend.e_plus - e_.col(bend.link));
+  }
+}
+
+template <int dim>
+void StringModel<dim>::exclude_slack_links() {
+  if (num_slack_ == 0) return;
+  for_each_link([&](int j, int u, int) {
+    if (link_slack(j)) system_->exclude(u);
+  });
+}
+
+template <int dim>
+const Eigen::VectorXd& StringModel<dim>::solve_tensions(double t) {
+  if (!allows_slack()) return system_->solve(t);
+  exclude_slack_links();
+  // Round-off is not a release: a tension counts as negative below −slack_tolerance times the larger
+  // of max |T| and the physical tension scale (as find_slack judges slack).
+  return system_->solve_complementarity(t, [&](double max_abs) {
+    return options_.slack_tolerance * std::max(max_abs, physical_scales().tension);
+  });
+}
+
+template <int dim>
+void StringModel<dim>::set_slack(int j, bool slack) {
+  if (!allows_slack()) throw InputError("a link can be declared slack only with solver.slack = \"allow\"");
+  if (j < 0 || j >= chain_.num_links()) throw InputError(fmt::format("set_slack: no link {}", j));
+  char& flag = slack_[static_cast<std::size_t>(j)];
+  if ((flag != 0) != slack) num_slack_ += slack ? 1 : -1;
+  flag = slack ? 1 : 0;
+  slack_offset_[static_cast<std::size_t>(j)] = 0;
+}
+
+template <int dim>
+double StringModel<dim>::slack_gap() const {
+  double g = 1;
+  if (num_slack_ == 0) return g;
+  for (int j = 0; j < chain_.num_links(); ++j) {
+    if (!slack_[static_cast<std::size_t>(j)]) continue;
+    const double h = chain_.link_length(j);
+    const double l = (x_.col(chain_.link_end(j)) - x_.col(chain_.link_start(j))).norm();
+    g = std::min(g, (h - l) / h + slack_offset_[static_cast<std::size_t>(j)]);
+  }
+  return g;
+}
+
+template <int dim>
+void StringModel<dim>::accept_step(double t, const Eigen::Ref<const Eigen::VectorXd>& y) {
+  if (!allows_slack() || !system_) return;
+  // A taut link shorter than (1 − kSlackGap) h is slack: the tension solve released it during the step
+  // (a taut link's length is held to the integration tolerance, far below kSlackGap). A slack link past
+  // its length is a snap the root function missed: refuse to go on with a string longer than its
+  // material (the one root function would stay negative). O(N), no tension solve.
+  unpack_state(t, y);
+  for (int j = 0; j < chain_.num_links(); ++j) {
+    const double h = chain_.link_length(j);
+    const double gap = (h - (x_.col(chain_.link_end(j)) - x_.col(chain_.link_start(j))).norm()) / h;
+    if (!link_slack(j)) {
+      if (gap > kSlackGap) set_slack(j, true);
+    } else if (gap + slack_offset_[static_cast<std::size_t>(j)] < -kSlackGap) {
+      throw NumericalError(fmt::format("at t = {:.9g} s slack link {} (s = {:.6g} m) is {:.3g} of its length past it: "
+                                       "its snap taut was not located",
+                                       t, j, chain_.link_midpoint(j), -(gap + slack_offset_[static_cast<std::size_t>(j)])),
+                           t);
+    }
+  }
+}
+
+template <int dim>
+typename StringModel<dim>::SnapResult StringModel<dim>::snap(double t) {
+  SnapResult result;
+  links();
+  const int L = chain_.num_links();
+  // 1. The slack links at their length are caught: taut again.
+  for (int j = 0; j < L; ++j)
+    if (link_slack(j) && (chain_.link_length(j) - l_[j]) / chain_.link_length(j) + slack_offset_[static_cast<std::size_t>(j)] <= kSnapWindow) {
+      set_slack(j, false);
+      ++result.caught;
+    }
+  if (result.caught == 0) {
+    // The root was located on ARKODE's interpolant; the state of the step recomputed to the event
+    // differs from it by the integration error, so the link may be a little short of its length:
+    // catch the nearest slack link if it is within kSnapWindow plus that error (kCatchWindow).
+    int nearest = -1;
+    double nearest_gap = INFINITY;
+    for (int j = 0; j < L; ++j) {
+      if (!link_slack(j)) continue;
+      const double gap = (chain_.link_length(j) - l_[j]) / chain_.link_length(j) + slack_offset_[static_cast<std::size_t>(j)];
+      if (gap < nearest_gap) {
+        nearest_gap = gap;
+        nearest = j;
+      }
+    }
+    if (nearest < 0 || !(nearest_gap < kCatchWindow)) return result;
+    set_slack(nearest, false);
+    ++result.caught;
+  }
+  // 2. The impulse problem on the taut links: w = −(1 + e) u⁻ − A P ≥ 0, P ≥ 0, P w = 0 (the
+  //    tension matrix A: a link's rate of lengthening changes by (A P)_j).
+  const double e = options_.snap_restitution;
+  Eigen::VectorXd u_before = Eigen::VectorXd::Zero(L);
+  double u_scale = 0;
+  system_->zero();
+  assemble_matrix();
+  for_each_link([&](int j, int u, int) {
+    u_before[j] = e_.col(j).dot(dv_.col(j));
+    system_->rhs(u) = -(1 + e) * u_before[j];
+    if (!link_slack(j)) u_scale = std::max(u_scale, std::abs(u_before[j]));
+  });
+  exclude_slack_links();
+  const Eigen::VectorXd P = system_->solve_complementarity(
+      t, [&](double max_abs) { return options_.slack_tolerance * max_abs; });
+  // 3. The velocities jump; the supports take the impulses at prescribed nodes.
+  add_link_responses(v_, -P);
+  for_each_link([&](int j, int u, int) {
+    const int a = chain_.link_start(j), b = chain_.link_end(j);
+    const Vec<dim> J = P[u] * e_.col(j);  // on node a; −J on node b
+    if (path_of_[a] >= 0) {
+      result.support_impulse -= J;
+      result.support_work -= J.dot(v_.col(a));
+    }
+    if (path_of_[b] >= 0) {
+      result.support_impulse += J;
+      result.support_work += J.dot(v_.col(b));
+    }
+  });
+  // 4. The energy dissipated, Σ P_j (u⁻_j + u⁺_j)/2, and the links that separate go slack.
+  links();
+  for_each_link([&](int j, int u, int) {
+    const double u_after = e_.col(j).dot(dv_.col(j));
+    result.dissipated += 0.5 * P[u] * (u_before[j] + u_after);
+    if (!link_slack(j) && u_after < -kSeparation * u_scale) {
+      set_slack(j, true);
+      // Its root function starts at +kSlackGap, never at zero: ARKODE deactivates a root function that
+      // is zero at a restart, and would miss the link's return to its length if it came at once.
+      slack_offset_[static_cast<std::size_t>(j)] =
+          std::max(0.0, (l_[j] - chain_.link_length(j)) / chain_.link_length(j)) + kSlackGap;
+    }
+  });
+  return result;
 }
 
 template class StringModel<2>;

@@ -55,7 +55,7 @@ template <int dim>
 class QuadraticString;
 
 /// SlackPolicy (defaults.hpp): what a run does at a slack link.
-/// "stop", "warn", "ignore".
+/// "stop", "warn", "ignore", "allow".
 const char* to_string(SlackPolicy policy);
 
 /// Where and when a string first went slack.
@@ -85,6 +85,9 @@ struct StringModelOptions {
   /// (quadratic elements, consistent mass, tension at the Gauss points, order 4 for smooth arcs:
   /// quadratic_string.hpp; open strings without fronts only).
   std::string elements = defaults::kElements;
+  /// slack = allow: Newton's coefficient of restitution e of a link that snaps taut (0: perfectly
+  /// inelastic, 1: elastic); the approach speed of its ends becomes −e times itself.
+  double snap_restitution = 0;
   void validate() const;
 };
 
@@ -195,6 +198,47 @@ class StringModel final : public OdeSystem {
   /// possibly longer or shorter, state after a transfer.
   EventAction handle_events(double t, Eigen::VectorXd& y, const std::vector<int>& found);
 
+  // --- unilateral links (slack = allow; docs/model.md "Slack and snap-taut") ------------------
+  bool allows_slack() const { return options_.slack == SlackPolicy::kAllow; }
+  /// Link j is slack: T_j = 0 and its length is free (< h_j) until it snaps taut.
+  bool link_slack(int j) const { return !slack_.empty() && slack_[static_cast<std::size_t>(j)] != 0; }
+  int num_slack_links() const { return num_slack_; }
+  /// Declares link j slack before the run (a string laid shorter than its length); slack = allow
+  /// only. make_consistent() then leaves its length alone and refuses it if it is not shorter than h_j.
+  void set_slack(int j, bool slack);
+  /// The snap root function at the current positions: min over the slack links of (h_j − l_j)/h_j
+  /// (plus the link's offset, ≥ 0, when it went slack at full length), 1 with none. One root function
+  /// for all links (ARKODE evaluates every root function at every step: N per-link functions cost N
+  /// times more evaluations of the same numbers).
+  double slack_gap() const;
+  /// What a snap did: the energy it dissipated (J, ≥ 0), the work and impulse of the supports'
+  /// impulses (J, N s), and how many links it caught.
+  struct SnapResult {
+    double dissipated = 0, support_work = 0;
+    Vec<dim> support_impulse = Vec<dim>::Zero();
+    int caught = 0;
+  };
+  /// The impact at the current state (a slack link reached its length): the links within
+  /// kSnapWindow of their length become taut, and the impulsive tensions P ≥ 0 of the taut links
+  /// solve the complementarity problem u⁺ = u⁻ + A P ≤ −e u⁻, P (u⁺ + e u⁻) = 0 (u: rate of
+  /// lengthening); the velocities jump, and links that separate afterwards go slack.
+  SnapResult snap(double t);
+  /// At an accepted step (t, y): the taut links shorter than (1 − kSlackGap) h_j (released by the
+  /// complementarity problem during the step) become slack; a slack link past its length (a snap not
+  /// located) throws NumericalError. O(N), no tension solve.
+  void accept_step(double t, const Eigen::Ref<const Eigen::VectorXd>& y);
+  /// A released link goes slack once shorter than (1 − kSlackGap) h; a link that goes slack at a snap
+  /// starts with its root function at +kSlackGap.
+  static constexpr double kSlackGap = 2e-7;
+  /// At a snap the slack links within kSnapWindow of their length are caught; if none is (the state
+  /// recomputed to the event is a little short of the located root), the nearest one within
+  /// kCatchWindow.
+  static constexpr double kSnapWindow = 1e-7;
+  static constexpr double kCatchWindow = 1e-5;
+  /// After a snap, a taut link goes slack when it separates faster than this share of the largest
+  /// approach speed of the snap (slower, it stays taut and the tension solve releases it if it must).
+  static constexpr double kSeparation = 1e-6;
+
   // --- access -------------------------------------------------------------------------------
   const Chain<dim>& chain() const { return chain_; }
   Chain<dim>& chain() { return chain_; }
@@ -292,6 +336,14 @@ class StringModel final : public OdeSystem {
   /// Positions and velocities of the nodes in an arc at (t, y) into x, v (the others untouched).
   void fill_moving(double t, const Eigen::Ref<const Eigen::VectorXd>& y, Points<dim>& x, Points<dim>& v) const;
   double evaluate_current(double t);
+  /// The tension solve of an evaluation: the linear system, or with slack = allow the
+  /// complementarity problem on the taut links (slack ones excluded).
+  const Eigen::VectorXd& solve_tensions(double t);
+  /// target_a −= w_a ν_j e_j, target_b += w_b ν_j e_j for every link j (and a bent link's end along
+  /// e⁺): the mass-weighted response to link multipliers ν (projection: corrections; snap: −P).
+  void add_link_responses(Points<dim>& target, const Eigen::VectorXd& nu) const;
+  /// Excludes the slack links from the assembled tension system (their T = 0).
+  void exclude_slack_links();
   template <class Visit>
   void for_each_link(Visit&& visit) const;
   friend class StringJacobian<dim>;
@@ -342,6 +394,9 @@ class StringModel final : public OdeSystem {
   Eigen::VectorXd l_;
   double x_max_ = 0, h_min_ = INFINITY;
   ImpulsiveStart impulsive_start_;
+  std::vector<char> slack_;            // per link: slack (slack = allow)
+  std::vector<double> slack_offset_;   // per link: its root function's offset
+  int num_slack_ = 0;
 };
 
 template <int dim>

@@ -357,7 +357,8 @@ void StringSolver<dim>::record_sample(double t, const Eigen::VectorXd& y) {
 template <int dim>
 void StringSolver<dim>::check_slack(double t, const Eigen::VectorXd& y) {
   const SlackPolicy policy = model_.options().slack;
-  if (policy == SlackPolicy::kIgnore || (policy == SlackPolicy::kWarn && summary_.slack)) return;
+  if (policy == SlackPolicy::kIgnore || policy == SlackPolicy::kAllow || (policy == SlackPolicy::kWarn && summary_.slack))
+    return;
   const std::optional<SlackReport> slack = model_.find_slack(t, y);
   if (!slack) return;
   summary_.slack = slack;
@@ -416,6 +417,7 @@ const RunSummary& StringSolver<dim>::run() {
     auto output_time = [&](long k) { return std::min(options_.t_end, k * options_.output_interval); };
     // At every accepted step: the constraints, slack, the caller's hook and the step record.
     auto after_step = [&](double t, const Eigen::VectorXd& y) {
+      model_.accept_step(t, y);  // slack = allow: the links released at this step go slack
       summary_.max_constraint_violation =
           std::max(summary_.max_constraint_violation, model_.max_constraint_violation(t, y));
       check_slack(t, y);

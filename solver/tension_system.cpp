@@ -391,6 +391,8 @@ TensionSystem::TensionSystem(const std::vector<int>& arc_links, const std::vecto
   diag_slot_.assign(n, -1);
   next_slot_.assign(n, -1);
   prev_slot_of_next_.assign(n, -1);
+  next_.assign(static_cast<std::size_t>(n), -1);
+  prev_.assign(static_cast<std::size_t>(n), -1);
   for (int u = 0; u < n; ++u) diag_slot_[u] = pattern_.find(u, u);
   for (const ArcBlock& arc : arcs_) {
     const int f = arc.first_unknown, m = arc.num_links;
@@ -399,6 +401,8 @@ TensionSystem::TensionSystem(const std::vector<int>& arc_links, const std::vecto
       const int next = i + 1 < m ? f + i + 1 : f;
       next_slot_[f + i] = pattern_.find(f + i, next);
       prev_slot_of_next_[f + i] = pattern_.find(next, f + i);
+      next_[static_cast<std::size_t>(f + i)] = next;
+      prev_[static_cast<std::size_t>(next)] = f + i;
     }
   }
 
@@ -413,6 +417,44 @@ TensionSystem::~TensionSystem() = default;
 void TensionSystem::zero() {
   std::fill(values_.begin(), values_.end(), 0.0);
   rhs_.setZero();
+  if (num_excluded_ > 0) {
+    std::fill(excluded_.begin(), excluded_.end(), 0);
+    num_excluded_ = 0;
+  }
+}
+
+void TensionSystem::exclude(int u) {
+  if (excluded_.empty()) excluded_.assign(static_cast<std::size_t>(size()), 0);
+  if (!excluded_[static_cast<std::size_t>(u)]) {
+    excluded_[static_cast<std::size_t>(u)] = 1;
+    ++num_excluded_;
+  }
+  rhs_[u] = 0;
+  if (next_slot_[u] >= 0) set_coupling(u, 0.0);
+  const int p = prev_[static_cast<std::size_t>(u)];
+  if (p >= 0 && next_slot_[p] >= 0) set_coupling(p, 0.0);
+}
+
+double TensionSystem::complementarity_residual(int u, const std::vector<double>& values, const Eigen::VectorXd& rhs,
+                                               const Eigen::VectorXd& T) const {
+  // Row u of A: its diagonal, its coupling with the next unknown, and the previous unknown's with it.
+  double AT = values[static_cast<std::size_t>(diag_slot_[u])] * T[u];
+  const int next = next_[static_cast<std::size_t>(u)];
+  if (next >= 0) AT += values[static_cast<std::size_t>(next_slot_[u])] * T[next];
+  const int p = prev_[static_cast<std::size_t>(u)];
+  if (p >= 0 && prev_slot_of_next_[p] >= 0) AT += values[static_cast<std::size_t>(prev_slot_of_next_[p])] * T[p];
+  return rhs[u] - AT;
+}
+
+void TensionSystem::complementarity_failure(double t, const std::vector<int>& violating) const {
+  std::string which;
+  for (std::size_t k = 0; k < violating.size() && k < 5; ++k) which += (k ? ", " : "") + describe(violating[k]);
+  if (violating.size() > 5) which += fmt::format(" and {} more", violating.size() - 5);
+  throw NumericalError(fmt::format("at t = {:.9g} s the complementarity problem of the slack links (T >= 0, "
+                                   "acceleration of the length <= 0, one of them zero) did not settle after {} "
+                                   "pivoting passes: {} still violate it",
+                                   t, kMaxPasses, which),
+                       t);
 }
 
 int TensionSystem::slot(int row, int col) const {
@@ -425,6 +467,9 @@ const Eigen::VectorXd& TensionSystem::solve(double t) {
   ++solves_;
   solution_ = rhs_;
   const SolveStatus status = backend_->factor_solve(values_.data(), solution_.data());
+  if (num_excluded_ > 0 && status.ok)
+    for (int u = 0; u < size(); ++u)
+      if (excluded_[static_cast<std::size_t>(u)]) solution_[u] = 0;  // exact, also on a closed arc
   if (!status.ok)
     throw NumericalError(fmt::format("the tension system is singular at t = {:.9g} s: {} has pivot {:.3g} ({}); "
                                      "the string cannot move as its constraints require (taut between "

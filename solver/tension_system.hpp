@@ -27,6 +27,8 @@
 ///   - "eigen":       Eigen's SparseLU, analyzePattern once, factorize each call (the fallback when
 ///                    chainsim is built with CHAINSIM_WITH_KLU=OFF),
 ///   - "auto":        tridiagonal (the fastest for arcs: measured in docs/string_solver.md).
+#include <algorithm>
+#include <cmath>
 #include <memory>
 #include <string>
 #include <vector>
@@ -139,8 +141,37 @@ class TensionSystem {
   const Eigen::VectorXd& rhs_vector() const { return rhs_; }
 
   /// Factors and solves A T = b. Throws NumericalError naming the link (or junction unknown), the
-  /// pivot and the time t when the matrix is singular, or when the solution is not finite.
+  /// pivot and the time t when the matrix is singular, or when the solution is not finite. Excluded
+  /// unknowns (exclude()) come out exactly zero.
   const Eigen::VectorXd& solve(double t);
+
+  // --- unilateral links ([solver] slack = "allow", docs/model.md "Slack and snap-taut") -------
+  /// Takes unknown u out of the system until the next zero(): its couplings with its neighbours and
+  /// its right side become zero (its diagonal stays), so T_u = 0 and the others do not see it. O(1).
+  void exclude(int u);
+  bool excluded(int u) const { return !excluded_.empty() && excluded_[static_cast<std::size_t>(u)] != 0; }
+  /// The linear complementarity problem of unilateral links on the assembled system (A, b), with the
+  /// unknowns excluded so far held at zero:
+  ///     T ≥ 0,   w = b − A T ≥ 0,   T_u w_u = 0   for every other unknown u.
+  /// A = −G W Gᵀ is negative definite, so −A is symmetric positive definite and the problem has one
+  /// solution (a P-matrix LCP). Block principal pivoting (Júdice & Pires): each pass releases
+  /// (excludes) the unknowns with T_u < −tolerance and takes back the released ones with
+  /// w_u < −tolerance |A_uu|, and solves again, O(N) a pass; after kBlockPasses passes that have not
+  /// settled it changes one unknown a pass (Murty's least-index rule, finite for a P-matrix). The
+  /// first pass is a plain solve(): a system with no negative unknown costs nothing more.
+  /// `tolerance(max |T|)` gives the absolute tolerance (N or N s); it is called only when a T_u < 0.
+  /// Throws NumericalError, naming t and the unknowns still in violation, after kMaxPasses passes.
+  template <class Tolerance>
+  const Eigen::VectorXd& solve_complementarity(double t, Tolerance&& tolerance);
+  static constexpr int kBlockPasses = 8;
+  static constexpr int kMaxPasses = 200;
+  /// What the complementarity solves did: calls that released an unknown, their passes summed and
+  /// the most passes one call took.
+  struct ComplementarityStats {
+    long calls_with_release = 0, passes = 0;
+    int max_passes = 0;
+  };
+  const ComplementarityStats& complementarity_stats() const { return lcp_stats_; }
   /// The last solution.
   const Eigen::VectorXd& solution() const { return solution_; }
   /// Number of factor-and-solve calls so far.
@@ -158,6 +189,66 @@ class TensionSystem {
   std::unique_ptr<TensionBackend> backend_;
   std::string backend_name_;
   long solves_ = 0;
+  // unilateral links: per unknown, excluded (1) or not (0), the unknowns before and after it in its arc (−1)
+  std::vector<char> excluded_;
+  int num_excluded_ = 0;
+  std::vector<int> prev_, next_;
+  std::vector<double> full_values_;
+  Eigen::VectorXd full_rhs_;
+  ComplementarityStats lcp_stats_;
+  /// w_u = b_u − (A T)_u with the values `values` and right side `rhs`.
+  double complementarity_residual(int u, const std::vector<double>& values, const Eigen::VectorXd& rhs,
+                                  const Eigen::VectorXd& T) const;
+  [[noreturn]] void complementarity_failure(double t, const std::vector<int>& violating) const;
 };
+
+template <class Tolerance>
+const Eigen::VectorXd& TensionSystem::solve_complementarity(double t, Tolerance&& tolerance) {
+  solve(t);
+  const int n = size();
+  double max_abs = 0, min_T = 0;
+  for (int u = 0; u < n; ++u) {
+    min_T = std::min(min_T, solution_[u]);
+    max_abs = std::max(max_abs, std::abs(solution_[u]));
+  }
+  if (!(min_T < 0)) return solution_;
+  const double tol = tolerance(max_abs);
+  if (!(min_T < -tol)) return solution_;
+  // The assembled system with the caller's exclusions, kept to restore and to measure w.
+  full_values_ = values_;
+  full_rhs_ = rhs_;
+  const std::vector<char> fixed = excluded_.empty() ? std::vector<char>(static_cast<std::size_t>(n), 0) : excluded_;
+  std::vector<char> released(static_cast<std::size_t>(n), 0);
+  std::vector<int> violating;
+  ++lcp_stats_.calls_with_release;
+  for (int pass = 1;; ++pass) {
+    violating.clear();
+    for (int u = 0; u < n; ++u) {
+      if (fixed[static_cast<std::size_t>(u)]) continue;
+      if (!released[static_cast<std::size_t>(u)]) {
+        if (solution_[u] < -tol) violating.push_back(u);
+      } else if (complementarity_residual(u, full_values_, full_rhs_, solution_) <
+                 -tol * std::abs(full_values_[static_cast<std::size_t>(diag_slot_[u])])) {
+        violating.push_back(u);
+      }
+    }
+    lcp_stats_.passes += 1;
+    lcp_stats_.max_passes = std::max(lcp_stats_.max_passes, pass);
+    if (violating.empty()) return solution_;
+    if (pass >= kMaxPasses) complementarity_failure(t, violating);
+    if (pass < kBlockPasses) {
+      for (int u : violating) released[static_cast<std::size_t>(u)] ^= 1;
+    } else {
+      released[static_cast<std::size_t>(violating.front())] ^= 1;  // least index
+    }
+    values_ = full_values_;
+    rhs_ = full_rhs_;
+    excluded_ = fixed;
+    num_excluded_ = static_cast<int>(std::count(fixed.begin(), fixed.end(), 1));
+    for (int u = 0; u < n; ++u)
+      if (released[static_cast<std::size_t>(u)]) exclude(u);
+    solve(t);
+  }
+}
 
 }  // namespace chainsim

@@ -132,8 +132,11 @@ int run_string_scene(const SceneSpec& spec, const std::filesystem::path& dir, bo
     out << fmt::format("links      max | |dx| - h | / h = {:.3e} (stabilization time {:g} s)\n",
                        s.max_constraint_violation, s.stabilization_time);
     out << fmt::format("slack      {} (policy {})\n",
-                       s.slack ? s.slack->message()
-                               : s.slack_policy == SlackPolicy::kIgnore ? "not checked" : "none at any accepted step",
+                       s.slack                                   ? s.slack->message()
+                       : s.slack_policy == SlackPolicy::kIgnore ? "not checked"
+                       : s.slack_policy == SlackPolicy::kAllow
+                           ? "allowed: links go slack and snap taut (W_snap, W_snap_supports in energy.csv)"
+                           : "none at any accepted step",
                        to_string(s.slack_policy));
     if (!s.tolerance_warning.empty()) out << fmt::format("warning    {}\n", s.tolerance_warning);
     out << fmt::format("outputs    {}: {}\n", dir.string(), output_files(dir));

@@ -12,7 +12,7 @@ void parse_solver(const Section& top, Context& ctx) {
   auto& so = ctx.spec.solver;
   Section s(subtable(top, "solver"), "solver", ctx,
             {"method", "rtol", "atol", "max_step", "initial_step", "max_steps", "stabilization_time", "backend", "linear_solver",
-             "check_slack", "slack_tolerance", "slack", "max_wall_s"},
+             "check_slack", "slack_tolerance", "slack", "snap_restitution", "max_wall_s"},
             {{"t_end", "in [stop]"}, {"output_interval", "as interval in [output]"}, {"vtk", "as formats in [output]"}});
   // Each value is checked by the option struct that owns its range, one field at a time.
   // The method is checked once, here at its key; the other fields by their ranges alone.
@@ -54,7 +54,7 @@ void parse_solver(const Section& top, Context& ctx) {
   model("backend", [&](StringModelOptions& o) { o.backend = so.backend; });
   so.linear_solver = s.choice("linear_solver", {"auto", "banded", "klu"}, so.linear_solver);
   const std::optional<bool> check_slack = s.boolean("check_slack");
-  so.slack = s.choice("slack", {"stop", "warn", "ignore"}, so.slack);
+  so.slack = s.choice("slack", {"stop", "warn", "ignore", "allow"}, so.slack);
   if (s.has("check_slack") && s.has("slack"))
     s.fail("check_slack", fmt::format("solver.check_slack = {} and solver.slack = {} both say what a slack link does: "
                                       "give one of them (check_slack = true is slack = \"stop\", false is slack = "
@@ -63,6 +63,20 @@ void parse_solver(const Section& top, Context& ctx) {
   if (check_slack) so.slack = *check_slack ? "stop" : "ignore";
   so.slack_tolerance = s.number("slack_tolerance").value_or(so.slack_tolerance);
   model("slack_tolerance", [&](StringModelOptions& o) { o.slack_tolerance = so.slack_tolerance; });
+  so.snap_restitution = s.number("snap_restitution").value_or(so.snap_restitution);
+  model("snap_restitution", [&](StringModelOptions& o) { o.snap_restitution = so.snap_restitution; });
+  if (so.slack == "allow") {
+    IntegratorOptions method;
+    method.method = so.method;
+    if (method.implicit_method())
+      s.fail("method", fmt::format("solver.method = \"{}\" is implicit, and implicit methods do not meet solver.slack = "
+                                   "\"allow\" (their Newton systems know no slack link): use an explicit method "
+                                   "(\"auto\", \"erk8\", ...)",
+                                   so.method));
+  } else if (s.has("snap_restitution")) {
+    s.fail("snap_restitution", fmt::format("solver.snap_restitution = {} applies only with solver.slack = \"allow\"",
+                                           s.text("snap_restitution")));
+  }
   so.max_wall_s = s.positive("max_wall_s");
 }
 

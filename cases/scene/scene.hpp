@@ -25,7 +25,8 @@
 ///     [effects.fold]   s0 (m), f          [effects.plane] point (m), normal (the table of a heap)
 ///     [solver]   method, rtol, atol, max_step, initial_step, max_steps, stabilization_time, backend,
 ///                linear_solver = auto | banded | klu,
-///                slack = stop | warn | ignore (check_slack = true | false: its older form),
+///                slack = stop | warn | ignore | allow (check_slack = true | false: its older form),
+///                snap_restitution (slack = allow),
 ///                slack_tolerance, max_wall_s (s)
 ///     [output]   interval (s), fields = [nodes, tension, energy, stats], formats = [csv, vtk]
 ///     [stop]     t_end (s), [[stop.front]] front = fold | heap_start | heap_end, s0 (m)
@@ -161,9 +162,12 @@ struct SceneSpec {
     std::string linear_solver = defaults::kLinearSolver;
     double slack_tolerance = defaults::kSlackTolerance;
     /// What a slack link (a negative tension at an accepted step) does: "stop" (a numerical failure),
-    /// "warn" (reported, the run goes on) or "ignore". The older key check_slack = true / false is
+    /// "warn" (reported, the run goes on), "ignore", or "allow" (unilateral links: slack links fly
+    /// freely and snap taut, docs/model.md "Slack and snap-taut"). The older key check_slack = true / false is
     /// read as "stop" / "ignore".
     std::string slack = defaults::kSceneSlack;
+    /// slack = "allow": Newton's restitution of a link that snaps taut, in [0, 1] (0: perfectly inelastic).
+    double snap_restitution = 0;
     std::optional<double> max_wall_s;  ///< s of wall-clock time the run may take (> 0); none: no limit
   } solver;
   // [output]

@@ -110,7 +110,7 @@ json scene_to_json(const SceneSpec& spec) {
   for (const FrontStop& f : spec.stop.fronts) stops.push_back({{"front", f.front}, {"s0", f.s0}});
   // string.nodes: 41 unless the resolution is set by link_length.
   const json nodes = spec.link_length ? json(nullptr) : json(spec.nodes.value_or(41));
-  return {
+  json out = {
       {"model", spec.model},
       {"string",
        {{"dimension", spec.dimension},
@@ -140,6 +140,9 @@ json scene_to_json(const SceneSpec& spec) {
       {"output", output_json(spec)},
       {"stop", {{"t_end", spec.stop.t_end}, {"front", stops}}},
   };
+  // Only where it applies, so that a scene without slack = "allow" writes what it always wrote.
+  if (so.slack == "allow") out["solver"]["snap_restitution"] = so.snap_restitution;
+  return out;
 }
 
 }  // namespace chainsim

@@ -273,7 +273,23 @@ SceneParts<dim> build_scene_parts(const SceneSpec& spec) {
   mo.backend = so.backend;
   mo.linear_solver = so.linear_solver;
   mo.elements = spec.elements;
-  mo.slack = so.slack == "warn" ? SlackPolicy::kWarn : so.slack == "ignore" ? SlackPolicy::kIgnore : SlackPolicy::kStop;
+  mo.slack = so.slack == "warn"     ? SlackPolicy::kWarn
+             : so.slack == "ignore" ? SlackPolicy::kIgnore
+             : so.slack == "allow"  ? SlackPolicy::kAllow
+                                    : SlackPolicy::kStop;
+  mo.snap_restitution = so.snap_restitution;
+  if (mo.slack == SlackPolicy::kAllow) {
+    if (spec.has_fronts())
+      at_key(spec, "solver.slack", [&] {
+        throw InputError("solver.slack = \"allow\" does not meet fronts (heaps, folds) yet: a scene with fronts takes "
+                         "slack = \"stop\", \"warn\" or \"ignore\"");
+      });
+    if (spec.elements == "quadratic")
+      at_key(spec, "solver.slack", [&] {
+        throw InputError("solver.slack = \"allow\" needs link elements: string.elements = \"quadratic\" has no "
+                         "tension per link to release");
+      });
+  }
   mo.slack_tolerance = so.slack_tolerance;
   StringSolverOptions run;
   run.integrator = io;

@@ -12,7 +12,12 @@
 // run (parse, build, project, integrate), their ratios, and the step counts and final tip
 // positions, which show that the three runs compute the same motion.
 //
-// Usage: chainsim_bench_scene [--quick]
+// With --slack: what [solver] slack = "allow" costs (docs/model.md "Slack and snap-taut"), the same
+// scenes with slack = "stop" and "allow", interleaved: (a) the minimal scene above, a taut run that
+// never goes slack; (b) the swinging U (cases/scenes/swinging_u.toml) to t = 0.4 s, before its first
+// slack, and with "allow" to t = 1 s.
+//
+// Usage: chainsim_bench_scene [--quick] [--slack]
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -124,10 +129,68 @@ Sample bare(int links, double t_end) {
   return measure(t0, solver);
 }
 
+
+/// The U of cases/scenes/swinging_u.toml (101 nodes) with the given slack policy, to t_end.
+std::string swinging_u(const char* slack, double t_end) {
+  return fmt::format(R"([string]
+density = 0.1
+nodes = 101
+[shape]
+kind = "polyline"
+points = [[0.0, 0.0], [0.3, -0.4], [0.6, -0.4], [0.3, 0.0]]
+corner_radius = 0.12
+[ends]
+start = "fixed"
+end = "fixed"
+[effects.gravity]
+g = [0.0, -9.81]
+[solver]
+slack = "{}"
+[output]
+interval = {}
+[stop]
+t_end = {}
+)",
+                     slack, t_end, t_end);
+}
+
+int slack_bench(bool quick) {
+  const int repeats = quick ? 3 : 11;
+  const double t_end = quick ? 0.5 : 2.0;
+  auto with_slack = [](std::string text, const char* policy) {
+    return text.replace(text.find("[solver]\n"), 9, fmt::format("[solver]\nslack = \"{}\"\n", policy));
+  };
+  const std::vector<std::pair<std::string, std::string>> scenes = {
+      {"(a) hanging chain, slack = stop", with_slack(minimal_scene(100, t_end), "stop")},
+      {"(a) hanging chain, slack = allow", with_slack(minimal_scene(100, t_end), "allow")},
+      {"(b) swinging U to 0.4 s, stop", swinging_u("stop", 0.4)},
+      {"(b) swinging U to 0.4 s, allow", swinging_u("allow", 0.4)},
+      {"(b) swinging U to 1 s, allow", swinging_u("allow", 1.0)}};
+  std::vector<std::vector<Sample>> runs(scenes.size());
+  for (int r = 0; r < repeats; ++r)
+    for (std::size_t k = 0; k < scenes.size(); ++k) runs[k].push_back(from_scene(scenes[k].second));
+  std::printf("chainsim_bench_scene --slack%s: median of %d\n\n", quick ? " --quick" : "", repeats);
+  std::printf("  %-36s %10s %8s\n", "", "run (ms)", "steps");
+  std::vector<double> run(scenes.size());
+  for (std::size_t k = 0; k < scenes.size(); ++k) {
+    std::vector<double> a;
+    for (const auto& s : runs[k]) a.push_back(s.run);
+    run[k] = median(a);
+    std::printf("  %-36s %10.2f %8ld\n", scenes[k].first.c_str(), 1e3 * run[k], runs[k].front().steps);
+  }
+  std::printf("\n  ratios allow/stop: (a) %.3f   (b) %.3f\n", run[1] / run[0], run[3] / run[2]);
+  return 0;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
-  const bool quick = argc > 1 && std::strcmp(argv[1], "--quick") == 0;
+  bool quick = false, slack = false;
+  for (int k = 1; k < argc; ++k) {
+    if (std::strcmp(argv[k], "--quick") == 0) quick = true;
+    if (std::strcmp(argv[k], "--slack") == 0) slack = true;
+  }
+  if (slack) return slack_bench(quick);
   const int links = 100;
   const double t_end = quick ? 0.5 : 2.0;
   const int repeats = quick ? 3 : 11;

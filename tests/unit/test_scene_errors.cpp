@@ -68,7 +68,7 @@ TEST_CASE("bad scenes are refused with the location, the key, the value and what
        "s.toml:13:10: unknown effect [effects.gravty]; valid effects: gravity, drag, heap, fold, plane (did you mean [effects.gravity]?)"},
       {"a solver key of the old format",
        kBase + std::string("[solver]\nt_end = 1.0\n"),
-       "s.toml:19:1: unknown key 't_end' in [solver]; valid keys: method, rtol, atol, max_step, initial_step, max_steps, stabilization_time, backend, linear_solver, check_slack, slack_tolerance, slack, max_wall_s; t_end is now written in [stop]"},
+       "s.toml:19:1: unknown key 't_end' in [solver]; valid keys: method, rtol, atol, max_step, initial_step, max_steps, stabilization_time, backend, linear_solver, check_slack, slack_tolerance, slack, snap_restitution, max_wall_s; t_end is now written in [stop]"},
       {"a top-level key",
        std::string("title = \"x\"\n") + kBase,
        "s.toml:1:1: unknown top-level key 'title'; valid sections: string, shape, velocity, ends, effects, solver, output, stop; valid top-level keys: model"},
@@ -387,7 +387,9 @@ TEST_CASE("solver.slack and solver.max_wall_s are parsed and checked, and check_
   // Defaults: slack = "stop", no wall-clock limit.
   CHECK(solver("").slack == "stop");
   CHECK_FALSE(solver("").max_wall_s);
-  for (const char* value : {"stop", "warn", "ignore"}) CHECK(solver(std::string("slack = \"") + value + "\"\n").slack == value);
+  for (const char* value : {"stop", "warn", "ignore", "allow"})
+    CHECK(solver(std::string("slack = \"") + value + "\"\n").slack == value);
+  CHECK(solver("slack = \"allow\"\nsnap_restitution = 0.5\n").snap_restitution == 0.5);
   // check_slack, the older key: true is "stop", false is "ignore".
   CHECK(solver("check_slack = true\n").slack == "stop");
   CHECK(solver("check_slack = false\n").slack == "ignore");
@@ -395,12 +397,16 @@ TEST_CASE("solver.slack and solver.max_wall_s are parsed and checked, and check_
   CHECK(solver("max_wall_s = 0.5\n").max_wall_s == 0.5);
   const BadScene cases[] = {
       {"slack misspelt", kBase + "\n[solver]\nslack = \"wran\"\n",
-       "s.toml:20:9: solver.slack = \"wran\" is not allowed; valid values: stop, warn, ignore (did you mean \"warn\"?)"},
+       "s.toml:20:9: solver.slack = \"wran\" is not allowed; valid values: stop, warn, ignore, allow (did you mean \"warn\"?)"},
       {"slack as a boolean", kBase + "\n[solver]\nslack = true\n", "s.toml:20:9: solver.slack = true must be a string"},
       {"slack and check_slack together", kBase + "\n[solver]\ncheck_slack = true\nslack = \"warn\"\n",
        "s.toml:20:15: solver.check_slack = true and solver.slack = \"warn\" both say what a slack link does: give one of them (check_slack = true is slack = \"stop\", false is slack = \"ignore\")"},
       {"a key misspelt", kBase + "\n[solver]\nslak = \"warn\"\n",
-       "s.toml:20:1: unknown key 'slak' in [solver]; valid keys: method, rtol, atol, max_step, initial_step, max_steps, stabilization_time, backend, linear_solver, check_slack, slack_tolerance, slack, max_wall_s (did you mean 'slack'?)"},
+       "s.toml:20:1: unknown key 'slak' in [solver]; valid keys: method, rtol, atol, max_step, initial_step, max_steps, stabilization_time, backend, linear_solver, check_slack, slack_tolerance, slack, snap_restitution, max_wall_s (did you mean 'slack'?)"},
+      {"snap_restitution above 1", kBase + "\n[solver]\nslack = \"allow\"\nsnap_restitution = 1.5\n", "s.toml:21:20: solver.snap_restitution = 1.5 is out of range: allowed 0 <= snap_restitution <= 1"},
+      {"snap_restitution below 0", kBase + "\n[solver]\nslack = \"allow\"\nsnap_restitution = -0.1\n", "s.toml:21:20: solver.snap_restitution = -0.1 is out of range: allowed 0 <= snap_restitution <= 1"},
+      {"snap_restitution without slack = allow", kBase + "\n[solver]\nsnap_restitution = 0.5\n", "s.toml:20:20: solver.snap_restitution = 0.5 applies only with solver.slack = \"allow\""},
+      {"slack = allow with an implicit method", kBase + "\n[solver]\nmethod = \"dirk3\"\nslack = \"allow\"\n", "s.toml:20:10: solver.method = \"dirk3\" is implicit, and implicit methods do not meet solver.slack = \"allow\" (their Newton systems know no slack link): use an explicit method (\"auto\", \"erk8\", ...)"},
       {"no wall time", kBase + "\n[solver]\nmax_wall_s = 0\n",
        "s.toml:20:14: solver.max_wall_s = 0 is out of range: allowed max_wall_s > 0"},
       {"a negative wall time", kBase + "\n[solver]\nmax_wall_s = -5.0\n",

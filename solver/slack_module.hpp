@@ -1,0 +1,23 @@
+#pragma once
+/// @file slack_module.hpp
+/// The module of unilateral links ([solver] slack = "allow"; docs/model.md "Slack and snap-taut"):
+/// what a string whose links may go slack adds to the one discrete string (string_module.hpp). The
+/// string keeps its one arc; its tension solve becomes a complementarity problem (StringModel::
+/// solve_tensions) and its slack links are flagged (StringModel::link_slack). The module adds
+///   - one root function, the smallest gap (h_j − l_j)/h_j of the slack links (StringModel::slack_gap),
+///     at which the string snaps taut (StringModel::snap);
+///   - the ledgers W_snap (J, ≤ 0: the energy the snaps dissipated, given to the string with its sign),
+///     W_snap_supports (J: the work of the supports' impulses at snaps, zero at fixed ends) and the
+///     impulse of all external forces (the momentum ledger p − p0 − impulse, closed across snaps: the
+///     impulsive tensions are internal);
+///   - the recorded quantity snaps (series.csv): the number of snaps so far.
+#include <memory>
+
+#include "string_module.hpp"
+
+namespace chainsim {
+
+template <int dim>
+std::unique_ptr<StringModule<dim>> make_slack_module();
+
+}  // namespace chainsim
