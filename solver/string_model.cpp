@@ -16,6 +16,9 @@ namespace {
 /// A link shorter than this fraction of its material length is a trial state the model cannot use
 /// (the unit vector e_j is undefined): ARKODE retries with a smaller step.
 constexpr double kCollapsedLink = 1e-6;
+/// A bent link's part on either side of its point may be this short (a node crossing an edge passes
+/// within 1e-8 h of it, shocks/edge_front.hpp).
+constexpr double kBentLinkFloor = 1e-10;
 /// The projection is converged when every link length is right to the larger of this relative
 /// accuracy and the round-off of its coordinates, kRoundoffUlps · ε · max|x| / h_min: a link's length
 /// cannot be represented more accurately than its end points' coordinates.
@@ -244,7 +247,7 @@ void StringModel<dim>::bend_links() {
     const Vec<dim> to_a = bend.point - x_.col(a), from_b = x_.col(b) - bend.point;
     bend.l_minus = to_a.norm();
     bend.l_plus = from_b.norm();
-    const double floor = kCollapsedLink * chain_.link_length(j);
+    const double floor = kBentLinkFloor * chain_.link_length(j);
     if (!(bend.l_minus > floor) || !(bend.l_plus > floor) || !std::isfinite(bend.l_minus + bend.l_plus))
       throw RecoverableError(fmt::format("link {} has reached the point it is bent over ({:g} and {:g} m from it)", j,
                                          bend.l_minus, bend.l_plus));
@@ -268,6 +271,12 @@ void StringModel<dim>::bend_couplings() {
     for (const Bend& bend : bends_)
       if (bend.link == j) system_->set_coupling(u, w_[chain_.link_end(j)] * bend.e_plus.dot(e_.col(next)));
   });
+}
+
+template <int dim>
+double StringModel<dim>::link_tension(int link) const {
+  const int u = link_unknown_[static_cast<std::size_t>(link)];
+  return u >= 0 && system_ ? system_->solution()[u] : std::numeric_limits<double>::quiet_NaN();
 }
 
 template <int dim>
@@ -411,6 +420,7 @@ double StringModel<dim>::evaluate_current(double t) {
     }
     if (module_) external_ += force_.col(i) + force_nc_.col(i) + reaction_.col(i);
   }
+  if (module_ && !bends_.empty()) external_ += bend_reaction();  // the points the links are bent over
   return power;
 }
 
@@ -433,7 +443,10 @@ template <int dim>
 void StringModel<dim>::events(double t, const Eigen::Ref<const Eigen::VectorXd>& y, Eigen::Ref<Eigen::VectorXd> g) {
   if (!module_) return;
   unpack_state(t, y);
-  refresh();
+  if (module_->events_need_tensions())
+    evaluate_current(t);
+  else
+    refresh();
   module_->events(*this, g);
 }
 

@@ -225,6 +225,8 @@ class StringModel final : public OdeSystem {
   void clear_bends() { bends_.clear(); }
   /// The force the points of the bent links exert on the string after an evaluation (N): Σ T (e⁻ − e⁺).
   Vec<dim> bend_reaction() const;
+  /// The tension of link `link` after an evaluation (N): its multiplier; NaN for a link in no arc.
+  double link_tension(int link) const;
   const Points<dim>& accelerations() const { return a_; }
   /// The sum of the uniform fields the forces declare (Force::uniform_field; gravity's g, zero
   /// without one): the weight per unit mass in the physical scales, and what the module books for
@@ -254,7 +256,7 @@ class StringModel final : public OdeSystem {
   /// Recomputes the masses (and the module's fronts) at the current x(), v(); no tension solve.
   void refresh();
   /// Sum over the moving nodes of the applied forces and the prescribed nodes' support reactions,
-  /// after an evaluation (N).
+  /// and the force of the points the links are bent over (bend_reaction), after an evaluation (N).
   const Vec<dim>& external_force() const { return external_; }
   /// Sum of the prescribed nodes' support reactions on the string, after an evaluation (N).
   Vec<dim> support_reaction() const;
