@@ -72,20 +72,25 @@ void EdgeFront<dim>::cut(FrontLayout& layout) {
 
 template <int dim>
 void EdgeFront<dim>::initialize(StringModel<dim>& model) {
-  Points<dim>& x = model.x();
+  const Points<dim>& x = model.x();
   const double h = this->m_.h;
-  int a = link_;
-  // The material point s0 on a node: that node sits on the edge, where the bent link has no direction.
-  // It is moved 2 kCross h off the edge along its side (the projection at the start restores the links).
-  const double l_minus = this->expected_s0 - model.chain().node_coordinate(a);
+  // The material point s0 on a node c: that node sits on the edge, where the bent link has no
+  // direction. The string is taken as it was just before c reached the edge: the side up to c moves
+  // back from the edge by 2 kCross h along its tangent there, the side after c towards it, each
+  // rigidly (every link keeps its length; the bent link is (c, c + 1)).
+  const double l_minus = this->expected_s0 - model.chain().node_coordinate(link_);
   const double nudge = 2 * kCross * h;
-  if (l_minus < nudge && a >= 1) {
-    const Vec<dim> t = unit_vector<dim>(point_ - x.col(a - 1), "the string before the edge");
-    x.col(a) = point_ - nudge * t;
-  } else if (h - l_minus < nudge && a + 2 < this->m_.n) {
-    const Vec<dim> t = unit_vector<dim>(x.col(a + 2) - point_, "the string after the edge");
-    x.col(a + 1) = point_ + nudge * t;
+  const int c = l_minus < nudge ? link_ : h - l_minus < nudge ? link_ + 1 : -1;
+  if (c >= 0) {
+    if (c == 0 || c + 1 >= this->m_.n)
+      throw InputError("the edge point is on an end node of the string: an edge needs string on both sides");
+    const Vec<dim> tm = unit_vector<dim>(point_ - x.col(c - 1), "the string before the edge");
+    const Vec<dim> tp = unit_vector<dim>(x.col(c + 1) - point_, "the string after the edge");
+    for (int i = 0; i < this->m_.n; ++i)
+      model.move_initial_node(i, Vec<dim>(x.col(i) - nudge * (i <= c ? tm : tp)));
+    link_ = c;
   }
+  const int a = link_;
   model.bend_link(a, point_);
   if (table_ == EdgeSpec<dim>::Table::kNone) return;
   // The table: the face the string on its side lies on, through x0, normal to that side's tangent, on

@@ -221,6 +221,12 @@ class StringModel final : public OdeSystem {
   /// tension system. Link elements only; implicit methods refuse a bent link (its linearisation is not
   /// written). Replaces any earlier bend of the same link.
   void bend_link(int link, const Vec<dim>& point);
+  /// Moves node `node` of the initial shape (and of the current state) to `x`: a module placing its
+  /// fronts before the start (an edge moves a node off its point).
+  void move_initial_node(int node, const Vec<dim>& x) {
+    chain_.positions().col(node) = x;
+    x_.col(node) = x;
+  }
   /// Straightens every bent link.
   void clear_bends() { bends_.clear(); }
   /// The force the points of the bent links exert on the string after an evaluation (N): Σ T (e⁻ − e⁺).
