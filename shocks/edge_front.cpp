@@ -127,6 +127,11 @@ void EdgeFront<dim>::evaluate(const StringModel<dim>& model, FrontState<dim>& s,
   const double lm = to_a.norm(), lp = from_b.norm();
   t_minus_ = unit_vector<dim>(to_a, "the bent link before the edge");
   t_plus_ = unit_vector<dim>(from_b, "the bent link after the edge");
+  // A trial stage that carries node a (or b) past x0 by more than kOvershoot h is refused (the
+  // integrator retries a shorter step): past x0 the bent link's geometry turns back on itself, so
+  // a step over a crossing must end within that distance, where the crossing's root is located.
+  if (g_minus(model) < -kOvershoot * h || g_plus(model) < -kOvershoot * h)
+    throw RecoverableError(fmt::format("a node of link {} has passed the edge within a step", a));
   // ṡ0 = dl⁻/dt = −dl⁺/dt (the bent link keeps l⁻ + l⁺ = h): the − side gains material at ṡ0.
   const double s0_dot = -t_plus_.dot(v.col(b));
   jump_ = jump::pinned_tension_plus<dim>(0.0, t_minus_, t_plus_, this->dissipation, lambda, s0_dot);
@@ -213,11 +218,14 @@ EventAction EdgeFront<dim>::cross(StringModel<dim>& model, const FrontState<dim>
   const double h = this->m_.h, past = kMirror * kCross * h;
   const int sign = e0 != 0 ? +1 : -1;
   const double delta = e0 != 0 ? g_minus(model) : g_plus(model);
-  const Vec<dim> shift_minus = sign * (delta + past) * t_minus_, shift_plus = sign * (delta + past) * t_plus_;
-  for (int i = arc.first; i <= arc.last; ++i) {
-    if (i == node || model.is_prescribed(i)) continue;
-    x.col(i) += i < node ? shift_minus : shift_plus;
-  }
+  // A side held by a prescribed node stays (the projection then moves the crossing node instead).
+  bool held_minus = false, held_plus = false;
+  for (int i = arc.first; i <= arc.last; ++i)
+    if (i != node && model.is_prescribed(i)) (i < node ? held_minus : held_plus) = true;
+  const Vec<dim> shift_minus = held_minus ? Vec<dim>::Zero() : Vec<dim>(sign * (delta + past) * t_minus_);
+  const Vec<dim> shift_plus = held_plus ? Vec<dim>::Zero() : Vec<dim>(sign * (delta + past) * t_plus_);
+  for (int i = arc.first; i <= arc.last; ++i)
+    if (i != node) x.col(i) += i < node ? shift_minus : shift_plus;
   if (e0 != 0) {
     x.col(a) = point_ + past * t_plus_;
     v.col(a) = rotate_onto<dim>(v.col(a), t_minus_, t_plus_, axis_);

@@ -52,6 +52,8 @@ class EdgeFront final : public FrontKind<dim> {
   static constexpr double kCross = 1e-8;
   /// How far past x0 the crossing node is put (in kCross h): past the other root function's zero.
   static constexpr double kMirror = 2;
+  /// How far past x0 (in links) a trial stage may carry the bent link's node before it is refused.
+  static constexpr double kOvershoot = 1e-3;
 
   explicit EdgeFront(const EdgeSpec<dim>& spec);
 

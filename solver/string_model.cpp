@@ -248,12 +248,20 @@ void StringModel<dim>::bend_links() {
     bend.l_minus = to_a.norm();
     bend.l_plus = from_b.norm();
     const double floor = kBentLinkFloor * chain_.link_length(j);
-    if (!(bend.l_minus > floor) || !(bend.l_plus > floor) || !std::isfinite(bend.l_minus + bend.l_plus))
+    // A node within the floor of the point (a root function's search may pass there) keeps the
+    // direction of its side from the last evaluation.
+    const bool near_minus = !(bend.l_minus > floor) && bend.e_minus_last.squaredNorm() > 0;
+    const bool near_plus = !(bend.l_plus > floor) && bend.e_plus_last.squaredNorm() > 0;
+    if (near_minus) bend.l_minus = floor;
+    if (near_plus) bend.l_plus = floor;
+    if (!(bend.l_minus > 0) || !(bend.l_plus > 0) || !std::isfinite(bend.l_minus + bend.l_plus))
       throw RecoverableError(fmt::format("link {} has reached the point it is bent over ({:g} and {:g} m from it)", j,
                                          bend.l_minus, bend.l_plus));
     l_[j] = bend.l_minus + bend.l_plus;
-    e_.col(j) = to_a / bend.l_minus;
-    bend.e_plus = from_b / bend.l_plus;
+    e_.col(j) = near_minus ? bend.e_minus_last : Vec<dim>(to_a / bend.l_minus);
+    bend.e_plus = near_plus ? bend.e_plus_last : Vec<dim>(from_b / bend.l_plus);
+    bend.e_minus_last = e_.col(j);
+    bend.e_plus_last = bend.e_plus;
   }
 }
 

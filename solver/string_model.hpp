@@ -324,6 +324,7 @@ class StringModel final : public OdeSystem {
     int link = -1;
     Vec<dim> point = Vec<dim>::Zero();
     Vec<dim> e_plus = Vec<dim>::Zero();
+    Vec<dim> e_minus_last = Vec<dim>::Zero(), e_plus_last = Vec<dim>::Zero();  // of the last evaluation
     double l_minus = 0, l_plus = 0;
   };
   std::vector<Bend> bends_;
