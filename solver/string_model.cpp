@@ -711,7 +711,10 @@ double StringModel<dim>::max_constraint_violation(double t, const Eigen::Ref<con
   double worst = 0;
   for_each_link([&](int j, int, int) {
     const double h = chain_.link_length(j);
-    const double l = (position(chain_.link_end(j)) - position(chain_.link_start(j))).norm();
+    const Vec<dim> a = position(chain_.link_start(j)), b = position(chain_.link_end(j));
+    double l = (b - a).norm();
+    for (const Bend& bend : bends_)  // a bent link's length runs over its point
+      if (bend.link == j) l = (bend.point - a).norm() + (b - bend.point).norm();
     worst = std::max(worst, std::abs(l - h) / h);
   });
   return worst;

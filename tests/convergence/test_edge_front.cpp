@@ -10,6 +10,8 @@
 #include <vector>
 
 #include "cases/reduced/exact_solutions.hpp"
+#include "cases/scene/front_scene.hpp"
+#include "cases/scene/scene.hpp"
 #include "mesh/discretize.hpp"
 #include "mesh/errors.hpp"
 #include "shocks/edge_front.hpp"
@@ -213,4 +215,60 @@ TEST_CASE("edge: a coarse mesh (5 nodes) is still exact", "[edge]") {
   const double x_star = exact::edge_lift_off_x(0.0, 0.2, 1.0, kG);
   CHECK(coarse.t_lift == Approx(exact::edge_time(0.0, x_star, 0.2, 1.0, kG)).epsilon(1e-6));
   CHECK(coarse.x_error < 1e-7);
+}
+
+TEST_CASE("edge: bad [[effects.edge]] keys are refused with file:line, the key, the value and the range", "[edge][scene]") {
+  const std::string scene = R"([string]
+length = 1.0
+nodes = 21
+
+[shape]
+kind = "polyline"
+points = [[-0.8, 0.0], [0.0, 0.0], [0.0, -0.2]]
+
+[effects.gravity]
+g = [0.0, -9.81]
+
+[[effects.edge]]
+point = [0.0, 0.0]
+f = 0.0
+table = "before"
+
+[stop]
+t_end = 1.0
+)";
+  auto error = [&](const std::string& text) -> std::string {
+    try {
+      const SceneSpec spec = parse_scene_text(text, "s.toml");
+      if (spec.dimension == 3)
+        build_front_scene<3>(spec);
+      else
+        build_front_scene<2>(spec);
+    } catch (const InputError& e) {
+      return e.what();
+    }
+    return "";
+  };
+  auto edit = [](std::string text, const std::string& from, const std::string& to) {
+    const std::size_t at = text.find(from);
+    REQUIRE(at != std::string::npos);
+    return text.replace(at, from.size(), to);
+  };
+  CHECK(error(scene).empty());
+  using Catch::Matchers::Contains;
+  CHECK_THAT(error(edit(scene, "f = 0.0", "f = 1.5")),
+             Contains("s.toml:14:5: effects.edge[0].f = 1.5") && Contains("0 <= f <= 1"));
+  CHECK_THAT(error(edit(scene, "point = [0.0, 0.0]", "point = [0.1, 0.3]")),
+             Contains("s.toml:13:9: effects.edge[0].point = [0.1, 0.3] is not on the string") &&
+                 Contains("passes 0.316228 m from it") && Contains("allowed within 1e-06 m"));
+  const std::string scene3 =
+      edit(edit(edit(edit(scene, "nodes = 21", "nodes = 21\ndimension = 3"),
+                     "[[-0.8, 0.0], [0.0, 0.0], [0.0, -0.2]]", "[[-0.8, 0.0, 0.0], [0.0, 0.0, 0.0], [0.0, -0.2, 0.0]]"),
+                "g = [0.0, -9.81]", "g = [0.0, -9.81, 0.0]"),
+           "point = [0.0, 0.0]", "point = [0.0, 0.0, 0.0]");
+  CHECK_THAT(error(scene3), Contains("effects.edge[0] has no direction") && Contains("direction = [dx, dy, dz] (nonzero)"));
+  CHECK_THAT(error(edit(scene3, "f = 0.0", "f = 0.0\ndirection = [0.0, 0.0, 0.0]")),
+             Contains("effects.edge[0].direction = [0.0, 0.0, 0.0] is not a direction") &&
+                 Contains("allowed a finite nonzero vector"));
+  CHECK(error(edit(scene3, "f = 0.0", "f = 0.0\ndirection = [0.0, 0.0, 1.0]")).empty());
 }
