@@ -114,7 +114,7 @@ void FoldFront<dim>::crossings(const StringModel<dim>& /*model*/, const FrontSta
 }
 
 template <int dim>
-void FoldFront<dim>::checks(const FrontState<dim>& s, double* g) const {
+void FoldFront<dim>::checks(const StringModel<dim>& /*model*/, const FrontState<dim>& s, double* g) const {
   g[0] = std::min(std::cos(s.opening) - std::cos(kMaxOpeningDeg * kPi / 180), max_chord() - chord_);
 }
 

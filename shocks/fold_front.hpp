@@ -44,7 +44,7 @@ class FoldFront final : public FrontKind<dim> {
   /// One: positive while the arms are within kMaxOpeningDeg of antiparallel and the folded link's
   /// material spans its chord.
   int num_checks() const override { return 1; }
-  void checks(const FrontState<dim>& state, double* g) const override;
+  void checks(const StringModel<dim>& model, const FrontState<dim>& state, double* g) const override;
   std::string check_failed(const StringModel<dim>& model, const FrontState<dim>& state, double t) const override;
 
  private:

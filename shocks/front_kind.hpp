@@ -84,8 +84,9 @@ class FrontKind {
   virtual void trim(FrontLayout& /*layout*/) const {}
   /// Second pass, in order of s: split the moving part and take the arcs on either side.
   virtual void cut(FrontLayout& layout) = 0;
-  /// Checks of the initial shape before the first evaluation (InputError).
-  virtual void initialize(const StringModel<dim>& /*model*/) {}
+  /// Checks of the initial shape before the first evaluation (InputError); a kind may set up the
+  /// string there (an edge bends the link it lies in, StringModel::bend_link).
+  virtual void initialize(StringModel<dim>& /*model*/) {}
   /// Checks of the initial state after the first evaluation (InputError).
   virtual void check_initial(const FrontState<dim>& /*state*/) const {}
 
@@ -123,10 +124,23 @@ class FrontKind {
   virtual EventAction cross(StringModel<dim>& model, const FrontState<dim>& state, int e0) = 0;
   /// Root functions of the front's own that stop the run (positive while it may go on).
   virtual int num_checks() const { return 0; }
-  virtual void checks(const FrontState<dim>& /*state*/, double* /*g*/) const {}
+  virtual void checks(const StringModel<dim>& /*model*/, const FrontState<dim>& /*state*/, double* /*g*/) const {}
   virtual std::string check_failed(const StringModel<dim>& /*model*/, const FrontState<dim>& /*state*/,
                                    double /*t*/) const {
     return {};
+  }
+  /// Whether `checks` read the string's tensions (then the string solves for them before the root
+  /// functions are evaluated).
+  virtual bool checks_need_tensions() const { return false; }
+  /// The physical event a failed check is (the run's summary lists it in `events`), if any.
+  virtual std::optional<RunEvent> check_event(const StringModel<dim>& /*model*/, const FrontState<dim>& /*state*/,
+                                              double /*t*/) const {
+    return std::nullopt;
+  }
+  /// The force of the front's obstacle or support on the string that the outputs show (R_front<k>
+  /// in forces.csv), after an evaluation: by default the state's reaction.
+  virtual Vec<dim> recorded_reaction(const StringModel<dim>& /*model*/, const FrontState<dim>& state) const {
+    return state.reaction;
   }
 
  protected:

@@ -139,6 +139,11 @@ std::optional<double> FrontTracker<dim>::front_tension_at(const StringModel<dim>
 }
 
 template <int dim>
+bool FrontTracker<dim>::events_need_tensions() const {
+  return std::any_of(fronts_.begin(), fronts_.end(), [](const auto& front) { return front->checks_need_tensions(); });
+}
+
+template <int dim>
 void FrontTracker<dim>::ledger_rates(const StringModel<dim>& model, Eigen::Ref<Eigen::VectorXd> rates) const {
   // [ W_shocks | W_heaps | impulse | heap moment ]: the external forces on the string are the
   // string's (applied forces, prescribed nodes' reactions) plus the fronts' supports' reactions.
@@ -193,9 +198,10 @@ template <int dim>
 void FrontTracker<dim>::fill(const StringModel<dim>& model, const Eigen::Ref<const Eigen::VectorXd>& ledger,
                              ModuleLedger<dim>& out) const {
   out.fronts.clear();
-  for (const FrontState<dim>& s : fs_) {
-    FrontRecord<dim> r{s.s0, s.s0_dot, s.position, s.reaction, {s.heap ? 1.0 : 0.0}};
-    for (int d = 0; d < dim; ++d) r.fields.push_back(s.reaction[d]);
+  for (std::size_t k = 0; k < fs_.size(); ++k) {
+    const FrontState<dim>& s = fs_[k];
+    FrontRecord<dim> r{s.s0, s.s0_dot, s.position, fronts_[k]->recorded_reaction(model, s), {s.heap ? 1.0 : 0.0}};
+    for (int d = 0; d < dim; ++d) r.fields.push_back(r.reaction[d]);
     for (int d = 0; d < dim; ++d) r.fields.push_back(s.plane_normal[d]);
     out.fronts.push_back(std::move(r));
   }
@@ -219,7 +225,7 @@ void FrontTracker<dim>::events(const StringModel<dim>& model, Eigen::Ref<Eigen::
   // Then each front's own checks, positive while the run may go on.
   int q = 2 * static_cast<int>(fronts_.size()) + static_cast<int>(options_.stop_at.size());
   for (std::size_t k = 0; k < fronts_.size(); ++k) {
-    fronts_[k]->checks(fs_[k], g.data() + q);
+    fronts_[k]->checks(model, fs_[k], g.data() + q);
     q += fronts_[k]->num_checks();
   }
 }
@@ -246,7 +252,13 @@ EventAction FrontTracker<dim>::handle_events(StringModel<dim>& model, double t, 
               fmt::format("front {} reached s0 = {:.9g} m", options_.stop_at[k].front, options_.stop_at[k].s)};
   for (std::size_t k = 0, q = static_cast<std::size_t>(2 * nf) + options_.stop_at.size(); k < fronts_.size(); ++k)
     for (int c = 0; c < fronts_[k]->num_checks(); ++c)
-      if (found[q++] != 0) return {EventAction::Kind::kStop, fronts_[k]->check_failed(model, fs_[k], t)};
+      if (found[q++] != 0) {
+        if (std::optional<RunEvent> event = fronts_[k]->check_event(model, fs_[k], t)) {
+          event->front = static_cast<int>(k);
+          events_.push_back(std::move(*event));
+        }
+        return {EventAction::Kind::kStop, fronts_[k]->check_failed(model, fs_[k], t)};
+      }
   // Energy, momentum and held masses before, to book what the crossing changes.
   const double E_before = model.kinetic_energy() + model.potential_energy(ledger);
   const Vec<dim> p_before = model.momentum();

@@ -138,6 +138,8 @@ class FrontTracker final : public StringModule<dim> {
   /// The tension at an arc's end node on its front's side, after an evaluation: the end tension of
   /// the jump conditions (τ at a heap, τ∓ at a fold), which its partial link carries to the node.
   std::optional<double> front_tension_at(const StringModel<dim>& model, int node) const override;
+  bool events_need_tensions() const override;
+  std::vector<RunEvent> run_events() const override { return events_; }
 
  private:
   int num_checks() const;
@@ -146,6 +148,7 @@ class FrontTracker final : public StringModule<dim> {
   FrontMaterial material_;
   std::vector<std::unique_ptr<FrontKind<dim>>> fronts_;
   std::vector<FrontState<dim>> fs_;
+  std::vector<RunEvent> events_;
   long transfers_ = 0;
   double w_remesh_ = 0;
   Vec<dim> heap_moment0_ = Vec<dim>::Zero();  // Σ held mass × its first moment at t = 0

@@ -231,7 +231,7 @@ typename HeapFront<dim>::End HeapFront<dim>::end(const StringModel<dim>& model) 
 }
 
 template <int dim>
-void HeapFront<dim>::initialize(const StringModel<dim>& model) {
+void HeapFront<dim>::initialize(StringModel<dim>& model) {
   if (pot_ && !on_plane_) {  // a pinned pot's mouth: the tangent at the front of the initial string
     const End e = end(model);
     const int links = model.arcs()[static_cast<std::size_t>(e.arc)].num_links();

@@ -48,7 +48,7 @@ class HeapFront final : public FrontKind<dim> {
 
   void trim(FrontLayout& layout) const override;
   void cut(FrontLayout& layout) override;
-  void initialize(const StringModel<dim>& model) override;
+  void initialize(StringModel<dim>& model) override;
   void evaluate(const StringModel<dim>& model, FrontState<dim>& state, Eigen::VectorXd& mass,
                 Points<dim>& force) override;
   std::optional<double> tension_at(const StringModel<dim>& model, const FrontState<dim>& state,

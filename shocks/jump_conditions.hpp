@@ -33,6 +33,7 @@
 ///
 /// Reversing the orientation of s (s → ℓ − s) flips t and ṡ0 and swaps the sides; every formula
 /// here is invariant under that change (tested).
+#include <algorithm>
 #include <cmath>
 
 #include <Eigen/Core>
@@ -200,6 +201,19 @@ template <int dim>
 Eigen::Vector2d pinned_cone(const Vector<dim>& force, const Vector<dim>& n_minus, const Vector<dim>& n_plus) {
   const double c = n_minus.dot(n_plus), fm = force.dot(n_minus), fp = force.dot(n_plus), det = 1 - c * c;
   return Eigen::Vector2d((fm - c * fp) / det, (fp - c * fm) / det);
+}
+
+/// The lift-off margin of a pinned front: min(F·P t⁻, −F·P t⁺), P = I − d dᵀ the projection normal to
+/// the edge's line d (`axis`; in 2D the out-of-plane axis, P t = t). F lies in the normal cone of
+/// pinned_cone exactly where both are ≥ 0: P t⁻ is normal to n⁻ and points to n⁺'s side, −P t⁺ is
+/// normal to n⁺ and points to n⁻'s side, so the two have the signs of β and α (pinned_cone) with
+/// positive factors (sin θ). Unlike pinned_cone it stays defined at a 180° kink (a peg: n⁻ = −n⁺, the
+/// cone the half-space F·t⁻ ≥ 0, lift-off where F0 reaches zero) and needs no face normals.
+template <int dim>
+double pinned_lift_off_margin(const Vector<dim>& force, const Vector<dim>& t_minus, const Vector<dim>& t_plus,
+                              const Vector<dim>& axis) {
+  const Vector<dim> pm = t_minus - t_minus.dot(axis) * axis, pp = t_plus - t_plus.dot(axis) * axis;
+  return std::min(force.dot(pm), -force.dot(pp));
 }
 
 }  // namespace chainsim::jump

@@ -17,6 +17,9 @@ namespace {
 /// A link shorter than this fraction of its material length is a trial state the model cannot use
 /// (the unit vector e_j is undefined): ARKODE retries with a smaller step.
 constexpr double kCollapsedLink = 1e-6;
+/// A bent link's part on either side of its point may be this short (a node crossing an edge passes
+/// within 1e-8 h of it, shocks/edge_front.hpp).
+constexpr double kBentLinkFloor = 1e-10;
 /// The projection is converged when every link length is right to the larger of this relative
 /// accuracy and the round-off of its coordinates, kRoundoffUlps · ε · max|x| / h_min: a link's length
 /// cannot be represented more accurately than its end points' coordinates.
@@ -266,13 +269,21 @@ void StringModel<dim>::bend_links() {
     const Vec<dim> to_a = bend.point - x_.col(a), from_b = x_.col(b) - bend.point;
     bend.l_minus = to_a.norm();
     bend.l_plus = from_b.norm();
-    const double floor = kCollapsedLink * chain_.link_length(j);
-    if (!(bend.l_minus > floor) || !(bend.l_plus > floor) || !std::isfinite(bend.l_minus + bend.l_plus))
+    const double floor = kBentLinkFloor * chain_.link_length(j);
+    // A node within the floor of the point (a root function's search may pass there) keeps the
+    // direction of its side from the last evaluation.
+    const bool near_minus = !(bend.l_minus > floor) && bend.e_minus_last.squaredNorm() > 0;
+    const bool near_plus = !(bend.l_plus > floor) && bend.e_plus_last.squaredNorm() > 0;
+    if (near_minus) bend.l_minus = floor;
+    if (near_plus) bend.l_plus = floor;
+    if (!(bend.l_minus > 0) || !(bend.l_plus > 0) || !std::isfinite(bend.l_minus + bend.l_plus))
       throw RecoverableError(fmt::format("link {} has reached the point it is bent over ({:g} and {:g} m from it)", j,
                                          bend.l_minus, bend.l_plus));
     l_[j] = bend.l_minus + bend.l_plus;
-    e_.col(j) = to_a / bend.l_minus;
-    bend.e_plus = from_b / bend.l_plus;
+    e_.col(j) = near_minus ? bend.e_minus_last : Vec<dim>(to_a / bend.l_minus);
+    bend.e_plus = near_plus ? bend.e_plus_last : Vec<dim>(from_b / bend.l_plus);
+    bend.e_minus_last = e_.col(j);
+    bend.e_plus_last = bend.e_plus;
   }
 }
 
@@ -290,6 +301,12 @@ void StringModel<dim>::bend_couplings() {
     for (const Bend& bend : bends_)
       if (bend.link == j) system_->set_coupling(u, w_[chain_.link_end(j)] * bend.e_plus.dot(e_.col(next)));
   });
+}
+
+template <int dim>
+double StringModel<dim>::link_tension(int link) const {
+  const int u = link_unknown_[static_cast<std::size_t>(link)];
+  return u >= 0 && system_ ? system_->solution()[u] : std::numeric_limits<double>::quiet_NaN();
 }
 
 template <int dim>
@@ -435,6 +452,7 @@ double StringModel<dim>::evaluate_current(double t) {
     if (module_)
       external_ += force_.col(i) + force_nc_.col(i) + (path_of_[i] >= 0 ? Vec<dim>(reaction_.col(path_of_[i])) : Vec<dim>::Zero());
   }
+  if (module_ && !bends_.empty()) external_ += bend_reaction();  // the points the links are bent over
   return power;
 }
 
@@ -457,7 +475,10 @@ template <int dim>
 void StringModel<dim>::events(double t, const Eigen::Ref<const Eigen::VectorXd>& y, Eigen::Ref<Eigen::VectorXd> g) {
   if (!module_) return;
   unpack_state(t, y);
-  refresh();
+  if (module_->events_need_tensions())
+    evaluate_current(t);
+  else
+    refresh();
   module_->events(*this, g);
 }
 
@@ -712,7 +733,10 @@ double StringModel<dim>::max_constraint_violation(double t, const Eigen::Ref<con
   for_each_link([&](int j, int, int) {
     if (link_slack(j)) return;
     const double h = chain_.link_length(j);
-    const double l = (position(chain_.link_end(j)) - position(chain_.link_start(j))).norm();
+    const Vec<dim> a = position(chain_.link_start(j)), b = position(chain_.link_end(j));
+    double l = (b - a).norm();
+    for (const Bend& bend : bends_)  // a bent link's length runs over its point
+      if (bend.link == j) l = (bend.point - a).norm() + (b - bend.point).norm();
     worst = std::max(worst, std::abs(l - h) / h);
   });
   return worst;

@@ -270,10 +270,18 @@ class StringModel final : public OdeSystem {
   /// tension system. Link elements only; implicit methods refuse a bent link (its linearisation is not
   /// written). Replaces any earlier bend of the same link.
   void bend_link(int link, const Vec<dim>& point);
+  /// Moves node `node` of the initial shape (and of the current state) to `x`: a module placing its
+  /// fronts before the start (an edge moves a node off its point).
+  void move_initial_node(int node, const Vec<dim>& x) {
+    chain_.positions().col(node) = x;
+    x_.col(node) = x;
+  }
   /// Straightens every bent link.
   void clear_bends() { bends_.clear(); }
   /// The force the points of the bent links exert on the string after an evaluation (N): Σ T (e⁻ − e⁺).
   Vec<dim> bend_reaction() const;
+  /// The tension of link `link` after an evaluation (N): its multiplier; NaN for a link in no arc.
+  double link_tension(int link) const;
   const Points<dim>& accelerations() const { return a_; }
   /// The sum of the uniform fields the forces declare (Force::uniform_field; gravity's g, zero
   /// without one): the weight per unit mass in the physical scales, and what the module books for
@@ -303,7 +311,7 @@ class StringModel final : public OdeSystem {
   /// Recomputes the masses (and the module's fronts) at the current x(), v(); no tension solve.
   void refresh();
   /// Sum over the moving nodes of the applied forces and the prescribed nodes' support reactions,
-  /// after an evaluation (N).
+  /// and the force of the points the links are bent over (bend_reaction), after an evaluation (N).
   const Vec<dim>& external_force() const { return external_; }
   /// Sum of the prescribed nodes' support reactions on the string, after an evaluation (N).
   Vec<dim> support_reaction() const;
@@ -373,6 +381,7 @@ class StringModel final : public OdeSystem {
     int link = -1;
     Vec<dim> point = Vec<dim>::Zero();
     Vec<dim> e_plus = Vec<dim>::Zero();
+    Vec<dim> e_minus_last = Vec<dim>::Zero(), e_plus_last = Vec<dim>::Zero();  // of the last evaluation
     double l_minus = 0, l_plus = 0;
   };
   std::vector<Bend> bends_;

@@ -20,6 +20,7 @@
 /// A string without a module runs the same code with one arc and none of these.
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <Eigen/Core>
@@ -52,6 +53,16 @@ struct FrontRecord {
   /// The module's further values for the ParaView fronts, in the order of StringModule::front_fields()
   /// (a vector field: dim values).
   std::vector<double> fields;
+};
+
+/// A physical event a module located during the run (the summary's `events`): its kind ("lift_off"),
+/// time (s), front, position (m, dim components) and further named values.
+struct RunEvent {
+  std::string kind;
+  double t = 0;
+  int front = -1;
+  std::vector<double> position;
+  std::vector<std::pair<std::string, double>> values;
 };
 
 /// A field of the ParaView fronts that the module adds (a point-data array of fronts_XXXX.vtp).
@@ -138,6 +149,11 @@ class StringModule {
   /// after an evaluation; nothing if no front is next to it. A prescribed node whose arc has no full
   /// link (a front at the fixed end) reports this tension: the one-sided limit at the node.
   virtual std::optional<double> front_tension_at(const StringModel<dim>& model, int node) const = 0;
+  /// Whether the root functions read the tensions (then the string evaluates its tension system
+  /// before events(), else it only refreshes the module's masses and forces).
+  virtual bool events_need_tensions() const { return false; }
+  /// The physical events of the run so far (e.g. a chain lifting off an edge), for the run's summary.
+  virtual std::vector<RunEvent> run_events() const { return {}; }
 };
 
 }  // namespace chainsim

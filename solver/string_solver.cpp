@@ -109,6 +109,12 @@ nlohmann::json to_json(const RunSummary& s) {
                       {"frames", s.frames},
                       {"samples", s.samples.size()},
                       {"stats", to_json(s.stats)}};
+  j["events"] = nlohmann::json::array();
+  for (const RunEvent& e : s.events) {
+    nlohmann::json event = {{"kind", e.kind}, {"t", e.t}, {"front", e.front}, {"position", e.position}};
+    for (const auto& [name, value] : e.values) event[name] = value;
+    j["events"].push_back(std::move(event));
+  }
   j.update(model_json(s));
   nlohmann::json slack = {{"policy", to_string(s.slack_policy)}, {"detected", s.slack.has_value()}};
   if (s.slack)
@@ -381,6 +387,7 @@ const RunSummary& StringSolver<dim>::run() {
     summary_.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     summary_.tension_solves = model_.tension_solves() - solves_before;
     summary_.transfers = (model_.module() ? model_.module()->transfers() : 0) - transfers_before;
+    summary_.events = model_.module() ? model_.module()->run_events() : std::vector<RunEvent>{};
     if (integrator) {
       summary_.stats = integrator->stats();
       summary_.t_stop = integrator->time();

@@ -175,6 +175,9 @@ struct RunSummary {
   /// link at it, N); per front k, R_front{k}_x.. (the force of the front's support on the string at
   /// the front, N; zero for a front without one).
   std::vector<std::string> force_columns;
+  /// The physical events the module located (StringModule::run_events), in the summary's `events`:
+  /// one JSON object each, {"kind", "t", "front", "position", and the event's values}; empty without.
+  std::vector<RunEvent> events;
   /// energy_drift / energy_scale (0 if the scale is 0).
   double relative_energy_drift() const { return energy_scale > 0 ? energy_drift / energy_scale : 0.0; }
   double relative_energy_residual() const { return relative_energy_drift(); }

@@ -62,6 +62,14 @@ std::string name_fronts(const std::string& reason, const std::vector<std::string
   return fmt::format("the {} front{}", names[k], reason.substr(end));
 }
 
+/// The key a layout refusal of the tracker is located at: the first heap, else the fold, else the first edge.
+template <int dim>
+std::string fit_key_of(const SceneSpec& spec, const std::optional<FoldSpec>& fold, const std::vector<HeapSpec<dim>>& heaps) {
+  if (!heaps.empty()) return "effects.heap[0]";
+  if (fold) return "effects.fold.s0";
+  return spec.effects.edges.empty() ? "effects.fold" : "effects.edge[0]";
+}
+
 }  // namespace
 
 template <int dim>
@@ -75,7 +83,6 @@ std::unique_ptr<StringModel<dim>> build_front_model(const SceneSpec& spec, scene
                                                     StringScene<dim>& scene) {
   CHAINSIM_VERIFY(spec.has_fronts(), "a scene without fronts runs on StringModel (build_string_scene)");
   const auto& fx = spec.effects;
-  const std::string first_front = fx.heaps.empty() ? "effects.fold" : "effects.heap[0]";
 
   // 1. The string, its forces and ends (build_string_scene built them).
   const double ell = parts.length;
@@ -176,6 +183,67 @@ std::unique_ptr<StringModel<dim>> build_front_model(const SceneSpec& spec, scene
     fold = FoldSpec{fx.fold->dissipation, s0};
   }
 
+  // 4b. Edges: where the initial shape passes through each edge's point (its material coordinate s0).
+  std::vector<EdgeSpec<dim>> edges;
+  for (std::size_t k = 0; k < fx.edges.size(); ++k) {
+    const EdgeEntry& entry = fx.edges[k];
+    const std::string key = fmt::format("effects.edge[{}]", k);
+    const Vec<dim> point = as_vec<dim>(spec, entry.point, key + ".point");
+    EdgeSpec<dim> edge;
+    edge.point = point;
+    edge.dissipation = entry.dissipation;
+    edge.table = entry.table == "before"  ? EdgeSpec<dim>::Table::kBefore
+                 : entry.table == "after" ? EdgeSpec<dim>::Table::kAfter
+                                          : EdgeSpec<dim>::Table::kNone;
+    if constexpr (dim == 3) {
+      if (!entry.direction)
+        fail_at(spec, key,
+                fmt::format("{} has no direction: a 3D edge needs its line, direction = [dx, dy, dz] (nonzero)", key));
+      const Vec<dim> dir = as_vec<dim>(spec, *entry.direction, key + ".direction");
+      if (!(dir.norm() > 0) || !std::isfinite(dir.norm()))
+        fail_at(spec, key + ".direction",
+                fmt::format("{}.direction = {} is not a direction: allowed a finite nonzero vector [dx, dy, dz]", key,
+                            text_of(spec, key + ".direction")));
+      edge.axis = dir.normalized();
+    } else if (entry.direction) {
+      const std::vector<double>& dir = *entry.direction;
+      if (dir.size() != 3 || dir[0] != 0 || dir[1] != 0 || dir[2] == 0)
+        fail_at(spec, key + ".direction",
+                fmt::format("{}.direction = {}: in 2D an edge's line is the out-of-plane axis; allowed [0, 0, 1] (or "
+                            "leave it out)",
+                            key, text_of(spec, key + ".direction")));
+    }
+    // The nearest point of the initial shape: the closest of fine samples, refined by golden section.
+    const int samples = std::max(4000, 40 * chain.num_links());
+    double best_s = 0, best = INFINITY;
+    for (int i = 0; i <= samples; ++i) {
+      const double s = ell * i / samples, dist = (parts.curve->point(s) - point).norm();
+      if (dist < best) best = dist, best_s = s;
+    }
+    double lo = std::max(0.0, best_s - ell / samples), hi = std::min(ell, best_s + ell / samples);
+    for (int it = 0; it < 100 && hi - lo > 1e-15 * ell; ++it) {
+      const double m1 = lo + 0.382 * (hi - lo), m2 = hi - 0.382 * (hi - lo);
+      if ((parts.curve->point(m1) - point).norm() < (parts.curve->point(m2) - point).norm())
+        hi = m2;
+      else
+        lo = m1;
+    }
+    edge.s0 = 0.5 * (lo + hi);
+    best = (parts.curve->point(edge.s0) - point).norm();
+    if (!(best <= kPlaceTolerance * ell))
+      fail_at(spec, key + ".point",
+              fmt::format("{}.point = {} is not on the string: the initial shape passes {:.6g} m from it at the "
+                          "nearest (at s = {:.6g} m); allowed within {:g} m (1e-6 of its length): the string runs over "
+                          "the edge where its initial shape passes through the point",
+                          key, text_of(spec, key + ".point"), best, edge.s0, kPlaceTolerance * ell));
+    if (!(edge.s0 > s_lo && edge.s0 < s_hi) || (fx.fold && std::abs(edge.s0 - fx.fold->s0) < 2 * chain.link_length(0)))
+      fail_at(spec, key + ".point",
+              fmt::format("{}.point = {} is at s = {:.6g} m of the string: allowed inside its moving part, {:g} < s < "
+                          "{:g} m, and two links from a fold",
+                          key, text_of(spec, key + ".point"), edge.s0, s_lo, s_hi));
+    edges.push_back(edge);
+  }
+
   // 5. Stop events: a front reaching a material coordinate inside the string.
   const std::vector<std::string> names = scene_build::front_names(spec);
   const std::vector<int> stop_fronts = scene_build::front_stop_indices(spec);
@@ -187,7 +255,10 @@ std::unique_ptr<StringModel<dim>> build_front_model(const SceneSpec& spec, scene
       fail_at(spec, key,
               fmt::format("{} = {} is outside the string: allowed 0 <= s0 <= {} m", key, text_of(spec, key), ell));
     const std::string& name = names[static_cast<std::size_t>(stop_fronts[k])];
-    const double s_start = name == "fold" ? fx.fold->s0 : name == "heap_start" ? s_lo : s_hi;
+    const double s_start = name == "fold"         ? fx.fold->s0
+                           : name == "heap_start" ? s_lo
+                           : name == "heap_end"   ? s_hi
+                                                  : edges[std::stoul(name.substr(4))].s0;
     if (std::abs(s - s_start) <= kPlaceTolerance * ell)
       fail_at(spec, key,
               fmt::format("{} = {} is where the {} front starts: a stop event needs a front that gets there", key,
@@ -196,16 +267,32 @@ std::unique_ptr<StringModel<dim>> build_front_model(const SceneSpec& spec, scene
   }
 
   // 6. The model (the front tracker's own layout checks, located at the fronts) and the run options.
-  scene.front_names = names;
   nlohmann::json& d = scene.description;
   const StringModelOptions mo = parts.model;
-  const std::string fit_key = fold && heaps.empty() ? "effects.fold.s0" : first_front;
+  const std::string fit_key = fit_key_of(spec, fold, heaps);
+  std::vector<std::string> ordered_names;
   // Located at the front and naming it: the tracker's messages speak of "the heap's plane", "the fold".
+  // The fronts in order of s: heaps and the fold, the edges merged in by their s0 (the names follow,
+  // and the stop events' front indices with them).
   std::unique_ptr<StringModel<dim>> model = at_key(spec, fit_key, [&] {
     try {
-      // The fronts, one kind each, in order of s.
-      std::vector<std::unique_ptr<FrontKind<dim>>> kinds =
-          heap_and_fold_fronts<dim>(heaps, fold, ell, parts.chain.link_length(0));
+      std::vector<std::unique_ptr<FrontKind<dim>>> kinds;
+      std::vector<std::pair<std::unique_ptr<FrontKind<dim>>, std::string>> all;
+      std::vector<std::unique_ptr<FrontKind<dim>>> hf = heap_and_fold_fronts<dim>(heaps, fold, ell, parts.chain.link_length(0));
+      std::size_t n = 0;
+      for (auto& kind : hf) all.emplace_back(std::move(kind), names[n++]);
+      for (std::size_t k = 0; k < edges.size(); ++k)
+        all.emplace_back(std::make_unique<EdgeFront<dim>>(edges[k]), names[n++]);
+      std::stable_sort(all.begin(), all.end(),
+                       [](const auto& p, const auto& q) { return p.first->expected_s0 < q.first->expected_s0; });
+      for (auto& [kind, name] : all) {
+        kinds.push_back(std::move(kind));
+        ordered_names.push_back(name);
+      }
+      for (auto& stop : options.stop_at)
+        stop.front = static_cast<int>(std::find(ordered_names.begin(), ordered_names.end(),
+                                                names[static_cast<std::size_t>(stop.front)]) -
+                                      ordered_names.begin());
       return std::make_unique<StringModel<dim>>(make_front_model<dim>(
           std::move(parts.chain), std::move(parts.forces), std::move(parts.prescribed), std::move(kinds), options, mo));
     } catch (const RecoverableError& e) {  // a degenerate front geometry found while placing the fronts
@@ -215,16 +302,24 @@ std::unique_ptr<StringModel<dim>> build_front_model(const SceneSpec& spec, scene
       throw InputError(fmt::format("{}: {}", fit_key, e.what()));
     }
   });
+  scene.front_names = ordered_names;
   const FrontTracker<dim>& tracker = *front_tracker(*model);
   d["fronts"] = nlohmann::json::array();
-  for (std::size_t k = 0; k < names.size(); ++k) {
+  for (std::size_t k = 0; k < ordered_names.size(); ++k) {
     const auto& front = tracker.fronts()[k];
-    nlohmann::json f = {{"name", names[k]}, {"kind", front.name()},
+    const std::string& name = ordered_names[k];
+    nlohmann::json f = {{"name", name}, {"kind", front.name()},
                         {"f", front.dissipation}};
-    if (names[k] == "fold") {
+    if (name.rfind("edge", 0) == 0) {
+      const std::size_t e = std::stoul(name.substr(4));
+      f["s0"] = edges[e].s0;
+      f["point"] = to_array<dim>(edges[e].point);
+      f["table"] = fx.edges[e].table;
+      if constexpr (dim == 3) f["direction"] = to_array<dim>(edges[e].axis);
+    } else if (name == "fold") {
       f["s0"] = fold->s0;
     } else {
-      const bool start = names[k] == "heap_start";
+      const bool start = name == "heap_start";
       const auto& heap = *std::find_if(fx.heaps.begin(), fx.heaps.end(),
                                        [&](const HeapEntry& e) { return e.side == (start ? "start" : "end"); });
       f["side"] = heap.side;
@@ -239,7 +334,7 @@ std::unique_ptr<StringModel<dim>> build_front_model(const SceneSpec& spec, scene
   d["num_fronts"] = names.size();
   d["stop_events"] = nlohmann::json::array();
   for (const auto& stop : options.stop_at)
-    d["stop_events"].push_back({{"front", names[static_cast<std::size_t>(stop.front)]}, {"s0", stop.s}});
+    d["stop_events"].push_back({{"front", ordered_names[static_cast<std::size_t>(stop.front)]}, {"s0", stop.s}});
   scene.solver.record_steps = true;
   return model;
 }
@@ -255,6 +350,13 @@ nlohmann::json front_summary(const FrontScene<dim>& scene, const RunSummary& run
   if (!run.samples.empty())
     for (std::size_t k = 0; k < scene.front_names.size(); ++k) final_s0[scene.front_names[k]] = run.samples.back().fronts[k].s0;
   j["fronts_final_s0"] = final_s0;
+  // The events name their front.
+  for (auto& event : j["events"])
+    if (event.contains("front") && event["front"].is_number_integer()) {
+      const int k = event["front"].get<int>();
+      if (k >= 0 && static_cast<std::size_t>(k) < scene.front_names.size())
+        event["front"] = scene.front_names[static_cast<std::size_t>(k)];
+    }
   return j;
 }
 

@@ -25,6 +25,7 @@
 #include <nlohmann/json.hpp>
 
 #include "cases/scene/scene.hpp"
+#include "shocks/edge_front.hpp"
 #include "shocks/front_tracker.hpp"
 #include "solver/string_solver.hpp"
 

@@ -34,6 +34,21 @@ void parse_heaps(const Section& effects, Context& ctx) {
   }
 }
 
+/// [[effects.edge]]: edges and pegs the string runs over (their place on the string: front_scene.cpp).
+void parse_edges(const Section& effects, Context& ctx) {
+  const auto tables = table_array(effects, "edge", "edge");
+  for (std::size_t k = 0; k < tables.size(); ++k) {
+    Section e(*tables[k], fmt::format("effects.edge[{}]", k), ctx, {"point", "direction", "f", "table"});
+    if (!e.has("point")) e.missing("point", "m, the edge's point, which the initial shape passes through");
+    EdgeEntry edge;
+    edge.point = e.vector("point");
+    if (e.has("direction")) edge.direction = e.vector("direction");
+    edge.dissipation = e.number_in("f", 0.0, 0.0, 1.0);
+    edge.table = e.choice("table", {"none", "before", "after"}, "none");
+    ctx.spec.effects.edges.push_back(edge);
+  }
+}
+
 }  // namespace
 
 void parse_effects(const Section& top, Context& ctx) {
@@ -52,6 +67,7 @@ void parse_effects(const Section& top, Context& ctx) {
     fx.drag = d.number_in("coefficient", 0.0, 0.0, INFINITY);
   }
   parse_heaps(s, ctx);
+  parse_edges(s, ctx);
   if (s.has("fold")) {
     Section f(subtable(s, "fold"), "effects.fold", ctx, {"s0", "f"});
     if (!f.has("s0")) f.missing("s0", "m, the material coordinate of the fold at t = 0");

@@ -56,7 +56,7 @@ SceneSpec parse_table(const toml::table& root, const SourceText& text) {
 
 const std::vector<EffectTable>& effect_tables() {
   static const std::vector<EffectTable> tables = {
-      {"gravity", false}, {"drag", false}, {"heap", true}, {"fold", false}, {"plane", false}};
+      {"gravity", false}, {"drag", false}, {"heap", true}, {"fold", false}, {"plane", false}, {"edge", true}};
   return tables;
 }
 

@@ -79,6 +79,14 @@ struct FoldEntry {
   double dissipation = 0;  ///< f, in [0, 1]
 };
 
+/// An edge or a peg the string runs over: [[effects.edge]].
+struct EdgeEntry {
+  std::vector<double> point;             ///< the edge's point (m); the initial shape passes through it
+  std::optional<std::vector<double>> direction;  ///< 3D: the edge's line (any length > 0); 2D: the out-of-plane axis
+  double dissipation = 0;                ///< f, in [0, 1]
+  std::string table = "none";            ///< "none" | "before" | "after": the side of the string that lies on a table
+};
+
 /// A smooth rigid plane (the table under a heap): [effects.plane].
 struct PlaneEntry {
   std::vector<double> point;   ///< a point of the plane (m)
@@ -146,9 +154,10 @@ struct SceneSpec {
     std::vector<HeapEntry> heaps;                ///< [[effects.heap]], at most one per side
     std::optional<FoldEntry> fold;               ///< [effects.fold]
     std::optional<PlaneEntry> plane;             ///< [effects.plane]
+    std::vector<EdgeEntry> edges;                ///< [[effects.edge]]
   } effects;
-  /// The scene has a heap or a fold: the string runs with front tracking.
-  bool has_fronts() const { return !effects.heaps.empty() || effects.fold.has_value(); }
+  /// The scene has a heap, a fold or an edge: the string runs with front tracking.
+  bool has_fronts() const { return !effects.heaps.empty() || effects.fold.has_value() || !effects.edges.empty(); }
   // [solver]
   struct Solver {
     std::string method = defaults::kScene.method;

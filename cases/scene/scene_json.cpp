@@ -83,6 +83,13 @@ json effects_json(const SceneSpec::Effects& fx) {
   }
   if (fx.fold) j["fold"] = {{"s0", fx.fold->s0}, {"f", fx.fold->dissipation}};
   if (fx.plane) j["plane"] = {{"point", fx.plane->point}, {"normal", fx.plane->normal}};
+  if (!fx.edges.empty()) {
+    j["edge"] = json::array();
+    for (const EdgeEntry& e : fx.edges) {
+      j["edge"].push_back({{"point", e.point}, {"f", e.dissipation}, {"table", e.table}});
+      if (e.direction) j["edge"].back()["direction"] = *e.direction;
+    }
+  }
   return j;
 }
 

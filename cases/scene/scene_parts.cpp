@@ -314,6 +314,7 @@ std::vector<std::string> front_names(const SceneSpec& spec) {
   if (has_heap("start")) names.push_back("heap_start");
   if (spec.effects.fold) names.push_back("fold");
   if (has_heap("end")) names.push_back("heap_end");
+  for (std::size_t k = 0; k < spec.effects.edges.size(); ++k) names.push_back(fmt::format("edge{}", k));
   return names;
 }
 

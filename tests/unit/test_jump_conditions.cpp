@@ -318,3 +318,30 @@ TEST_CASE("pinned front at any angle, in 3D and with s reversed: the momentum ba
     }
   }
 }
+
+TEST_CASE("pinned front: the lift-off margin has the signs of the normal cone's coordinates, and is defined at a peg",
+          "[unit][shocks][jump][edge]") {
+  // Against pinned_cone (F0 = α n⁻ + β n⁺): margin = min(F·t⁻, −F·t⁺) = min(β, α) sin θ at every turn angle
+  // θ in (0, π), for forces inside and outside the cone.
+  const Vector<2> zero = Vector<2>::Zero();
+  for (const double theta : {0.3, 1.0, 1.5707963267948966, 2.5, 3.0}) {
+    const Vector<2> tm(1.0, 0.0), tp(std::cos(theta), -std::sin(theta));
+    const Vector<2> nm = face_normal<2>(tm, tp - tm), np = face_normal<2>(tp, tp - tm);
+    for (const double a : {-1.0, 0.5, 2.0})
+      for (const double b : {-0.7, 0.3, 1.5}) {
+        const Vector<2> F = a * nm + b * np;
+        const Eigen::Vector2d ab = pinned_cone<2>(F, nm, np);
+        const double margin = pinned_lift_off_margin<2>(F, tm, tp, zero);
+        CHECK_THAT(margin, WithinAbs(std::min(ab[0], ab[1]) * std::sin(theta), 1e-12));
+      }
+  }
+  // A peg: the string turns by 180°, n⁻ = −n⁺ (pinned_cone is singular there); the cone is the half-plane
+  // F·t⁻ ≥ 0, and F0 = (τ⁻ + τ⁺ − 2 λ ṡ0²) t⁻.
+  const Vector<2> up(0.0, 1.0), down(0.0, -1.0);
+  const Vector<2> F0 = pinned_reaction<2>(up, down, 3.0, 4.0, 1.0, 2.0);  // τ∓ = 3, 4 N, λ = 1, ṡ0 = 2
+  CHECK_THAT(F0[1], WithinAbs(3.0 + 4.0 - 8.0, 1e-12));
+  CHECK_THAT(pinned_lift_off_margin<2>(F0, up, down, zero), WithinAbs(-1.0, 1e-12));
+  // In 3D the part of F along the edge's line does not count.
+  const Vector<3> d(0.0, 0.0, 1.0), tm3(1.0, 0.0, 0.5), tp3(0.0, -1.0, 0.5);
+  CHECK_THAT(pinned_lift_off_margin<3>(Vector<3>(1.0, 2.0, 5.0), tm3, tp3, d), WithinAbs(1.0, 1e-12));
+}

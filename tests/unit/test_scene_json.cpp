@@ -34,6 +34,7 @@ TEST_CASE("every effect table of the scene format is written back to scene_effec
       {"fold", "[effects.fold]\ns0 = 0.5\nf = 0.5\n"},
       {"plane", "[[effects.heap]]\nside = \"end\"\ns0 = 0.5\nf = 0.5\npoint = [0.0, -0.5]\non_plane = true\n"
                 "[effects.plane]\npoint = [0.0, -0.5]\nnormal = [0.0, 1.0]\n"},
+      {"edge", "[[effects.edge]]\npoint = [0.0, -0.5]\nf = 0.5\n"},
   };
   REQUIRE(!effect_tables().empty());
   for (const EffectTable& table : effect_tables()) {

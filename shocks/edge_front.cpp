@@ -1,0 +1,283 @@
+// An edge front: see edge_front.hpp (the scheme) and docs/model.md §8 (the physics).
+#include "edge_front.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include <Eigen/Geometry>
+#include <fmt/format.h>
+
+#include "mesh/errors.hpp"
+#include "shocks/jump_conditions.hpp"
+
+namespace chainsim {
+
+namespace {
+
+/// v rotated by the rotation that takes the unit vector `from` to `to` (about their normal; at a
+/// 180° turn about `axis`, or in 2D by π): its length kept.
+template <int dim>
+Vec<dim> rotate_onto(const Vec<dim>& v, const Vec<dim>& from, const Vec<dim>& to, const Vec<dim>& axis) {
+  const double c = from.dot(to);
+  if constexpr (dim == 2) {
+    const double s = from[0] * to[1] - from[1] * to[0];
+    return Vec<dim>(c * v[0] - s * v[1], s * v[0] + c * v[1]);
+  } else {
+    Vec<dim> k = from.cross(to);
+    double s = k.norm();
+    if (s > 1e-12) {
+      k /= s;
+    } else {
+      if (c > 0) return v;
+      // A 180° turn: about the edge's line if it is normal to the string, else any normal to it.
+      k = axis - axis.dot(from) * from;
+      if (!(k.norm() > 1e-6)) k = from.unitOrthogonal();
+      k.normalize();
+      s = 0;
+    }
+    return c * v + s * k.cross(v) + (1 - c) * k.dot(v) * k;  // Rodrigues
+  }
+}
+
+template <int dim>
+std::string show(const Vec<dim>& v) {
+  std::string out = "[";
+  for (int d = 0; d < dim; ++d) out += fmt::format("{}{:.6g}", d ? ", " : "", v[d]);
+  return out + "]";
+}
+
+}  // namespace
+
+void check_edge_dissipation(double f, const std::string& name) {
+  if (!(f >= 0 && f <= 1))
+    throw InputError(fmt::format("{}.f = {} is out of range: allowed 0 <= f <= 1", name, f));
+}
+
+template <int dim>
+EdgeFront<dim>::EdgeFront(const EdgeSpec<dim>& spec) : point_(spec.point), axis_(spec.axis), table_(spec.table) {
+  check_edge_dissipation(spec.dissipation);
+  this->dissipation = spec.dissipation;
+  this->expected_s0 = spec.s0;
+}
+
+template <int dim>
+void EdgeFront<dim>::cut(FrontLayout& layout) {
+  const double h = this->m_.h;
+  const int a = std::clamp(static_cast<int>(std::floor(this->expected_s0 / h)), 0, this->m_.n - 2);
+  if (a < layout.first || a + 1 > layout.last)
+    throw InputError("the edge must lie inside the moving part of the string");
+  link_ = a;
+  this->arc_minus = this->arc_plus = layout.arc;  // the string runs on through the edge
+}
+
+template <int dim>
+void EdgeFront<dim>::initialize(StringModel<dim>& model) {
+  const Points<dim>& x = model.x();
+  const double h = this->m_.h;
+  // The material point s0 on a node c: that node sits on the edge, where the bent link has no
+  // direction. The string is taken as it was just before c reached the edge: the side up to c moves
+  // back from the edge by 2 kCross h along its tangent there, the side after c towards it, each
+  // rigidly (every link keeps its length; the bent link is (c, c + 1)).
+  const double l_minus = this->expected_s0 - model.chain().node_coordinate(link_);
+  const double nudge = 2 * kCross * h;
+  const int c = l_minus < nudge ? link_ : h - l_minus < nudge ? link_ + 1 : -1;
+  if (c >= 0) {
+    if (c == 0 || c + 1 >= this->m_.n)
+      throw InputError("the edge point is on an end node of the string: an edge needs string on both sides");
+    const Vec<dim> tm = unit_vector<dim>(point_ - x.col(c - 1), "the string before the edge");
+    const Vec<dim> tp = unit_vector<dim>(x.col(c + 1) - point_, "the string after the edge");
+    for (int i = 0; i < this->m_.n; ++i)
+      model.move_initial_node(i, Vec<dim>(x.col(i) - nudge * (i <= c ? tm : tp)));
+    link_ = c;
+  }
+  const int a = link_;
+  model.bend_link(a, point_);
+  if (table_ == EdgeSpec<dim>::Table::kNone) return;
+  // The table: the face the string on its side lies on, through x0, normal to that side's tangent, on
+  // the side away from the bend (jump::face_normal).
+  const Vec<dim> tm = unit_vector<dim>(point_ - x.col(a), "the string before the edge");
+  const Vec<dim> tp = unit_vector<dim>(x.col(a + 1) - point_, "the string after the edge");
+  const bool before = table_ == EdgeSpec<dim>::Table::kBefore;
+  if (!((tp - tm).norm() > 1e-9))
+    throw InputError("the string does not turn at the edge: a table needs the string to bend over its edge");
+  table_normal_ = jump::face_normal<dim>(before ? tm : tp, tp - tm);
+  const Vec<dim> g = model.uniform_field();
+  if (g.dot(table_normal_) > 0)
+    throw InputError(fmt::format("the table under the string {} the edge has its outward normal {} along the uniform "
+                                 "field {}: the field pulls the string off it, so no table holds it",
+                                 before ? "before" : "after", show<dim>(table_normal_), show<dim>(g)));
+  const int first = before ? 0 : a + 1, last = before ? a : this->m_.n - 1;
+  for (int i = first; i <= last; ++i) {
+    const double off = table_normal_.dot(x.col(i) - point_);
+    if (std::abs(off) > 1e-6 * this->m_.ell)
+      throw InputError(fmt::format("node {} of the string {} the edge is {:.6g} m off the table (the face through the "
+                                   "edge point with outward normal {}): the string there must lie on it",
+                                   i, before ? "before" : "after", off, show<dim>(table_normal_)));
+  }
+}
+
+template <int dim>
+void EdgeFront<dim>::evaluate(const StringModel<dim>& model, FrontState<dim>& s, Eigen::VectorXd& mass,
+                              Points<dim>& force) {
+  const Points<dim>& x = model.x();
+  const Points<dim>& v = model.v();
+  const double h = this->m_.h, lambda = this->m_.lambda;
+  const int a = link_, b = link_ + 1;
+  const Vec<dim> to_a = point_ - x.col(a), from_b = x.col(b) - point_;
+  const double lm = to_a.norm(), lp = from_b.norm();
+  t_minus_ = unit_vector<dim>(to_a, "the bent link before the edge");
+  t_plus_ = unit_vector<dim>(from_b, "the bent link after the edge");
+  // A trial stage that carries node a (or b) past x0 by more than kOvershoot h is refused (the
+  // integrator retries a shorter step): past x0 the bent link's geometry turns back on itself, so
+  // a step over a crossing must end within that distance, where the crossing's root is located.
+  if (g_minus(model) < -kOvershoot * h || g_plus(model) < -kOvershoot * h)
+    throw RecoverableError(fmt::format("a node of link {} has passed the edge within a step", a));
+  // ṡ0 = dl⁻/dt = −dl⁺/dt (the bent link keeps l⁻ + l⁺ = h): the − side gains material at ṡ0.
+  const double s0_dot = -t_plus_.dot(v.col(b));
+  jump_ = jump::pinned_tension_plus<dim>(0.0, t_minus_, t_plus_, this->dissipation, lambda, s0_dot);
+  s.s0 = model.chain().node_coordinate(a) + lm;
+  s.s0_dot = s0_dot;
+  s.l_minus = lm;
+  s.l_plus = lp;
+  s.direction = t_minus_;
+  s.position = point_;
+  s.power_shock = -jump::pinned_dissipation_rate<dim>(t_minus_, t_plus_, this->dissipation, lambda, s0_dot);
+  s.power_heap = 0;
+  // The partial links' masses (the bent link's lumped halves replaced), the jump as a load on b.
+  mass[a] += lambda * (lm - 0.5 * h);
+  mass[b] += lambda * (lp - 0.5 * h);
+  force.col(b) -= jump_ * t_plus_;
+  // What the edge's support gives the string besides the bent link's T (e⁻ − e⁺), which the string
+  // books itself: the load, the table's support, and the momentum of the material moved from a to b.
+  s.reaction = -jump_ * t_plus_ + lambda * s0_dot * (v.col(a) - v.col(b));
+  if (table_ != EdgeSpec<dim>::Table::kNone) {
+    const bool before = table_ == EdgeSpec<dim>::Table::kBefore;
+    const Vec<dim> g = model.uniform_field();
+    const double gn = g.dot(table_normal_);
+    const int first = before ? 0 : b, last = before ? a : this->m_.n - 1;
+    for (int i = first; i <= last; ++i) {
+      if (!model.in_arc(i) || model.is_prescribed(i)) continue;
+      const Vec<dim> support = -mass[i] * gn * table_normal_;
+      force.col(i) += support;
+      s.reaction += support;
+    }
+  }
+}
+
+template <int dim>
+double EdgeFront<dim>::potential_moment(const StringModel<dim>& model, const FrontState<dim>& s,
+                                        const Vec<dim>& g) const {
+  // The partial links lumped on a and b; their material lies along them, at their midpoints.
+  const double lambda = this->m_.lambda;
+  return lambda * g.dot(0.5 * s.l_minus * (point_ - model.x().col(link_)) +
+                        0.5 * s.l_plus * (point_ - model.x().col(link_ + 1)));
+}
+
+template <int dim>
+double EdgeFront<dim>::g_minus(const StringModel<dim>& model) const {
+  const Points<dim>& x = model.x();
+  const int a = link_;
+  const ArcRange& arc = model.arcs()[static_cast<std::size_t>(this->arc_minus)];
+  const Vec<dim> d = a > arc.first ? Vec<dim>((x.col(a) - x.col(a - 1)).normalized()) : t_minus_;
+  return d.dot(point_ - x.col(a));
+}
+
+template <int dim>
+double EdgeFront<dim>::g_plus(const StringModel<dim>& model) const {
+  const Points<dim>& x = model.x();
+  const int b = link_ + 1;
+  const ArcRange& arc = model.arcs()[static_cast<std::size_t>(this->arc_minus)];
+  const Vec<dim> d = b < arc.last ? Vec<dim>((x.col(b + 1) - x.col(b)).normalized()) : t_plus_;
+  return d.dot(x.col(b) - point_);
+}
+
+template <int dim>
+void EdgeFront<dim>::crossings(const StringModel<dim>& model, const FrontState<dim>& /*s*/, double* g) const {
+  const double h = this->m_.h;
+  g[0] = g_minus(model) / h - kCross;  // node a reaches the edge (material flows to the + side)
+  g[1] = g_plus(model) / h - kCross;   // node b reaches it (material flows back)
+}
+
+template <int dim>
+EventAction EdgeFront<dim>::cross(StringModel<dim>& model, const FrontState<dim>& s, int e0) {
+  Points<dim>& x = model.x();
+  Points<dim>& v = model.v();
+  const int a = link_, b = link_ + 1;
+  const int node = e0 != 0 ? a : b;
+  const int next = e0 != 0 ? a - 1 : b + 1;
+  const ArcRange& arc = model.arcs()[static_cast<std::size_t>(this->arc_minus)];
+  if (next < arc.first || next > arc.last || model.is_prescribed(node))
+    return {EventAction::Kind::kStop,
+            fmt::format("the string's {} (node {}) has reached the edge: its last material slides over it at s0 = "
+                        "{:.9g} m",
+                        next < arc.first ? "first node" : next > arc.last ? "last node" : "held node", node, s.s0)};
+  // The node passes to the other side, kMirror kCross h past x0, its velocity turned with the string
+  // (speed kept). Each side moves on along its tangent at the edge by the node's distance δ to x0 and
+  // that much again: as the string would in the next (δ + kMirror kCross h)/|ṡ0|, rigidly, so that its
+  // links and the new bent link keep their lengths (a straight side exactly).
+  const double h = this->m_.h, past = kMirror * kCross * h;
+  const int sign = e0 != 0 ? +1 : -1;
+  const double delta = e0 != 0 ? g_minus(model) : g_plus(model);
+  // A side held by a prescribed node stays (the projection then moves the crossing node instead).
+  bool held_minus = false, held_plus = false;
+  for (int i = arc.first; i <= arc.last; ++i)
+    if (i != node && model.is_prescribed(i)) (i < node ? held_minus : held_plus) = true;
+  const Vec<dim> shift_minus = held_minus ? Vec<dim>::Zero() : Vec<dim>(sign * (delta + past) * t_minus_);
+  const Vec<dim> shift_plus = held_plus ? Vec<dim>::Zero() : Vec<dim>(sign * (delta + past) * t_plus_);
+  for (int i = arc.first; i <= arc.last; ++i)
+    if (i != node) x.col(i) += i < node ? shift_minus : shift_plus;
+  if (e0 != 0) {
+    x.col(a) = point_ + past * t_plus_;
+    v.col(a) = rotate_onto<dim>(v.col(a), t_minus_, t_plus_, axis_);
+    link_ = a - 1;
+  } else {
+    x.col(b) = point_ - past * t_minus_;
+    v.col(b) = rotate_onto<dim>(v.col(b), t_plus_, t_minus_, axis_);
+    link_ = b;
+  }
+  model.clear_bends();
+  model.bend_link(link_, point_);
+  model.rebuild();
+  model.refresh();
+  return {EventAction::Kind::kTransfer, {}};
+}
+
+template <int dim>
+Vec<dim> EdgeFront<dim>::recorded_reaction(const StringModel<dim>& model, const FrontState<dim>& s) const {
+  const double tm = tension_minus(model);
+  if (!std::isfinite(tm)) return Vec<dim>::Zero();
+  return jump::pinned_reaction<dim>(t_minus_, t_plus_, tm, tm + jump_, this->m_.lambda, s.s0_dot);
+}
+
+template <int dim>
+void EdgeFront<dim>::checks(const StringModel<dim>& model, const FrontState<dim>& s, double* g) const {
+  g[0] = jump::pinned_lift_off_margin<dim>(recorded_reaction(model, s), t_minus_, t_plus_, axis_);
+}
+
+template <int dim>
+std::string EdgeFront<dim>::check_failed(const StringModel<dim>& model, const FrontState<dim>& s, double t) const {
+  return fmt::format("lifted off the edge at t = {:.9g} s: the edge at {} would have to pull the string (its reaction "
+                     "F0 = {} N leaves the edge's normal cone; tensions {:.6g} N before and {:.6g} N after it, "
+                     "material speed {:.6g} m/s, s0 = {:.9g} m)",
+                     t, show<dim>(point_), show<dim>(recorded_reaction(model, s)), tension_minus(model),
+                     tension_plus(model), std::abs(s.s0_dot), s.s0);
+}
+
+template <int dim>
+std::optional<RunEvent> EdgeFront<dim>::check_event(const StringModel<dim>& model, const FrontState<dim>& s,
+                                                    double t) const {
+  RunEvent e;
+  e.kind = "lift_off";
+  e.t = t;
+  e.position.assign(point_.data(), point_.data() + dim);
+  e.values = {{"s0", s.s0},
+              {"s0_dot", s.s0_dot},
+              {"tension_minus", tension_minus(model)},
+              {"tension_plus", tension_plus(model)}};
+  return e;
+}
+
+template class EdgeFront<2>;
+template class EdgeFront<3>;
+
+}  // namespace chainsim

@@ -1,0 +1,108 @@
+#pragma once
+/// @file edge_front.hpp
+/// An edge front (front_kind.hpp): a point fixed in space (a sharp edge, a peg) over which the string
+/// runs, material flowing through it (docs/model.md §8 has the physics, docs/shocks.md the numerics).
+///
+/// The string runs on through the edge in one arc; the link (a, b = a + 1) whose material holds the
+/// edge is bent over the point x0 (StringModel::bend_link): |x0 − x_a| + |x_b − x0| = h, its tension
+/// the multiplier τ⁻ of that constraint. The edge adds
+///   - the partial links' masses: node a carries λ l⁻ of the bent link, node b λ l⁺ (l∓ its two
+///     lengths), so each side's mass is λ × its material length (the scheme is exact for motions
+///     along straight sides, as at a heap);
+///   - the tension jump of its f as a known load on b: τ⁺ = τ⁻ + [τ], [τ] = −½ f λ sgn(ṡ0) ṡ0² |[t]|²
+///     (jump::pinned_tension_plus), which works at −D (jump::pinned_dissipation_rate);
+///   - optionally a table: the string on one side lies on the face through the edge (normal n, fixed
+///     at the start), which holds it against the uniform field's normal component (a known load
+///     −m_i (g·n) n on each of its nodes; no work, the string slides along the face).
+/// The edge's reaction F0 = −[τ t] + λ ṡ0² [t] (jump::pinned_reaction) is what forces.csv shows
+/// (R_front<k>). It can only push: its root function is jump::pinned_lift_off_margin, and where it
+/// reaches zero the chain lifts off the edge and the run stops (an event of the summary).
+/// Crossing: when node a comes within kCross h of x0 (material flowing from the − side to the +
+/// side) it passes to the other side, put just past x0 (x0 + kMirror kCross h t⁺) with its velocity rotated from
+/// t⁻ to t⁺ (its speed kept: no energy lost), and the link before it is bent instead; the same the
+/// other way; each side moves on rigidly by as much (cross()), so that every link keeps its length.
+#include <optional>
+#include <string>
+
+#include "shocks/front_kind.hpp"
+
+namespace chainsim {
+
+/// An edge (or a peg): the string runs over the point `point` at its material coordinate s0.
+template <int dim>
+struct EdgeSpec {
+  /// Which side of the string lies on a face through the edge (a table).
+  enum class Table { kNone, kBefore, kAfter };
+  Vec<dim> point = Vec<dim>::Zero();  ///< x0 (m)
+  double dissipation = 0;             ///< f of the kink, in [0, 1]
+  double s0 = 0;                      ///< the material coordinate where the initial shape passes through x0 (m)
+  /// In 3D the edge's line (unit); in 2D zero (the out-of-plane axis). The lift-off cone lies normal
+  /// to it. The crossing point is held at x0 (it does not slide along the line).
+  Vec<dim> axis = Vec<dim>::Zero();
+  Table table = Table::kNone;
+};
+
+/// f in [0, 1] (InputError naming `name`.f otherwise).
+void check_edge_dissipation(double f, const std::string& name = "edge");
+
+template <int dim>
+class EdgeFront final : public FrontKind<dim> {
+ public:
+  /// Node a crosses the edge when it comes this close to x0 (in links; above the string's collapsed-link floor).
+  static constexpr double kCross = 1e-8;
+  /// How far past x0 the crossing node is put (in kCross h): past the other root function's zero.
+  static constexpr double kMirror = 2;
+  /// How far past x0 (in links) a trial stage may carry the bent link's node before it is refused.
+  static constexpr double kOvershoot = 1e-3;
+
+  explicit EdgeFront(const EdgeSpec<dim>& spec);
+
+  const char* name() const override { return "edge"; }
+  const char* placed() const override { return "edge point"; }
+  const Vec<dim>& point() const { return point_; }
+  /// The bent link (its start node a).
+  int link() const { return link_; }
+
+  void cut(FrontLayout& layout) override;
+  void initialize(StringModel<dim>& model) override;
+  void evaluate(const StringModel<dim>& model, FrontState<dim>& state, Eigen::VectorXd& mass,
+                Points<dim>& force) override;
+  std::optional<double> tension_at(const StringModel<dim>& /*model*/, const FrontState<dim>& /*state*/,
+                                   int /*node*/) const override {
+    return std::nullopt;  // the edge is inside an arc: its bent link carries τ⁻
+  }
+  double potential_moment(const StringModel<dim>& model, const FrontState<dim>& state, const Vec<dim>& g) const override;
+  void crossings(const StringModel<dim>& model, const FrontState<dim>& state, double* g) const override;
+  int second_direction() const override { return -1; }
+  EventAction cross(StringModel<dim>& model, const FrontState<dim>& state, int e0) override;
+  /// One: the lift-off margin (N), positive while the edge pushes.
+  int num_checks() const override { return 1; }
+  void checks(const StringModel<dim>& model, const FrontState<dim>& state, double* g) const override;
+  std::string check_failed(const StringModel<dim>& model, const FrontState<dim>& state, double t) const override;
+  bool checks_need_tensions() const override { return true; }
+  std::optional<RunEvent> check_event(const StringModel<dim>& model, const FrontState<dim>& state,
+                                      double t) const override;
+  /// F0 of the jump conditions at the current tension (without the table's support).
+  Vec<dim> recorded_reaction(const StringModel<dim>& model, const FrontState<dim>& state) const override;
+
+  /// The tensions τ⁻, τ⁺ (N) after an evaluation.
+  double tension_minus(const StringModel<dim>& model) const { return model.link_tension(link_); }
+  double tension_plus(const StringModel<dim>& model) const { return model.link_tension(link_) + jump_; }
+
+ private:
+  /// Signed distances (m) from node a to x0 and from x0 to node b, along the sides' end links: a node
+  /// passing x0 between two steps changes their sign (|x0 − x_a| would not).
+  double g_minus(const StringModel<dim>& model) const;
+  double g_plus(const StringModel<dim>& model) const;
+
+  Vec<dim> point_ = Vec<dim>::Zero();
+  Vec<dim> axis_ = Vec<dim>::Zero();
+  typename EdgeSpec<dim>::Table table_ = EdgeSpec<dim>::Table::kNone;
+  Vec<dim> table_normal_ = Vec<dim>::Zero();  ///< the table's outward unit normal (set at initialize)
+  int link_ = -1;
+  // Of the last evaluation: the tangents on either side, the tension jump [τ] (N).
+  Vec<dim> t_minus_ = Vec<dim>::Zero(), t_plus_ = Vec<dim>::Zero();
+  double jump_ = 0;
+};
+
+}  // namespace chainsim

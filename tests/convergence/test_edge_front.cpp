@@ -1,0 +1,274 @@
+// An edge front (shocks/edge_front.hpp, docs/model.md §8): the chain sliding off a smooth table over
+// a sharp edge against its exact solution (cases/reduced/exact_solutions.hpp: exact::edge_*), the
+// heavy Atwood chain over a peg, the energy ledger with the edge's dissipation booked, and the hard cases.
+#include <catch2/catch.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "cases/reduced/exact_solutions.hpp"
+#include "cases/scene/front_scene.hpp"
+#include "cases/scene/scene.hpp"
+#include "mesh/discretize.hpp"
+#include "mesh/errors.hpp"
+#include "shocks/edge_front.hpp"
+#include "shocks/front_tracker.hpp"
+#include "solver/string_solver.hpp"
+
+using namespace chainsim;
+
+namespace {
+
+constexpr double kG = 9.81;
+
+struct TableRun {
+  RunSummary run;
+  double x_error = 0;        ///< max over the steps of |x − exact::edge_x| (m)
+  double tension_error = 0;  ///< max over the steps of |τ⁻ − λ (ℓ − x) ẍ| (N), the tension at the edge
+  double t_lift = 0;         ///< the lift-off event's time (s)
+};
+
+/// A chain of length 1 m and density 1 kg/m of `links` links lying straight on a table (y = 0, x < 0),
+/// x0 of it hanging over the edge at the origin, released at rest; edge dissipation f.
+TableRun table(int links, double f, double x0, double t_end = 10) {
+  const double ell = 1.0, lambda = 1.0;
+  Points<2> vertices(2, 3);
+  vertices << -(ell - x0), 0.0, 0.0, 0.0, 0.0, -x0;
+  Chain<2> chain = discretize<2>(*polyline_curve<2>(vertices), ell, lambda, links, false);
+  std::vector<std::unique_ptr<Force<2>>> forces;
+  forces.push_back(std::make_unique<Gravity<2>>(Vec<2>(0.0, -kG)));
+  EdgeSpec<2> edge;
+  edge.point = Vec<2>::Zero();
+  edge.dissipation = f;
+  edge.s0 = ell - x0;
+  edge.table = EdgeSpec<2>::Table::kBefore;
+  std::vector<std::unique_ptr<FrontKind<2>>> fronts;
+  fronts.push_back(std::make_unique<EdgeFront<2>>(edge));
+  StringModelOptions model_options;
+  model_options.stabilization_time = 0.02 * std::sqrt(ell / kG);  // as a scene's default
+  StringModel<2> model = make_front_model<2>(std::move(chain), std::move(forces), {}, std::move(fronts),
+                                             FrontOptions{}, model_options);
+  StringSolverOptions options;
+  options.t_end = t_end;
+  options.output_interval = t_end;
+  options.record_steps = true;
+  options.integrator.rtol = 1e-11;
+  options.integrator.atol = 1e-13;
+  StringSolver<2> solver(model, options);
+  TableRun out;
+  out.run = solver.run();
+  for (const StepSample& s : out.run.samples) {
+    const double x = ell - s.s0[0];
+    const double x_exact = exact::edge_x(f, s.t, x0, ell, kG);
+    out.x_error = std::max(out.x_error, std::abs(x - x_exact));
+    const double v = s.s0_dot[0];
+    const double tension = s.forces[0] + lambda * v * v;  // F0·e_x = τ⁻ − λ v²
+    const double tension_exact = lambda * (ell - x_exact) * exact::edge_acceleration(f, x_exact, x0, ell, kG);
+    out.tension_error = std::max(out.tension_error, std::abs(tension - tension_exact));
+  }
+  if (!out.run.events.empty()) out.t_lift = out.run.events.front().t;
+  return out;
+}
+
+
+/// The heavy Atwood chain over a sharp peg at the origin (2D): a chain of 1 m, 1 kg/m, of `links` links
+/// hangs over the peg, x0 on the + side (straight down from the peg), 1 − x0 on the − side (straight
+/// up to it, on the same vertical), released at rest; the peg's dissipation f.
+RunSummary peg(int links, double f, double x0) {
+  const double ell = 1.0, lambda = 1.0;
+  Points<2> vertices(2, 3);
+  vertices << 0.0, 0.0, 0.0, -(ell - x0), 0.0, -x0;
+  Chain<2> chain = discretize<2>(*polyline_curve<2>(vertices), ell, lambda, links, false);
+  std::vector<std::unique_ptr<Force<2>>> forces;
+  forces.push_back(std::make_unique<Gravity<2>>(Vec<2>(0.0, -kG)));
+  EdgeSpec<2> edge;
+  edge.dissipation = f;
+  edge.s0 = ell - x0;
+  std::vector<std::unique_ptr<FrontKind<2>>> fronts;
+  fronts.push_back(std::make_unique<EdgeFront<2>>(edge));
+  StringModelOptions model_options;
+  model_options.stabilization_time = 0.02 * std::sqrt(ell / kG);
+  StringModel<2> model =
+      make_front_model<2>(std::move(chain), std::move(forces), {}, std::move(fronts), FrontOptions{}, model_options);
+  StringSolverOptions options;
+  options.t_end = 10;
+  options.output_interval = 10;
+  options.record_steps = true;
+  options.integrator.rtol = 1e-11;
+  options.integrator.atol = 1e-13;
+  StringSolver<2> solver(model, options);
+  return solver.run();
+}
+
+/// The peg's reduced model, ℓ ẍ = g (2x − ℓ) − 2 f ẋ² (docs/model.md §8), x the longer side, integrated
+/// by classical RK4 with step dt until the peg lets go (τ⁻ + τ⁺ = 2 λ ẋ²) or t_max; x(t) by
+/// linear interpolation of the steps is returned through `at`.
+struct PegReference {
+  std::vector<double> t, x;
+  double t_lift = 0, x_lift = 0;
+  double x_at(double time) const {
+    const auto it = std::upper_bound(t.begin(), t.end(), time);
+    const std::size_t k = std::min<std::size_t>(std::max<std::ptrdiff_t>(it - t.begin(), 1), t.size() - 1);
+    const double w = (time - t[k - 1]) / (t[k] - t[k - 1]);
+    return (1 - w) * x[k - 1] + w * x[k];
+  }
+};
+
+PegReference peg_reference(double f, double x0, double dt) {
+  const double ell = 1.0;
+  auto acc = [&](double x, double v) { return (kG * (2 * x - ell) - 2 * f * v * v) / ell; };
+  // The margin τ⁻ + τ⁺ − 2 λ ẋ² (λ = 1): τ⁻ = (ℓ − x)(g + ẍ) on the rising side, τ⁺ = τ⁻ + 2 f ẋ².
+  auto margin = [&](double x, double v) { return 2 * (ell - x) * (kG + acc(x, v)) + 2 * f * v * v - 2 * v * v; };
+  PegReference r;
+  double x = x0, v = 0, t = 0;
+  r.t.push_back(t);
+  r.x.push_back(x);
+  while (true) {
+    const double k1x = v, k1v = acc(x, v);
+    const double k2x = v + 0.5 * dt * k1v, k2v = acc(x + 0.5 * dt * k1x, v + 0.5 * dt * k1v);
+    const double k3x = v + 0.5 * dt * k2v, k3v = acc(x + 0.5 * dt * k2x, v + 0.5 * dt * k2v);
+    const double k4x = v + dt * k3v, k4v = acc(x + dt * k3x, v + dt * k3v);
+    const double xn = x + dt / 6 * (k1x + 2 * k2x + 2 * k3x + k4x), vn = v + dt / 6 * (k1v + 2 * k2v + 2 * k3v + k4v);
+    const double m0 = margin(x, v), m1 = margin(xn, vn);
+    if (m1 <= 0) {  // linear interpolation of the margin's zero in the step
+      const double w = m0 / (m0 - m1);
+      r.t_lift = t + w * dt;
+      r.x_lift = x + w * (xn - x);
+      return r;
+    }
+    x = xn, v = vn, t += dt;
+    r.t.push_back(t);
+    r.x.push_back(x);
+  }
+}
+
+}  // namespace
+
+TEST_CASE("edge: a chain sliding off a table matches exact::edge_* on every mesh, f = 0 and f > 0", "[edge][convergence]") {
+  // The scheme is exact for motions along straight sides (the partial links' masses make each side's
+  // mass λ × its material length, a crossing moves a node with its speed): the errors are the
+  // integrator's and the crossings' 3e-8 h shifts, the same on every mesh, so no order can be
+  // measured; they are asserted below 1e-7 on four meshes (10 to 80 links) instead.
+  for (const double f : {0.0, 0.5}) {
+    for (const double x0 : {0.2, 0.35}) {
+      const double x_star = exact::edge_lift_off_x(f, x0, 1.0, kG);
+      const double t_star = exact::edge_time(f, x_star, x0, 1.0, kG);
+      for (int links : {11, 21, 41, 81}) {
+        const TableRun r = table(links, f, x0);
+        INFO("f = " << f << ", x0 = " << x0 << ", " << links << " links: " << r.run.stop_reason);
+        INFO("x error " << r.x_error << " m, tension error " << r.tension_error << " N, lift-off at " << r.t_lift
+                        << " s (exact " << t_star << " s)");
+        REQUIRE(r.run.status == "stopped");
+        REQUIRE(r.run.events.size() == 1);
+        CHECK(r.run.events[0].kind == "lift_off");
+        CHECK(r.run.stop_reason.rfind("lifted off the edge at t = ", 0) == 0);
+        CHECK(r.x_error < 1e-7);
+        CHECK(r.tension_error < 1e-6);
+        CHECK(std::abs(r.t_lift - t_star) < 1e-7);
+        CHECK(r.run.transfers > 0);
+        // The energy ledger closes with the edge's dissipation booked (−∫D dt in W_shocks).
+        CHECK(r.run.relative_energy_drift() < 1e-10);
+        CHECK(r.run.relative_momentum_residual() < 1e-10);
+        if (f > 0) CHECK(r.run.samples.back().terms["W_shocks"] < -0.01);  // W_shocks: the edge dissipated
+      }
+    }
+  }
+}
+
+TEST_CASE("edge: the heavy Atwood chain over a sharp peg", "[edge][convergence]") {
+  // f = 0: x − ℓ/2 = (x0 − ℓ/2) cosh(√(2g/ℓ) t), and the peg lets go at (x − ℓ/2)² = ℓ²/8 + (x0 − ℓ/2)²/2.
+  const double x0 = 0.6, u0 = x0 - 0.5, w = std::sqrt(2 * kG);
+  const double u_lift = std::sqrt(0.125 + 0.5 * u0 * u0), t_lift = std::acosh(u_lift / u0) / w;
+  // f > 0: the reduced model by RK4 (4th order in x; its lift-off time, a linear interpolation of the margin in a step, to 1e-9 s at dt = 2e-5 s).
+  const PegReference ref = peg_reference(0.5, x0, 2e-5);
+  const PegReference ref0 = peg_reference(0.0, x0, 2e-5);
+  CHECK(std::abs(ref0.t_lift - t_lift) < 1e-8);  // the reference's margin against the closed form
+  for (int links : {11, 21, 41}) {
+    for (const double f : {0.0, 0.5}) {
+      const RunSummary run = peg(links, f, x0);
+      INFO(links << " links, f = " << f << ": " << run.stop_reason);
+      REQUIRE(run.status == "stopped");
+      REQUIRE(run.events.size() == 1);
+      double x_error = 0;
+      for (const StepSample& s : run.samples) {
+        const double x = 1.0 - s.s0[0];
+        const double x_exact = f == 0 ? 0.5 + u0 * std::cosh(w * s.t) : ref.x_at(s.t);
+        x_error = std::max(x_error, std::abs(x - x_exact));
+      }
+      INFO("x error " << x_error << " m; lift-off at " << run.events[0].t << " s");
+      CHECK(x_error < (f == 0 ? 1e-7 : 1e-6));
+      CHECK(std::abs(run.events[0].t - (f == 0 ? t_lift : ref.t_lift)) < 1e-6);
+      CHECK(run.relative_energy_drift() < 1e-10);
+    }
+  }
+}
+
+TEST_CASE("edge: a coarse mesh (5 nodes) is still exact", "[edge]") {
+  // 4 links: the front crosses two nodes before the lift-off.
+  const TableRun coarse = table(4, 0.0, 0.2);
+  INFO(coarse.run.stop_reason);
+  REQUIRE(coarse.run.status == "stopped");
+  CHECK(coarse.run.transfers > 0);
+  const double x_star = exact::edge_lift_off_x(0.0, 0.2, 1.0, kG);
+  CHECK(coarse.t_lift == Approx(exact::edge_time(0.0, x_star, 0.2, 1.0, kG)).epsilon(1e-6));
+  CHECK(coarse.x_error < 1e-7);
+}
+
+TEST_CASE("edge: bad [[effects.edge]] keys are refused with file:line, the key, the value and the range", "[edge][scene]") {
+  const std::string scene = R"([string]
+length = 1.0
+nodes = 21
+
+[shape]
+kind = "polyline"
+points = [[-0.8, 0.0], [0.0, 0.0], [0.0, -0.2]]
+
+[effects.gravity]
+g = [0.0, -9.81]
+
+[[effects.edge]]
+point = [0.0, 0.0]
+f = 0.0
+table = "before"
+
+[stop]
+t_end = 1.0
+)";
+  auto error = [&](const std::string& text) -> std::string {
+    try {
+      const SceneSpec spec = parse_scene_text(text, "s.toml");
+      if (spec.dimension == 3)
+        build_front_scene<3>(spec);
+      else
+        build_front_scene<2>(spec);
+    } catch (const InputError& e) {
+      return e.what();
+    }
+    return "";
+  };
+  auto edit = [](std::string text, const std::string& from, const std::string& to) {
+    const std::size_t at = text.find(from);
+    REQUIRE(at != std::string::npos);
+    return text.replace(at, from.size(), to);
+  };
+  CHECK(error(scene).empty());
+  using Catch::Matchers::Contains;
+  CHECK_THAT(error(edit(scene, "f = 0.0", "f = 1.5")),
+             Contains("s.toml:14:5: effects.edge[0].f = 1.5") && Contains("0 <= f <= 1"));
+  CHECK_THAT(error(edit(scene, "point = [0.0, 0.0]", "point = [0.1, 0.3]")),
+             Contains("s.toml:13:9: effects.edge[0].point = [0.1, 0.3] is not on the string") &&
+                 Contains("passes 0.316228 m from it") && Contains("allowed within 1e-06 m"));
+  const std::string scene3 =
+      edit(edit(edit(edit(scene, "nodes = 21", "nodes = 21\ndimension = 3"),
+                     "[[-0.8, 0.0], [0.0, 0.0], [0.0, -0.2]]", "[[-0.8, 0.0, 0.0], [0.0, 0.0, 0.0], [0.0, -0.2, 0.0]]"),
+                "g = [0.0, -9.81]", "g = [0.0, -9.81, 0.0]"),
+           "point = [0.0, 0.0]", "point = [0.0, 0.0, 0.0]");
+  CHECK_THAT(error(scene3), Contains("effects.edge[0] has no direction") && Contains("direction = [dx, dy, dz] (nonzero)"));
+  CHECK_THAT(error(edit(scene3, "f = 0.0", "f = 0.0\ndirection = [0.0, 0.0, 0.0]")),
+             Contains("effects.edge[0].direction = [0.0, 0.0, 0.0] is not a direction") &&
+                 Contains("allowed a finite nonzero vector"));
+  CHECK(error(edit(scene3, "f = 0.0", "f = 0.0\ndirection = [0.0, 0.0, 1.0]")).empty());
+}
