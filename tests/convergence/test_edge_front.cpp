@@ -61,10 +61,10 @@ TableRun table(int links, double f, double x0, double t_end = 10) {
   TableRun out;
   out.run = solver.run();
   for (const StepSample& s : out.run.samples) {
-    const double x = ell - s.s0[0];
+    const double x = ell - s.fronts[0].s0;
     const double x_exact = exact::edge_x(f, s.t, x0, ell, kG);
     out.x_error = std::max(out.x_error, std::abs(x - x_exact));
-    const double v = s.s0_dot[0];
+    const double v = s.fronts[0].s0_dot;
     const double tension = s.forces[0] + lambda * v * v;  // F0·e_x = τ⁻ − λ v²
     const double tension_exact = lambda * (ell - x_exact) * exact::edge_acceleration(f, x_exact, x0, ell, kG);
     out.tension_error = std::max(out.tension_error, std::abs(tension - tension_exact));
@@ -194,7 +194,7 @@ TEST_CASE("edge: the heavy Atwood chain over a sharp peg", "[edge][convergence]"
       REQUIRE(run.events.size() == 1);
       double x_error = 0;
       for (const StepSample& s : run.samples) {
-        const double x = 1.0 - s.s0[0];
+        const double x = 1.0 - s.fronts[0].s0;
         const double x_exact = f == 0 ? 0.5 + u0 * std::cosh(w * s.t) : ref.x_at(s.t);
         x_error = std::max(x_error, std::abs(x - x_exact));
       }
