@@ -9,6 +9,8 @@
 
 #include <nlohmann/json.hpp>
 
+#include "tests/unit/test_scene_support.hpp"
+
 #include "cases/canonical/canonical_string.hpp"
 #include "canonical_test_support.hpp"
 
@@ -113,7 +115,7 @@ TEST_CASE("a sliding chain whose hanging part swings converges under refinement 
 }
 
 TEST_CASE("chainsim compare prints the summary keys and rejects bad input", "[convergence][shocks][cli]") {
-  const std::string out = "/tmp/chainsim_test_compare";
+  const std::string out = chainsim::test::temp_path("compare").string();
   const std::string cmd = std::string(CHAINSIM_BINARY) + " compare folded --nodes 21 --f 0.5 --json --out " + out +
                           " 2>&1";
   FILE* pipe = popen(cmd.c_str(), "r");

@@ -16,6 +16,7 @@
 #include <nlohmann/json.hpp>
 
 #include "cases/reduced/exact_solutions.hpp"
+#include "tests/unit/test_scene_support.hpp"
 
 namespace {
 
@@ -60,9 +61,7 @@ double rel(double a, double b) { return std::abs(a - b) / std::abs(b); }
 
 TEST_CASE("chainsim canonical: string solver, reduced ODE and quadrature agree, and the figures are drawn",
           "[problems][cli]") {
-  const fs::path dir = fs::temp_directory_path() / "chainsim_test_canonical_job";
-  fs::remove_all(dir);
-  fs::create_directories(dir);
+  const fs::path dir = chainsim::test::temp_dir("canonical_job");
   const std::string binary = CHAINSIM_BINARY;
   REQUIRE(shell(binary + " canonical --quick --out " + dir.string() + " > " + (dir / "log.txt").string() + " 2>&1") == 0);
   std::stringstream log;

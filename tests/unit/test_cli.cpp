@@ -42,11 +42,8 @@ Result run(const std::string& args, bool stdout_only = false) {
   return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, out};
 }
 
-std::string temp_dir(const std::string& name) {
-  auto dir = std::filesystem::temp_directory_path() / ("chainsim_test_" + name);
-  std::filesystem::remove_all(dir);
-  return dir.string();
-}
+/// A fresh path for one test's outputs (not created: the commands make it).
+std::string temp_dir(const std::string& name) { return chainsim::test::temp_path(name).string(); }
 
 }  // namespace
 

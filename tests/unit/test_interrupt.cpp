@@ -17,6 +17,7 @@
 #include <catch2/catch.hpp>
 #include <nlohmann/json.hpp>
 
+#include "tests/unit/test_scene_support.hpp"
 extern char** environ;
 
 namespace {
@@ -87,9 +88,7 @@ TEST_CASE("chainsim run stopped by SIGINT or SIGTERM leaves valid outputs marked
   // SIGTERM (a batch scheduler) once killed the run: exit 143, the earlier outputs removed, nothing written.
   const auto [signal, cause] = GENERATE(std::pair{SIGINT, "the user"}, std::pair{SIGTERM, "SIGTERM"});
   CAPTURE(signal);
-  const auto dir = std::filesystem::temp_directory_path() / "chainsim_test_sigint";
-  std::filesystem::remove_all(dir);
-  std::filesystem::create_directories(dir);
+  const auto dir = chainsim::test::temp_dir("sigint");
   std::ofstream(dir / "long.toml") << kLongSwing;
   const std::string log = (dir / "stderr.txt").string();
   const pid_t pid = spawn_run((dir / "long.toml").string(), (dir / "out").string(), log);
@@ -133,9 +132,7 @@ TEST_CASE("SIGTERM while the outputs are written: they are finished, whole, and 
           "[unit][cli]") {
   // Before: the run died half-way through nodes.csv, leaving .nodes.csv.tmp and no stats.json.
   // 2001 nodes, 401 frames: nodes.csv of 800,000 rows takes a good fraction of a second to write.
-  const auto dir = std::filesystem::temp_directory_path() / "chainsim_test_sigterm_write";
-  std::filesystem::remove_all(dir);
-  std::filesystem::create_directories(dir);
+  const auto dir = chainsim::test::temp_dir("sigterm_write");
   std::string scene = kLongSwing;
   scene.replace(scene.find("nodes = 101"), 11, "nodes = 2001");
   scene.replace(scene.find("interval = 0.05"), 15, "interval = 0.0005\nformats = [\"csv\"]\nmax_megabytes = 10000");

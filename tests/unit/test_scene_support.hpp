@@ -10,15 +10,35 @@
 #include <catch2/catch.hpp>
 #include <fmt/format.h>
 
+#include <unistd.h>
+
 #include "cases/scene/front_scene.hpp"
 #include "cases/scene/scene.hpp"
 
 namespace chainsim::test {
 
-/// An empty directory for one test's files (under the system's temporary directory).
-inline std::filesystem::path temp_dir(const std::string& name) {
-  auto dir = std::filesystem::temp_directory_path() / ("chainsim_test_" + name);
+/// The prefix of this process's temporary paths: the process id is in it, so two test runs at once
+/// (two build trees, CI stages) never share a directory.
+inline std::string temp_prefix() { return "chainsim_test_" + std::to_string(static_cast<long>(::getpid())) + "_"; }
+
+/// A path for one test's files under the system's temporary directory, removed if it exists.
+inline std::filesystem::path temp_path(const std::string& name) {
+  auto dir = std::filesystem::temp_directory_path() / (temp_prefix() + name);
   std::filesystem::remove_all(dir);
+  return dir;
+}
+
+/// Removes every temp_path of this process (tests/test_main.cpp, after a run that passed).
+inline void remove_temp_paths() {
+  std::error_code ignored;
+  const std::string prefix = temp_prefix();
+  for (const auto& entry : std::filesystem::directory_iterator(std::filesystem::temp_directory_path(), ignored))
+    if (entry.path().filename().string().rfind(prefix, 0) == 0) std::filesystem::remove_all(entry.path(), ignored);
+}
+
+/// An empty directory for one test's files (temp_path, created).
+inline std::filesystem::path temp_dir(const std::string& name) {
+  auto dir = temp_path(name);
   std::filesystem::create_directories(dir);
   return dir;
 }

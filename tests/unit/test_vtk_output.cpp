@@ -12,6 +12,7 @@
 
 #include "mesh/errors.hpp"
 #include "solver/vtk_output.hpp"
+#include "tests/unit/test_scene_support.hpp"
 
 using namespace chainsim;
 
@@ -50,9 +51,7 @@ nlohmann::json as_json(const Eigen::MatrixXd& m) {
 }  // namespace
 
 TEST_CASE("VTK frames read back exactly with VTK's reader, binary (default) and ascii", "[unit][vtk]") {
-  const auto dir = std::filesystem::temp_directory_path() / "chainsim_test_vtk_roundtrip";
-  std::filesystem::remove_all(dir);
-  std::filesystem::create_directories(dir);
+  const auto dir = chainsim::test::temp_dir("vtk_roundtrip");
   const VtkPolyline line = awkward_polyline();
   write_vtp(dir / "default.vtp", line);
   write_vtp(dir / "binary.vtp", line, VtkEncoding::kBinary);
