@@ -4,7 +4,8 @@
 Usage: /usr/bin/python3 docs/figures/make_scene_figures.py RESULTS_DIR
 where RESULTS_DIR/<scene>/ holds the outputs of
     build/chainsim run cases/scenes/<scene>.toml --out RESULTS_DIR/<scene>
-for shaken_chain, travelling_loop, whip_crack, pendulum_release and folded_chain_ends_apart (string scenes) and
+for shaken_chain, travelling_loop, whip_crack, pendulum_release, folded_chain_ends_apart, swinging_u,
+pendulum_whip and thrown_chain (string scenes; the last three with slack = "allow"), chain_off_table_edge (an edge) and
 falling_chain, folded_chain, sliding_chain, swinging_sliding_chain, tilted_falling_chain and
 curved_falling_chain (scenes with fronts), and RESULTS_DIR/<scene>_reduced/ the same canonical scenes run with
 model = "reduced". docs/figures/run_scene_figures.sh RESULTS_DIR does all of it (and `chainsim plot` on each
@@ -179,8 +180,44 @@ def folded_chain_ends_apart(run, ax):
     decorate(ax[1], "t (s)", "free end height (m)", "it follows the energy-conserving fold (f = 0)")
 
 
+def chain_off_table_edge(run, ax):
+    snapshots(ax[0], run, [0, 0.1, 0.22, 0.32, 0.42, 0.525], "chain sliding off a smooth table over its edge, f = 0")
+    g, ell, x0 = 9.81, 1.0, 0.2
+    ts = np.asarray(run.series["t"])
+    ax[1].plot(ts, ell - np.asarray(run.fronts[0].s0), lw=2, alpha=0.7, label="hanging length 1 - s0 (string solver)")
+    ax[1].plot(ts, x0 * np.cosh(math.sqrt(g / ell) * ts), "k:", lw=2, label="x0 cosh(sqrt(g/l) t), exact for f = 0")
+    x_star = (ell + math.sqrt(ell * ell + 8 * x0 * x0)) / 4
+    ax[1].axhline(x_star, color="r", lw=0.8, ls="--", label=f"lift-off length x* = {x_star:.4f} m")
+    decorate(ax[1], "t (s)", "m", "the edge pushes while the table part's tension exceeds its momentum flux")
+
+
+def slack_panel(ax, run, title):
+    """The energy the snaps dissipated (W_snap) against time."""
+    e = run.energy
+    ax.plot(e["t"], 1e3 * np.asarray(e["W_snap"]), label="W_snap (mJ): booked by the snaps")
+    if "W_snap_supports" in e:
+        ax.plot(e["t"], 1e3 * np.asarray(e["W_snap_supports"]), "--", label="W_snap_supports (mJ)")
+    decorate(ax, "t (s)", "mJ", title)
+
+
+def swinging_u(run, ax):
+    snapshots(ax[0], run, [0, 0.4, 0.5, 0.6, 0.8, 1.0], 'swinging U, slack = "allow": links go slack and snap taut')
+    slack_panel(ax[1], run, "energy lost at the snaps (perfectly inelastic)")
+
+
+def pendulum_whip(run, ax):
+    snapshots(ax[0], run, [0, 0.3, 0.45, 0.6, 0.8, 1.0], 'chain pendulum past its whip, slack = "allow"')
+    slack_panel(ax[1], run, "energy lost at the snaps after the whip")
+
+
+def thrown_chain(run, ax):
+    snapshots(ax[0], run, [0, 0.3, 0.6, 0.9, 1.2, 1.5], "chain thrown up at 7 rad/s, goes slack and is caught")
+    slack_panel(ax[1], run, "energy lost at the snaps when the chain is caught")
+
+
 SCENES = [shaken_chain, travelling_loop, whip_crack, pendulum_release, falling_chain, folded_chain, sliding_chain,
-          swinging_sliding_chain, tilted_falling_chain, curved_falling_chain, folded_chain_ends_apart]
+          swinging_sliding_chain, tilted_falling_chain, curved_falling_chain, folded_chain_ends_apart,
+          chain_off_table_edge, swinging_u, pendulum_whip, thrown_chain]
 
 
 def main():
