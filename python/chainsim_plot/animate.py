@@ -72,7 +72,7 @@ def animate(run, out_path, speed=1.0, fps=25, fmt=None):
     for ax, proj in zip(axes, projections):
         layout.limits(ax, proj)
         space_axes(ax, proj, adjustable="box")
-        layout.draw_planes(ax, proj, label=False)
+        layout.draw_obstacles(ax, proj, label=False)
         heaps.append([ax.plot([], [], "o", color=HEAP_COLOR, alpha=0.6, mew=0)[0] for _ in layout.heaps(t_first)])
         (line,) = ax.plot([], [], "-", lw=1.6, color="tab:blue")
         (mark,) = ax.plot([], [], "o", ms=6, mfc="none", color=FRONT_COLOR, linestyle="none")

@@ -1,6 +1,6 @@
 """The figures of a run: each function draws onto matplotlib axes or writes one PNG and returns its path.
 
-    snapshots.png  the string at several times (x-y; x-y and x-z in 3D), heaps, the plane and the fronts
+    snapshots.png  the string at several times (x-y; x-y and x-z in 3D), heaps, the plane, the edges (their tables) and the fronts
     energy.png     the energy ledger: K, V, each work term, and the residual of the balance
     tension.png    the tension along s at the same times, the fronts' s0 dotted (and T(s, t) when the links
                    do not change)
@@ -194,11 +194,21 @@ class Layout:
         return [(f, p) for f in self.run.fronts for p in [self.front_point(f, t)] if p is not None]
 
     def draw_planes(self, ax, proj, extra=0.0, label=True):
-        """The plane (table) under each heap on a plane, as its trace on the projection `proj` (only where
-        the projection sees it edge-on). `extra`: how much further right it must reach (staggered
-        snapshots)."""
+        """The obstacles (draw_obstacles): the old name, kept."""
+        self.draw_obstacles(ax, proj, extra, label)
+
+    def draw_obstacles(self, ax, proj, extra=0.0, label=True):
+        """The obstacles, drawn once and the same in the snapshots and the animation: the plane (table)
+        under each heap on a plane, as its trace on the projection `proj` (only where the projection sees
+        it edge-on), and each edge (edge_geometry): a grey wedge at its point between the two arms' initial
+        directions (the obstacle lies inside the bend) and, with `table = "before"|"after"`, the table's
+        face as a thick grey line from the point along that side's initial direction. `extra`: how much
+        further right they must reach (staggered snapshots)."""
         a, b = proj
         for f in self.run.fronts:
+            if f.kind == "edge":
+                self._draw_edge(ax, f, proj, extra, label)
+                continue
             if f.kind != "heap" or not f.on_plane or f.plane_normal is None or f.point is None:
                 continue
             n = f.plane_normal
@@ -212,7 +222,61 @@ class Layout:
             centre = p + np.dot(0.5 * (self.lo[[a, b]] + self.hi[[a, b]]) - p, d) * d
             half = 0.6 * self.size
             ends = np.array([centre - half * d, centre + (half + extra) * d])
-            ax.plot(ends[:, 0], ends[:, 1], "k-", lw=2.5, alpha=0.45, label="plane (table)" if label else None)
+            self._face(ax, ends, "plane (table)" if label else None)
+
+    @staticmethod
+    def _face(ax, ends, label):
+        """A rigid surface seen edge-on: a thick grey line between `ends`."""
+        ax.plot(ends[:, 0], ends[:, 1], "k-", lw=2.5, alpha=0.45, label=label)
+
+    def edge_geometry(self, f):
+        """(point, before, after) of the edge front f: its point and the unit directions, from it, of the
+        string's two sides in the first frame (before: s < s0, after: s > s0; None where that side has no
+        node away from the point). Each side's direction is the one to its node nearest the point."""
+        frames = self.run.nodes
+        x = frames.positions(0)
+        s = frames.s(0)
+        p = f.point
+        s0 = f.s0_at(frames.times[0]) if f.series is not None and f"s0_{f.k}" in f.series else f.info.get("s0")
+        if s is None or s0 is None:
+            return p, None, None
+        dist = np.linalg.norm(x - p, axis=1)
+        away = dist > 1e-9 * self.size
+
+        def side(mask):
+            q = np.flatnonzero(mask & away)
+            if len(q) == 0:
+                return None
+            j = q[np.argmin(dist[q])]
+            return (x[j] - p) / dist[j]
+        return p, side(s < s0), side(s > s0)
+
+    def _draw_edge(self, ax, f, proj, extra, label):
+        if f.point is None:
+            return
+        a, b = proj
+        p, before, after = self.edge_geometry(f)
+        p2 = p[[a, b]]
+        r = 0.07 * self.size
+        arms = [d[[a, b]] for d in (before, after) if d is not None and np.linalg.norm(d[[a, b]]) > 1e-9]
+        if len(arms) == 2:
+            wedge = np.array([p2, p2 + r * arms[0], p2 + r * arms[1]])
+            ax.fill(wedge[:, 0], wedge[:, 1], color="0.45", alpha=0.6, lw=0, gid=f"obstacle {f.name}",
+                    label=f"edge ({f.name})" if label else None)
+        else:
+            ax.plot([p2[0]], [p2[1]], "^", ms=9, color="0.45", alpha=0.6, mew=0, gid=f"obstacle {f.name}",
+                    label=f"edge ({f.name})" if label else None)
+        side = {"before": before, "after": after}.get(f.info.get("table"))
+        if side is None:
+            return
+        d = side[[a, b]]
+        if np.linalg.norm(d) < 1e-9:
+            return  # the table seen face-on in this projection
+        d = d / np.linalg.norm(d)
+        corners = np.array([[u, v] for u in (self.lo[a], self.hi[a] + extra) for v in (self.lo[b], self.hi[b])])
+        length = max(float(np.max((corners - p2) @ d)), 0.0) + 0.08 * self.size
+        self._face(ax, np.array([p2, p2 + length * d]), "table" if label else None)
+        ax.lines[-1].set_gid(f"table {f.name}")
 
     def heaps(self, t):
         """[(front, position, marker size)] of the heaps at time t: a heap on a plane sits at the moving
@@ -262,7 +326,7 @@ def draw_snapshots(axes, run, picks, layout=None):
     shifts = [q * layout.stagger for q in range(len(picks))]
     for ax, proj in zip(axes, layout.projections):
         a, b = proj
-        layout.draw_planes(ax, proj, extra=shifts[-1])
+        layout.draw_obstacles(ax, proj, extra=shifts[-1])
         for q, k in enumerate(picks):
             pts = layout.curve(k)
             ax.plot(pts[:, a] + shifts[q], pts[:, b], "-", lw=1.3, color=colors[q],
@@ -298,6 +362,8 @@ def snapshots_figure(run, out_dir, wanted=None):
         notes.append("open markers: the fronts")
     if any(f.kind == "heap" for f in run.fronts):
         notes.append("brown discs: the heaps (area grows with their mass)")
+    if any(f.kind == "edge" for f in run.fronts):
+        notes.append("grey wedge: the edge, inside the bend; thick grey line: the table")
     title = f"{run.name}: the string at {len(picks)} times\n" + textwrap.fill("; ".join(notes), 70 * n)
     fig.suptitle(title, fontsize=9)
     fig.tight_layout()

@@ -80,6 +80,8 @@ def run_dir(kind):
         args = ["run", scene("falling_chain", 21), "--out", out]
     elif kind == "fold":
         args = ["run", scene("folded_chain", 21), "--out", out]
+    elif kind == "edge":
+        args = ["run", scene("chain_off_table_edge", 21), "--out", out]
     elif kind == "string3d":
         path = os.path.join(ROOT, "pendulum3d.toml")
         with open(path, "w") as fh:
@@ -457,3 +459,67 @@ if __name__ == "__main__":
             failures += 1
             print("FAIL", name, repr(e))
     sys.exit(1 if failures else 0)
+
+
+# --- the obstacles: one drawing for the snapshots and the animation ---------------------------------
+
+def obstacle_artists(fig):
+    """{gid: artist} of the obstacles drawn on the figure's first axes (gids "obstacle NAME", "table NAME")."""
+    ax = fig.axes[0]
+    return {a.get_gid(): a for a in list(ax.patches) + list(ax.lines)
+            if a.get_gid() and a.get_gid().split()[0] in ("obstacle", "table")}
+
+
+def drawn_figures(directory):
+    """(snapshots figure, animation figure) of the run, drawn in this process (the animation to a GIF at
+    1 frame per second), kept open to read their artists."""
+    import matplotlib.pyplot as plt
+    from chainsim_plot import animate as anim_module
+    from chainsim_plot.figures import draw_snapshots
+    from chainsim_plot.readers import load_run
+    run = load_run(directory)
+    fig, ax = plt.subplots()
+    draw_snapshots([ax], run, [0, len(run.nodes) - 1])
+    kept = []
+    close = anim_module.plt.close
+    anim_module.plt.close = kept.append
+    try:
+        anim_module.animate(run, os.path.join(ROOT, os.path.basename(directory) + "_obstacles"), fps=1, fmt="gif")
+    finally:
+        anim_module.plt.close = close
+    return fig, kept[0]
+
+
+def test_reader_edge_drawn_as_an_obstacle_in_snapshots_and_animation():
+    """The chain off the table's edge (edge at the origin, the table before it along -x, the string hanging
+    along -y from it, cases/scenes/chain_off_table_edge.toml): a grey wedge at the origin between -x and -y,
+    and the table's face from the origin along -x past the chain's far end (x = -0.8 m), the same in the
+    snapshots and in the animation's frames."""
+    import matplotlib.pyplot as plt
+    for fig in drawn_figures(run_dir("edge")):
+        drawn = obstacle_artists(fig)
+        assert sorted(drawn) == ["obstacle edge0", "table edge0"]
+        wedge = drawn["obstacle edge0"].get_xy()[:3]
+        assert np.allclose(wedge[0], [0, 0], atol=1e-9)
+        r = np.linalg.norm(wedge[1])
+        assert r > 0 and np.allclose(wedge[1:], [[-r, 0], [0, -r]], atol=1e-9 * r + 1e-12)
+        x, y = drawn["table edge0"].get_data()
+        assert np.allclose([x[0], y[0]], [0, 0], atol=1e-12) and np.allclose(y, 0, atol=1e-12)
+        assert x[1] < -0.8
+        plt.close(fig)
+
+
+def test_reader_run_without_obstacles_draws_none():
+    """A run with no edge draws no obstacle: the free whip draws nothing but the string and its markers;
+    the falling chain draws its plane (table) as before, and no edge."""
+    import matplotlib.pyplot as plt
+    for fig in drawn_figures(run_dir("string")):
+        assert obstacle_artists(fig) == {}
+        assert not fig.axes[0].patches
+        plt.close(fig)
+    fig, anim_fig = drawn_figures(run_dir("fronts"))
+    for f in (fig, anim_fig):
+        assert obstacle_artists(f) == {} and not f.axes[0].patches
+    assert "plane (table)" in [line.get_label() for line in fig.axes[0].lines]
+    plt.close(fig)
+    plt.close(anim_fig)
