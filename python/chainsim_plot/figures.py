@@ -202,7 +202,8 @@ class Layout:
         under each heap on a plane, as its trace on the projection `proj` (only where the projection sees
         it edge-on), and each edge (edge_geometry): a grey wedge at its point between the two arms' initial
         directions (the obstacle lies inside the bend) and, with `table = "before"|"after"`, the table's
-        face as a thick grey line from the point along that side's initial direction. `extra`: how much
+        face as a thick grey line from the point along that side's initial direction (in 3D only on a
+        projection that sees the table edge-on). `extra`: how much
         further right they must reach (staggered snapshots)."""
         a, b = proj
         for f in self.run.fronts:
@@ -269,9 +270,13 @@ class Layout:
         side = {"before": before, "after": after}.get(f.info.get("table"))
         if side is None:
             return
+        if self.dim == 3 and "direction" in f.info:  # the table's plane holds the edge and that side
+            n = np.cross(side, np.asarray(f.info["direction"], dtype=float))
+            if abs(n[3 - a - b]) > 1e-9 * np.linalg.norm(n):
+                return  # drawn only where the projection sees it edge-on, as a heap's plane
         d = side[[a, b]]
         if np.linalg.norm(d) < 1e-9:
-            return  # the table seen face-on in this projection
+            return
         d = d / np.linalg.norm(d)
         corners = np.array([[u, v] for u in (self.lo[a], self.hi[a] + extra) for v in (self.lo[b], self.hi[b])])
         length = max(float(np.max((corners - p2) @ d)), 0.0) + 0.08 * self.size

@@ -82,6 +82,12 @@ def run_dir(kind):
         args = ["run", scene("folded_chain", 21), "--out", out]
     elif kind == "edge":
         args = ["run", scene("chain_off_table_edge", 21), "--out", out]
+    elif kind == "edge3d":  # the same, in 3D: the edge along z
+        args = ["run", scene("chain_off_table_edge", 21, {
+            r"(?m)^nodes = 21": "nodes = 21\ndimension = 3",
+            r"\[\[-0.8, 0.0\], \[0.0, 0.0\], \[0.0, -0.2\]\]": "[[-0.8, 0.0, 0.0], [0.0, 0.0, 0.0], [0.0, -0.2, 0.0]]",
+            r"g = \[0.0, -9.81\]": "g = [0.0, -9.81, 0.0]",
+            r"(?m)^point = \[0.0, 0.0\]": "point = [0.0, 0.0, 0.0]\ndirection = [0.0, 0.0, 1.0]"}), "--out", out]
     elif kind == "string3d":
         path = os.path.join(ROOT, "pendulum3d.toml")
         with open(path, "w") as fh:
@@ -507,6 +513,28 @@ def test_reader_edge_drawn_as_an_obstacle_in_snapshots_and_animation():
         assert np.allclose([x[0], y[0]], [0, 0], atol=1e-12) and np.allclose(y, 0, atol=1e-12)
         assert x[1] < -0.8
         plt.close(fig)
+
+
+def test_reader_3d_edge_drawn_where_the_projection_sees_it():
+    """The chain off the table's edge in 3D, the edge along z: on x-y as in 2D (wedge between -x and -y, the
+    table along -x); on x-z the hanging side and the table (the plane y = 0) are seen face-on: a marker at
+    the edge, no table line."""
+    import matplotlib.pyplot as plt
+    from chainsim_plot.figures import Layout
+    from chainsim_plot.readers import load_run
+    run = load_run(run_dir("edge3d"))
+    layout = Layout(run)
+    fig, axes = plt.subplots(1, 2)
+    for ax, proj in zip(axes, layout.projections):
+        layout.draw_obstacles(ax, proj)
+    xy = {a.get_gid(): a for a in list(axes[0].patches) + list(axes[0].lines) if a.get_gid()}
+    xz = {a.get_gid(): a for a in list(axes[1].patches) + list(axes[1].lines) if a.get_gid()}
+    assert sorted(xy) == ["obstacle edge0", "table edge0"] and sorted(xz) == ["obstacle edge0"]
+    wedge = xy["obstacle edge0"].get_xy()[:3]
+    r = np.linalg.norm(wedge[1])
+    assert np.allclose(wedge, [[0, 0], [-r, 0], [0, -r]], atol=1e-9)
+    assert np.allclose(np.ravel(xz["obstacle edge0"].get_data()), 0, atol=1e-12)
+    plt.close(fig)
 
 
 def test_reader_run_without_obstacles_draws_none():
