@@ -40,7 +40,7 @@ EdgeComparison compare_edge_with_exact(const EdgeCaseSetup& setup) {
   std::vector<std::unique_ptr<FrontKind<2>>> fronts;
   fronts.push_back(std::make_unique<EdgeFront<2>>(edge));
   StringModelOptions model_options;
-  model_options.stabilization_time = 0.02 * t0;  // as the other canonical problems and a scene's default
+  model_options.stabilization_time = 0.02 * std::sqrt(ell / g);  // as a scene's default
   StringModel<2> model = make_front_model<2>(std::move(chain), std::move(forces), {}, std::move(fronts),
                                              FrontOptions{}, model_options);
   StringSolverOptions options;
