@@ -38,9 +38,12 @@ int run_canonical_command(const CanonicalCommandOptions& options, std::ostream& 
 
 /// `chainsim compare falling|folded|sliding --nodes N ...`: the string solver (front tracking) and the
 /// reduced ODE on the same problem; writes string_series.csv, reduced_series.csv and summary.json.
+/// `chainsim compare edge --x0 X0 ...`: the chain sliding off a table over an edge against its exact
+/// solution (edge_case.hpp); writes string_series.csv, exact_series.csv and summary.json.
 struct CompareCommandOptions {
   std::string problem;
-  StringCaseSetup setup;  ///< problem is filled in from `problem`
+  StringCaseSetup setup;  ///< problem is filled in from `problem` (edge: its chain, nodes, t_max, integrator)
+  std::optional<double> x0;  ///< edge only: the hanging fraction at release (default 0.2)
   std::string out;        ///< output directory; "" = results/compare/<problem>
   bool json = false;
 };

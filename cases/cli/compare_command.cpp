@@ -1,54 +1,120 @@
-// `chainsim compare`: the string solver against the reduced ODE (see commands.hpp).
+// `chainsim compare`: the string solver against the reduced ODE, or (edge) against the exact solution
+// (see commands.hpp).
 #include <filesystem>
+#include <optional>
 #include <ostream>
 
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
+#include "cases/canonical/edge_case.hpp"
 #include "cases/cli/commands.hpp"
 #include "mesh/errors.hpp"
 #include "solver/output.hpp"
 
 namespace chainsim {
 
+namespace {
+
+/// `compare edge`'s setup from the command's options; the options it has no use for are refused.
+EdgeCaseSetup edge_setup(const CompareCommandOptions& options) {
+  const StringCaseSetup& s = options.setup;
+  if (s.eta0)
+    throw InputError(fmt::format("--eta0 = {}: compare edge starts from --x0, the hanging fraction (0 < x0 < 1)",
+                                 *s.eta0));
+  if (s.force != 0)
+    throw InputError(fmt::format("--force = {}: only the folded chain has an end force (compare edge: 0)", s.force));
+  if (s.eps != StringCaseSetup{}.eps)
+    throw InputError(fmt::format("--eps = {}: compare edge stops at the lift-off and has no cutoff", s.eps));
+  EdgeCaseSetup e;
+  e.chain = s.chain;
+  e.nodes = s.nodes;
+  if (options.x0) e.x0 = *options.x0;
+  e.t_max_over_t0 = s.t_max_over_t0;
+  e.integrator = s.integrator;
+  e.validate();
+  return e;
+}
+
+void print_edge(const nlohmann::json& s, std::ostream& out) {
+  auto number = [&](const char* key) { return s[key].is_number() ? fmt::format("{:.12g}", s[key].get<double>()) : "none"; };
+  auto error = [&](const char* key) { return s[key].is_number() ? fmt::format("{:.3g}", s[key].get<double>()) : "none"; };
+  out << fmt::format("edge, f = {}, x0 = {}, {} nodes: string solver vs exact solution\n", s["f"].get<double>(),
+                     s["x0"].get<double>(), s["nodes"].get<int>());
+  out << fmt::format("  lift-off t (s)   string {}   exact {:.12g}   abs. error {}\n", number("t_lift_off"),
+                     s["t_lift_off_exact"].get<double>(), error("abs_err_t_lift_off"));
+  out << fmt::format("  lift-off x (m)   string {}   exact {:.12g}   abs. error {}\n", number("x_lift_off"),
+                     s["x_lift_off_exact"].get<double>(), error("abs_err_x_lift_off"));
+  out << fmt::format("  max |x error|    {:.3g} m (equal times)\n", s["max_abs_err_x"].get<double>());
+  out << fmt::format("  max |T error|    {:.3g} N at the edge ({:.3g} relative to lambda g l)\n",
+                     s["max_abs_err_tension"].get<double>(), s["max_rel_err_tension"].get<double>());
+}
+
+}  // namespace
+
 int run_compare_command(CompareCommandOptions options, std::ostream& out) {
-  options.setup.problem = parse_problem(options.problem);
-  options.setup.validate();
+  const bool edge = options.problem == "edge";
+  std::optional<EdgeCaseSetup> edge_case;
+  if (edge) {
+    edge_case = edge_setup(options);
+  } else {
+    if (options.problem != "falling" && options.problem != "folded" && options.problem != "sliding")
+      throw InputError(fmt::format("problem = \"{}\" is not a known problem: allowed falling, folded, sliding, edge",
+                                   options.problem));
+    if (options.x0)
+      throw InputError(fmt::format("--x0 = {}: only compare edge takes --x0 ({} starts from --eta0)", *options.x0,
+                                   options.problem));
+    options.setup.problem = parse_problem(options.problem);
+    options.setup.validate();
+  }
   const std::filesystem::path dir =
       options.out.empty() ? std::filesystem::path("results") / "compare" / options.problem
                           : std::filesystem::path(options.out);
   const RunDirectory run_dir(dir);  // held until the outputs are written
   run_dir.clear();
-  const Comparison c = compare_with_reduced(options.setup);
-  samples_table(c.string.run).write(dir / "string_series.csv");
-  c.reduced.series.write(dir / "reduced_series.csv");
-  write_json(dir / "summary.json", c.summary);  // written last: its presence means the set is complete
-  const bool failed = c.string.run.status == "failed";
-  const std::string error = fmt::format("the string solver failed: {}", c.string.run.error);
+  std::optional<Comparison> c;
+  std::optional<EdgeComparison> e;
+  if (edge) {
+    e = compare_edge_with_exact(*edge_case);
+    samples_table(e->run).write(dir / "string_series.csv");
+    e->exact.write(dir / "exact_series.csv");
+  } else {
+    c = compare_with_reduced(options.setup);
+    samples_table(c->string.run).write(dir / "string_series.csv");
+    c->reduced.series.write(dir / "reduced_series.csv");
+  }
+  const RunSummary& run = edge ? e->run : c->string.run;
+  const nlohmann::json& s = edge ? e->summary : c->summary;
+  write_json(dir / "summary.json", s);  // written last: its presence means the set is complete
+  const bool failed = run.status == "failed";
+  const std::string error = fmt::format("the string solver failed: {}", run.error);
   if (options.json) {
-    nlohmann::json j = c.summary;
+    nlohmann::json j = s;
     if (failed) {
       j["error"] = error;
       j["exit_code"] = 3;
     }
     out << json_text(j) << '\n';
   } else {
-    const auto& s = c.summary;
-    out << fmt::format("{} chain, f = {}, {} nodes: string solver vs reduced ODE\n", options.problem,
-                       options.setup.chain.dissipation, options.setup.nodes);
-    out << fmt::format("  t_stop/t0        string {:.12g}   reduced {:.12g}   rel. error {:.3g}\n",
-                       s["t_stop_over_t0"].get<double>(), s["t_stop_over_t0_reduced"].get<double>(),
-                       s["rel_err_t_stop"].get<double>());
-    out << fmt::format("  max |eta error|  {:.3g} (equal times)\n", s["max_abs_err_eta"].get<double>());
-    out << fmt::format("  max rel. P error {:.3g} ({})\n", s["max_rel_err_P"].get<double>(),
-                       s["P_compared_at"].get<std::string>());
+    if (edge) {
+      print_edge(s, out);
+    } else {
+      out << fmt::format("{} chain, f = {}, {} nodes: string solver vs reduced ODE\n", options.problem,
+                         options.setup.chain.dissipation, options.setup.nodes);
+      out << fmt::format("  t_stop/t0        string {:.12g}   reduced {:.12g}   rel. error {:.3g}\n",
+                         s["t_stop_over_t0"].get<double>(), s["t_stop_over_t0_reduced"].get<double>(),
+                         s["rel_err_t_stop"].get<double>());
+      out << fmt::format("  max |eta error|  {:.3g} (equal times)\n", s["max_abs_err_eta"].get<double>());
+      out << fmt::format("  max rel. P error {:.3g} ({})\n", s["max_rel_err_P"].get<double>(),
+                         s["P_compared_at"].get<std::string>());
+    }
     out << fmt::format("  energy ledger    {:.3g} (relative)   momentum ledger {:.3g}\n",
                        s["energy_residual"].get<double>(), s["momentum_residual"].get<double>());
     out << fmt::format("  stop: {} ({} crossings, {} steps, {:.3g} s)\n", s["stop_reason"].get<std::string>(),
                        s["transfers"].get<long>(), s["steps"].get<long>(), s["wall_s"].get<double>());
     out << fmt::format("  outputs in {}\n", dir.string());
   }
-  if (failed) throw NumericalError(error, c.string.run.t_stop);
+  if (failed) throw NumericalError(error, run.t_stop);
   return 0;
 }
 

@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "cases/canonical/edge_case.hpp"
 #include "cases/reduced/exact_solutions.hpp"
 #include "cases/scene/front_scene.hpp"
 #include "cases/scene/scene.hpp"
@@ -35,31 +36,19 @@ struct TableRun {
 /// x0 of it hanging over the edge at the origin, released at rest; edge dissipation f.
 TableRun table(int links, double f, double x0, double t_end = 10) {
   const double ell = 1.0, lambda = 1.0;
-  Points<2> vertices(2, 3);
-  vertices << -(ell - x0), 0.0, 0.0, 0.0, 0.0, -x0;
-  Chain<2> chain = discretize<2>(*polyline_curve<2>(vertices), ell, lambda, links, false);
-  std::vector<std::unique_ptr<Force<2>>> forces;
-  forces.push_back(std::make_unique<Gravity<2>>(Vec<2>(0.0, -kG)));
-  EdgeSpec<2> edge;
-  edge.point = Vec<2>::Zero();
-  edge.dissipation = f;
-  edge.s0 = ell - x0;
-  edge.table = EdgeSpec<2>::Table::kBefore;
-  std::vector<std::unique_ptr<FrontKind<2>>> fronts;
-  fronts.push_back(std::make_unique<EdgeFront<2>>(edge));
-  StringModelOptions model_options;
-  model_options.stabilization_time = 0.02 * std::sqrt(ell / kG);  // as a scene's default
-  StringModel<2> model = make_front_model<2>(std::move(chain), std::move(forces), {}, std::move(fronts),
-                                             FrontOptions{}, model_options);
-  StringSolverOptions options;
-  options.t_end = t_end;
-  options.output_interval = t_end;
-  options.record_steps = true;
-  options.integrator.rtol = 1e-11;
-  options.integrator.atol = 1e-13;
-  StringSolver<2> solver(model, options);
+  EdgeCaseSetup setup;  // the run of `chainsim compare edge` (cases/canonical/edge_case.hpp)
+  setup.chain.length = ell;
+  setup.chain.density = lambda;
+  setup.chain.gravity = kG;
+  setup.chain.dissipation = f;
+  setup.nodes = links + 1;
+  setup.x0 = x0 / ell;
+  setup.t_max_over_t0 = t_end / setup.chain.t0();
+  setup.integrator = IntegratorOptions{};
+  setup.integrator.rtol = 1e-11;
+  setup.integrator.atol = 1e-13;
   TableRun out;
-  out.run = solver.run();
+  out.run = compare_edge_with_exact(setup).run;
   for (const StepSample& s : out.run.samples) {
     const double x = ell - s.fronts[0].s0;
     const double x_exact = exact::edge_x(f, s.t, x0, ell, kG);

@@ -1,5 +1,6 @@
 // The chainsim executable: exit codes, error messages and the --json summary.
 #include <array>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -439,4 +440,59 @@ TEST_CASE("paths and --set keys that are not UTF-8 give JSON with U+FFFD and the
   const auto error = nlohmann::json::parse(bad.output);
   CHECK(error["exit_code"] == 2);
   CHECK_THAT(error["error"].get<std::string>(), Catch::Matchers::Contains("'string.\xef\xbf\xbd' is not a scene key"));
+}
+
+TEST_CASE("chainsim compare edge --json: the chain off a table's edge against exact::edge_*, and bad input",
+          "[unit][cli][edge]") {
+  // The bounds of test_edge_front.cpp ("a chain sliding off a table matches exact::edge_*"), here with the
+  // command's defaults (101 nodes, x0 = 0.2, erk5 at rtol 1e-9).
+  for (const char* f : {"0", "0.5"}) {
+    CAPTURE(f);
+    const std::string out = temp_dir(std::string("cli_compare_edge_") + f);
+    const Result r = run(std::string("compare edge --json --f ") + f + " --out " + out, true);
+    REQUIRE(r.status == 0);
+    const auto j = nlohmann::json::parse(r.output);
+    CAPTURE(r.output);
+    for (const char* key : {"t_lift_off", "t_lift_off_exact", "abs_err_t_lift_off", "x_lift_off", "x_lift_off_exact",
+                            "abs_err_x_lift_off", "max_abs_err_x", "max_abs_err_tension", "max_rel_err_tension",
+                            "t_stop_over_t0", "t_stop_over_t0_exact", "rel_err_t_stop", "energy_residual",
+                            "momentum_residual", "events", "nodes", "x0", "f"})
+      CHECK(j.contains(key));
+    CHECK(j["problem"] == "edge");
+    CHECK(j["status"] == "stopped");
+    REQUIRE(j["events"].size() == 1);
+    CHECK(j["events"][0]["kind"] == "lift_off");
+    // x* = (ℓ + √(ℓ² + 8 x0²))/4 at f = 0, independently of exact::edge_lift_off_x.
+    if (std::string(f) == "0") CHECK(j["x_lift_off_exact"].get<double>() == Approx((1 + std::sqrt(1.32)) / 4));
+    CHECK(j["abs_err_t_lift_off"].get<double>() < 1e-7);
+    CHECK(j["abs_err_x_lift_off"].get<double>() < 1e-7);
+    CHECK(j["max_abs_err_x"].get<double>() < 1e-7);
+    CHECK(j["max_abs_err_tension"].get<double>() < 1e-6);
+    CHECK(j["energy_residual"].get<double>() < 1e-8);
+    CHECK(j["momentum_residual"].get<double>() < 1e-8);
+    for (const char* file : {"string_series.csv", "exact_series.csv", "summary.json"})
+      CHECK(std::filesystem::exists(out + "/" + file));
+  }
+  const std::string out = " --out " + temp_dir("cli_compare_edge_bad");
+  struct Case {
+    const char* args;
+    const char* message;
+  };
+  const Case cases[] = {
+      {"compare edge --f 1.5", "chainsim: error: --f = 1.5 is out of range: allowed 0 <= f <= 1"},
+      {"compare edge --f -0.5", "chainsim: error: --f = -0.5 is out of range: allowed 0 <= f <= 1"},
+      {"compare edge --x0 0", "chainsim: error: --x0 = 0 is out of range: allowed 0 < x0 < 1"},
+      {"compare edge --x0 1", "chainsim: error: --x0 = 1 is out of range: allowed 0 < x0 < 1"},
+      {"compare edge --nodes 2", "chainsim: error: --nodes = 2 is out of range: allowed 3 <= nodes <= 200001"},
+      {"compare edge --eta0 0.3", "chainsim: error: --eta0 = 0.3: compare edge starts from --x0"},
+      {"compare sliding --x0 0.3", "chainsim: error: --x0 = 0.3: only compare edge takes --x0"},
+      {"compare hanging", "chainsim: error: problem = \"hanging\" is not a known problem: allowed falling, folded, "
+                          "sliding, edge"},
+  };
+  for (const Case& c : cases) {
+    CAPTURE(c.args);
+    const Result r = run(std::string(c.args) + out);
+    CHECK(r.status == 2);
+    CHECK_THAT(r.output, Catch::Matchers::StartsWith(c.message));
+  }
 }
