@@ -84,6 +84,14 @@ void EdgeFront<dim>::initialize(StringModel<dim>& model) {
   if (c >= 0) {
     if (c == 0 || c + 1 >= this->m_.n)
       throw InputError("the edge point is on an end node of the string: an edge needs string on both sides");
+    // A held node (a fixed or driven end) cannot be moved: its support or path starts where it is.
+    for (int i = 0; i < this->m_.n; ++i)
+      if (model.is_prescribed(i))
+        throw InputError(fmt::format(
+            "the edge point {} is on node {} (s = {:.9g} m) and node {} of the string is held (a fixed or driven "
+            "end): the edge needs its point inside a link there (the string is moved back by {:.3g} m to put it "
+            "there, which a held node cannot follow); move the point along the string or change string.nodes",
+            show<dim>(point_), c, model.chain().node_coordinate(c), i, nudge));
     const Vec<dim> tm = unit_vector<dim>(point_ - x.col(c - 1), "the string before the edge");
     const Vec<dim> tp = unit_vector<dim>(x.col(c + 1) - point_, "the string after the edge");
     for (int i = 0; i < this->m_.n; ++i)
@@ -91,7 +99,7 @@ void EdgeFront<dim>::initialize(StringModel<dim>& model) {
     link_ = c;
   }
   const int a = link_;
-  model.bend_link(a, point_);
+  set_link(model, a);
   if (table_ == EdgeSpec<dim>::Table::kNone) return;
   // The table: the face the string on its side lies on, through x0, normal to that side's tangent, on
   // the side away from the bend (jump::face_normal).
@@ -174,11 +182,19 @@ double EdgeFront<dim>::potential_moment(const StringModel<dim>& model, const Fro
 }
 
 template <int dim>
+void EdgeFront<dim>::set_link(StringModel<dim>& model, int a) {
+  link_ = a;
+  model.bend_link(a, point_);
+  bent_minus_ = unit_vector<dim>(point_ - model.x().col(a), "the bent link before the edge");
+  bent_plus_ = unit_vector<dim>(model.x().col(a + 1) - point_, "the bent link after the edge");
+}
+
+template <int dim>
 double EdgeFront<dim>::g_minus(const StringModel<dim>& model) const {
   const Points<dim>& x = model.x();
   const int a = link_;
   const ArcRange& arc = model.arcs()[static_cast<std::size_t>(this->arc_minus)];
-  const Vec<dim> d = a > arc.first ? Vec<dim>((x.col(a) - x.col(a - 1)).normalized()) : t_minus_;
+  const Vec<dim> d = a > arc.first ? Vec<dim>((x.col(a) - x.col(a - 1)).normalized()) : bent_minus_;
   return d.dot(point_ - x.col(a));
 }
 
@@ -187,7 +203,7 @@ double EdgeFront<dim>::g_plus(const StringModel<dim>& model) const {
   const Points<dim>& x = model.x();
   const int b = link_ + 1;
   const ArcRange& arc = model.arcs()[static_cast<std::size_t>(this->arc_minus)];
-  const Vec<dim> d = b < arc.last ? Vec<dim>((x.col(b + 1) - x.col(b)).normalized()) : t_plus_;
+  const Vec<dim> d = b < arc.last ? Vec<dim>((x.col(b + 1) - x.col(b)).normalized()) : bent_plus_;
   return d.dot(x.col(b) - point_);
 }
 
@@ -211,19 +227,25 @@ EventAction EdgeFront<dim>::cross(StringModel<dim>& model, const FrontState<dim>
             fmt::format("the string's {} (node {}) has reached the edge: its last material slides over it at s0 = "
                         "{:.9g} m",
                         next < arc.first ? "first node" : next > arc.last ? "last node" : "held node", node, s.s0)};
-  // The node passes to the other side, kMirror kCross h past x0, its velocity turned with the string
-  // (speed kept). Each side moves on along its tangent at the edge by the node's distance δ to x0 and
-  // that much again: as the string would in the next (δ + kMirror kCross h)/|ṡ0|, rigidly, so that its
-  // links and the new bent link keep their lengths (a straight side exactly).
+  // Neither side may be held by a prescribed node (a fixed or driven end): the crossing moves the
+  // material δ + kMirror kCross h over the edge ahead of time, each side on along itself, and a held
+  // node cannot follow. On the side the node leaves, the new bent link would end at a node more than
+  // h from the edge along a taut side (no position of the crossing node gives it its length); on the
+  // other side the crossing node would have to leave the line. Either way the projection after the
+  // crossing fails. The run stops instead, before the crossing, with where it happens.
+  int held = -1;
+  for (int i = arc.first; i <= arc.last && held < 0; ++i)
+    if (i != node && model.is_prescribed(i)) held = i;
+  if (held >= 0)
+    return {EventAction::Kind::kStop,
+            fmt::format("the string {} the edge is held at node {} (a fixed or driven end) and node {} has reached the "
+                        "edge at s0 = {:.9g} m: an edge carries material over it only while the string on both sides "
+                        "is free to move along itself",
+                        held < node ? "before" : "after", held, node, s.s0)};
   const double h = this->m_.h, past = kMirror * kCross * h;
   const int sign = e0 != 0 ? +1 : -1;
   const double delta = e0 != 0 ? g_minus(model) : g_plus(model);
-  // A side held by a prescribed node stays (the projection then moves the crossing node instead).
-  bool held_minus = false, held_plus = false;
-  for (int i = arc.first; i <= arc.last; ++i)
-    if (i != node && model.is_prescribed(i)) (i < node ? held_minus : held_plus) = true;
-  const Vec<dim> shift_minus = held_minus ? Vec<dim>::Zero() : Vec<dim>(sign * (delta + past) * t_minus_);
-  const Vec<dim> shift_plus = held_plus ? Vec<dim>::Zero() : Vec<dim>(sign * (delta + past) * t_plus_);
+  const Vec<dim> shift_minus = sign * (delta + past) * t_minus_, shift_plus = sign * (delta + past) * t_plus_;
   for (int i = arc.first; i <= arc.last; ++i)
     if (i != node) x.col(i) += i < node ? shift_minus : shift_plus;
   if (e0 != 0) {
@@ -236,7 +258,7 @@ EventAction EdgeFront<dim>::cross(StringModel<dim>& model, const FrontState<dim>
     link_ = b;
   }
   model.clear_bends();
-  model.bend_link(link_, point_);
+  set_link(model, link_);
   model.rebuild();
   model.refresh();
   return {EventAction::Kind::kTransfer, {}};

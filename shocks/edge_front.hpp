@@ -100,6 +100,11 @@ class EdgeFront final : public FrontKind<dim> {
   typename EdgeSpec<dim>::Table table_ = EdgeSpec<dim>::Table::kNone;
   Vec<dim> table_normal_ = Vec<dim>::Zero();  ///< the table's outward unit normal (set at initialize)
   int link_ = -1;
+  /// The bent link's directions to and from x0 when it was bent (fixed until the next crossing): the
+  /// signed distance of an arc's end node has no link beyond it to measure along (set_link()).
+  Vec<dim> bent_minus_ = Vec<dim>::Zero(), bent_plus_ = Vec<dim>::Zero();
+  /// Bends link `a` over x0 and fixes its directions.
+  void set_link(StringModel<dim>& model, int a);
   // Of the last evaluation: the tangents on either side, the tension jump [τ] (N).
   Vec<dim> t_minus_ = Vec<dim>::Zero(), t_plus_ = Vec<dim>::Zero();
   double jump_ = 0;
