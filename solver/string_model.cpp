@@ -131,10 +131,15 @@ StringModel<dim>::StringModel(Chain<dim> chain, std::vector<std::unique_ptr<Forc
     quadratic_ = std::make_shared<QuadraticString<dim>>(chain_, prescribed_);
   }
   // 3. Workspace, the state, then slots, masses and the tension system.
-  for (Points<dim>* p : {&a_, &force_, &force_nc_, &tension_force_, &b_}) *p = Points<dim>::Zero(dim, n);
+  for (Points<dim>* p : {&a_, &force_, &tension_force_, &b_}) *p = Points<dim>::Zero(dim, n);
   // Per node only where they exist: the module's forces with a module, the reactions at the
-  // prescribed nodes (column k for prescribed_[k]): 32 bytes per 2D node less for a plain string.
+  // prescribed nodes (column k for prescribed_[k]): 32 bytes per 2D node less for a plain string;
+  // the non-conservative forces with such a force (or quadratic elements, which take the array),
+  // 16 bytes more (force_nc(i) stands in with +0.0, the very terms the zeroed array added).
   module_force_ = Points<dim>::Zero(dim, module_ ? n : 0);
+  const bool nonconservative =
+      quadratic_ || std::any_of(forces_.begin(), forces_.end(), [](const auto& f) { return !f->conservative(); });
+  force_nc_ = Points<dim>::Zero(dim, nonconservative ? n : 0);
   reaction_ = Points<dim>::Zero(dim, static_cast<Eigen::Index>(prescribed_.size()));
   for (Points<dim>* p : {&dx_, &dv_, &e_}) *p = Points<dim>::Zero(dim, L);
   l_ = Eigen::VectorXd::Zero(L);
@@ -386,9 +391,9 @@ double StringModel<dim>::evaluate_current(double t) {
     if (arc_of_[i] < 0) continue;
     if (path_of_[i] < 0) {
       if (module_)
-        b_.col(i) = w_[i] * (force_.col(i) + force_nc_.col(i) + module_force_.col(i));
+        b_.col(i) = w_[i] * (force_.col(i) + force_nc(i) + module_force_.col(i));
       else
-        b_.col(i) = w_[i] * (force_.col(i) + force_nc_.col(i));
+        b_.col(i) = w_[i] * (force_.col(i) + force_nc(i));
     } else {
       b_.col(i) = prescribed_[static_cast<std::size_t>(path_of_[i])].path->acceleration(t);
     }
@@ -440,17 +445,17 @@ double StringModel<dim>::evaluate_current(double t) {
     if (arc_of_[i] < 0) continue;
     if (path_of_[i] < 0) {
       a_.col(i) = quadratic_ ? Vec<dim>(quadratic_->accelerations().col(i)) : Vec<dim>(b_.col(i) + w_[i] * tension_force_.col(i));
-      power += force_nc_.col(i).dot(v_.col(i));
+      power += force_nc(i).dot(v_.col(i));
     } else {
       a_.col(i) = b_.col(i);
       // the support's reaction R_i = m a − F − T − (module force); drag on it is applied work too
       auto reaction = reaction_.col(path_of_[i]);
-      reaction = (quadratic_ ? Vec<dim>(quadratic_->inertia().col(i)) : Vec<dim>(m_[i] * a_.col(i))) - force_.col(i) - force_nc_.col(i) - tension_force_.col(i);
+      reaction = (quadratic_ ? Vec<dim>(quadratic_->inertia().col(i)) : Vec<dim>(m_[i] * a_.col(i))) - force_.col(i) - force_nc(i) - tension_force_.col(i);
       if (module_) reaction -= module_force_.col(i);
-      power += (reaction + force_nc_.col(i)).dot(v_.col(i));
+      power += (reaction + force_nc(i)).dot(v_.col(i));
     }
     if (module_)
-      external_ += force_.col(i) + force_nc_.col(i) + (path_of_[i] >= 0 ? Vec<dim>(reaction_.col(path_of_[i])) : Vec<dim>::Zero());
+      external_ += force_.col(i) + force_nc(i) + (path_of_[i] >= 0 ? Vec<dim>(reaction_.col(path_of_[i])) : Vec<dim>::Zero());
   }
   if (module_ && !bends_.empty()) external_ += bend_reaction();  // the points the links are bent over
   return power;
@@ -751,7 +756,7 @@ typename StringModel<dim>::PhysicalScales StringModel<dim>::physical_scales() co
     if (!in_arc(i)) continue;
     v2_max = std::max(v2_max, v_.col(i).squaredNorm());
     if (path_of_[i] < 0)
-      loads += (force_.col(i) + force_nc_.col(i) - m_[i] * g).norm();
+      loads += (force_.col(i) + force_nc(i) - m_[i] * g).norm();
     else
       a_driven = std::max(a_driven, b_.col(i).norm());  // the path's acceleration
   }

@@ -399,6 +399,9 @@ class StringModel final : public OdeSystem {
   Vec<dim> external_ = Vec<dim>::Zero();
   // workspace
   Points<dim> x_, v_, a_, force_, force_nc_, module_force_, tension_force_, b_, reaction_;
+  /// Node i's non-conservative force: +0 (exactly what the zeroed array held) when force_nc_ is not
+  /// kept, for a run with no such force.
+  Vec<dim> force_nc(int i) const { return force_nc_.cols() ? Vec<dim>(force_nc_.col(i)) : Vec<dim>::Zero(); }
   Points<dim> dx_, dv_, e_;
   Eigen::VectorXd l_;
   double x_max_ = 0, h_min_ = INFINITY;

@@ -30,13 +30,18 @@ class TridiagonalBackend final : public TensionBackend {
  public:
   std::string name() const override { return "tridiagonal"; }
 
-  void analyze(const SparsePattern& pattern, const std::vector<ArcBlock>& arcs) override {
+  void analyze(const SparsePattern& pattern, const std::vector<ArcBlock>& arcs, const ArcSlots& slots) override {
     arcs_ = arcs;
     const int n = pattern.n;
     int expected = 0;
-    diag_.assign(n, -1);
-    lower_.assign(n, -1);
-    upper_.assign(n, -1);
+    // The system's slots: A(u, u) = diag, A(u, u+1) = next[u], A(u+1, u) = prev_of_next[u] (the
+    // backend keeps no copy of them).
+    CHAINSIM_VERIFY(slots.diag && slots.next && slots.prev_of_next && static_cast<int>(slots.diag->size()) == n &&
+                        static_cast<int>(slots.next->size()) == n && static_cast<int>(slots.prev_of_next->size()) == n,
+                    "one diagonal, next and previous slot per unknown");
+    diag_ = slots.diag->data();
+    upper_ = slots.next->data();
+    lower_of_prev_ = slots.prev_of_next->data();
     corner_lo_.assign(arcs.size(), -1);
     corner_up_.assign(arcs.size(), -1);
     int covered = 0;
@@ -45,9 +50,10 @@ class TridiagonalBackend final : public TensionBackend {
       const int f = arc.first_unknown, m = arc.num_links;
       covered += m;
       for (int i = 0; i < m; ++i) {
-        diag_[f + i] = pattern.find(f + i, f + i);
-        if (i > 0) lower_[f + i] = pattern.find(f + i, f + i - 1);
-        if (i + 1 < m) upper_[f + i] = pattern.find(f + i, f + i + 1);
+        CHAINSIM_VERIFY(diag_[f + i] == pattern.find(f + i, f + i) &&
+                            (i + 1 == m || (upper_[f + i] == pattern.find(f + i, f + i + 1) &&
+                                            lower_of_prev_[f + i] == pattern.find(f + i + 1, f + i))),
+                        "the tension system's slots are its pattern's");
       }
       expected += m + 2 * (m - 1);
       if (arc.closed && m >= 3) {
@@ -94,7 +100,7 @@ class TridiagonalBackend final : public TensionBackend {
     r[f] *= inv;
     if (second) second[0] *= inv;
     for (int i = 1; i < m; ++i) {
-      const double a = A[lower_[f + i]];
+      const double a = A[lower_of_prev_[f + i - 1]];  // A(f+i, f+i-1)
       const double b = bmod ? bmod[i] : A[diag_[f + i]];
       piv = b - a * cp_[static_cast<std::size_t>(i - 1)];
       if (!(std::abs(piv) > kSingularPivot * std::abs(b))) return {false, f + i, piv, "Thomas elimination"};
@@ -135,7 +141,11 @@ class TridiagonalBackend final : public TensionBackend {
   }
 
   std::vector<ArcBlock> arcs_;
-  std::vector<int> diag_, lower_, upper_, corner_lo_, corner_up_;
+  // the system's slots (ArcSlots): A(u, u), A(u, u+1) and A(u+1, u)
+  const int* diag_ = nullptr;
+  const int* upper_ = nullptr;
+  const int* lower_of_prev_ = nullptr;
+  std::vector<int> corner_lo_, corner_up_;
   std::vector<double> cp_, z_, bb_;
 };
 
@@ -145,7 +155,7 @@ class EigenBackend final : public TensionBackend {
  public:
   std::string name() const override { return "eigen"; }
 
-  void analyze(const SparsePattern& pattern, const std::vector<ArcBlock>&) override {
+  void analyze(const SparsePattern& pattern, const std::vector<ArcBlock>&, const ArcSlots&) override {
     std::vector<Eigen::Triplet<double>> triplets;
     for (int c = 0; c < pattern.n; ++c)
       for (int k = pattern.col_ptr[c]; k < pattern.col_ptr[c + 1]; ++k)
@@ -185,7 +195,9 @@ class EigenBackend final : public TensionBackend {
 class KluBackend final : public TensionBackend {
  public:
   std::string name() const override { return "klu"; }
-  void analyze(const SparsePattern& pattern, const std::vector<ArcBlock>&) override { lu_.analyze(pattern); }
+  void analyze(const SparsePattern& pattern, const std::vector<ArcBlock>&, const ArcSlots&) override {
+    lu_.analyze(pattern);
+  }
   SolveStatus factor_solve(const double* values, double* rhs) override {
     SolveStatus s = lu_.factor(values);
     if (s.ok) lu_.solve(rhs);
@@ -391,8 +403,6 @@ TensionSystem::TensionSystem(const std::vector<int>& arc_links, const std::vecto
   diag_slot_.assign(n, -1);
   next_slot_.assign(n, -1);
   prev_slot_of_next_.assign(n, -1);
-  next_.assign(static_cast<std::size_t>(n), -1);
-  prev_.assign(static_cast<std::size_t>(n), -1);
   for (int u = 0; u < n; ++u) diag_slot_[u] = pattern_.find(u, u);
   for (const ArcBlock& arc : arcs_) {
     const int f = arc.first_unknown, m = arc.num_links;
@@ -401,15 +411,28 @@ TensionSystem::TensionSystem(const std::vector<int>& arc_links, const std::vecto
       const int next = i + 1 < m ? f + i + 1 : f;
       next_slot_[f + i] = pattern_.find(f + i, next);
       prev_slot_of_next_[f + i] = pattern_.find(next, f + i);
-      next_[static_cast<std::size_t>(f + i)] = next;
-      prev_[static_cast<std::size_t>(next)] = f + i;
     }
   }
 
   // 4. Backend: symbolic analysis once.
   backend_name_ = backend == "auto" ? "tridiagonal" : backend;
   backend_ = make_tension_backend(backend_name_);
-  backend_->analyze(pattern_, arcs_);
+  backend_->analyze(pattern_, arcs_, ArcSlots{&diag_slot_, &next_slot_, &prev_slot_of_next_});
+}
+
+void TensionSystem::link_neighbours() {
+  const int n = size();
+  next_.assign(static_cast<std::size_t>(n), -1);
+  prev_.assign(static_cast<std::size_t>(n), -1);
+  for (const ArcBlock& arc : arcs_) {
+    const int f = arc.first_unknown, m = arc.num_links;
+    for (int i = 0; i < m; ++i) {
+      if (i + 1 == m && !arc.closed) break;
+      const int next = i + 1 < m ? f + i + 1 : f;
+      next_[static_cast<std::size_t>(f + i)] = next;
+      prev_[static_cast<std::size_t>(next)] = f + i;
+    }
+  }
 }
 
 TensionSystem::~TensionSystem() = default;
@@ -425,6 +448,7 @@ void TensionSystem::zero() {
 
 void TensionSystem::exclude(int u) {
   if (excluded_.empty()) excluded_.assign(static_cast<std::size_t>(size()), 0);
+  if (prev_.empty()) link_neighbours();
   if (!excluded_[static_cast<std::size_t>(u)]) {
     excluded_[static_cast<std::size_t>(u)] = 1;
     ++num_excluded_;

@@ -62,13 +62,22 @@ struct SolveStatus {
   std::string detail;  ///< backend-specific note
 };
 
+/// Where each unknown u's arc entries sit in the value array (−1 where there is none), kept by the
+/// TensionSystem that owns the backend (a backend reads them, it does not copy them: 12 bytes a link).
+struct ArcSlots {
+  const std::vector<int>* diag = nullptr;          ///< A(u, u)
+  const std::vector<int>* next = nullptr;          ///< A(u, v), v the next link of u's arc
+  const std::vector<int>* prev_of_next = nullptr;  ///< A(v, u)
+};
+
 /// A sparse direct solver that keeps its symbolic analysis between calls.
 class TensionBackend {
  public:
   virtual ~TensionBackend() = default;
   virtual std::string name() const = 0;
-  /// Symbolic phase, called once with the pattern and the arc blocks it contains.
-  virtual void analyze(const SparsePattern& pattern, const std::vector<ArcBlock>& arcs) = 0;
+  /// Symbolic phase, called once with the pattern, the arc blocks it contains and their slots (which
+  /// outlive the backend).
+  virtual void analyze(const SparsePattern& pattern, const std::vector<ArcBlock>& arcs, const ArcSlots& slots) = 0;
   /// Numeric factorization of A (values in pattern order) and solve of A x = b; `rhs` holds b on entry
   /// and x on return. Reports a singular (or numerically singular) matrix instead of throwing.
   virtual SolveStatus factor_solve(const double* values, double* rhs) = 0;
@@ -189,13 +198,16 @@ class TensionSystem {
   std::unique_ptr<TensionBackend> backend_;
   std::string backend_name_;
   long solves_ = 0;
-  // unilateral links: per unknown, excluded (1) or not (0), the unknowns before and after it in its arc (−1)
+  // unilateral links: per unknown, excluded (1) or not (0), the unknowns before and after it in its arc
+  // (−1; built by the first exclude(), so a run that never releases a link does not hold them)
   std::vector<char> excluded_;
   int num_excluded_ = 0;
   std::vector<int> prev_, next_;
   std::vector<double> full_values_;
   Eigen::VectorXd full_rhs_;
   ComplementarityStats lcp_stats_;
+  /// Builds prev_ and next_.
+  void link_neighbours();
   /// w_u = b_u − (A T)_u with the values `values` and right side `rhs`.
   double complementarity_residual(int u, const std::vector<double>& values, const Eigen::VectorXd& rhs,
                                   const Eigen::VectorXd& T) const;
