@@ -104,6 +104,9 @@ def pyelastica_seconds(path):
     return r["extrapolated_s"], f"measured now: {r['per_step_s'] * 1e6:.2f} us per step x {PYELASTICA_STEPS:.3g}"
 
 
+HAVE_TIME = os.path.exists("/usr/bin/time")
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--chainsim", default=str(ROOT / "build" / "chainsim"))
@@ -138,8 +141,9 @@ def main():
         error, _ = case.measure(first, {})
         for k in range(opts.repeats):
             out = Path(tmp) / f"run{k + 1}"
-            cmd = ["/usr/bin/time", "-f", "%e %U %S", opts.chainsim, "run", opts.scene, "--out", str(out),
-                   "--quiet"] + sets
+            # /usr/bin/time (Debian's package time) is optional: a fresh machine may not have it.
+            cmd = (["/usr/bin/time", "-f", "%e %U %S"] if HAVE_TIME else []) + [
+                opts.chainsim, "run", opts.scene, "--out", str(out), "--quiet"] + sets
             before = resource.getrusage(resource.RUSAGE_CHILDREN)
             start = time.perf_counter()
             p = subprocess.run(cmd, capture_output=True, text=True, cwd=ROOT)
@@ -147,7 +151,8 @@ def main():
             after = resource.getrusage(resource.RUSAGE_CHILDREN)
             if p.returncode != 0:
                 sys.exit(f"{' '.join(cmd)} failed ({p.returncode}): {p.stderr.strip()}")
-            elapsed.append(float(p.stderr.strip().splitlines()[-1].split()[0]))
+            if HAVE_TIME:
+                elapsed.append(float(p.stderr.strip().splitlines()[-1].split()[0]))
             cpu.append(after.ru_utime + after.ru_stime - before.ru_utime - before.ru_stime)
     wall = statistics.median(timed)
     py_s, py_how = pyelastica_seconds(opts.pyelastica)
@@ -155,7 +160,8 @@ def main():
     print(f"omega1 relative error {error:.3e} (target {TARGET:g}: {'met' if error <= TARGET else 'NOT met'}); "
           f"{summary.get('steps')} steps, {summary.get('rhs_evals')} right-hand sides, solver {summary['wall_s']:.4f} s")
     print(f"chainsim run, whole process, {opts.repeats} runs: elapsed median {wall:.4f} s "
-          f"({', '.join(f'{e:.4f}' for e in timed)}); /usr/bin/time %e median {statistics.median(elapsed):.2f} s; "
+          f"({', '.join(f'{e:.4f}' for e in timed)}); "
+          + (f"/usr/bin/time %e median {statistics.median(elapsed):.2f} s; " if elapsed else "") +
           f"CPU (user + system) median {statistics.median(cpu):.4f} s")
     print(f"PyElastica: {py_s:.1f} s ({py_how})")
     print(f"ratio PyElastica / chainsim: {py_s / wall:,.0f}x (elapsed, whole process), "
