@@ -206,6 +206,7 @@ class Layout:
         projection that sees the table edge-on). `extra`: how much
         further right they must reach (staggered snapshots)."""
         a, b = proj
+        self._draw_contact_obstacles(ax, proj, extra, label)
         for f in self.run.fronts:
             if f.kind == "edge":
                 self._draw_edge(ax, f, proj, extra, label)
@@ -224,6 +225,39 @@ class Layout:
             half = 0.6 * self.size
             ends = np.array([centre - half * d, centre + (half + extra) * d])
             self._face(ax, ends, "plane (table)" if label else None)
+
+    def _draw_contact_obstacles(self, ax, proj, extra, label):
+        """The obstacles of [[effects.surface]] and [[effects.cylinder]] (the summary's `obstacles`): a
+        plane as its trace (where the projection sees it edge-on), a cylinder as a grey disc (2D, or a 3D
+        cylinder whose axis is normal to the projection)."""
+        from matplotlib.patches import Circle
+        a, b = proj
+        first = {"surface": True, "cylinder": True}
+        for o in self.run.summary.get("obstacles", []):
+            kind = o.get("kind")
+            lab = ("surface" if kind == "surface" else "cylinder") if label and first.get(kind) else None
+            if kind == "surface":
+                n = np.asarray(o["normal"], dtype=float)
+                if self.dim == 3 and abs(n[3 - a - b]) > 1e-9 * np.linalg.norm(n):
+                    continue
+                d = np.array([-n[b], n[a]])
+                d = d / np.linalg.norm(d)
+                if d[0] < 0:
+                    d = -d
+                p = np.asarray(o["point"], dtype=float)[[a, b]]
+                centre = p + np.dot(0.5 * (self.lo[[a, b]] + self.hi[[a, b]]) - p, d) * d
+                half = 0.6 * self.size
+                self._face(ax, np.array([centre - half * d, centre + (half + extra) * d]), lab)
+            elif kind == "cylinder":
+                if self.dim == 3:
+                    axis = np.asarray(o.get("axis", [0, 0, 1]), dtype=float)
+                    if abs(axis[a]) + abs(axis[b]) > 1e-9 * np.linalg.norm(axis):
+                        continue
+                c = np.asarray(o["center"], dtype=float)[[a, b]]
+                ax.add_patch(Circle(c, o["radius"], facecolor="0.75", edgecolor="0.45", lw=1.0, zorder=0, label=lab))
+            else:
+                continue
+            first[kind] = False
 
     @staticmethod
     def _face(ax, ends, label):

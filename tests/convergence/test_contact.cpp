@@ -1,0 +1,244 @@
+// Contact along arcs with rigid obstacles (solver/contact_module.hpp; docs/model.md §10), each
+// against an independent reference:
+//  - a chain lying on a smooth table pulled along it by an end force F: the motion of a free string
+//    (every node at ½ (F/M) t² along the table), the tension F s/ℓ, the contact force λ g per length;
+//  - a chain dropped flat onto the table: the momentum along the table conserved, the energy lost the
+//    normal kinetic energy at landing ½ M v_n², booked in W_impacts;
+//  - the heavy Atwood chain over a pulley of radius R: ℓ ẍ = g (x1 − x2) with the wrapped arc πR moving
+//    with the chain (x1 − ℓ_free/2 a cosh), at second order in the mesh; the tension where the shorter
+//    side meets the pulley, λ x2 (g + ẍ); and the lift-off of that side where it reaches λ ẋ²;
+//  - the energy and momentum ledgers closed with the obstacles' work and impulse in them.
+#include <cmath>
+#include <cstdio>
+#include <vector>
+
+#include <catch2/catch.hpp>
+
+#include "mesh/errors.hpp"
+#include "solver/contact_module.hpp"
+#include "solver/string_solver.hpp"
+
+using namespace chainsim;
+
+namespace {
+
+constexpr double kG = 9.81;
+constexpr double kPi = 3.141592653589793;
+
+StringSolverOptions contact_run(double t_end, double interval, double rtol = 1e-10) {
+  StringSolverOptions so;
+  so.integrator.rtol = rtol;
+  so.integrator.atol = 1e-3 * rtol;
+  so.integrator.method = "erk5";
+  so.t_end = t_end;
+  so.output_interval = interval;
+  return so;
+}
+
+Obstacle<2> table() {
+  Obstacle<2> o;
+  o.kind = Obstacle<2>::Kind::kPlane;
+  o.point = Vec<2>(0.0, 0.0);
+  o.normal = Vec<2>(0.0, 1.0);
+  o.name = "table";
+  return o;
+}
+
+StringModelOptions contact_options() {
+  StringModelOptions mo;
+  mo.stabilization_time = 0.05;
+  return mo;
+}
+
+/// A straight chain of `links` links, length ℓ, density λ, along +x from the origin lifted by `height`.
+Chain<2> straight_chain(int links, double ell, double lambda, double height, const Vec<2>& velocity) {
+  Chain<2> chain = Chain<2>::uniform(lambda, ell, links, false);
+  for (int i = 0; i <= links; ++i) {
+    chain.positions().col(i) = Vec<2>(i * ell / links, height);
+    chain.velocities().col(i) = velocity;
+  }
+  return chain;
+}
+
+}  // namespace
+
+TEST_CASE("contact: a chain on a smooth table pulled along it moves as a free string", "[contact]") {
+  const double ell = 1.2, lambda = 0.8, F = 0.6, T = 0.5;
+  const int links = 12;
+  std::vector<std::unique_ptr<Force<2>>> forces;
+  forces.push_back(std::make_unique<Gravity<2>>(Vec<2>(0.0, -kG)));
+  forces.push_back(std::make_unique<EndLoad<2>>(links, Vec<2>(F, 0.0)));
+  std::vector<Obstacle<2>> obstacles = {table()};
+  StringModel<2> model(straight_chain(links, ell, lambda, 0.0, Vec<2>::Zero()), std::move(forces), {},
+                       contact_options(), make_contact_module<2>(obstacles));
+  StringSolver<2> solver(model, contact_run(T, T / 4));
+  const RunSummary& s = solver.run();
+  REQUIRE(s.status == "completed");
+  const auto& last = solver.frames().back();
+  const double M = lambda * ell, a = F / M, shift = 0.5 * a * T * T;
+  double position_error = 0;
+  for (int i = 0; i <= links; ++i)
+    position_error = std::max(position_error, (last.x.col(i) - Vec<2>(i * ell / links + shift, 0.0)).norm());
+  // The tension F s/ℓ (s from the free end) and the contact force λ g per length at the last state.
+  Points<2> x = last.x, v = last.v;
+  model.evaluate(last.t, x, v);
+  double tension_error = 0, force_error = 0, total_contact = 0;
+  for (int j = 0; j < links; ++j)
+    // link j pulls the lumped masses of nodes 0..j, λ h (j + ½), at F/M
+    tension_error = std::max(tension_error, std::abs(model.link_tension(j) - F * (j + 0.5) / links));
+  REQUIRE(model.contacts().size() == static_cast<std::size_t>(links + 1));
+  for (std::size_t k = 0; k < model.contacts().size(); ++k) {
+    const int i = model.contacts()[k].node;
+    force_error = std::max(force_error, std::abs(model.contact_force(k) - model.masses()[i] * kG));
+    total_contact += model.contact_force(k);
+  }
+  std::printf("\ntable pull: position error %.3g m (shift %.6g m), tension error %.3g N, contact force error %.3g N, "
+              "sum %.12g N (lambda g l = %.12g N), energy drift %.3g, momentum residual %.3g\n",
+              position_error, shift, tension_error, force_error, total_contact, lambda * kG * ell,
+              s.relative_energy_drift(), s.relative_momentum_residual());
+  CHECK(position_error < 1e-9 * ell);
+  CHECK(tension_error < 1e-9 * F);
+  CHECK(force_error < 1e-9 * lambda * kG * ell / links);
+  CHECK(std::abs(total_contact - lambda * kG * ell) < 1e-9 * lambda * kG * ell);
+  CHECK(last.terms["impacts"] == 0);
+  CHECK(last.terms["lift_offs"] == 0);
+  CHECK(s.relative_energy_drift() < 1e-8);
+  CHECK(s.relative_momentum_residual() < 1e-8);
+}
+
+TEST_CASE("contact: a chain dropped flat onto a table keeps its momentum along it and loses its normal energy",
+          "[contact]") {
+  const double ell = 1.0, lambda = 1.3, height = 0.05, vx = 0.7;
+  const int links = 10;
+  std::vector<std::unique_ptr<Force<2>>> forces;
+  forces.push_back(std::make_unique<Gravity<2>>(Vec<2>(0.0, -kG)));
+  std::vector<Obstacle<2>> obstacles = {table()};
+  StringModel<2> model(straight_chain(links, ell, lambda, height, Vec<2>(vx, 0.0)), std::move(forces), {},
+                       contact_options(), make_contact_module<2>(obstacles));
+  const double t_land = std::sqrt(2 * height / kG), T = 2 * t_land;
+  StringSolver<2> solver(model, contact_run(T, T / 8));
+  const RunSummary& s = solver.run();
+  REQUIRE(s.status == "completed");
+  const auto& last = solver.frames().back();
+  const double M = lambda * ell, lost = 0.5 * M * 2 * kG * height;  // ½ M v_n², v_n² = 2 g height
+  double speed_error = 0, height_error = 0;
+  for (int i = 0; i <= links; ++i) {
+    speed_error = std::max(speed_error, (last.v.col(i) - Vec<2>(vx, 0.0)).norm());
+    height_error = std::max(height_error, std::abs(last.x(1, i)));
+  }
+  std::printf("\nflat drop: impacts %g, W_impacts %.15g J (-1/2 M v_n^2 = %.15g J), speed error %.3g m/s, height "
+              "%.3g m, x at T %.12g (exact %.12g), energy drift %.3g, momentum residual %.3g\n",
+              last.terms["impacts"], last.terms["W_impacts"], -lost, speed_error, height_error, last.x(0, 0), vx * T,
+              s.relative_energy_drift(), s.relative_momentum_residual());
+  CHECK(last.terms["impacts"] == 1);
+  CHECK(std::abs(last.terms["W_impacts"] + lost) < 1e-8 * lost);
+  CHECK(speed_error < 1e-8 * vx);
+  CHECK(height_error < 1e-9);
+  CHECK(std::abs(last.x(0, 0) - vx * T) < 1e-9);
+  CHECK(s.relative_energy_drift() < 1e-8);
+  CHECK(s.relative_momentum_residual() < 1e-8);
+}
+
+namespace {
+
+/// The heavy Atwood chain over a pulley of radius R at the origin: the shorter side (x2) hangs at
+/// x = −R, the longer (x1) at x = +R, the wrapped half circle between; s from the shorter side's end.
+struct Atwood {
+  double ell, R, x1, x2;
+  double free() const { return x1 + x2; }
+  Vec<2> at(double s) const {
+    if (s <= x2) return Vec<2>(-R, s - x2);
+    if (s <= x2 + kPi * R) {
+      const double phi = (s - x2) / R;
+      return Vec<2>(-R * std::cos(phi), R * std::sin(phi));
+    }
+    return Vec<2>(R, -(s - x2 - kPi * R));
+  }
+  /// u = x1 − ℓ_free/2 at time t from rest: u0 cosh(√(2g/ℓ) t).
+  double u(double t) const { return (x1 - 0.5 * free()) * std::cosh(std::sqrt(2 * kG / ell) * t); }
+  /// The lift-off of the shorter side where λ x2 (g + ẍ) = λ ẋ²: 4u² + πR u − (ℓ ℓ_free/2 + 2 u0²) = 0.
+  double u_lift() const {
+    const double u0 = x1 - 0.5 * free(), b = ell - free(), c = ell * free() / 2 + 2 * u0 * u0;
+    return (-b + std::sqrt(b * b + 16 * c)) / 8;
+  }
+  double t_of(double u) const { return std::acosh(u / (x1 - 0.5 * free())) / std::sqrt(2 * kG / ell); }
+};
+
+struct AtwoodRun {
+  double u = 0;              // x1 − ℓ_free/2 at t_end, from the longer side's end
+  double tension_error = 0;  // relative, at the shorter side's contact point, at the frames
+  double drift = 0, momentum = 0, w_impacts = 0;
+  double lifts = 0;
+};
+
+AtwoodRun atwood_run(const Atwood& a, int links, double t_end) {
+  const double lambda = 1.0;
+  Chain<2> chain = Chain<2>::uniform(lambda, a.ell, links, false);
+  for (int i = 0; i <= links; ++i) chain.positions().col(i) = a.at(i * a.ell / links);
+  std::vector<std::unique_ptr<Force<2>>> forces;
+  forces.push_back(std::make_unique<Gravity<2>>(Vec<2>(0.0, -kG)));
+  Obstacle<2> pulley;
+  pulley.kind = Obstacle<2>::Kind::kCylinder;
+  pulley.point = Vec<2>(0.0, 0.0);
+  pulley.radius = a.R;
+  pulley.name = "pulley";
+  StringModel<2> model(std::move(chain), std::move(forces), {}, contact_options(), make_contact_module<2>({pulley}));
+  StringSolver<2> solver(model, contact_run(t_end, t_end / 10, 1e-10));
+  const RunSummary& s = solver.run();
+  REQUIRE(s.status == "completed");
+  AtwoodRun r;
+  const auto& last = solver.frames().back();
+  r.u = -last.x(1, links) - 0.5 * a.free();
+  r.drift = s.relative_energy_drift();
+  r.momentum = s.relative_momentum_residual();
+  r.w_impacts = last.terms["W_impacts"];
+  r.lifts = last.terms["lift_offs"];
+  // The tension where the shorter side meets the pulley (y = 0), extrapolated linearly in height from
+  // the two hanging links next below it, against λ x2 (g + ẍ).
+  for (const auto& f : solver.frames()) {
+    if (f.t == 0) continue;
+    Points<2> x = f.x, v = f.v;
+    model.evaluate(f.t, x, v);
+    // The first held node from the shorter side's end; the links two and three below it hang free.
+    int first = links + 1;
+    for (const auto& c : model.contacts()) first = std::min(first, c.node);
+    const int j = first - 2;
+    REQUIRE(j >= 1);
+    const double y1 = 0.5 * (x(1, j) + x(1, j + 1)), y0 = 0.5 * (x(1, j - 1) + x(1, j));
+    const double T1 = model.link_tension(j), T0 = model.link_tension(j - 1);
+    const double T_contact = T1 + (T1 - T0) / (y1 - y0) * (0 - y1);
+    const double u = a.u(f.t), x2 = 0.5 * a.free() - u, xdd = 2 * kG / a.ell * u;
+    const double exact = lambda * x2 * (kG + xdd);
+    r.tension_error = std::max(r.tension_error, std::abs(T_contact - exact) / exact);
+  }
+  return r;
+}
+
+}  // namespace
+
+TEST_CASE("contact: the heavy Atwood chain over a pulley converges at second order to the cosh", "[contact]") {
+  const Atwood a{1.0, 0.1, 0.0, 0.0};
+  Atwood atwood = a;
+  atwood.x2 = 0.5 * (a.ell - kPi * a.R) - 0.05;
+  atwood.x1 = a.ell - kPi * a.R - atwood.x2;
+  const double t_lift = atwood.t_of(atwood.u_lift());
+  const double t_end = 0.8 * t_lift;
+  const double exact = atwood.u(t_end);
+  std::printf("\nAtwood pulley: l = %g, R = %g, x1 = %g, x2 = %g; lift-off at u = %.9g, t = %.9g s; u(%.6g) = %.12g\n",
+              atwood.ell, atwood.R, atwood.x1, atwood.x2, atwood.u_lift(), t_lift, t_end, exact);
+  std::vector<double> errors;
+  for (int links : {25, 50, 100}) {
+    const AtwoodRun r = atwood_run(atwood, links, t_end);
+    errors.push_back(std::abs(r.u - exact));
+    std::printf("  %4d links: u %.12g, error %.3g m, contact tension error %.3g, W_impacts %.3g J, lift-offs %g, "
+                "energy drift %.3g, momentum residual %.3g\n",
+                links, r.u, errors.back(), r.tension_error, r.w_impacts, r.lifts, r.drift, r.momentum);
+    CHECK(r.drift < 1e-7);
+    CHECK(r.momentum < 1e-7);
+    CHECK(r.tension_error < 0.05);
+  }
+  const double order = std::log2(errors[1] / errors[2]);
+  std::printf("  observed order %.2f, %.2f\n", std::log2(errors[0] / errors[1]), order);
+  CHECK(order > 1.7);
+  CHECK(errors.back() < 1e-3 * exact);
+}
