@@ -23,7 +23,7 @@ using namespace chainsim;
 namespace {
 
 constexpr double kG = 9.81;
-constexpr double kPi = 3.141592653589793;
+constexpr double kPulleyPi = 3.141592653589793;  // (chainsim::kPi exists too)
 
 StringSolverOptions contact_run(double t_end, double interval, double rtol = 1e-10) {
   StringSolverOptions so;
@@ -148,11 +148,11 @@ struct Atwood {
   double free() const { return x1 + x2; }
   Vec<2> at(double s) const {
     if (s <= x2) return Vec<2>(-R, s - x2);
-    if (s <= x2 + kPi * R) {
+    if (s <= x2 + kPulleyPi * R) {
       const double phi = (s - x2) / R;
       return Vec<2>(-R * std::cos(phi), R * std::sin(phi));
     }
-    return Vec<2>(R, -(s - x2 - kPi * R));
+    return Vec<2>(R, -(s - x2 - kPulleyPi * R));
   }
   /// u = x1 − ℓ_free/2 at time t from rest: u0 cosh(√(2g/ℓ) t).
   double u(double t) const { return (x1 - 0.5 * free()) * std::cosh(std::sqrt(2 * kG / ell) * t); }
@@ -169,9 +169,14 @@ struct AtwoodRun {
   double tension_error = 0;  // relative, at the shorter side's contact point, at the frames
   double drift = 0, momentum = 0, w_impacts = 0;
   double lifts = 0;
+  /// Where τ₂ − λ ẋ² (the contact force per length at φ = 0, times R) first reaches zero, interpolated
+  /// between frames (s); NaN if it does not by t_end.
+  double t_zero = std::nan("");
+  /// The angle of the lowest held node of the shorter side at t_end (rad).
+  double phi_last = 0;
 };
 
-AtwoodRun atwood_run(const Atwood& a, int links, double t_end) {
+AtwoodRun atwood_run(const Atwood& a, int links, double t_end, int frames = 10) {
   const double lambda = 1.0;
   Chain<2> chain = Chain<2>::uniform(lambda, a.ell, links, false);
   for (int i = 0; i <= links; ++i) chain.positions().col(i) = a.at(i * a.ell / links);
@@ -183,7 +188,7 @@ AtwoodRun atwood_run(const Atwood& a, int links, double t_end) {
   pulley.radius = a.R;
   pulley.name = "pulley";
   StringModel<2> model(std::move(chain), std::move(forces), {}, contact_options(), make_contact_module<2>({pulley}));
-  StringSolver<2> solver(model, contact_run(t_end, t_end / 10, 1e-10));
+  StringSolver<2> solver(model, contact_run(t_end, t_end / frames, 1e-10));
   const RunSummary& s = solver.run();
   REQUIRE(s.status == "completed");
   AtwoodRun r;
@@ -195,6 +200,7 @@ AtwoodRun atwood_run(const Atwood& a, int links, double t_end) {
   r.lifts = last.terms["lift_offs"];
   // The tension where the shorter side meets the pulley (y = 0), extrapolated linearly in height from
   // the two hanging links next below it, against λ x2 (g + ẍ).
+  double t_prev = 0, d_prev = 0;
   for (const auto& f : solver.frames()) {
     if (f.t == 0) continue;
     Points<2> x = f.x, v = f.v;
@@ -202,6 +208,8 @@ AtwoodRun atwood_run(const Atwood& a, int links, double t_end) {
     // The first held node from the shorter side's end; the links two and three below it hang free.
     int first = links + 1;
     for (const auto& c : model.contacts()) first = std::min(first, c.node);
+    r.phi_last = std::atan2(x(1, first), -x(0, first));
+    if (!std::isnan(r.t_zero)) continue;
     const int j = first - 2;
     REQUIRE(j >= 1);
     const double y1 = 0.5 * (x(1, j) + x(1, j + 1)), y0 = 0.5 * (x(1, j - 1) + x(1, j));
@@ -209,7 +217,12 @@ AtwoodRun atwood_run(const Atwood& a, int links, double t_end) {
     const double T_contact = T1 + (T1 - T0) / (y1 - y0) * (0 - y1);
     const double u = a.u(f.t), x2 = 0.5 * a.free() - u, xdd = 2 * kG / a.ell * u;
     const double exact = lambda * x2 * (kG + xdd);
-    r.tension_error = std::max(r.tension_error, std::abs(T_contact - exact) / exact);
+    if (f.t < 0.99 * t_end) r.tension_error = std::max(r.tension_error, std::abs(T_contact - exact) / exact);
+    // τ₂ − λ ẋ², ẋ the speed of the longer side's end.
+    const double d = T_contact - lambda * v.col(links).squaredNorm();
+    if (t_prev > 0 && d_prev > 0 && d <= 0) r.t_zero = t_prev + (f.t - t_prev) * d_prev / (d_prev - d);
+    t_prev = f.t;
+    d_prev = d;
   }
   return r;
 }
@@ -219,8 +232,8 @@ AtwoodRun atwood_run(const Atwood& a, int links, double t_end) {
 TEST_CASE("contact: the heavy Atwood chain over a pulley converges at second order to the cosh", "[contact]") {
   const Atwood a{1.0, 0.1, 0.0, 0.0};
   Atwood atwood = a;
-  atwood.x2 = 0.5 * (a.ell - kPi * a.R) - 0.05;
-  atwood.x1 = a.ell - kPi * a.R - atwood.x2;
+  atwood.x2 = 0.5 * (a.ell - kPulleyPi * a.R) - 0.05;
+  atwood.x1 = a.ell - kPulleyPi * a.R - atwood.x2;
   const double t_lift = atwood.t_of(atwood.u_lift());
   const double t_end = 0.8 * t_lift;
   const double exact = atwood.u(t_end);
@@ -241,4 +254,31 @@ TEST_CASE("contact: the heavy Atwood chain over a pulley converges at second ord
   std::printf("  observed order %.2f, %.2f\n", std::log2(errors[0] / errors[1]), order);
   CHECK(order > 1.7);
   CHECK(errors.back() < 1e-3 * exact);
+}
+
+TEST_CASE("contact: the heavy Atwood chain lifts off the pulley where its contact force per length reaches zero",
+          "[contact]") {
+  Atwood atwood{1.0, 0.1, 0.0, 0.0};
+  atwood.x2 = 0.5 * (atwood.ell - kPulleyPi * atwood.R) - 0.05;
+  atwood.x1 = atwood.ell - kPulleyPi * atwood.R - atwood.x2;
+  const double t_lift = atwood.t_of(atwood.u_lift());
+  std::printf("\nAtwood lift-off: exact t* = %.9g s (u* = %.9g m)\n", t_lift, atwood.u_lift());
+  std::vector<double> errors;
+  for (int links : {25, 50, 100}) {
+    const AtwoodRun r = atwood_run(atwood, links, 1.15 * t_lift, 460);
+    errors.push_back(std::abs(r.t_zero - t_lift));
+    std::printf("  %4d links: (tau2 - lambda v^2) = 0 at t = %.9g s, error %.3g s; the shorter side's lowest held node "
+                "at %.3g rad at 1.15 t*; lift-offs %g, energy drift %.3g, momentum residual %.3g\n",
+                links, r.t_zero, errors.back(), r.phi_last, r.lifts, r.drift, r.momentum);
+    REQUIRE(!std::isnan(r.t_zero));
+    // Past t* the shorter side has left the pulley near φ = 0: its contact point has moved up the pulley
+    // (the mesh's angular step is h/R = 0.4, 0.2, 0.1 rad).
+    CHECK(r.phi_last > 0.4);
+    CHECK(r.drift < 1e-7);
+    CHECK(r.momentum < 1e-7);
+  }
+  const double order = std::log2(errors[1] / errors[2]);
+  std::printf("  observed order %.2f, %.2f\n", std::log2(errors[0] / errors[1]), order);
+  CHECK(errors.back() < 2e-3 * t_lift);
+  CHECK(order > 1.5);
 }

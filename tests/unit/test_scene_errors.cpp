@@ -407,6 +407,26 @@ TEST_CASE("solver.slack and solver.max_wall_s are parsed and checked, and check_
       {"snap_restitution below 0", kBase + "\n[solver]\nslack = \"allow\"\nsnap_restitution = -0.1\n", "s.toml:21:20: solver.snap_restitution = -0.1 is out of range: allowed 0 <= snap_restitution <= 1"},
       {"snap_restitution without slack = allow", kBase + "\n[solver]\nsnap_restitution = 0.5\n", "s.toml:20:20: solver.snap_restitution = 0.5 applies only with solver.slack = \"allow\""},
       {"slack = allow with an implicit method", kBase + "\n[solver]\nmethod = \"dirk3\"\nslack = \"allow\"\n", "s.toml:20:10: solver.method = \"dirk3\" is implicit, and implicit methods do not meet solver.slack = \"allow\" (their Newton systems know no slack link): use an explicit method (\"auto\", \"erk8\", ...)"},
+      {"a surface with a zero normal", kBase + "[[effects.surface]]\npoint = [0.0, -2.0]\nnormal = [0.0, 0.0]\n",
+       "s.toml:20:10: effects.surface[0].normal = [0.0, 0.0] is not a normal: allowed a finite nonzero vector"},
+      {"a surface point of the wrong dimension", kBase + "[[effects.surface]]\npoint = [0.0, -2.0, 1.0]\nnormal = [0.0, 1.0]\n",
+       "s.toml:19:9: effects.surface[0].point = [0.0, -2.0, 1.0] has 3 components but string.dimension = 2"},
+      {"a cylinder of radius 0", kBase + "[[effects.cylinder]]\ncenter = [0.5, -0.5]\nradius = 0.0\n",
+       "s.toml:20:10: effects.cylinder[0].radius = 0 is out of range: allowed radius > 0"},
+      {"a cylinder without radius", kBase + "[[effects.cylinder]]\ncenter = [0.5, -0.5]\n",
+       "s.toml:18:1: effects.cylinder[0] needs radius (m, > 0)"},
+      {"a 2D cylinder with an axis", kBase + "[[effects.cylinder]]\ncenter = [0.5, -0.5]\nradius = 0.1\naxis = [0.0, 0.0, 1.0]\n",
+       "s.toml:21:8: effects.cylinder[0].axis = [0.0, 0.0, 1.0]: in 2D a cylinder is a circle about the out-of-plane axis; "
+       "allowed: no axis key"},
+      {"a string starting inside a surface", kBase + "[[effects.surface]]\npoint = [0.0, -0.5]\nnormal = [0.0, 1.0]\n",
+       "s.toml:18:1: node 6 of the string starts 0.1 m inside the obstacle effects.surface[0] (allowed: on or outside its "
+       "surface, within 0.001 of a link length)"},
+      {"obstacles with slack = allow", kBase + "[[effects.cylinder]]\ncenter = [0.5, -0.5]\nradius = 0.1\n[solver]\nslack = \"allow\"\n",
+       "s.toml:22:9: solver.slack = \"allow\" does not meet obstacles ([[effects.surface]], [[effects.cylinder]]) yet: "
+       "allowed \"stop\", \"warn\" or \"ignore\""},
+      {"obstacles with an implicit method", kBase + "[[effects.cylinder]]\ncenter = [0.5, -0.5]\nradius = 0.1\n[solver]\nmethod = \"dirk3\"\n",
+       "s.toml:22:10: solver.method = \"dirk3\" is implicit, and implicit methods do not meet obstacles (their Newton "
+       "systems know no contact): allowed an explicit method (\"auto\", \"erk5\", \"erk8\", ...)"},
       {"no wall time", kBase + "\n[solver]\nmax_wall_s = 0\n",
        "s.toml:20:14: solver.max_wall_s = 0 is out of range: allowed max_wall_s > 0"},
       {"a negative wall time", kBase + "\n[solver]\nmax_wall_s = -5.0\n",
