@@ -361,3 +361,41 @@ TEST_CASE("contact: the heavy Atwood chain lifts off the pulley where its contac
   for (double e : errors) CHECK(e < 0.05 * t_lift);
   CHECK(errors.back() < 0.006 * t_lift);
 }
+
+TEST_CASE("contact: a cylinder in 3D holds the Atwood chain as the circle does in 2D", "[contact]") {
+  // The same chain in the plane z = 0 over a cylinder whose axis is the z line through (0, 0, 0.3): the
+  // axis's offset along itself and its length do not matter.
+  const Atwood atwood = atwood_case();
+  const int links = 25;
+  const double t_end = 0.2;
+  const double u2 = atwood_run(atwood, links, t_end).u;
+  Chain<3> chain = Chain<3>::uniform(1.0, atwood.ell, links, false);
+  for (int i = 0; i <= links; ++i) {
+    chain.positions().col(i) << atwood.at(i * atwood.ell / links), 0.0;
+    chain.velocities().col(i) << atwood.v0 * atwood.tangent(i * atwood.ell / links), 0.0;
+  }
+  std::vector<std::unique_ptr<Force<3>>> forces;
+  forces.push_back(std::make_unique<Gravity<3>>(Vec<3>(0.0, -kG, 0.0)));
+  Obstacle<3> pulley;
+  pulley.kind = Obstacle<3>::Kind::kCylinder;
+  pulley.point = Vec<3>(0.0, 0.0, 0.3);
+  pulley.axis = Vec<3>(0.0, 0.0, 1.0);
+  pulley.radius = atwood.R;
+  pulley.name = "pulley";
+  StringModelOptions mo;
+  mo.stabilization_time = 0.05;
+  StringModel<3> model(std::move(chain), std::move(forces), {}, mo, make_contact_module<3>({pulley}));
+  StringSolver<3> solver(model, contact_run(t_end, t_end / 4, 1e-11));
+  const RunSummary& s = solver.run();
+  REQUIRE(s.status == "completed");
+  const auto& last = solver.frames().back();
+  const double u3 = 0.5 * (last.x(1, 0) - last.x(1, links));
+  double z = 0;
+  for (int i = 0; i <= links; ++i) z = std::max(z, std::abs(last.x(2, i)));
+  std::printf("\n3D cylinder: u %.12g (2D %.12g), |z| <= %.3g, energy drift %.3g, momentum residual %.3g\n", u3, u2, z,
+              s.relative_energy_drift(), s.relative_momentum_residual());
+  CHECK(std::abs(u3 - u2) < 1e-8);
+  CHECK(z < 1e-12);
+  CHECK(s.relative_energy_drift() < 1e-8);
+  CHECK(s.relative_momentum_residual() < 1e-8);
+}
