@@ -238,21 +238,26 @@ class Layout:
         from matplotlib.patches import Circle
         a, b = proj
         first = {"surface": True, "cylinder": True}
+        count = {"surface": 0, "cylinder": 0}
         for o in self.run.summary.get("obstacles", []):
             kind = o.get("kind")
-            lab = ("surface" if kind == "surface" else "cylinder") if label and first.get(kind) else None
+            if kind not in count:
+                continue
+            gid = f"obstacle {kind}{count[kind]}"  # surface0, cylinder0, ... in the scene's order
+            count[kind] += 1
+            lab = kind if label and first[kind] else None
             if kind == "surface":
                 if not self._plane_trace(ax, o["point"], o["normal"], proj, extra, lab):
                     continue
-            elif kind == "cylinder":
+                ax.lines[-1].set_gid(gid)
+            else:
                 if self.dim == 3:
                     axis = np.asarray(o.get("axis", [0, 0, 1]), dtype=float)
                     if abs(axis[a]) + abs(axis[b]) > 1e-9 * np.linalg.norm(axis):
                         continue
                 c = np.asarray(o["center"], dtype=float)[[a, b]]
-                ax.add_patch(Circle(c, o["radius"], facecolor="0.75", edgecolor="0.45", lw=1.0, zorder=0, label=lab))
-            else:
-                continue
+                ax.add_patch(Circle(c, o["radius"], facecolor="0.75", edgecolor="0.45", lw=1.0, zorder=0, label=lab,
+                                    gid=gid))
             first[kind] = False
 
     @staticmethod
