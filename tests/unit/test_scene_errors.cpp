@@ -65,7 +65,7 @@ TEST_CASE("bad scenes are refused with the location, the key, the value and what
        "s.toml:16:2: unknown section [stp]; valid sections: string, shape, velocity, ends, effects, solver, output, stop; valid top-level keys: model (did you mean [stop]?)"},
       {"typo in an effect",
        edit(kBase, "[effects.gravity]", "[effects.gravty]"),
-       "s.toml:13:10: unknown effect [effects.gravty]; valid effects: gravity, drag, heap, fold, plane, edge (did you mean [effects.gravity]?)"},
+       "s.toml:13:10: unknown effect [effects.gravty]; valid effects: gravity, drag, heap, fold, plane, edge, surface, cylinder (did you mean [effects.gravity]?)"},
       {"a solver key of the old format",
        kBase + std::string("[solver]\nt_end = 1.0\n"),
        "s.toml:19:1: unknown key 't_end' in [solver]; valid keys: method, rtol, atol, max_step, initial_step, max_steps, stabilization_time, backend, linear_solver, check_slack, slack_tolerance, slack, snap_restitution, max_wall_s; t_end is now written in [stop]"},
