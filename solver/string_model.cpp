@@ -358,6 +358,55 @@ void StringModel<dim>::assemble_matrix() {
     if (next >= 0) system_->set_coupling(u, w_[b] * e_.col(j).dot(e_.col(next)));
   });
   if (!bends_.empty()) bend_couplings();
+  if (!contacts_.empty()) contact_couplings();
+}
+
+template <int dim>
+void StringModel<dim>::contact_couplings() {
+  // Node i held with normal n: its response to a force f is w_i P f, P = I − n nᵀ. In the rows of its
+  // links jm (ending at i) and jp (starting at i) the entries w_i e·e' become w_i (e·e' − (e·n)(e'·n)).
+  const int L = chain_.num_links();
+  for (const NodeContact<dim>& c : contacts_) {
+    const int i = c.node;
+    const int jm = i > 0 ? i - 1 : (chain_.closed() ? L - 1 : -1), jp = i < L ? i : -1;
+    const int um = jm >= 0 ? link_unknown_[static_cast<std::size_t>(jm)] : -1;
+    const int up = jp >= 0 ? link_unknown_[static_cast<std::size_t>(jp)] : -1;
+    if (um >= 0) system_->add_diagonal(um, w_[i] * std::pow(e_.col(jm).dot(c.normal), 2));
+    if (up >= 0) system_->add_diagonal(up, w_[i] * std::pow(e_.col(jp).dot(c.normal), 2));
+    if (um >= 0 && up >= 0)
+      system_->set_coupling(um, w_[i] * (e_.col(jm).dot(e_.col(jp)) - e_.col(jm).dot(c.normal) * e_.col(jp).dot(c.normal)));
+  }
+}
+
+template <int dim>
+void StringModel<dim>::constrain_contact_nodes() {
+  contact_bn_.resize(contacts_.size());
+  for (std::size_t k = 0; k < contacts_.size(); ++k) {
+    const NodeContact<dim>& c = contacts_[k];
+    const int i = c.node;
+    // g'' = n·a + curvature = −2α g' − β² g: the surface's normal acceleration with the drift control.
+    const double target = -c.curvature - 2 * alpha_ * c.normal.dot(v_.col(i)) - beta2_ * c.gap;
+    contact_bn_[k] = c.normal.dot(b_.col(i));
+    b_.col(i) += (target - contact_bn_[k]) * c.normal;
+  }
+}
+
+template <int dim>
+double StringModel<dim>::place_contact_nodes() {
+  double worst = 0;
+  for (const NodeContact<dim>& c : contacts_) {
+    x_.col(c.node) -= c.gap * c.normal;
+    worst = std::max(worst, std::abs(c.gap) / h_min_);
+  }
+  return worst;
+}
+
+template <int dim>
+double StringModel<dim>::contact_power() const {
+  double p = 0;
+  for (std::size_t k = 0; k < contacts_.size(); ++k)
+    p += contact_force_[k] * contacts_[k].normal.dot(v_.col(contacts_[k].node));
+  return p;
 }
 
 template <int dim>
@@ -368,6 +417,8 @@ void StringModel<dim>::refresh() {
   module_->add_mass_and_forces(*this, m_, module_force_);
   for (int i = 0; i < chain_.num_nodes(); ++i)
     if (slot_[i] >= 0) w_[i] = 1.0 / m_[i];
+  contacts_.clear();
+  module_->node_contacts(*this, contacts_);
 }
 
 template <int dim>
@@ -410,6 +461,7 @@ double StringModel<dim>::evaluate_current(double t) {
     system_->zero();
     assemble_matrix();
     beta2_ = capped_beta2();  // the drift control's position term, capped (capped_beta2)
+    if (!contacts_.empty()) constrain_contact_nodes();
     for_each_link([&](int j, int u, int) {
       const int a = chain_.link_start(j), b = chain_.link_end(j);
       const double h = chain_.link_length(j), l = l_[j];
@@ -458,6 +510,20 @@ double StringModel<dim>::evaluate_current(double t) {
       external_ += force_.col(i) + force_nc(i) + (path_of_[i] >= 0 ? Vec<dim>(reaction_.col(path_of_[i])) : Vec<dim>::Zero());
   }
   if (module_ && !bends_.empty()) external_ += bend_reaction();  // the points the links are bent over
+  if (!contacts_.empty()) {
+    // A held node moves with w_i P (its force) + c_i n; the contact force N n is what that takes:
+    // N = m_i (c_i − n·b_i) − n·(tension force), b_i its unconstrained acceleration.
+    contact_force_.resize(contacts_.size());
+    for (std::size_t k = 0; k < contacts_.size(); ++k) {
+      const NodeContact<dim>& c = contacts_[k];
+      const int i = c.node;
+      const double fn = c.normal.dot(tension_force_.col(i));
+      a_.col(i) -= w_[i] * fn * c.normal;
+      const double target = c.normal.dot(b_.col(i));
+      contact_force_[k] = m_[i] * (target - contact_bn_[k]) - fn;
+      external_ += contact_force_[k] * c.normal;
+    }
+  }
   return power;
 }
 
@@ -517,10 +583,18 @@ void StringModel<dim>::project(double t) {
   auto correct = [&](Points<dim>& target, const Eigen::VectorXd& nu) { add_link_responses(target, nu); };
   double violation = 0, previous = INFINITY, roundoff = 0;
   for (int iteration = 0;; ++iteration) {
+    double gap_violation = 0;
+    if (!contacts_.empty()) {
+      // The held nodes back on their surfaces first (a correction along the links' directions moves
+      // a node on a cylinder off it at second order), then the links.
+      refresh();
+      gap_violation = place_contact_nodes();
+      refresh();
+    }
     links();
     const double tolerance = constraint_tolerance();
     roundoff = tolerance;
-    violation = 0;
+    violation = gap_violation;
     for_each_link([&](int j, int, int) {
       if (!link_slack(j)) violation = std::max(violation, std::abs(l_[j] - chain_.link_length(j)) / chain_.link_length(j));
     });
@@ -539,7 +613,9 @@ void StringModel<dim>::project(double t) {
     exclude_slack_links();
     correct(x_, system_->solve(t));
   }
-  // Velocities: one linear projection onto e_j·Δv_j = 0.
+  // Velocities: one linear projection onto e_j·Δv_j = 0 (held nodes: onto n·v = 0 first, then with
+  // their responses w_i P: the mass-weighted projection onto both).
+  for (const NodeContact<dim>& c : contacts_) v_.col(c.node) -= c.normal.dot(v_.col(c.node)) * c.normal;
   links();
   system_->zero();
   assemble_matrix();
@@ -805,6 +881,18 @@ void StringModel<dim>::add_link_responses(Points<dim>& target, const Eigen::Vect
   for (const Bend& bend : bends_) {
     const int u = link_unknown_[static_cast<std::size_t>(bend.link)];
     if (u >= 0) target.col(chain_.link_end(bend.link)) += w_[chain_.link_end(bend.link)] * nu[u] * (bend.e_plus - e_.col(bend.link));
+  }
+  if (contacts_.empty()) return;
+  // A held node responds with w_i P: take back the normal part of its response (the links at it
+  // are the only ones that moved it, so its response is its links' terms above).
+  const int L = chain_.num_links();
+  for (const NodeContact<dim>& c : contacts_) {
+    const int i = c.node;
+    const int jm = i > 0 ? i - 1 : (chain_.closed() ? L - 1 : -1), jp = i < L ? i : -1;
+    Vec<dim> response = Vec<dim>::Zero();
+    if (jm >= 0 && link_unknown_[static_cast<std::size_t>(jm)] >= 0) response += nu[link_unknown_[static_cast<std::size_t>(jm)]] * e_.col(jm);
+    if (jp >= 0 && link_unknown_[static_cast<std::size_t>(jp)] >= 0) response -= nu[link_unknown_[static_cast<std::size_t>(jp)]] * e_.col(jp);
+    target.col(i) -= w_[i] * c.normal.dot(response) * c.normal;
   }
 }
 

@@ -283,6 +283,14 @@ class StringModel final : public OdeSystem {
   /// The tension of link `link` after an evaluation (N): its multiplier; NaN for a link in no arc.
   double link_tension(int link) const;
   const Points<dim>& accelerations() const { return a_; }
+  // --- nodes held on obstacles (a contact module; docs/model.md §10) ---------------------------
+  /// The nodes the module holds on obstacles (StringModule::node_contacts), at the last refresh().
+  const std::vector<NodeContact<dim>>& contacts() const { return contacts_; }
+  /// After an evaluation: the normal force N_k (N) of contacts()[k] on its node (≥ 0 while it holds).
+  double contact_force(std::size_t k) const { return contact_force_[k]; }
+  /// After an evaluation: Σ_k N_k n_k · v_k, the power of the contact forces (W; zero on the surface,
+  /// up to the drift control).
+  double contact_power() const;
   /// The sum of the uniform fields the forces declare (Force::uniform_field; gravity's g, zero
   /// without one): the weight per unit mass in the physical scales, and what the module books for
   /// material not lumped on nodes.
@@ -385,6 +393,17 @@ class StringModel final : public OdeSystem {
     double l_minus = 0, l_plus = 0;
   };
   std::vector<Bend> bends_;
+  // Node contacts (refresh(): from the module): held nodes, their normal forces after an evaluation,
+  // and n·b of their unconstrained accelerations (evaluate_current).
+  std::vector<NodeContact<dim>> contacts_;
+  std::vector<double> contact_force_, contact_bn_;
+  /// evaluate_current: each held node's b_i becomes P b_i + c_i n (P = I − n nᵀ, c_i the normal
+  /// acceleration the surface asks, with the drift control of its gap).
+  void constrain_contact_nodes();
+  /// assemble_matrix: the held nodes' inverse masses become w_i P in the rows of their two links.
+  void contact_couplings();
+  /// project(): puts the held nodes back on their surfaces (x −= gap n); returns the largest gap / h.
+  double place_contact_nodes();
   void bend_links();               // links(): the bent links' lengths and directions
   void bend_couplings();           // assemble_matrix(): their couplings at the end node
   double bend_rate(const Bend& bend) const;  // d(l⁻ + l⁺)/dt

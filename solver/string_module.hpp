@@ -93,6 +93,21 @@ struct ModuleLedger {
   bool has_momentum_ledger = false;     ///< impulse is integrated: p − p0 − impulse → 0
 };
 
+/// A node held on the surface of a rigid obstacle (a contact module, solver/contact_module.hpp;
+/// docs/model.md §10): while it is listed, the node's gap stays zero, its normal acceleration is the
+/// one the surface's curvature asks, and the contact force N n (N ≥ 0 while it holds) is the
+/// multiplier of that constraint, eliminated node by node from the tension system
+/// (StringModel::contact_force).
+template <int dim>
+struct NodeContact {
+  int node = -1;
+  Vec<dim> normal = Vec<dim>::Zero();  ///< the obstacle's unit outward normal at the node
+  double gap = 0;                      ///< the node's signed distance from the surface (m), ≥ 0 outside
+  /// The gap's second derivative at zero acceleration (m/s²): |Q v|² − (n·v)² over the distance
+  /// from a cylinder's axis (Q the projection normal to the axis), 0 for a plane.
+  double curvature = 0;
+};
+
 /// What an event means.
 struct EventAction {
   enum class Kind { kNone, kTransfer, kStop } kind = Kind::kNone;
@@ -152,6 +167,9 @@ class StringModule {
   /// Whether the root functions read the tensions (then the string evaluates its tension system
   /// before events(), else it only refreshes the module's masses and forces).
   virtual bool events_need_tensions() const { return false; }
+  /// The nodes held on obstacles at the current positions and velocities (called by refresh(), after
+  /// add_mass_and_forces); none without a contact module.
+  virtual void node_contacts(const StringModel<dim>&, std::vector<NodeContact<dim>>&) const {}
   /// The physical events of the run so far (e.g. a chain lifting off an edge), for the run's summary.
   virtual std::vector<RunEvent> run_events() const { return {}; }
 };

@@ -49,6 +49,29 @@ void parse_edges(const Section& effects, Context& ctx) {
   }
 }
 
+/// [[effects.surface]] and [[effects.cylinder]]: the rigid obstacles the string touches along arcs
+/// (solver/contact_module.hpp; their geometry is checked against the dimension in scene_parts.cpp).
+void parse_obstacles(const Section& effects, Context& ctx) {
+  const auto surfaces = table_array(effects, "surface", "surface");
+  for (std::size_t k = 0; k < surfaces.size(); ++k) {
+    Section e(*surfaces[k], fmt::format("effects.surface[{}]", k), ctx, {"point", "normal"});
+    if (!e.has("point")) e.missing("point", "m, a point of the plane");
+    if (!e.has("normal")) e.missing("normal", "a vector normal to the plane (any length > 0), pointing to the side the string is on");
+    ctx.spec.effects.surfaces.push_back(SurfaceEntry{e.vector("point"), e.vector("normal")});
+  }
+  const auto cylinders = table_array(effects, "cylinder", "cylinder");
+  for (std::size_t k = 0; k < cylinders.size(); ++k) {
+    Section e(*cylinders[k], fmt::format("effects.cylinder[{}]", k), ctx, {"center", "radius", "axis"});
+    if (!e.has("center")) e.missing("center", "m, the centre of the circle (2D) or a point of the axis (3D)");
+    if (!e.has("radius")) e.missing("radius", "m, > 0");
+    CylinderEntry cylinder;
+    cylinder.center = e.vector("center");
+    cylinder.radius = *e.positive("radius");
+    if (e.has("axis")) cylinder.axis = e.vector("axis");
+    ctx.spec.effects.cylinders.push_back(cylinder);
+  }
+}
+
 }  // namespace
 
 void parse_effects(const Section& top, Context& ctx) {
@@ -68,6 +91,7 @@ void parse_effects(const Section& top, Context& ctx) {
   }
   parse_heaps(s, ctx);
   parse_edges(s, ctx);
+  parse_obstacles(s, ctx);
   if (s.has("fold")) {
     Section f(subtable(s, "fold"), "effects.fold", ctx, {"s0", "f"});
     if (!f.has("s0")) f.missing("s0", "m, the material coordinate of the fold at t = 0");

@@ -56,7 +56,8 @@ SceneSpec parse_table(const toml::table& root, const SourceText& text) {
 
 const std::vector<EffectTable>& effect_tables() {
   static const std::vector<EffectTable> tables = {
-      {"gravity", false}, {"drag", false}, {"heap", true}, {"fold", false}, {"plane", false}, {"edge", true}};
+      {"gravity", false}, {"drag", false}, {"heap", true}, {"fold", false}, {"plane", false}, {"edge", true},
+      {"surface", true}, {"cylinder", true}};
   return tables;
 }
 

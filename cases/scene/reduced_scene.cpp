@@ -57,6 +57,9 @@ ReducedSetup match(const SceneSpec& spec) {
   if (!spec.has_fronts())
     refuse("needs a fold or a heap: the reduced models are the falling chain (a heap at the end, on a table), the "
            "folded chain (a fold) and the sliding chain (a heap at the start, at a hole)");
+  if (spec.has_obstacles())
+    refuse("has no obstacle: remove [[effects.surface]] and [[effects.cylinder]] (the string solver runs them: model = "
+           "\"string\")");
   if (!fx.edges.empty()) refuse("has no edge: remove [[effects.edge]] (the string solver runs it: model = \"string\")");
   const FrontScene<dim> scene = build_front_scene<dim>(spec);
   const std::vector<std::string> names = scene_build::front_names(spec);

@@ -93,6 +93,20 @@ struct PlaneEntry {
   std::vector<double> normal;  ///< its normal, towards the string's side (any length > 0)
 };
 
+/// A rigid smooth plane the string lies on, slides over, lands on and lifts off: [[effects.surface]]
+/// (solver/contact_module.hpp).
+struct SurfaceEntry {
+  std::vector<double> point;   ///< a point of the plane (m)
+  std::vector<double> normal;  ///< its normal, towards the string's side (any length > 0)
+};
+
+/// A rigid smooth cylinder (a circle in 2D): a pulley, a peg with a radius: [[effects.cylinder]].
+struct CylinderEntry {
+  std::vector<double> center;  ///< the centre (2D) or a point of the axis (3D) (m)
+  double radius = 0;           ///< m, > 0
+  std::optional<std::vector<double>> axis;  ///< 3D: the axis (any length > 0); 2D: not given
+};
+
 /// A stop event: [[stop.front]].
 struct FrontStop {
   std::string front;  ///< "fold" | "heap_start" | "heap_end"
@@ -155,7 +169,11 @@ struct SceneSpec {
     std::optional<FoldEntry> fold;               ///< [effects.fold]
     std::optional<PlaneEntry> plane;             ///< [effects.plane]
     std::vector<EdgeEntry> edges;                ///< [[effects.edge]]
+    std::vector<SurfaceEntry> surfaces;          ///< [[effects.surface]]
+    std::vector<CylinderEntry> cylinders;        ///< [[effects.cylinder]]
   } effects;
+  /// The scene has a surface or a cylinder: the string runs with the contact module.
+  bool has_obstacles() const { return !effects.surfaces.empty() || !effects.cylinders.empty(); }
   /// The scene has a heap, a fold or an edge: the string runs with front tracking.
   bool has_fronts() const { return !effects.heaps.empty() || effects.fold.has_value() || !effects.edges.empty(); }
   // [solver]

@@ -90,6 +90,17 @@ json effects_json(const SceneSpec::Effects& fx) {
       if (e.direction) j["edge"].back()["direction"] = *e.direction;
     }
   }
+  if (!fx.surfaces.empty()) {
+    j["surface"] = json::array();
+    for (const SurfaceEntry& e : fx.surfaces) j["surface"].push_back({{"point", e.point}, {"normal", e.normal}});
+  }
+  if (!fx.cylinders.empty()) {
+    j["cylinder"] = json::array();
+    for (const CylinderEntry& e : fx.cylinders) {
+      j["cylinder"].push_back({{"center", e.center}, {"radius", e.radius}});
+      if (e.axis) j["cylinder"].back()["axis"] = *e.axis;
+    }
+  }
   return j;
 }
 

@@ -3,10 +3,78 @@
 #include "cases/scene/front_scene.hpp"
 #include "cases/scene/scene.hpp"
 #include "cases/scene/scene_build.hpp"
+#include "solver/contact_module.hpp"
 
 namespace chainsim {
 
 using scene_build::at_key;
+
+namespace {
+
+/// The scene's obstacles (solver/contact_module.hpp), each checked at its key; and what they do not
+/// meet refused at the key at fault.
+template <int dim>
+std::vector<Obstacle<dim>> contact_obstacles(const SceneSpec& spec) {
+  const auto& fx = spec.effects;
+  const std::string first = fx.surfaces.empty() ? "effects.cylinder[0]" : "effects.surface[0]";
+  if (spec.has_fronts())
+    scene_build::fail_at(spec, first, "[[effects.surface]] and [[effects.cylinder]] do not meet fronts (heaps, folds, "
+                                      "edges) yet: allowed in a scene without [[effects.heap]], [effects.fold] and "
+                                      "[[effects.edge]]");
+  if (spec.solver.slack == "allow")
+    scene_build::fail_at(spec, "solver.slack", "solver.slack = \"allow\" does not meet obstacles ([[effects.surface]], "
+                                               "[[effects.cylinder]]) yet: allowed \"stop\", \"warn\" or \"ignore\"");
+  if (spec.elements == "quadratic")
+    scene_build::fail_at(spec, "string.elements", "string.elements = \"quadratic\" does not meet obstacles: allowed "
+                                                  "\"links\" (the contact holds nodes)");
+  IntegratorOptions method;
+  method.method = spec.solver.method;
+  if (method.implicit_method())
+    scene_build::fail_at(spec, "solver.method",
+                         fmt::format("solver.method = \"{}\" is implicit, and implicit methods do not meet obstacles "
+                                     "(their Newton systems know no contact): allowed an explicit method (\"auto\", "
+                                     "\"erk5\", \"erk8\", ...)",
+                                     spec.solver.method));
+  auto unit = [&](const std::vector<double>& v, const std::string& key, const std::string& what) {
+    const Vec<dim> u = scene_build::as_vec<dim>(spec, v, key);
+    if (!(u.norm() > 0) || !u.allFinite())
+      scene_build::fail_at(spec, key, fmt::format("{} = {} is not {}: allowed a finite nonzero vector", key,
+                                                  scene_build::text_of(spec, key), what));
+    return Vec<dim>(u.normalized());
+  };
+  std::vector<Obstacle<dim>> obstacles;
+  for (std::size_t k = 0; k < fx.surfaces.size(); ++k) {
+    const std::string key = fmt::format("effects.surface[{}]", k);
+    Obstacle<dim> o;
+    o.kind = Obstacle<dim>::Kind::kPlane;
+    o.name = key;
+    o.point = scene_build::as_vec<dim>(spec, fx.surfaces[k].point, key + ".point");
+    o.normal = unit(fx.surfaces[k].normal, key + ".normal", "a normal");
+    obstacles.push_back(o);
+  }
+  for (std::size_t k = 0; k < fx.cylinders.size(); ++k) {
+    const std::string key = fmt::format("effects.cylinder[{}]", k);
+    const CylinderEntry& c = fx.cylinders[k];
+    Obstacle<dim> o;
+    o.kind = Obstacle<dim>::Kind::kCylinder;
+    o.name = key;
+    o.point = scene_build::as_vec<dim>(spec, c.center, key + ".center");
+    o.radius = c.radius;
+    if constexpr (dim == 3) {
+      if (!c.axis) scene_build::fail_at(spec, key, fmt::format("{}.axis is missing: in 3D a cylinder needs its axis, a "
+                                                               "finite nonzero vector [ax, ay, az]", key));
+      o.axis = unit(*c.axis, key + ".axis", "an axis");
+    } else if (c.axis) {
+      scene_build::fail_at(spec, key + ".axis", fmt::format("{}.axis = {}: in 2D a cylinder is a circle about the "
+                                                            "out-of-plane axis; allowed: no axis key",
+                                                            key, scene_build::text_of(spec, key + ".axis")));
+    }
+    obstacles.push_back(o);
+  }
+  return obstacles;
+}
+
+}  // namespace
 
 template <int dim>
 StringScene<dim> build_string_scene(const SceneSpec& spec) {
@@ -27,12 +95,28 @@ StringScene<dim> build_string_scene(const SceneSpec& spec) {
     if (spec.start.prescribed()) fit_key = "ends.start";
     if (spec.end.prescribed()) fit_key = "ends.end";
     const StringModelOptions& mo = parts.model;
+    std::unique_ptr<StringModule<dim>> contact;
+    if (spec.has_obstacles()) {
+      contact = make_contact_module<dim>(contact_obstacles<dim>(spec));
+      fit_key = spec.effects.surfaces.empty() ? "effects.cylinder" : "effects.surface";
+    }
     scene.model = at_key(spec, fit_key, [&] {
       auto model = std::make_unique<StringModel<dim>>(std::move(parts.chain), std::move(parts.forces),
-                                                      std::move(parts.prescribed), mo);
+                                                      std::move(parts.prescribed), mo, std::move(contact));
       model->make_consistent(0.0);
       return model;
     });
+  }
+  if (spec.has_obstacles()) {
+    // The obstacles as the run's summary (and stats.json, which the plot tool reads) lists them.
+    nlohmann::json obstacles = nlohmann::json::array();
+    for (const SurfaceEntry& e : spec.effects.surfaces)
+      obstacles.push_back({{"kind", "surface"}, {"point", e.point}, {"normal", e.normal}});
+    for (const CylinderEntry& e : spec.effects.cylinders) {
+      obstacles.push_back({{"kind", "cylinder"}, {"center", e.center}, {"radius", e.radius}});
+      if (e.axis) obstacles.back()["axis"] = *e.axis;
+    }
+    scene.description["obstacles"] = obstacles;
   }
   // The model's part of the description, read back from it as the run's summary reads it.
   RunSummary built;

@@ -205,25 +205,60 @@ class Layout:
         face as a thick grey line from the point along that side's initial direction (in 3D only on a
         projection that sees the table edge-on). `extra`: how much
         further right they must reach (staggered snapshots)."""
-        a, b = proj
+        self._draw_contact_obstacles(ax, proj, extra, label)
         for f in self.run.fronts:
             if f.kind == "edge":
                 self._draw_edge(ax, f, proj, extra, label)
                 continue
             if f.kind != "heap" or not f.on_plane or f.plane_normal is None or f.point is None:
                 continue
-            n = f.plane_normal
-            if self.dim == 3 and abs(n[3 - a - b]) > 1e-9 * np.linalg.norm(n):
+            self._plane_trace(ax, f.point, f.plane_normal, proj, extra, "plane (table)" if label else None)
+
+    def _plane_trace(self, ax, point, normal, proj, extra, label):
+        """A plane through `point` with `normal`, as its trace on the projection `proj` (only where the
+        projection sees it edge-on); False where it does not."""
+        a, b = proj
+        n = np.asarray(normal, dtype=float)
+        if self.dim == 3 and abs(n[3 - a - b]) > 1e-9 * np.linalg.norm(n):
+            return False
+        d = np.array([-n[b], n[a]])
+        d = d / np.linalg.norm(d)
+        if d[0] < 0:
+            d = -d
+        p = np.asarray(point, dtype=float)[[a, b]]
+        centre = p + np.dot(0.5 * (self.lo[[a, b]] + self.hi[[a, b]]) - p, d) * d
+        half = 0.6 * self.size
+        self._face(ax, np.array([centre - half * d, centre + (half + extra) * d]), label)
+        return True
+
+    def _draw_contact_obstacles(self, ax, proj, extra, label):
+        """The obstacles of [[effects.surface]] and [[effects.cylinder]] (the summary's `obstacles`): a
+        plane as its trace (where the projection sees it edge-on), a cylinder as a grey disc (2D, or a 3D
+        cylinder whose axis is normal to the projection)."""
+        from matplotlib.patches import Circle
+        a, b = proj
+        first = {"surface": True, "cylinder": True}
+        count = {"surface": 0, "cylinder": 0}
+        for o in self.run.summary.get("obstacles", []):
+            kind = o.get("kind")
+            if kind not in count:
                 continue
-            d = np.array([-n[b], n[a]])
-            d = d / np.linalg.norm(d)
-            if d[0] < 0:
-                d = -d
-            p = f.point[[a, b]]
-            centre = p + np.dot(0.5 * (self.lo[[a, b]] + self.hi[[a, b]]) - p, d) * d
-            half = 0.6 * self.size
-            ends = np.array([centre - half * d, centre + (half + extra) * d])
-            self._face(ax, ends, "plane (table)" if label else None)
+            gid = f"obstacle {kind}{count[kind]}"  # surface0, cylinder0, ... in the scene's order
+            count[kind] += 1
+            lab = kind if label and first[kind] else None
+            if kind == "surface":
+                if not self._plane_trace(ax, o["point"], o["normal"], proj, extra, lab):
+                    continue
+                ax.lines[-1].set_gid(gid)
+            else:
+                if self.dim == 3:
+                    axis = np.asarray(o.get("axis", [0, 0, 1]), dtype=float)
+                    if abs(axis[a]) + abs(axis[b]) > 1e-9 * np.linalg.norm(axis):
+                        continue
+                c = np.asarray(o["center"], dtype=float)[[a, b]]
+                ax.add_patch(Circle(c, o["radius"], facecolor="0.75", edgecolor="0.45", lw=1.0, zorder=0, label=lab,
+                                    gid=gid))
+            first[kind] = False
 
     @staticmethod
     def _face(ax, ends, label):

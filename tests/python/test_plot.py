@@ -88,6 +88,10 @@ def run_dir(kind):
             r"\[\[-0.8, 0.0\], \[0.0, 0.0\], \[0.0, -0.2\]\]": "[[-0.8, 0.0, 0.0], [0.0, 0.0, 0.0], [0.0, -0.2, 0.0]]",
             r"g = \[0.0, -9.81\]": "g = [0.0, -9.81, 0.0]",
             r"(?m)^point = \[0.0, 0.0\]": "point = [0.0, 0.0, 0.0]\ndirection = [0.0, 0.0, 1.0]"}), "--out", out]
+    elif kind == "pulley":
+        args = ["run", scene("atwood_pulley", 21, {r"(?m)^t_end = .*": "t_end = 0.1"}), "--out", out]
+    elif kind == "landing":
+        args = ["run", scene("chain_landing_on_table", 11, {r"(?m)^t_end = .*": "t_end = 0.15"}), "--out", out]
     elif kind == "string3d":
         path = os.path.join(ROOT, "pendulum3d.toml")
         with open(path, "w") as fh:
@@ -535,6 +539,25 @@ def test_reader_3d_edge_drawn_where_the_projection_sees_it():
     assert np.allclose(wedge, [[0, 0], [-r, 0], [0, -r]], atol=1e-9)
     assert np.allclose(np.ravel(xz["obstacle edge0"].get_data()), 0, atol=1e-12)
     plt.close(fig)
+
+
+def test_reader_surface_and_cylinder_drawn_as_obstacles():
+    """Contact along arcs: the pulley of cases/scenes/atwood_pulley.toml (centre at the origin, radius 0.1 m)
+    is a disc, the table of cases/scenes/chain_landing_on_table.toml (y = 0) a grey line along it, in the
+    snapshots and in the animation's frames."""
+    import matplotlib.pyplot as plt
+    for fig in drawn_figures(run_dir("pulley")):
+        drawn = obstacle_artists(fig)
+        assert sorted(drawn) == ["obstacle cylinder0"]
+        disc = drawn["obstacle cylinder0"]
+        assert np.allclose(disc.center, [0, 0], atol=1e-12) and abs(disc.radius - 0.1) < 1e-12
+        plt.close(fig)
+    for fig in drawn_figures(run_dir("landing")):
+        drawn = obstacle_artists(fig)
+        assert sorted(drawn) == ["obstacle surface0"]
+        x, y = drawn["obstacle surface0"].get_data()
+        assert np.allclose(y, 0, atol=1e-12) and x[0] < 0 and x[1] > 1.0
+        plt.close(fig)
 
 
 def test_reader_run_without_obstacles_draws_none():

@@ -35,6 +35,8 @@ TEST_CASE("every effect table of the scene format is written back to scene_effec
       {"plane", "[[effects.heap]]\nside = \"end\"\ns0 = 0.5\nf = 0.5\npoint = [0.0, -0.5]\non_plane = true\n"
                 "[effects.plane]\npoint = [0.0, -0.5]\nnormal = [0.0, 1.0]\n"},
       {"edge", "[[effects.edge]]\npoint = [0.0, -0.5]\nf = 0.5\n"},
+      {"surface", "[[effects.surface]]\npoint = [0.0, -2.0]\nnormal = [0.0, 1.0]\n"},
+      {"cylinder", "[[effects.cylinder]]\ncenter = [0.5, -0.5]\nradius = 0.1\n"},
   };
   REQUIRE(!effect_tables().empty());
   for (const EffectTable& table : effect_tables()) {

@@ -1,0 +1,54 @@
+#pragma once
+/// @file contact_module.hpp
+/// The module of rigid obstacles the string touches along arcs ([[effects.surface]],
+/// [[effects.cylinder]]; docs/model.md §10): smooth one-sided planes and cylinders (circles in 2D)
+/// that the string's nodes may not pass through. What it adds to the one discrete string
+/// (string_module.hpp):
+///   - the nodes held on a surface (StringModule::node_contacts): while held, a node's gap stays zero
+///     and its normal force N ≥ 0 is the multiplier of that constraint, eliminated node by node from
+///     the tension system (StringModel: the held node's inverse mass becomes w P, P = I − n nᵀ, so
+///     the system stays tridiagonal along the string);
+///   - two root functions: the smallest gap of a free node (a landing: the node is held, and the
+///     velocities are projected, mass-weighted, onto the constraints — a perfectly inelastic impact,
+///     whose energy is booked in W_impacts and whose impulse in the momentum ledger), and the smallest
+///     normal force of a held node (a lift-off: the node is let go, and so is every other held node
+///     whose force would then pull, one at a time, most negative first);
+///   - the ledgers W_contact (J: the work of the contact forces, zero on the exact solution; it books
+///     the drift control's share), W_impacts (J, ≤ 0: the kinetic energy the landings took) and the
+///     impulse of all external forces (the momentum ledger p − p0 − impulse, closed across impacts);
+///   - the recorded quantities impacts and lift_offs (series.csv): how many landings and lift-offs.
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "string_module.hpp"
+
+namespace chainsim {
+
+/// One rigid obstacle.
+template <int dim>
+struct Obstacle {
+  enum class Kind { kPlane, kCylinder };
+  Kind kind = Kind::kPlane;
+  Vec<dim> point = Vec<dim>::Zero();   ///< plane: a point of it; cylinder: a point of its axis (the centre in 2D)
+  Vec<dim> normal = Vec<dim>::Zero();  ///< plane: its unit normal, towards the side the string is on
+  Vec<dim> axis = Vec<dim>::Zero();    ///< cylinder in 3D: its unit axis (unused in 2D)
+  double radius = 0;                   ///< cylinder (m)
+  std::string name;                    ///< for messages: "effects.surface[0]"
+  /// The signed distance of x from the surface (m), > 0 outside, its outward unit normal there, and
+  /// the gap's second derivative at zero acceleration for a velocity v (m/s²).
+  double gap(const Vec<dim>& x) const;
+  Vec<dim> outward(const Vec<dim>& x) const;
+  double curvature(const Vec<dim>& x, const Vec<dim>& v) const;
+};
+
+/// The contact module of `obstacles` (non-empty). A node that starts within kInitialContact of its
+/// length h from a surface is held on it; one further inside is refused (InputError).
+template <int dim>
+std::unique_ptr<StringModule<dim>> make_contact_module(std::vector<Obstacle<dim>> obstacles);
+
+/// A node this share of a link length from a surface at the start is on it (the discretized shape is
+/// a polygon inscribed in a curved one); further inside, the scene is refused.
+inline constexpr double kInitialContact = 1e-3;
+
+}  // namespace chainsim
