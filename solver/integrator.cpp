@@ -199,8 +199,13 @@ struct Integrator::Impl {
   /// Krylov dimension of GMRES: with the system's Newton solver as preconditioner one or two
   /// iterations suffice; the rest is room for what it leaves out (drag, a module's loads).
   static constexpr int kKrylovDimension = 10;
-  /// Newton iterations per stage before ARKODE calls it a convergence failure (its default is 3).
-  static constexpr int kNewtonIterations = 8;
+  /// Newton iterations per stage before ARKODE calls it a convergence failure (its default is 3). With the
+  /// linearisation kept over steps (kLinearizationSteps), a stale one that converges slowly must fail
+  /// soon, so that SUNDIALS' Newton re-linearises the stage: at 8 (the limit while the string was
+  /// re-linearised at every step) the travelling loop with dirk4 (cases/scenes/travelling_loop.toml)
+  /// took 14,094 Newton iterations and 14,631 right-hand sides, at 4, 9,746 and 10,257 (10,170 when
+  /// re-linearised at every step). At 3 it took 1,000 steps instead of 508.
+  static constexpr int kNewtonIterations = 4;
   /// ARKODE's crdown: the Newton convergence rate it assumes at least, crate = max(crdown · crate,
   /// ‖δ_m‖/‖δ_{m−1}‖), is reset to 1 at every linearisation, so with its default 0.3 the first
   /// stage after it converges only if its second correction is below nlscoef/0.3 = 0.33 in the
@@ -210,6 +215,21 @@ struct Integrator::Impl {
   /// and Newton "failed" at every fourth step or so (docs/string_solver.md, "The implicit path").
   /// 0.05 lets the measured rate count; the remaining-error estimate crate·‖δ‖ ≤ nlscoef is kept.
   static constexpr double kNewtonRateFloor = 0.05;
+  /// Steps between Newton set-ups (ARKODE's msbp) and between linearisations (msbj): ARKODE's defaults.
+  /// A set-up at every step (what was done before) cost a linearisation, a factorisation and a second
+  /// Newton iteration per step (ARKODE resets its convergence rate to 1 at a set-up, so the first stage
+  /// after it can never converge in one iteration): 94 set-ups and 924 Newton iterations over the 94
+  /// steps of the hanging chain's first mode at 250 links, against 14 and 441 over 78 steps now.
+  static constexpr int kLinearizationSteps = 20;
+  static constexpr int kJacobianSteps = 51;
+  /// ARKODE's nlscoef: Newton stops when its estimated error is below this fraction of the error test's
+  /// tolerance (its default is 0.1). With the stage's right-hand side deduced from the stage equation,
+  /// the stage's Newton error enters the step's result itself (y_{n+1} is the last stage of these
+  /// stiffly accurate methods) instead of through h J times it: at 0.1 a swinging 10-link chain
+  /// (dirk3, rtol 1e-7, test_string_energy.cpp) drifted 1.1e-7 in energy and 2.2e-7 in its
+  /// constraints, against 2.4e-8 and 1.6e-7 with the stages' right-hand sides evaluated; at 0.03,
+  /// 6.0e-8 and 1.4e-7.
+  static constexpr double kNewtonTolerance = 0.03;
 
   /// The linear solver of an implicit method (after creation and after every resize). With the
   /// system's Newton solver: the solver itself (direct_newton_solver()) when it is exact, else GMRES
@@ -229,12 +249,21 @@ struct Integrator::Impl {
       check(ARKStepSetLinearSolver(mem, ls, nullptr), "ARKStepSetLinearSolver");
       check(ARKStepSetPreconditioner(mem, Impl::newton_linearize, Impl::newton_solve), "ARKStepSetPreconditioner");
       if (jv_work) check(ARKStepSetJacTimes(mem, nullptr, Impl::jac_times), "ARKStepSetJacTimes");
-      // A fresh linearisation at every step: it costs a few right-hand sides, and a stale one is far
-      // off on the fast modes of a fine string (γ ω² ≫ 1), where Newton then fails and cuts the step.
-      check(ARKStepSetLSetupFrequency(mem, 1), "ARKStepSetLSetupFrequency");
-      check(ARKStepSetJacEvalFrequency(mem, 1), "ARKStepSetJacEvalFrequency");
+      // Newton's settings (docs/string_solver.md, "Newton's settings"): the linearisation kept over
+      // ARKODE's default of up to 20 steps and refactored when γ changes by more than 20 %, a failure
+      // to converge with a kept one re-linearising the stage (SUNDIALS' Newton solver does, without
+      // cutting the step); the stage's right-hand side deduced from the converged stage equation
+      // (F_i = (z_i − the explicit part)/γ, no evaluation of F at the stage: an evaluation multiplies
+      // the stage's Newton error by the stiff J, whose fastest modes grow with the links). The stage
+      // predictor stays ARKODE's default, the last step's state: the "cutoff" one (3) saved a fifth of
+      // the Newton iterations but made the steps depend on the round-off of the linear solve (banded and
+      // KLU took 84 and 85 steps at 250 links, where with this one both take 96, the same ω1 to 7 digits).
+      check(ARKStepSetLSetupFrequency(mem, kLinearizationSteps), "ARKStepSetLSetupFrequency");
+      check(ARKStepSetJacEvalFrequency(mem, kJacobianSteps), "ARKStepSetJacEvalFrequency");
       check(ARKStepSetMaxNonlinIters(mem, kNewtonIterations), "ARKStepSetMaxNonlinIters");
       check(ARKStepSetNonlinCRDown(mem, kNewtonRateFloor), "ARKStepSetNonlinCRDown");
+      check(ARKStepSetDeduceImplicitRhs(mem, SUNTRUE), "ARKStepSetDeduceImplicitRhs");
+      check(ARKStepSetNonlinConvCoef(mem, kNewtonTolerance), "ARKStepSetNonlinConvCoef");
       return;
     }
     const sunindextype n = N_VGetLength(y);

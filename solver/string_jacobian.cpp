@@ -185,7 +185,7 @@ void StringJacobian<dim>::linearize(double t, const Eigen::Ref<const Eigen::Vect
 }
 
 template <int dim>
-bool StringJacobian<dim>::assemble(SpMat& out, int rows, int cols, const std::vector<Eigen::Triplet<double>>& entries,
+bool StringJacobian<dim>::assemble(BlockMat& out, int rows, int cols, const std::vector<Eigen::Triplet<double>>& entries,
                                    Slots& s) {
   bool same = out.rows() == rows && out.cols() == cols && s.rows.size() == entries.size();
   for (std::size_t k = 0; same && k < entries.size(); ++k)
@@ -204,9 +204,9 @@ bool StringJacobian<dim>::assemble(SpMat& out, int rows, int cols, const std::ve
   for (std::size_t k = 0; k < entries.size(); ++k) {
     s.rows[k] = entries[k].row();
     s.cols[k] = entries[k].col();
-    const int* first = out.innerIndexPtr() + out.outerIndexPtr()[s.cols[k]];
-    const int* last = out.innerIndexPtr() + out.outerIndexPtr()[s.cols[k] + 1];
-    s.slot[k] = static_cast<int>(std::lower_bound(first, last, s.rows[k]) - out.innerIndexPtr());
+    const int* first = out.innerIndexPtr() + out.outerIndexPtr()[s.rows[k]];  // row-major: rows are outer
+    const int* last = out.innerIndexPtr() + out.outerIndexPtr()[s.rows[k] + 1];
+    s.slot[k] = static_cast<int>(std::lower_bound(first, last, s.cols[k]) - out.innerIndexPtr());
   }
   return true;
 }
@@ -256,9 +256,9 @@ template <int dim>
 template <class Emit>
 void StringJacobian<dim>::for_each_entry(double gamma, Emit&& emit) const {
   for (int i = 0; i < nv_; ++i) emit(i, i, 1.0);
-  auto add = [&](const SpMat& block, int row0, int col0, double scale) {
+  auto add = [&](const BlockMat& block, int row0, int col0, double scale) {
     for (int c = 0; c < block.outerSize(); ++c)
-      for (SpMat::InnerIterator it(block, c); it; ++it)
+      for (BlockMat::InnerIterator it(block, c); it; ++it)
         emit(row0 + static_cast<int>(it.row()), col0 + static_cast<int>(it.col()), scale * it.value());
   };
   add(P_, 0, 0, -gamma * gamma);
@@ -333,8 +333,12 @@ void StringJacobian<dim>::solve(const Eigen::Ref<const Eigen::VectorXd>& r, Eige
   const auto rx = r.head(nv_), rv = r.segment(nv_, nv_);
   Eigen::VectorXd& sol = work_;
   sol.resize(nv_ + nt_);
-  sol.head(nv_) = rv + gamma_ * (P_ * rx);
-  sol.tail(nt_) = -(Qx_ * rx);
+  auto head = sol.head(nv_);  // rv + γ P rx, −Qx rx: the products summed in place (no temporaries)
+  auto tail = sol.tail(nt_);
+  head = rv;
+  head.noalias() += gamma_ * (P_ * rx);
+  tail.setZero();
+  tail.noalias() -= Qx_ * rx;
   if (banded_)
     band_->solve(sol.data());
   else

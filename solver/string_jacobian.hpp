@@ -75,9 +75,12 @@ class StringJacobian {
 
  private:
   using SpMat = Eigen::SparseMatrix<double>;
+  /// The linearisation's blocks, row-major: their products with a vector (every Newton solve's
+  /// right-hand side) are then one gather per row.
+  using BlockMat = Eigen::SparseMatrix<double, Eigen::RowMajor>;
   StringModel<dim>& model_;
   int nv_ = 0, nt_ = 0;  // dim · free nodes; tension unknowns
-  SpMat P_, Qx_, Qv_, WGt_;
+  BlockMat P_, Qx_, Qv_, WGt_;
   std::vector<double> a_values_;  // A, in the tension system's pattern (a_pattern_)
   SparsePattern a_pattern_;
   double gamma_ = 0;
@@ -101,7 +104,7 @@ class StringJacobian {
   Slots slots_[4];  // P, Qx, Qv, W Gᵀ
   /// out = the (rows × cols) matrix of `entries` (duplicates summed): only the values when the
   /// sequence of (row, column) is that of the last call, else the pattern anew (returns true).
-  static bool assemble(SpMat& out, int rows, int cols, const std::vector<Eigen::Triplet<double>>& entries, Slots& s);
+  static bool assemble(BlockMat& out, int rows, int cols, const std::vector<Eigen::Triplet<double>>& entries, Slots& s);
   std::vector<Eigen::Triplet<double>> entries_;  // the augmented system's assembly (kept: no reallocation)
   mutable Eigen::VectorXd work_;                 // the augmented right-hand side and solution of solve()
 };
