@@ -1,0 +1,45 @@
+// The cost of a front crossing (docs/shocks.md, "The cost of a crossing"), counted, not timed: each
+// crossing is a located root, polished, and the integrator resumes with the step it would have taken
+// next (no fresh first step and no ramp). A crossing then costs a bounded number of right-hand sides,
+// the same on every mesh: the right-hand sides per crossing of the three canonical problems on two
+// meshes. (The cost of a run still grows like N²: N crossings, each with O(1) right-hand sides of O(N)
+// work; docs/work-precision.md, "Fronts on fine meshes".)
+#include <catch2/catch.hpp>
+
+#include <cstdio>
+
+#include <nlohmann/json.hpp>
+
+#include "cases/canonical/canonical_string.hpp"
+#include "canonical_test_support.hpp"
+
+using namespace chainsim;
+using test::setup_for;
+
+TEST_CASE("a front crossing costs a bounded number of right-hand sides on every mesh", "[convergence][shocks]") {
+  for (Problem problem : {Problem::kFalling, Problem::kFolded, Problem::kSliding}) {
+    const int meshes[2] = {100, 400};
+    double per_crossing[2] = {0, 0};
+    for (int m = 0; m < 2; ++m) {
+      StringCaseSetup setup = setup_for(problem, 0.83, meshes[m]);
+      setup.eps = 0.5;  // half of each run (the sliding chain: from the start to half the chain out)
+      const Comparison c = compare_with_reduced(setup);
+      const auto& s = c.summary;
+      const double crossings = s["transfers"].get<double>();
+      const double rhs = s["rhs_evals"].get<double>(), steps = s["steps"].get<double>();
+      per_crossing[m] = rhs / crossings;
+      std::printf("%-8s %4d nodes: %4.0f crossings, %5.0f steps, %6.0f right-hand sides: %4.2f steps and %5.2f "
+                  "right-hand sides per crossing\n",
+                  to_string(problem).c_str(), meshes[m], crossings, steps, rhs, steps / crossings, rhs / crossings);
+      INFO(to_string(problem) << ", " << meshes[m] << " nodes");
+      REQUIRE(s["status"] == "stopped");
+      CHECK(crossings >= 0.48 * meshes[m]);
+      // Measured 30-49 (erk5, rtol 1e-9): the step that finds the root, the polish's step and
+      // corrections, the steps to the next crossing. Resuming each crossing from ARKODE's estimate of a
+      // first step and its ramp took more than twice as many.
+      CHECK(rhs / crossings <= 60);
+    }
+    // Not more on the finer mesh: a crossing's cost does not grow with N.
+    CHECK(per_crossing[1] <= 1.1 * per_crossing[0]);
+  }
+}
