@@ -17,7 +17,10 @@
 
 namespace chainsim {
 
+/// The module of unilateral links around `inner`, the fronts' module (nullptr: a string without
+/// fronts). It passes the inner module's layout, masses, forces, ledgers and events through and adds
+/// its own after them; the fronts' events are handled first at an event that finds both.
 template <int dim>
-std::unique_ptr<StringModule<dim>> make_slack_module();
+std::unique_ptr<StringModule<dim>> make_slack_module(std::unique_ptr<StringModule<dim>> inner);
 
 }  // namespace chainsim
