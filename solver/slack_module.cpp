@@ -13,7 +13,8 @@ namespace {
 /// give the nodes. Zero while every taut link keeps its length; a link the complementarity problem
 /// released (T_j = 0) that returns to its length before it has gone slack (before it is shorter than
 /// (1 − kSlackGap) h_j) is pulled back by the drift control with T_j > 0 while dl_j/dt > 0: this is
-/// the energy it loses, the snap that was not located. O(N).
+/// the energy it loses, the snap that was not located. O(N), no square root: a link with a tension is
+/// taut-flagged, its length within kSlackGap of h_j, so dl_j/dt = Δx_j·Δv_j / h_j to that share of itself.
 template <int dim>
 double link_power(const StringModel<dim>& model) {
   const Chain<dim>& chain = model.chain();
@@ -23,7 +24,7 @@ double link_power(const StringModel<dim>& model) {
     if (!(T != 0) || std::isnan(T)) continue;  // slack, released, or in no arc
     const int a = chain.link_start(j), b = chain.link_end(j);
     const Vec<dim> dx = model.x().col(b) - model.x().col(a);
-    power -= T * dx.dot(model.v().col(b) - model.v().col(a)) / dx.norm();
+    power -= T * dx.dot(model.v().col(b) - model.v().col(a)) / chain.link_length(j);
   }
   return power;
 }
