@@ -40,7 +40,8 @@ SlackRun run_scene(const SceneSpec& spec) {
   return run;
 }
 
-double term(const Frame<2>& frame, const std::string& name) {
+template <int dim>
+double term(const Frame<dim>& frame, const std::string& name) {
   if (!frame.terms.names) return 0.0;
   for (std::size_t k = 0; k < frame.terms.names->size(); ++k)
     if ((*frame.terms.names)[k].name == name) return frame.terms.values[k];
@@ -135,8 +136,8 @@ TEST_CASE("slack with fronts: a chain fed into a heap by a slack stretch closes 
   CHECK(run.summary.relative_momentum_residual() < 1e-10);  // measured 3.0e-12
 }
 
-TEST_CASE("slack with fronts: a fold whose free arm goes slack closes its momentum and energy ledgers",
-          "[slack][shocks]") {
+TEMPLATE_TEST_CASE_SIG("slack with fronts: a fold whose free arm goes slack closes its momentum and energy ledgers",
+                       "[slack][shocks]", ((int dim), dim), 2, 3) {
   // The folded chain of the paper (fold at the fixed end, f = 0.5, λ = 1, g = 9.81) whose free arm's top
   // 0.2 m of material is laid slack, its nodes 0.5 h apart on the arm's line: the taut part of the arm,
   // pulled down at the fold, falls faster than g and leaves the slack stretch (at g) behind, whose
@@ -144,16 +145,21 @@ TEST_CASE("slack with fronts: a fold whose free arm goes slack closes its moment
   const int links = 50;
   const double ell = 1, h = ell / links, lambda = 1, g = 9.81;
   const int taut_links = 40;  // links 40..49 are laid slack
-  Chain<2> chain = Chain<2>::uniform(lambda, ell, links, false);
-  for (int i = 0; i <= links; ++i)
-    chain.positions().col(i) = Vec<2>(0.0, i <= taut_links ? i * h : taut_links * h + 0.5 * (i - taut_links) * h);
-  std::vector<std::unique_ptr<Force<2>>> forces;
-  forces.push_back(std::make_unique<Gravity<2>>(Vec<2>(0.0, -g)));
-  std::vector<PrescribedNode<2>> fixed = {{0, std::make_shared<LinearPath<2>>(Vec<2>(0.0, 0.0), Vec<2>(0.0, 0.0))}};
+  Chain<dim> chain = Chain<dim>::uniform(lambda, ell, links, false);
+  for (int i = 0; i <= links; ++i) {
+    chain.positions().col(i).setZero();
+    chain.positions()(1, i) = i <= taut_links ? i * h : taut_links * h + 0.5 * (i - taut_links) * h;
+  }
+  Vec<dim> down = Vec<dim>::Zero();
+  down[1] = -g;
+  std::vector<std::unique_ptr<Force<dim>>> forces;
+  forces.push_back(std::make_unique<Gravity<dim>>(down));
+  std::vector<PrescribedNode<dim>> fixed = {
+      {0, std::make_shared<LinearPath<dim>>(Vec<dim>::Zero().eval(), Vec<dim>::Zero().eval())}};
   StringModelOptions mo;
   mo.slack = SlackPolicy::kAllow;
   mo.stabilization_time = 0.009;
-  StringModel<2> model = make_front_model<2>(std::move(chain), std::move(forces), fixed, {}, FoldSpec{0.5, 0.0},
+  StringModel<dim> model = make_front_model<dim>(std::move(chain), std::move(forces), fixed, {}, FoldSpec{0.5, 0.0},
                                              FrontOptions{}, mo);
   for (int j = taut_links; j < links; ++j) model.set_slack(j, true);
   StringSolverOptions so;
@@ -161,12 +167,12 @@ TEST_CASE("slack with fronts: a fold whose free arm goes slack closes its moment
   so.integrator.atol = 1e-11;
   so.t_end = 0.4;
   so.output_interval = 0.05;
-  StringSolver<2> solver(model, so);
+  StringSolver<dim> solver(model, so);
   const RunSummary s = solver.run();
-  const Frame<2>& last = solver.frames().back();
-  std::printf("\nslack fold: %s at t = %.4g s, snaps %g, W_snap %.4e J, W_shocks %.4e J, W_links %.3e J, slack links "
+  const Frame<dim>& last = solver.frames().back();
+  std::printf("\nslack fold (%dD): %s at t = %.4g s, snaps %g, W_snap %.4e J, W_shocks %.4e J, W_links %.3e J, slack links "
               "left %d, transfers %ld, energy %.3e, momentum %.3e\n",
-              s.status.c_str(), last.t, term(last, "snaps"), term(last, "W_snap"), term(last, "W_shocks"),
+              dim, s.status.c_str(), last.t, term(last, "snaps"), term(last, "W_snap"), term(last, "W_shocks"),
               term(last, "W_links"), model.num_slack_links(), s.transfers, s.relative_energy_drift(),
               s.relative_momentum_residual());
   REQUIRE(s.status == "completed");
