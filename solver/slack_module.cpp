@@ -53,7 +53,13 @@ class SlackModule final : public StringModule<dim> {
     const int k = inner_ledgers();
     if (inner_) inner_->ledger_rates(model, rates.head(k));
     rates[k] = rates[k + 1] = 0;  // the snaps' terms jump at events only
-    rates[k + 2] = link_power(model);
+    // W_links counts from the first release on (or from the start with links laid slack): until the
+    // complementarity problem has released a link every link is taut and its rate is the drift's, which
+    // a taut run does not book either; the O(N) pass then costs nothing on a run that never goes slack.
+    if (!counting_)
+      counting_ = model.num_slack_links() > 0 ||
+                  (model.has_tension_system() && model.tension_system().complementarity_stats().calls_with_release > 0);
+    rates[k + 2] = counting_ ? link_power(model) : 0.0;
     if (inner_)
       rates.template segment<dim>(k + 3).setZero();
     else
@@ -148,6 +154,7 @@ class SlackModule final : public StringModule<dim> {
 
   std::unique_ptr<StringModule<dim>> inner_;
   long snaps_ = 0;
+  mutable bool counting_ = false;  // W_links: a link has been released
 };
 
 }  // namespace
