@@ -130,7 +130,7 @@ class SlackModule final : public StringModule<dim> {
         if (action.kind == EventAction::Kind::kTransfer) model.refresh();
       }
     }
-    if (found[static_cast<std::size_t>(k)] == 0 && model.num_slack_links() == 0) return action;
+    if (found[static_cast<std::size_t>(k)] == 0) return action;
     const typename StringModel<dim>::SnapResult snap = model.snap(t);
     if (snap.caught == 0) return action;
     ledger[kl] -= snap.dissipated;
