@@ -434,7 +434,7 @@ TEST_CASE("slack: the swinging U and the whip close their energy ledgers to roun
 TEST_CASE("slack: the swinging U on 201 to 1601 nodes: the state at t = 1 s converges slowly", "[slack][.long]") {
   // The study behind docs/model.md §9 "Does the U converge?" (CHAINSIM_LONG_TESTS; about 3 minutes):
   // the largest distance between the same material point on successive meshes keeps falling, but
-  // slowly after the kink forms (measured 6.5e-3, 6.0e-3, 4.5e-3 m: orders 0.12 and 0.43), and W_snap,
+  // slowly after the kink forms (measured 6.5e-3, 6.0e-3, 4.5e-3 m: orders 0.12 and 0.41), and W_snap,
   // the energy the snaps dissipate, falls overall. The measured figures are printed.
   const std::vector<int> meshes = {201, 401, 801, 1601};
   std::vector<Points<2>> x;
@@ -461,7 +461,7 @@ TEST_CASE("slack: the swinging U on 201 to 1601 nodes: the state at t = 1 s conv
                 std::log2(differences[k - 1] / differences[k]));
     CHECK(differences[k] < differences[k - 1]);
   }
-  // W_snap is not monotone on these meshes (measured −1.65, −1.11, −1.20, −0.83 mJ) but falls overall.
+  // W_snap is not monotone on these meshes (measured −1.65, −1.11, −1.19, −0.81 mJ) but falls overall.
   CHECK(std::abs(w_snaps.back()) < 0.6 * std::abs(w_snaps.front()));
 }
 
