@@ -1,79 +1,170 @@
 // The module of unilateral links: see slack_module.hpp.
 #include "slack_module.hpp"
 
+#include <cmath>
+
 #include "string_model.hpp"
 
 namespace chainsim {
 
 namespace {
 
+/// −Σ T_j dl_j/dt over the links of the arcs, after an evaluation (W): the power the link tensions
+/// give the nodes. Zero while every taut link keeps its length; a link the complementarity problem
+/// released (T_j = 0) that returns to its length before it has gone slack (before it is shorter than
+/// (1 − kSlackGap) h_j) is pulled back by the drift control with T_j > 0 while dl_j/dt > 0: this is
+/// the energy it loses, the snap that was not located. O(N), no square root: a link with a tension is
+/// taut-flagged, its length within kSlackGap of h_j, so dl_j/dt = Δx_j·Δv_j / h_j to that share of itself.
+template <int dim>
+double link_power(const StringModel<dim>& model) {
+  const Chain<dim>& chain = model.chain();
+  double power = 0;
+  for (int j = 0; j < chain.num_links(); ++j) {
+    const double T = model.link_tension(j);
+    if (!(T != 0) || std::isnan(T)) continue;  // slack, released, or in no arc
+    const int a = chain.link_start(j), b = chain.link_end(j);
+    const Vec<dim> dx = model.x().col(b) - model.x().col(a);
+    power -= T * dx.dot(model.v().col(b) - model.v().col(a)) / chain.link_length(j);
+  }
+  return power;
+}
+
 template <int dim>
 class SlackModule final : public StringModule<dim> {
  public:
-  // [ W_snap | W_snap_supports | impulse (dim) ]
+  explicit SlackModule(std::unique_ptr<StringModule<dim>> inner) : inner_(std::move(inner)) {}
+
+  // Ledgers: [ the inner module's | W_snap | W_snap_supports | W_links | impulse (dim) ]. Without an inner module
+  // the impulse is that of all external forces (its rate the string's external force, its jumps the
+  // supports' impulses at snaps); with one (fronts), the inner module integrates the external forces'
+  // impulse and this one holds only the snaps' support impulses, added to it in fill().
   std::vector<ArcRange> initial_arcs(const Chain<dim>& chain) override {
+    if (inner_) return inner_->initial_arcs(chain);
     return {ArcRange{0, chain.num_nodes() - 1, chain.closed()}};
   }
-  void initialize(StringModel<dim>&) override {}
-  void add_mass_and_forces(const StringModel<dim>&, Eigen::VectorXd&, Points<dim>&) override {}
-  int num_ledgers() const override { return 2 + dim; }
-  void ledger_rates(const StringModel<dim>& model, Eigen::Ref<Eigen::VectorXd> rates) const override {
-    rates[0] = rates[1] = 0;  // the snaps' terms jump at events only
-    rates.template segment<dim>(2) = model.external_force();
+  void initialize(StringModel<dim>& model) override {
+    if (inner_) inner_->initialize(model);
   }
-  Eigen::VectorXd ledger_scale(double mass, double speed, double) const override {
+  void add_mass_and_forces(const StringModel<dim>& model, Eigen::VectorXd& mass, Points<dim>& force) override {
+    if (inner_) inner_->add_mass_and_forces(model, mass, force);
+  }
+  int num_ledgers() const override { return inner_ledgers() + 3 + dim; }
+  void ledger_rates(const StringModel<dim>& model, Eigen::Ref<Eigen::VectorXd> rates) const override {
+    const int k = inner_ledgers();
+    if (inner_) inner_->ledger_rates(model, rates.head(k));
+    rates[k] = rates[k + 1] = 0;  // the snaps' terms jump at events only
+    // W_links counts from the first release on (or from the start with links laid slack): until the
+    // complementarity problem has released a link every link is taut and its rate is the drift's, which
+    // a taut run does not book either; the O(N) pass then costs nothing on a run that never goes slack.
+    if (!counting_)
+      counting_ = model.num_slack_links() > 0 ||
+                  (model.has_tension_system() && model.tension_system().complementarity_stats().calls_with_release > 0);
+    rates[k + 2] = counting_ ? link_power(model) : 0.0;
+    if (inner_)
+      rates.template segment<dim>(k + 3).setZero();
+    else
+      rates.template segment<dim>(k + 3) = model.external_force();
+  }
+  Eigen::VectorXd ledger_scale(double mass, double speed, double length) const override {
+    const int k = inner_ledgers();
     Eigen::VectorXd scale(num_ledgers());
-    scale.head(2).setConstant(mass * speed * speed);
-    scale.template segment<dim>(2).setConstant(mass * speed);
+    if (inner_) scale.head(k) = inner_->ledger_scale(mass, speed, length);
+    scale.segment(k, 3).setConstant(mass * speed * speed);
+    scale.template segment<dim>(k + 3).setConstant(mass * speed);
     return scale;
   }
-  double potential_correction(const StringModel<dim>&, const Eigen::Ref<const Eigen::VectorXd>&) const override {
-    return 0;
+  double potential_correction(const StringModel<dim>& model, const Eigen::Ref<const Eigen::VectorXd>& ledger) const override {
+    return inner_ ? inner_->potential_correction(model, ledger.head(inner_ledgers())) : 0.0;
   }
   std::vector<LedgerTerm> ledger_terms() const override {
     using K = LedgerTerm::Kind;
-    return {{"W_snap", K::kWork}, {"W_snap_supports", K::kWork}, {"snaps", K::kQuantity}};
+    std::vector<LedgerTerm> terms = inner_ ? inner_->ledger_terms() : std::vector<LedgerTerm>{};
+    terms.insert(terms.end(), {{"W_snap", K::kWork},
+                               {"W_snap_supports", K::kWork},
+                               {"W_links", K::kNumerical},
+                               {"snaps", K::kQuantity}});
+    return terms;
   }
-  std::vector<FrontField> front_fields() const override { return {}; }
-  void fill(const StringModel<dim>&, const Eigen::Ref<const Eigen::VectorXd>& ledger,
+  std::vector<FrontField> front_fields() const override {
+    return inner_ ? inner_->front_fields() : std::vector<FrontField>{};
+  }
+  void fill(const StringModel<dim>& model, const Eigen::Ref<const Eigen::VectorXd>& ledger,
             ModuleLedger<dim>& out) const override {
-    out.fronts.clear();
-    out.terms = {ledger[0], ledger[1], static_cast<double>(snaps_)};
-    out.impulse = ledger.template segment<dim>(2);
+    const int k = inner_ledgers();
+    if (inner_) {
+      inner_->fill(model, ledger.head(k), out);
+      out.impulse += ledger.template segment<dim>(k + 3);
+    } else {
+      out.fronts.clear();
+      out.terms.clear();
+      out.impulse = ledger.template segment<dim>(k + 3);
+      out.support.setZero();
+    }
+    out.terms.insert(out.terms.end(), {ledger[k], ledger[k + 1], ledger[k + 2], static_cast<double>(snaps_)});
     out.has_momentum_ledger = true;
-    out.support.setZero();
   }
-  int num_events() const override { return 1; }
+  int num_events() const override { return inner_events() + 1; }
   void events(const StringModel<dim>& model, Eigen::Ref<Eigen::VectorXd> g) const override {
-    g[0] = model.slack_gap();
+    const int k = inner_events();
+    if (inner_) inner_->events(model, g.head(k));
+    g[k] = model.slack_gap();
   }
-  std::vector<int> event_directions() const override { return {-1}; }
+  std::vector<int> event_directions() const override {
+    std::vector<int> directions = inner_ ? inner_->event_directions() : std::vector<int>{};
+    directions.push_back(-1);
+    return directions;
+  }
   EventAction handle_events(StringModel<dim>& model, double t, Eigen::Ref<Eigen::VectorXd> ledger,
-                            const std::vector<int>&) override {
+                            const std::vector<int>& found) override {
+    const int k = inner_events(), kl = inner_ledgers();
+    EventAction action;
+    // The fronts' events first (a crossing rebuilds the arcs; a slack link that leaves them is taut
+    // again, StringModel::rebuild), then the snap on the layout they leave.
+    if (inner_) {
+      const std::vector<int> inner_found(found.begin(), found.begin() + k);
+      bool any = false;
+      for (int f : inner_found) any = any || f != 0;
+      if (any) {
+        action = inner_->handle_events(model, t, ledger.head(kl), inner_found);
+        if (action.kind == EventAction::Kind::kStop) return action;
+        if (action.kind == EventAction::Kind::kTransfer) model.refresh();
+      }
+    }
+    if (found[static_cast<std::size_t>(k)] == 0) return action;
     const typename StringModel<dim>::SnapResult snap = model.snap(t);
-    if (snap.caught == 0) return {};
-    ledger[0] -= snap.dissipated;
-    ledger[1] += snap.support_work;
-    ledger.template segment<dim>(2) += snap.support_impulse;
+    if (snap.caught == 0) return action;
+    ledger[kl] -= snap.dissipated;
+    ledger[kl + 1] += snap.support_work;
+    ledger.template segment<dim>(kl + 3) += snap.support_impulse;
     ++snaps_;
     return {EventAction::Kind::kTransfer, ""};  // the velocities changed: the integrator restarts
   }
-  long transfers() const override { return 0; }
-  int num_fronts() const override { return 0; }
-  std::optional<double> front_tension_at(const StringModel<dim>&, int) const override { return std::nullopt; }
-
+  long transfers() const override { return inner_ ? inner_->transfers() : 0; }
+  int num_fronts() const override { return inner_ ? inner_->num_fronts() : 0; }
+  std::optional<double> front_tension_at(const StringModel<dim>& model, int node) const override {
+    return inner_ ? inner_->front_tension_at(model, node) : std::nullopt;
+  }
+  bool events_need_tensions() const override { return inner_ && inner_->events_need_tensions(); }
+  std::vector<RunEvent> run_events() const override {
+    return inner_ ? inner_->run_events() : std::vector<RunEvent>{};
+  }
  private:
+  int inner_ledgers() const { return inner_ ? inner_->num_ledgers() : 0; }
+  int inner_events() const { return inner_ ? inner_->num_events() : 0; }
+
+  std::unique_ptr<StringModule<dim>> inner_;
   long snaps_ = 0;
+  mutable bool counting_ = false;  // W_links: a link has been released
 };
 
 }  // namespace
 
 template <int dim>
-std::unique_ptr<StringModule<dim>> make_slack_module() {
-  return std::make_unique<SlackModule<dim>>();
+std::unique_ptr<StringModule<dim>> make_slack_module(std::unique_ptr<StringModule<dim>> inner) {
+  return std::make_unique<SlackModule<dim>>(std::move(inner));
 }
 
-template std::unique_ptr<StringModule<2>> make_slack_module<2>();
-template std::unique_ptr<StringModule<3>> make_slack_module<3>();
+template std::unique_ptr<StringModule<2>> make_slack_module<2>(std::unique_ptr<StringModule<2>>);
+template std::unique_ptr<StringModule<3>> make_slack_module<3>(std::unique_ptr<StringModule<3>>);
 
 }  // namespace chainsim

@@ -10,14 +10,23 @@
 ///     W_snap_supports (J: the work of the supports' impulses at snaps, zero at fixed ends) and the
 ///     impulse of all external forces (the momentum ledger p − p0 − impulse, closed across snaps: the
 ///     impulsive tensions are internal);
+///   - W_links (J, numerical): −∫ Σ T_j dl_j/dt dt, the tensions' work on the links' changes of length
+///     (a released link that returns to its length before going slack is pulled back by the drift
+///     control: its loss is booked here, so the energy ledger closes to the integration error);
 ///   - the recorded quantity snaps (series.csv): the number of snaps so far.
+/// A string with fronts (heaps, folds) keeps its front tracker: this module wraps it, passes its layout,
+/// masses, forces, ledgers, events and fronts through, and adds its own ledgers and root function after
+/// the tracker's (docs/model.md §9 "Slack next to a front").
 #include <memory>
 
 #include "string_module.hpp"
 
 namespace chainsim {
 
+/// The module of unilateral links around `inner`, the fronts' module (nullptr: a string without
+/// fronts). It passes the inner module's layout, masses, forces, ledgers and events through and adds
+/// its own after them; the fronts' events are handled first at an event that finds both.
 template <int dim>
-std::unique_ptr<StringModule<dim>> make_slack_module();
+std::unique_ptr<StringModule<dim>> make_slack_module(std::unique_ptr<StringModule<dim>> inner);
 
 }  // namespace chainsim

@@ -74,14 +74,12 @@ StringModel<dim>::StringModel(Chain<dim> chain, std::vector<std::unique_ptr<Forc
   options_.validate();
   const int n = chain_.num_nodes(), L = chain_.num_links();
   if (allows_slack()) {
-    // Unilateral links: a module of their own (the snap root function, W_snap, the momentum ledger).
-    if (module_)
-      throw InputError("solver.slack = \"allow\" does not meet fronts (heaps, folds) yet: a scene with fronts takes "
-                       "slack = \"stop\", \"warn\" or \"ignore\"");
+    // Unilateral links: a module of their own (the snap root function, W_snap, the momentum ledger),
+    // wrapped around the fronts' module if there is one.
     if (options_.elements == "quadratic")
       throw InputError("solver.slack = \"allow\" needs link elements: string.elements = \"quadratic\" has no "
                        "tension per link to release");
-    module_ = make_slack_module<dim>();
+    module_ = make_slack_module<dim>(std::move(module_));
     slack_.assign(static_cast<std::size_t>(L), 0);
     slack_offset_.assign(static_cast<std::size_t>(L), 0.0);
   }
@@ -192,6 +190,10 @@ void StringModel<dim>::rebuild() {
   w_ = Eigen::VectorXd::Zero(n);
   for (int i = 0; i < n; ++i)
     if (slot_[i] >= 0) w_[i] = 1.0 / m_[i];
+  // A slack link that left the arcs (taken into a heap, or the folded link at a fold) is no longer a
+  // link of the tension system: the front's jump conditions hold its material.
+  for (int j = 0; j < L; ++j)
+    if (link_slack(j) && link_unknown_[static_cast<std::size_t>(j)] < 0) set_slack(j, false);
 }
 
 template <int dim>
@@ -947,6 +949,7 @@ void StringModel<dim>::accept_step(double t, const Eigen::Ref<const Eigen::Vecto
   // material (the one root function would stay negative). O(N), no tension solve.
   unpack_state(t, y);
   for (int j = 0; j < chain_.num_links(); ++j) {
+    if (link_unknown_[static_cast<std::size_t>(j)] < 0) continue;  // in no arc: a front holds it
     const double h = chain_.link_length(j);
     const double gap = (h - (x_.col(chain_.link_end(j)) - x_.col(chain_.link_start(j))).norm()) / h;
     if (!link_slack(j)) {

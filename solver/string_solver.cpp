@@ -280,6 +280,11 @@ void StringSolver<dim>::book(double t, const typename StringModel<dim>::Snapshot
     summary_.max_momentum_residual =
         std::max(summary_.max_momentum_residual, (snap.momentum - p0_ - snap.impulse).norm());
     summary_.momentum_scale = std::max(summary_.momentum_scale, snap.momentum.norm() + snap.impulse.norm());
+    // slack = allow: a string whose net momentum stays zero (a loop running along itself) is judged
+    // against the momentum its mass carries, sqrt(2 M K), not against the round-off of zero.
+    if (model_.allows_slack())
+      summary_.momentum_scale = std::max(
+          summary_.momentum_scale, std::sqrt(2 * model_.chain().density() * model_.chain().length() * snap.kinetic));
   }
 }
 

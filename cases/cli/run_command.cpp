@@ -135,7 +135,7 @@ int run_string_scene(const SceneSpec& spec, const std::filesystem::path& dir, bo
                        s.slack                                   ? s.slack->message()
                        : s.slack_policy == SlackPolicy::kIgnore ? "not checked"
                        : s.slack_policy == SlackPolicy::kAllow
-                           ? "allowed: links go slack and snap taut (W_snap, W_snap_supports in energy.csv)"
+                           ? "allowed: links go slack and snap taut (W_snap, W_snap_supports, W_links in energy.csv)"
                            : "none at any accepted step",
                        to_string(s.slack_policy));
     if (!s.tolerance_warning.empty()) out << fmt::format("warning    {}\n", s.tolerance_warning);

@@ -274,6 +274,7 @@ std::unique_ptr<StringModel<dim>> build_front_model(const SceneSpec& spec, scene
   // Located at the front and naming it: the tracker's messages speak of "the heap's plane", "the fold".
   // The fronts in order of s: heaps and the fold, the edges merged in by their s0 (the names follow,
   // and the stop events' front indices with them).
+  std::vector<const FrontKind<dim>*> kind_of;  // the fronts in order of s, held by the model's tracker
   std::unique_ptr<StringModel<dim>> model = at_key(spec, fit_key, [&] {
     try {
       std::vector<std::unique_ptr<FrontKind<dim>>> kinds;
@@ -286,6 +287,7 @@ std::unique_ptr<StringModel<dim>> build_front_model(const SceneSpec& spec, scene
       std::stable_sort(all.begin(), all.end(),
                        [](const auto& p, const auto& q) { return p.first->expected_s0 < q.first->expected_s0; });
       for (auto& [kind, name] : all) {
+        kind_of.push_back(kind.get());
         kinds.push_back(std::move(kind));
         ordered_names.push_back(name);
       }
@@ -303,10 +305,9 @@ std::unique_ptr<StringModel<dim>> build_front_model(const SceneSpec& spec, scene
     }
   });
   scene.front_names = ordered_names;
-  const FrontTracker<dim>& tracker = *front_tracker(*model);
   d["fronts"] = nlohmann::json::array();
   for (std::size_t k = 0; k < ordered_names.size(); ++k) {
-    const auto& front = tracker.fronts()[k];
+    const FrontKind<dim>& front = *kind_of[k];
     const std::string& name = ordered_names[k];
     nlohmann::json f = {{"name", name}, {"kind", front.name()},
                         {"f", front.dissipation}};

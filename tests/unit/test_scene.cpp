@@ -246,11 +246,12 @@ TEST_CASE("the example scenes parse, run and close their energy ledger", "[unit]
                                           << s.max_constraint_violation);
     CHECK(s.status == "completed");
     if (spec.solver.slack == "allow") {
-      // Unilateral links (docs/model.md §9): one root function (the snaps), W_snap booked. Measured
-      // relative drift <= 1.9e-7 (pendulum_whip), 4.4e-8 (swinging_u), momentum ledger <= 1e-14; the
-      // drift is the integration tolerance's, not round-off (model.md §9, "What it does to the runs").
+      // Unilateral links (docs/model.md §9): one root function (the snaps), W_snap and W_links booked.
+      // Measured relative drift 3.1e-9 (thrown_chain), 2.1e-10 (swinging_u), 3.8e-11 (pendulum_whip;
+      // 1.9e-7 and 4.4e-8 before W_links booked the released links that came back), momentum ledger
+      // <= 1e-14.
       CHECK(s.root_functions == 1);
-      CHECK(s.relative_energy_drift() < 2e-6);
+      CHECK(s.relative_energy_drift() < 2e-8);
       CHECK(s.relative_momentum_residual() < 1e-12);
       continue;
     }
