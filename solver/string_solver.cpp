@@ -684,17 +684,21 @@ class StringSolver<dim>::FrameFiles {
   std::size_t count_ = 0;
 };
 
-/// stream_outputs()'s writer: a thread that passes each recorded frame to FrameFiles. The frames stay
-/// in StringSolver::frames_; the thread reads those published to it (published_), which the solver
-/// never moves while the thread may read them (record_frame() waits for it before frames_ grows
-/// beyond its capacity).
+/// stream_outputs()'s writers: threads that pass each recorded frame to FrameFiles, one for the ParaView
+/// frames (whose cost is mostly the file system's: a file per frame) and one for the CSV files (mostly
+/// formatting numbers). The frames stay in StringSolver::frames_; the threads read those published to
+/// them (published_), which the solver never moves while a thread may read them (record_frame() waits
+/// for them before frames_ grows beyond its capacity).
 template <int dim>
 class StringSolver<dim>::Stream {
  public:
   Stream(std::filesystem::path directory, const OutputSelection& selection, const StringModel<dim>& model,
          const RunSummary& summary, const std::vector<Frame<dim>>& frames)
-      : dir(std::move(directory)), select(selection), files_(dir, selection, model, summary, {}), frames_(frames) {
-    thread_ = std::thread([this] { loop(); });
+      : dir(std::move(directory)), select(selection), frames_(frames) {
+    using Part = typename FrameFiles::Part;
+    if (select.vtk) lanes_.push_back(std::make_unique<Lane>(dir, select, model, summary, Part{true, false, false}));
+    if (select.csv) lanes_.push_back(std::make_unique<Lane>(dir, select, model, summary, Part{false, true, true}));
+    for (auto& lane : lanes_) lane->thread = std::thread([this, l = lane.get()] { loop(*l); });
   }
   ~Stream() { close(); }
 
@@ -709,54 +713,66 @@ class StringSolver<dim>::Stream {
   /// Returns when every published frame is written (the frames may then move).
   void drain() {
     std::unique_lock<std::mutex> lock(mutex_);
-    wake_.wait(lock, [&] { return written_ == published_; });
+    wake_.wait(lock, [&] {
+      return std::all_of(lanes_.begin(), lanes_.end(), [&](const auto& lane) { return lane->written == published_; });
+    });
   }
-  /// Writes what is published, stops the thread and commits the files; rethrows the thread's error.
+  /// Writes what is published, stops the threads and commits the files; rethrows a thread's error.
   void finish() {
     close();
-    if (error_) std::rethrow_exception(error_);
-    files_.commit();
+    for (auto& lane : lanes_)
+      if (lane->error) std::rethrow_exception(lane->error);
+    for (auto& lane : lanes_) lane->files.commit();
   }
 
   const std::filesystem::path dir;
   const OutputSelection select;
 
  private:
+  struct Lane {
+    Lane(const std::filesystem::path& directory, const OutputSelection& selection, const StringModel<dim>& model,
+         const RunSummary& summary, typename FrameFiles::Part part)
+        : files(directory, selection, model, summary, part) {}
+    FrameFiles files;
+    std::size_t written = 0;
+    std::exception_ptr error;
+    std::thread thread;
+  };
+
   void close() {
     {
       std::lock_guard<std::mutex> lock(mutex_);
       closing_ = true;
     }
     wake_.notify_all();
-    if (thread_.joinable()) thread_.join();
+    for (auto& lane : lanes_)
+      if (lane->thread.joinable()) lane->thread.join();
   }
-  void loop() {
+  void loop(Lane& lane) {
     std::unique_lock<std::mutex> lock(mutex_);
     for (;;) {
-      wake_.wait(lock, [&] { return written_ < published_ || closing_; });
-      if (written_ == published_) return;  // closing, nothing left
+      wake_.wait(lock, [&] { return lane.written < published_ || closing_; });
+      if (lane.written == published_) return;  // closing, nothing left
       const std::size_t end = published_;
       const Frame<dim>* frames = frames_.data();
       lock.unlock();
       try {
-        for (std::size_t k = written_; k < end && !error_; ++k) files_.add(frames[k]);
+        for (std::size_t k = lane.written; k < end && !lane.error; ++k) lane.files.add(frames[k]);
       } catch (...) {
-        error_ = std::current_exception();  // finish() rethrows it; the later frames are not written
+        lane.error = std::current_exception();  // finish() rethrows it; the later frames are not written
       }
       lock.lock();
-      written_ = end;
+      lane.written = end;
       wake_.notify_all();
     }
   }
 
-  FrameFiles files_;
   const std::vector<Frame<dim>>& frames_;
   std::mutex mutex_;
   std::condition_variable wake_;
-  std::size_t published_ = 0, written_ = 0;
+  std::size_t published_ = 0;
   bool closing_ = false;
-  std::exception_ptr error_;
-  std::thread thread_;
+  std::vector<std::unique_ptr<Lane>> lanes_;
 };
 
 template <int dim>
