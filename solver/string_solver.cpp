@@ -384,8 +384,11 @@ const RunSummary& StringSolver<dim>::run() {
   summary_ = RunSummary{};
   have_start_ = false;
   describe_model();
-  // The frames' files written while the run goes on (stream_outputs()), into a cleared directory.
-  if (stream_request_) {
+  // The frames' files written while the run goes on (stream_outputs()), into a cleared directory, when
+  // some grow with the nodes times the frames (nodes.csv, tension.csv, the ParaView frames): the
+  // others, a row per frame, are written after the run at no cost worth a thread during it.
+  if (stream_request_ && (stream_request_->second.vtk ||
+                          (stream_request_->second.csv && (stream_request_->second.nodes || stream_request_->second.tension)))) {
     const auto& [dir, select] = *stream_request_;
     ensure_directory(dir);
     clear_run_outputs(dir);
