@@ -7,6 +7,7 @@
 #include <condition_variable>
 #include <exception>
 #include <future>
+#include <limits>
 #include <mutex>
 #include <thread>
 
@@ -26,6 +27,9 @@ constexpr int kMaxDenseOrder = Integrator::kMaxDenseOrder;
 /// that ARKODE shortened to end at a frame, one interval after the previous one, ends a few rounding
 /// units short of the interval.
 constexpr double kStepOfFrames = 1 - 1e-9;
+/// A node that moves by less than this many units of round-off of the coordinates has not moved
+/// (check_tolerance: a string at rest moves by about one, 1e-16 m on a 1 m chain).
+constexpr double kRestMotion = 1e3;
 }  // namespace
 
 void StringSolverOptions::validate() const {
@@ -302,7 +306,10 @@ void StringSolver<dim>::check_tolerance() {
   const Eigen::VectorXd scale = model_.state_scale();
   const double position_scale = scale.size() > 0 ? scale[0] : 1.0;
   const double atol = options_.integrator.atol * position_scale, rtol = options_.integrator.rtol;
-  if (!(size > 0) || atol <= rtol * size) return;
+  // A string at rest moves by the round-off of its coordinates: there is no motion to resolve.
+  const double extent = x0.size() > 0 ? x0.cwiseAbs().maxCoeff() : 0.0;
+  if (!(size > kRestMotion * std::numeric_limits<double>::epsilon() * std::max(extent, position_scale))) return;
+  if (atol <= rtol * size) return;
   // The advice, rounded down to two significant digits so that a run given it does not warn again
   // (rtol × 1.9998e-5 m printed as 2e-9 did).
   const double advice = rtol * size / position_scale;
