@@ -4,7 +4,12 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <condition_variable>
+#include <exception>
 #include <future>
+#include <limits>
+#include <mutex>
+#include <thread>
 
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
@@ -22,6 +27,9 @@ constexpr int kMaxDenseOrder = Integrator::kMaxDenseOrder;
 /// that ARKODE shortened to end at a frame, one interval after the previous one, ends a few rounding
 /// units short of the interval.
 constexpr double kStepOfFrames = 1 - 1e-9;
+/// A node that moves by less than this many units of round-off of the coordinates has not moved
+/// (check_tolerance: a string at rest moves by about one, 1e-16 m on a 1 m chain).
+constexpr double kRestMotion = 1e3;
 }  // namespace
 
 void StringSolverOptions::validate() const {
@@ -303,7 +311,10 @@ void StringSolver<dim>::check_tolerance() {
   const Eigen::VectorXd scale = model_.state_scale();
   const double position_scale = scale.size() > 0 ? scale[0] : 1.0;
   const double atol = options_.integrator.atol * position_scale, rtol = options_.integrator.rtol;
-  if (!(size > 0) || atol <= rtol * size) return;
+  // A string at rest moves by the round-off of its coordinates: there is no motion to resolve.
+  const double extent = x0.size() > 0 ? x0.cwiseAbs().maxCoeff() : 0.0;
+  if (!(size > kRestMotion * std::numeric_limits<double>::epsilon() * std::max(extent, position_scale))) return;
+  if (atol <= rtol * size) return;
   // The advice, rounded down to two significant digits so that a run given it does not warn again
   // (rtol × 1.9998e-5 m printed as 2e-9 did).
   const double advice = rtol * size / position_scale;
@@ -354,8 +365,10 @@ void StringSolver<dim>::record_frame(double t, const Eigen::VectorXd& y) {
   f.x = std::move(snap.x);
   f.v = std::move(snap.v);
   f.tension = std::move(snap.tension);
+  if (stream_ && frames_.size() == frames_.capacity()) stream_->drain();  // frames_ moves: not while read
   frames_.push_back(std::move(f));
   summary_.frames = static_cast<long>(frames_.size());
+  if (stream_) stream_->publish(frames_.size());
 }
 
 template <int dim>
@@ -378,10 +391,23 @@ void StringSolver<dim>::check_slack(double t, const Eigen::VectorXd& y) {
 
 template <int dim>
 const RunSummary& StringSolver<dim>::run() {
+  stream_.reset();  // an earlier run's writer: its unfinished files are removed
   frames_.clear();
   summary_ = RunSummary{};
   have_start_ = false;
   describe_model();
+  // The frames' files written while the run goes on (stream_outputs()), into a cleared directory, when
+  // some grow with the nodes times the frames (nodes.csv, tension.csv, the ParaView frames): the
+  // others, a row per frame, are written after the run at no cost worth a thread during it.
+  if (stream_request_ && (stream_request_->second.vtk ||
+                          (stream_request_->second.csv && (stream_request_->second.nodes || stream_request_->second.tension)))) {
+    const auto& [dir, select] = *stream_request_;
+    ensure_directory(dir);
+    clear_run_outputs(dir);
+    frames_.reserve(static_cast<std::size_t>(
+        std::min(1e5, std::ceil(options_.t_end / options_.output_interval) + 2)));  // fewer waits in record_frame()
+    stream_ = std::make_unique<Stream>(dir, select, model_, summary_, frames_);
+  }
   const auto start = std::chrono::steady_clock::now();
   const long solves_before = model_.tension_solves();
   const long transfers_before = model_.module() ? model_.module()->transfers() : 0;
@@ -518,149 +544,300 @@ const RunSummary& StringSolver<dim>::run() {
   return summary_;
 }
 
+/// The files of the frames: nodes.csv, tension.csv, energy.csv, forces.csv (the CSV format selected)
+/// and the ParaView frames with their index string.pvd (the ParaView format), or a part of them,
+/// written a frame at a time (add(), in the frames' order) and committed together (commit()). Each
+/// file is its own AtomicFile; the rows of a frame are those of the frame alone, so the files are the
+/// same whether the frames come one by one during the run or all at once after it.
+template <int dim>
+class StringSolver<dim>::FrameFiles {
+ public:
+  /// Which files: the ParaView frames, nodes.csv, the other CSV files (each as `select` allows).
+  struct Part {
+    bool vtk = true, nodes_csv = true, other_csv = true;
+  };
+
+  FrameFiles(const std::filesystem::path& dir, const OutputSelection& select, const StringModel<dim>& model,
+             const RunSummary& summary, Part part)
+      : dir_(dir), select_(select), chain_(model.chain()), terms_(summary.ledger_terms) {
+    fronts_ = model.module() != nullptr;
+    if (fronts_) front_fields_ = model.module()->front_fields();
+    if (select.vtk && part.vtk) {
+      CHAINSIM_VERIFY(select.nodes, "the ParaView frames need the nodes field");
+      ensure_directory(dir / "frames");
+      vtk_ = true;
+    }
+    if (!select.csv) return;
+    if (select.nodes && part.nodes_csv) {
+      const char* axes[] = {"x", "y", "z"};
+      std::vector<std::string> columns = {"t", "node"};
+      if (fronts_) columns.emplace_back("s");
+      for (int d = 0; d < dim; ++d) columns.emplace_back(axes[d]);
+      for (int d = 0; d < dim; ++d) columns.push_back(std::string("v") + axes[d]);
+      nodes_.emplace(dir / "nodes.csv", columns);
+    }
+    if (!part.other_csv) return;
+    if (select.tension) tension_.emplace(dir / "tension.csv", std::vector<std::string>{"t", "link", "s_mid", "T"});
+    if (select.energy) {
+      std::vector<std::string> columns = {"t", "K", "V", "W_applied", "drift"};
+      for (const LedgerTerm& term : terms_)
+        if (term.energy()) columns.push_back(term.name);
+      energy_.emplace(dir / "energy.csv", columns);
+    }
+    if (select.forces && !summary.force_columns.empty()) {
+      std::vector<std::string> columns = {"t"};
+      columns.insert(columns.end(), summary.force_columns.begin(), summary.force_columns.end());
+      forces_.emplace(dir / "forces.csv", columns);
+    }
+  }
+
+  /// The next frame's rows and ParaView files.
+  void add(const Frame<dim>& f) {
+    const std::size_t k = count_++;
+    if (vtk_) add_vtk(f, k);
+    if (nodes_)
+      for (int i : f.moving) {
+        row_ = {f.t, static_cast<double>(i)};
+        if (fronts_) row_.push_back(chain_.node_coordinate(i));
+        for (int d = 0; d < dim; ++d) row_.push_back(f.x(d, i));
+        for (int d = 0; d < dim; ++d) row_.push_back(f.v(d, i));
+        nodes_->row(row_);
+      }
+    if (tension_)
+      for (int j = 0; j < chain_.num_links(); ++j)
+        if (!std::isnan(f.tension[j])) tension_->row({f.t, static_cast<double>(j), chain_.link_midpoint(j), f.tension[j]});
+    if (energy_) {
+      row_ = {f.t, f.kinetic, f.potential, f.work, f.drift};
+      for (std::size_t term = 0; term < terms_.size(); ++term)
+        if (terms_[term].energy()) row_.push_back(f.terms.values[term]);
+      energy_->row(row_);
+    }
+    if (forces_) {
+      row_ = {f.t};
+      row_.insert(row_.end(), f.forces.begin(), f.forces.end());
+      forces_->row(row_);
+    }
+  }
+
+  /// Moves every file to its name (the ParaView index written first).
+  void commit() {
+    if (vtk_) write_pvd(dir_ / "string.pvd", index_);
+    for (auto* file : {&nodes_, &tension_, &energy_, &forces_})
+      if (*file) (*file)->commit();
+  }
+
+ private:
+  /// The moving nodes, a line cell per link of an arc; with fronts, a point per front.
+  void add_vtk(const Frame<dim>& f, std::size_t k) {
+    const VtkEncoding encoding = select_.vtk_ascii ? VtkEncoding::kAscii : VtkEncoding::kBinary;
+    const auto count = static_cast<Eigen::Index>(f.moving.size());
+    std::vector<int> point_of(static_cast<std::size_t>(chain_.num_nodes()), -1);
+    VtkPolyline line;
+    line.points = Eigen::Matrix3Xd::Zero(3, count);
+    Eigen::MatrixXd velocity = Eigen::MatrixXd::Zero(3, count), mass(1, count), s(1, count);
+    for (Eigen::Index q = 0; q < count; ++q) {
+      const int i = f.moving[static_cast<std::size_t>(q)];
+      point_of[static_cast<std::size_t>(i)] = static_cast<int>(q);
+      line.points.col(q).head(dim) = f.x.col(i);
+      velocity.col(q).head(dim) = f.v.col(i);
+      mass(0, q) = chain_.mass(i);
+      s(0, q) = chain_.node_coordinate(i);
+    }
+    std::vector<double> cell_tension;
+    for (int j = 0; j < chain_.num_links(); ++j) {
+      if (std::isnan(f.tension[j])) continue;
+      line.segments.emplace_back(point_of[static_cast<std::size_t>(chain_.link_start(j))],
+                                 point_of[static_cast<std::size_t>(chain_.link_end(j))]);
+      cell_tension.push_back(f.tension[j]);
+    }
+    line.point_data = {{"velocity", velocity}, {"mass", mass}, {"s", s}};
+    if (select_.tension)
+      line.cell_data.emplace_back(
+          "tension", Eigen::Map<const Eigen::MatrixXd>(cell_tension.data(), 1,
+                                                        static_cast<Eigen::Index>(cell_tension.size())));
+    const std::string name = fmt::format("frame_{:04d}.vtp", k);
+    write_vtp(dir_ / "frames" / name, line, encoding);
+    index_.push_back({f.t, "frames/" + name, 0});
+    if (!fronts_) return;
+    // The fronts: a point each, with what a user looks for (the module's fields).
+    const auto nf = static_cast<Eigen::Index>(f.fronts.size());
+    VtkPolyline points;
+    points.vertices = true;
+    points.points = Eigen::Matrix3Xd::Zero(3, nf);
+    Eigen::MatrixXd s0(1, nf), s0_dot(1, nf);
+    for (Eigen::Index q = 0; q < nf; ++q) {
+      const FrontValues& front = f.fronts[static_cast<std::size_t>(q)];
+      points.points.col(q).head(dim) = front.position.head(dim);
+      s0(0, q) = front.s0;
+      s0_dot(0, q) = front.s0_dot;
+    }
+    points.point_data = {{"s0", s0}, {"s0_dot", s0_dot}};
+    std::size_t offset = 0;  // of the field in FrontValues::fields
+    for (const FrontField& field : front_fields_) {
+      Eigen::MatrixXd values = Eigen::MatrixXd::Zero(field.vector ? 3 : 1, nf);
+      const int components = field.vector ? dim : 1;
+      for (Eigen::Index q = 0; q < nf; ++q)
+        for (int c = 0; c < components; ++c)
+          values(c, q) = f.fronts[static_cast<std::size_t>(q)].fields[offset + static_cast<std::size_t>(c)];
+      points.point_data.emplace_back(field.name, values);
+      offset += static_cast<std::size_t>(components);
+    }
+    const std::string fronts_name = fmt::format("fronts_{:04d}.vtp", k);
+    write_vtp(dir_ / "frames" / fronts_name, points, encoding);
+    index_.push_back({f.t, "frames/" + fronts_name, 1});
+  }
+
+  std::filesystem::path dir_;
+  OutputSelection select_;
+  const Chain<dim>& chain_;
+  std::vector<LedgerTerm> terms_;
+  std::vector<FrontField> front_fields_;
+  bool fronts_ = false, vtk_ = false;
+  std::optional<CsvWriter> nodes_, tension_, energy_, forces_;
+  std::vector<PvdEntry> index_;
+  std::vector<double> row_;
+  std::size_t count_ = 0;
+};
+
+/// stream_outputs()'s writers: threads that pass each recorded frame to FrameFiles, one for the ParaView
+/// frames (whose cost is mostly the file system's: a file per frame) and one for the CSV files (mostly
+/// formatting numbers). The frames stay in StringSolver::frames_; the threads read those published to
+/// them (published_), which the solver never moves while a thread may read them (record_frame() waits
+/// for them before frames_ grows beyond its capacity).
+template <int dim>
+class StringSolver<dim>::Stream {
+ public:
+  Stream(std::filesystem::path directory, const OutputSelection& selection, const StringModel<dim>& model,
+         const RunSummary& summary, const std::vector<Frame<dim>>& frames)
+      : dir(std::move(directory)), select(selection), frames_(frames) {
+    using Part = typename FrameFiles::Part;
+    if (select.vtk) lanes_.push_back(std::make_unique<Lane>(dir, select, model, summary, Part{true, false, false}));
+    if (select.csv) lanes_.push_back(std::make_unique<Lane>(dir, select, model, summary, Part{false, true, true}));
+    for (auto& lane : lanes_) lane->thread = std::thread([this, l = lane.get()] { loop(*l); });
+  }
+  ~Stream() { close(); }
+
+  /// frames[0, count) may be written.
+  void publish(std::size_t count) {
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      published_ = count;
+    }
+    wake_.notify_all();
+  }
+  /// Returns when every published frame is written (the frames may then move).
+  void drain() {
+    std::unique_lock<std::mutex> lock(mutex_);
+    wake_.wait(lock, [&] {
+      return std::all_of(lanes_.begin(), lanes_.end(), [&](const auto& lane) { return lane->written == published_; });
+    });
+  }
+  /// Writes what is published, stops the threads and commits the files; rethrows a thread's error.
+  void finish() {
+    close();
+    for (auto& lane : lanes_)
+      if (lane->error) std::rethrow_exception(lane->error);
+    for (auto& lane : lanes_) lane->files.commit();
+  }
+
+  const std::filesystem::path dir;
+  const OutputSelection select;
+
+ private:
+  struct Lane {
+    Lane(const std::filesystem::path& directory, const OutputSelection& selection, const StringModel<dim>& model,
+         const RunSummary& summary, typename FrameFiles::Part part)
+        : files(directory, selection, model, summary, part) {}
+    FrameFiles files;
+    std::size_t written = 0;
+    std::exception_ptr error;
+    std::thread thread;
+  };
+
+  void close() {
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      closing_ = true;
+    }
+    wake_.notify_all();
+    for (auto& lane : lanes_)
+      if (lane->thread.joinable()) lane->thread.join();
+  }
+  void loop(Lane& lane) {
+    std::unique_lock<std::mutex> lock(mutex_);
+    for (;;) {
+      wake_.wait(lock, [&] { return lane.written < published_ || closing_; });
+      if (lane.written == published_) return;  // closing, nothing left
+      const std::size_t end = published_;
+      const Frame<dim>* frames = frames_.data();
+      lock.unlock();
+      try {
+        for (std::size_t k = lane.written; k < end && !lane.error; ++k) lane.files.add(frames[k]);
+      } catch (...) {
+        lane.error = std::current_exception();  // finish() rethrows it; the later frames are not written
+      }
+      lock.lock();
+      lane.written = end;
+      wake_.notify_all();
+    }
+  }
+
+  const std::vector<Frame<dim>>& frames_;
+  std::mutex mutex_;
+  std::condition_variable wake_;
+  std::size_t published_ = 0;
+  bool closing_ = false;
+  std::vector<std::unique_ptr<Lane>> lanes_;
+};
+
+template <int dim>
+StringSolver<dim>::~StringSolver() = default;
+
+template <int dim>
+void StringSolver<dim>::stream_outputs(const std::filesystem::path& dir, const OutputSelection& select) {
+  stream_request_.emplace(dir, select);
+}
+
+namespace {
+bool same_selection(const OutputSelection& a, const OutputSelection& b) {
+  return a.nodes == b.nodes && a.tension == b.tension && a.energy == b.energy && a.forces == b.forces &&
+         a.stats == b.stats && a.csv == b.csv && a.vtk == b.vtk && a.vtk_ascii == b.vtk_ascii;
+}
+}  // namespace
+
 template <int dim>
 void StringSolver<dim>::write_outputs(const std::filesystem::path& dir, const OutputSelection& select,
                                       const nlohmann::json* summary) const {
   CHAINSIM_VERIFY(!select.vtk || select.nodes, "the ParaView frames need the nodes field");
-  ensure_directory(dir);
-  // 1. Remove every output of an earlier run first: the directory then holds this run's files or
-  //    none, never a mix; stats.json, written last, marks a complete set.
-  clear_run_outputs(dir);
-  const auto& chain = model_.chain();
-  const int L = chain.num_links();
-  const bool fronts = model_.module() != nullptr;
-  // 2. ParaView frames (the moving nodes, a line cell per link of an arc), then their index: on a
-  //    second thread while this one writes the CSV files (both only read the frames; each file is its
-  //    own AtomicFile), so that the run's outputs cost the longer of the two, not their sum.
-  auto write_frames = [&]() {
-    ensure_directory(dir / "frames");
-    std::vector<PvdEntry> index;
-    const VtkEncoding encoding = select.vtk_ascii ? VtkEncoding::kAscii : VtkEncoding::kBinary;
-    const std::vector<FrontField> front_fields = fronts ? model_.module()->front_fields() : std::vector<FrontField>{};
-    for (std::size_t k = 0; k < frames_.size(); ++k) {
-      const auto& f = frames_[k];
-      const auto count = static_cast<Eigen::Index>(f.moving.size());
-      std::vector<int> point_of(static_cast<std::size_t>(chain.num_nodes()), -1);
-      VtkPolyline line;
-      line.points = Eigen::Matrix3Xd::Zero(3, count);
-      Eigen::MatrixXd velocity = Eigen::MatrixXd::Zero(3, count), mass(1, count), s(1, count);
-      for (Eigen::Index q = 0; q < count; ++q) {
-        const int i = f.moving[static_cast<std::size_t>(q)];
-        point_of[static_cast<std::size_t>(i)] = static_cast<int>(q);
-        line.points.col(q).head(dim) = f.x.col(i);
-        velocity.col(q).head(dim) = f.v.col(i);
-        mass(0, q) = chain.mass(i);
-        s(0, q) = chain.node_coordinate(i);
-      }
-      std::vector<double> cell_tension;
-      for (int j = 0; j < L; ++j) {
-        if (std::isnan(f.tension[j])) continue;
-        line.segments.emplace_back(point_of[static_cast<std::size_t>(chain.link_start(j))],
-                                   point_of[static_cast<std::size_t>(chain.link_end(j))]);
-        cell_tension.push_back(f.tension[j]);
-      }
-      line.point_data = {{"velocity", velocity}, {"mass", mass}, {"s", s}};
-      if (select.tension)
-        line.cell_data.emplace_back(
-            "tension", Eigen::Map<const Eigen::MatrixXd>(cell_tension.data(), 1,
-                                                          static_cast<Eigen::Index>(cell_tension.size())));
-      const std::string name = fmt::format("frame_{:04d}.vtp", k);
-      write_vtp(dir / "frames" / name, line, encoding);
-      index.push_back({f.t, "frames/" + name, 0});
-      if (!fronts) continue;
-      // The fronts: a point each, with what a user looks for (the module's fields).
-      const auto nf = static_cast<Eigen::Index>(f.fronts.size());
-      VtkPolyline points;
-      points.vertices = true;
-      points.points = Eigen::Matrix3Xd::Zero(3, nf);
-      Eigen::MatrixXd s0(1, nf), s0_dot(1, nf);
-      for (Eigen::Index q = 0; q < nf; ++q) {
-        const FrontValues& front = f.fronts[static_cast<std::size_t>(q)];
-        points.points.col(q).head(dim) = front.position.head(dim);
-        s0(0, q) = front.s0;
-        s0_dot(0, q) = front.s0_dot;
-      }
-      points.point_data = {{"s0", s0}, {"s0_dot", s0_dot}};
-      std::size_t offset = 0;  // of the field in FrontValues::fields
-      for (const FrontField& field : front_fields) {
-        Eigen::MatrixXd values = Eigen::MatrixXd::Zero(field.vector ? 3 : 1, nf);
-        const int components = field.vector ? dim : 1;
-        for (Eigen::Index q = 0; q < nf; ++q)
-          for (int c = 0; c < components; ++c)
-            values(c, q) = f.fronts[static_cast<std::size_t>(q)].fields[offset + static_cast<std::size_t>(c)];
-        points.point_data.emplace_back(field.name, values);
-        offset += static_cast<std::size_t>(components);
-      }
-      const std::string fronts_name = fmt::format("fronts_{:04d}.vtp", k);
-      write_vtp(dir / "frames" / fronts_name, points, encoding);
-      index.push_back({f.t, "frames/" + fronts_name, 1});
-    }
-    write_pvd(dir / "string.pvd", index);
-  };
-  std::future<void> frames_written;
-  if (select.vtk) frames_written = std::async(std::launch::async, write_frames);
-  // 3. CSV files, streamed from the frames (a row at a time: nothing but the frames in memory);
-  //    nodes.csv on a third thread.
-  if (select.csv) {
-    const char* axes[] = {"x", "y", "z"};
-    std::vector<std::string> columns = {"t", "node"};
-    if (fronts) columns.emplace_back("s");
-    for (int d = 0; d < dim; ++d) columns.emplace_back(axes[d]);
-    for (int d = 0; d < dim; ++d) columns.push_back(std::string("v") + axes[d]);
-    std::vector<double> row;
-    // nodes.csv, the largest file (half the numbers), on a thread of its own while this one writes
-    // the others: the CSV files cost the longer of the two, not their sum.
-    auto write_nodes = [&]() {
-      CsvWriter nodes(dir / "nodes.csv", columns);
-      std::vector<double> node_row;
-      for (const auto& f : frames_)
-        for (int i : f.moving) {
-          node_row = {f.t, static_cast<double>(i)};
-          if (fronts) node_row.push_back(chain.node_coordinate(i));
-          for (int d = 0; d < dim; ++d) node_row.push_back(f.x(d, i));
-          for (int d = 0; d < dim; ++d) node_row.push_back(f.v(d, i));
-          nodes.row(node_row);
-        }
-      nodes.commit();
+  if (stream_ && stream_->dir == dir && same_selection(stream_->select, select)) {
+    // 1.-3. Streamed during the run (the directory cleared when it started): the rest of the frames.
+    stream_->finish();
+  } else {
+    stream_.reset();  // another directory or selection: its unfinished files are removed
+    ensure_directory(dir);
+    // 1. Remove every output of an earlier run first: the directory then holds this run's files or
+    //    none, never a mix; stats.json, written last, marks a complete set.
+    clear_run_outputs(dir);
+    // 2. The ParaView frames and nodes.csv (half the numbers) each on a thread of their own while
+    //    this one writes the other CSV files (all only read the frames; each file is its own
+    //    AtomicFile), so that the outputs cost the longest of the three, not their sum.
+    using Part = typename FrameFiles::Part;
+    auto write = [&](Part part) {
+      FrameFiles files(dir, select, model_, summary_, part);
+      for (const auto& f : frames_) files.add(f);
+      files.commit();
     };
-    std::future<void> nodes_written;  // after what it reads: an error below waits for it, then frees them
-    if (select.nodes) nodes_written = std::async(std::launch::async, write_nodes);
-    if (select.tension) {
-      CsvWriter tension(dir / "tension.csv", {"t", "link", "s_mid", "T"});
-      for (const auto& f : frames_)
-        for (int j = 0; j < L; ++j)
-          if (!std::isnan(f.tension[j])) tension.row({f.t, static_cast<double>(j), chain.link_midpoint(j), f.tension[j]});
-      tension.commit();
-    }
-    if (select.energy) {
-      std::vector<std::string> energy_columns = {"t", "K", "V", "W_applied", "drift"};
-      const std::vector<LedgerTerm>& terms = summary_.ledger_terms;
-      for (const LedgerTerm& term : terms)
-        if (term.energy()) energy_columns.push_back(term.name);
-      CsvWriter energy(dir / "energy.csv", energy_columns);
-      for (const auto& f : frames_) {
-        row = {f.t, f.kinetic, f.potential, f.work, f.drift};
-        for (std::size_t k = 0; k < terms.size(); ++k)
-          if (terms[k].energy()) row.push_back(f.terms.values[k]);
-        energy.row(row);
-      }
-      energy.commit();
-      if (!summary_.samples.empty()) samples_table(summary_).write(dir / "series.csv");
-    }
-    if (select.forces && !summary_.force_columns.empty()) {
-      std::vector<std::string> force_columns = {"t"};
-      force_columns.insert(force_columns.end(), summary_.force_columns.begin(), summary_.force_columns.end());
-      CsvWriter forces(dir / "forces.csv", force_columns);
-      for (const auto& f : frames_) {
-        row = {f.t};
-        row.insert(row.end(), f.forces.begin(), f.forces.end());
-        forces.row(row);
-      }
-      forces.commit();
-    }
-    if (nodes_written.valid()) nodes_written.get();  // rethrows its error, if any
+    // Each future waits for its thread when it goes out of scope, before the frames it reads (an
+    // error below still waits for them); get() rethrows a thread's error.
+    std::future<void> frames_written, nodes_written;
+    if (select.vtk) frames_written = std::async(std::launch::async, write, Part{true, false, false});
+    if (select.csv && select.nodes) nodes_written = std::async(std::launch::async, write, Part{false, true, false});
+    write(Part{false, false, true});
+    if (nodes_written.valid()) nodes_written.get();
+    if (frames_written.valid()) frames_written.get();
   }
-  if (frames_written.valid()) frames_written.get();  // rethrows the frames' error, if any
+  // 3. The step record (runs that record steps).
+  if (select.csv && select.energy && !summary_.samples.empty()) samples_table(summary_).write(dir / "series.csv");
   // 4. stats.json, last.
   if (select.stats) write_json(dir / "stats.json", summary ? *summary : to_json(summary_));
 }

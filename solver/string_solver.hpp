@@ -211,6 +211,7 @@ template <int dim>
 class StringSolver {
  public:
   StringSolver(StringModel<dim>& model, const StringSolverOptions& options);
+  ~StringSolver();  ///< a streaming writer still at work is stopped; its unfinished files removed
 
   /// Called after every accepted step with (t, y).
   std::function<void(double, const Eigen::VectorXd&)> on_step;
@@ -231,6 +232,13 @@ class StringSolver {
   /// (`summary`, or to_json(summary()) when null) is written last.
   void write_outputs(const std::filesystem::path& dir, const OutputSelection& select = {},
                      const nlohmann::json* summary = nullptr) const;
+  /// Writes the next run()'s frame files (nodes, tension, energy and forces CSV; the ParaView frames)
+  /// into `dir` while it runs: a thread of their own writes each frame as it is recorded, so that
+  /// formatting the rows overlaps the integration instead of following it. write_outputs() with the
+  /// same `dir` and selection then only finishes them (the frames still queued, the ParaView index,
+  /// series.csv, stats.json last); any other call writes everything itself. The files are byte for byte
+  /// those of write_outputs() alone. Earlier outputs in `dir` are removed when the run starts.
+  void stream_outputs(const std::filesystem::path& dir, const OutputSelection& select = {});
 
  private:
   void record_frame(double t, const Eigen::VectorXd& y);
@@ -244,9 +252,17 @@ class StringSolver {
   /// Fills what every record holds (RunRecord) from the snapshot at t, after book().
   void fill_record(double t, const typename StringModel<dim>::Snapshot& snap, RunRecord& record) const;
 
+  /// The files of the frames, written a frame at a time (string_solver.cpp).
+  class FrameFiles;
+  /// The writer thread of stream_outputs() (string_solver.cpp).
+  class Stream;
+
   StringModel<dim>& model_;
   StringSolverOptions options_;
   std::vector<Frame<dim>> frames_;
+  /// stream_outputs()'s request (applied by run()) and the writer of the run in progress or done.
+  std::optional<std::pair<std::filesystem::path, OutputSelection>> stream_request_;
+  mutable std::unique_ptr<Stream> stream_;
   RunSummary summary_;
   Eigen::VectorXd final_state_;
   bool have_start_ = false;

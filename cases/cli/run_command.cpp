@@ -25,6 +25,7 @@
 
 #include <cmath>
 #include <filesystem>
+#include <iostream>
 #include <optional>
 #include <ostream>
 
@@ -78,6 +79,7 @@ int run_string_scene(const SceneSpec& spec, const std::filesystem::path& dir, bo
   SceneRun<dim> scene(spec);
   const RunDirectory run_dir(dir);
   run_dir.clear();
+  scene.stream(run_dir);  // the frames' files written while the run goes on
   const StringSolver<dim>& solver = scene.solver();
   const bool fronts = scene.has_fronts();
   // 4.-5. Integrate (a numerical failure, or a signal, still writes what was done), write, summary last.
@@ -93,6 +95,9 @@ int run_string_scene(const SceneSpec& spec, const std::filesystem::path& dir, bo
   if (interrupted && json) summary["exit_code"] = kInterruptedExit;
   // 6. Summary.
   const RunSummary& s = solver.summary();
+  // The JSON summary is for a program: the warning also goes to stderr, for the person who ran it
+  // (the text report has it on its 'warning' line).
+  if (json && !s.tolerance_warning.empty()) std::cerr << "chainsim: warning: " << s.tolerance_warning << '\n';
   if (json) {
     print_json(out, summary, spec, dir);
   } else if (!failure) {  // a failure is reported by its message (outputs written up to it)

@@ -10,7 +10,7 @@
 #include <vector>
 
 #include <fmt/format.h>
-#include <toml++/toml.h>
+#include "cases/scene/toml.hpp"
 
 #include "cases/scene/parse_sections.hpp"
 #include "cases/scene/scene.hpp"

@@ -3,7 +3,7 @@
 
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
-#include <toml++/toml.h>
+#include "cases/scene/toml.hpp"
 
 #include "cases/scene/scene_json.hpp"
 #include "mesh/errors.hpp"

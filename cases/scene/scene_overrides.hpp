@@ -13,7 +13,7 @@
 #include <string>
 #include <vector>
 
-#include <toml++/toml.h>
+#include "cases/scene/toml.hpp"
 
 #include "cases/scene/scene_text.hpp"
 

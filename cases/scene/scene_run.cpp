@@ -53,6 +53,11 @@ void SceneRun<dim>::write(const RunDirectory& dir, const nlohmann::json& summary
   solver_->write_outputs(dir.path(), scene_.output, &summary);
 }
 
+template <int dim>
+void SceneRun<dim>::stream(const RunDirectory& dir) {
+  solver_->stream_outputs(dir.path(), scene_.output);
+}
+
 template class SceneRun<2>;
 template class SceneRun<3>;
 

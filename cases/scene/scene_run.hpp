@@ -50,6 +50,9 @@ class SceneRun {
   void write(const std::filesystem::path& dir, const nlohmann::json& summary) const;
   /// The same into a directory this process already holds (`chainsim run` locks it for the whole run).
   void write(const RunDirectory& dir, const nlohmann::json& summary) const;
+  /// Writes the frames' files into `dir` (held by this process) while the next run() runs
+  /// (StringSolver::stream_outputs); write(dir, summary) then finishes them. Same files as write() alone.
+  void stream(const RunDirectory& dir);
 
  private:
   StringScene<dim> scene_;  ///< the model, its options and description (build_string_scene)

@@ -14,7 +14,7 @@
 #include <tuple>
 #include <vector>
 
-#include <toml++/toml.h>
+#include "cases/scene/toml.hpp"
 
 namespace chainsim::scene_text {
 

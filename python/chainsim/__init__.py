@@ -21,6 +21,7 @@ import os
 import sys
 import threading
 import time
+import warnings
 from typing import TYPE_CHECKING, Any, Callable, Dict, Iterable, List, Mapping, Optional, Sequence, Tuple, Union
 
 import numpy as np
@@ -34,7 +35,12 @@ from ._results import Comparison, ReducedResult, Result, result_of_run
 __version__: str = _core.__version__
 
 __all__ = ["ChainsimInputError", "NumericalError", "Scene", "Result", "ReducedResult", "Comparison", "reduced",
-           "compare", "sweep", "read_run", "plot", "__version__"]
+           "compare", "sweep", "read_run", "plot", "ToleranceWarning", "__version__"]
+
+
+class ToleranceWarning(UserWarning):
+    """Scene.run(): atol is coarser than rtol times the motion's size (the summary's
+    ``tolerance_warning``, which names the value of ``solver.atol`` that resolves the motion)."""
 
 if TYPE_CHECKING:  # pragma: no cover
     from pandas import DataFrame
@@ -226,6 +232,8 @@ class Scene:
         if result.status == "interrupted":
             _core.clear_interrupt()
             raise KeyboardInterrupt(result.summary.get("stop_reason", "interrupted"))
+        if "tolerance_warning" in result.summary:  # atol coarser than rtol x the motion's size
+            warnings.warn(result.summary["tolerance_warning"], ToleranceWarning, stacklevel=2)
         if run.error:
             error = NumericalError(run.error)
             error.result = result  # type: ignore[attr-defined]

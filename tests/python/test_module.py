@@ -13,6 +13,7 @@ import sys
 import tempfile
 import textwrap
 import time
+import warnings
 
 import numpy as np
 import pytest
@@ -345,3 +346,18 @@ def test_write_is_refused_while_a_run_holds_the_directory_and_clears_other_comma
     result.write(tmp_path / "c")
     assert sorted(os.listdir(tmp_path / "c")) == ["energy.csv", "forces.csv", "frames", "nodes.csv", "notes.txt",
                                                  "stats.json", "string.pvd", "tension.csv"]
+
+
+def test_a_coarse_atol_warns_with_the_value_to_set():
+    # The hanging chain on its first mode, amplitude 1e-5 m: atol 1e-6 m is 5 % of its 2e-5 m swing, far
+    # coarser than rtol = 1e-4 (issue 24, item 4); the advised atol runs without the warning.
+    scene = chainsim.Scene.from_file(os.path.join(SOURCE, "docs", "data", "hanging_chain_mode1.toml")).set(**{
+        "solver.method": "auto", "solver.rtol": 1e-4, "solver.atol": 1e-6, "stop.t_end": 1.8,
+        "output.interval": 0.05})
+    with pytest.warns(chainsim.ToleranceWarning, match=r"set solver.atol <= ") as caught:
+        result = scene.run()
+    assert str(caught[0].message) == result.summary["tolerance_warning"]
+    advised = float(result.summary["tolerance_warning"].rsplit("<= ", 1)[1])
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", chainsim.ToleranceWarning)
+        assert "tolerance_warning" not in scene.set(**{"solver.atol": advised}).run().summary

@@ -157,10 +157,14 @@ TEST_CASE("SIGTERM while the outputs are written: they are finished, whole, and 
   int status = 0;
   REQUIRE(waitpid(pid, &status, 0) == pid);
   REQUIRE(WIFEXITED(status));
-  // The run had reached t_end: it completed, and its set is whole.
-  CHECK(WEXITSTATUS(status) == 0);
+  // `chainsim run` writes nodes.csv while it integrates (StringSolver::stream_outputs): the signal came
+  // while the file was being written, during the integration (the run stops at its next accepted step:
+  // exit 130, "interrupted") or after it (the run had reached t_end: exit 0, "completed"). Either way
+  // the set is whole: every frame's rows, stats.json, no temporary file.
   const nlohmann::json stats = nlohmann::json::parse(read(out / "stats.json"));
-  CHECK(stats["status"] == "completed");
+  INFO("exit status " << WEXITSTATUS(status) << ", run " << stats["status"]);
+  CHECK(((WEXITSTATUS(status) == 0 && stats["status"] == "completed") ||
+         (WEXITSTATUS(status) == 130 && stats["status"] == "interrupted")));
   CHECK(data_rows(out / "nodes.csv") == stats["frames"].get<long>() * 2001);
   CHECK(temporary_files(out).empty());
 }

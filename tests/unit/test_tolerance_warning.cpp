@@ -7,6 +7,7 @@
 #include <catch2/catch.hpp>
 #include <nlohmann/json.hpp>
 
+#include "cases/scene/scene_run.hpp"
 #include "test_scene_support.hpp"
 
 namespace {
@@ -45,4 +46,22 @@ TEST_CASE("a run warns when atol is coarser than rtol times the motion's size", 
   // atol 1e-10 m is below rtol times the swing (2e-9 m): no warning.
   const auto fine = run_mode1("1e-10", dir / "fine");
   CHECK_FALSE(fine.contains("tolerance_warning"));
+}
+
+TEST_CASE("a string at rest does not warn about its tolerance", "[scene][tolerance]") {
+  // The chain of the scene tests hangs straight down under gravity: it stays at rest, its nodes move by
+  // round-off (about 1e-16 m), and there is no motion for atol to resolve. It used to warn, advising
+  // solver.atol <= 1e-24.
+  chainsim::SceneRun<2> run(chainsim::parse_scene_text(chainsim::test::kSceneBase, "rest.toml"));
+  REQUIRE_FALSE(run.run().has_value());
+  INFO(run.solver().summary().tolerance_warning);
+  CHECK(run.solver().summary().tolerance_warning.empty());
+  // A moving string still warns: the same chain released horizontally, with an atol of 10 % of its length.
+  chainsim::SceneRun<2> moving(chainsim::parse_scene_text(
+      chainsim::test::edit(chainsim::test::edit(chainsim::test::kSceneBase, "[[0.0, 0.0], [0.0, -1.0]]",
+                                                "[[0.0, 0.0], [1.0, 0.0]]"),
+                           "[stop]", "[solver]\natol = 1e-2\n\n[stop]"),
+      "moving.toml"));
+  REQUIRE_FALSE(moving.run().has_value());
+  CHECK_FALSE(moving.solver().summary().tolerance_warning.empty());
 }
