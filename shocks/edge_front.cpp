@@ -100,6 +100,8 @@ void EdgeFront<dim>::initialize(StringModel<dim>& model) {
   }
   const int a = link_;
   set_link(model, a);
+  start_minus_ = bent_minus_;
+  start_plus_ = bent_plus_;
   if (table_ == EdgeSpec<dim>::Table::kNone) return;
   // The table: the face the string on its side lies on, through x0, normal to that side's tangent, on
   // the side away from the bend (jump::face_normal).
@@ -179,6 +181,45 @@ double EdgeFront<dim>::potential_moment(const StringModel<dim>& model, const Fro
   const double lambda = this->m_.lambda;
   return lambda * g.dot(0.5 * s.l_minus * (point_ - model.x().col(link_)) +
                         0.5 * s.l_plus * (point_ - model.x().col(link_ + 1)));
+}
+
+template <int dim>
+void EdgeFront<dim>::draw(int index, ObstacleDrawing& drawing) const {
+  auto in_3d = [](const Vec<dim>& v) {
+    Eigen::Vector3d p = Eigen::Vector3d::Zero();
+    p.head(dim) = v;
+    return p;
+  };
+  auto segment = [&](const Eigen::Vector3d& from, const Eigen::Vector3d& to, int part) {
+    drawing.segments.emplace_back(from, to);
+    drawing.segment_obstacle.push_back(index);
+    drawing.segment_part.push_back(part);
+  };
+  const double ell = this->m_.ell;
+  const Eigen::Vector3d p = in_3d(point_), axis = in_3d(axis_);
+  drawing.points.push_back(p);
+  drawing.point_obstacle.push_back(index);
+  drawing.point_part.push_back(ObstacleDrawing::kEdge);
+  const Eigen::Vector3d half = 0.5 * ell * axis;  // a 3D edge's line (zero in 2D)
+  if (dim == 3) segment(p - half, p + half, ObstacleDrawing::kEdge);
+  if (table_ == EdgeSpec<dim>::Table::kNone) return;
+  // A face from the edge into `along` (normal to the edge's line), `depth` deep: a segment in 2D, the
+  // three other sides of a rectangle on the edge's line in 3D.
+  auto face = [&](const Vec<dim>& along, double depth, int part) {
+    Eigen::Vector3d w = in_3d(along);
+    w -= w.dot(axis) * axis;
+    const Eigen::Vector3d q = p + depth * w.normalized();
+    if (dim == 2) {
+      segment(p, q, part);
+    } else {
+      segment(p - half, q - half, part);
+      segment(q - half, q + half, part);
+      segment(q + half, p + half, part);
+    }
+  };
+  const bool before = table_ == EdgeSpec<dim>::Table::kBefore;
+  face(before ? Vec<dim>(-start_minus_) : start_plus_, ell, ObstacleDrawing::kTable);
+  face(before ? start_plus_ : Vec<dim>(-start_minus_), 0.25 * ell, ObstacleDrawing::kSide);
 }
 
 template <int dim>

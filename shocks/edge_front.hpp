@@ -85,6 +85,10 @@ class EdgeFront final : public FrontKind<dim> {
   /// F0 of the jump conditions at the current tension (without the table's support).
   Vec<dim> recorded_reaction(const StringModel<dim>& model, const FrontState<dim>& state) const override;
 
+  /// The edge's point (a 3D edge's line, ℓ long), and with a table its face (ℓ deep) and the wedge's
+  /// other face (ℓ/4 deep), along the sides' initial tangents.
+  void draw(int index, ObstacleDrawing& drawing) const override;
+
   /// The tensions τ⁻, τ⁺ (N) after an evaluation.
   double tension_minus(const StringModel<dim>& model) const { return model.link_tension(link_); }
   double tension_plus(const StringModel<dim>& model) const { return model.link_tension(link_) + jump_; }
@@ -103,6 +107,8 @@ class EdgeFront final : public FrontKind<dim> {
   /// The bent link's directions to and from x0 when it was bent (fixed until the next crossing): the
   /// signed distance of an arc's end node has no link beyond it to measure along (set_link()).
   Vec<dim> bent_minus_ = Vec<dim>::Zero(), bent_plus_ = Vec<dim>::Zero();
+  /// The sides' tangents at the edge at the start (the faces drawn along them).
+  Vec<dim> start_minus_ = Vec<dim>::Zero(), start_plus_ = Vec<dim>::Zero();
   /// Bends link `a` over x0 and fixes its directions.
   void set_link(StringModel<dim>& model, int a);
   // Of the last evaluation: the tangents on either side, the tension jump [τ] (N).

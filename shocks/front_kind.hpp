@@ -142,6 +142,9 @@ class FrontKind {
   virtual Vec<dim> recorded_reaction(const StringModel<dim>& /*model*/, const FrontState<dim>& state) const {
     return state.reaction;
   }
+  /// Adds the obstacle this front models, as obstacle number `index`, to the ParaView drawing (none
+  /// by default: a heap or a fold is no obstacle).
+  virtual void draw(int /*index*/, ObstacleDrawing& /*drawing*/) const {}
 
  protected:
   FrontMaterial m_;

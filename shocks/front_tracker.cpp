@@ -190,6 +190,24 @@ std::vector<LedgerTerm> FrontTracker<dim>::ledger_terms() const {
 }
 
 template <int dim>
+std::vector<int> FrontTracker<dim>::events_failed_at_start(const Eigen::Ref<const Eigen::VectorXd>& g) const {
+  // The checks come last in events(), after the crossings and the stops at s0.
+  const auto first = static_cast<Eigen::Index>(2 * fronts_.size() + options_.stop_at.size());
+  std::vector<int> found(static_cast<std::size_t>(g.size()), 0);
+  bool any = false;
+  for (Eigen::Index q = first; q < g.size(); ++q)
+    if (g[q] < 0) found[static_cast<std::size_t>(q)] = -1, any = true;
+  return any ? found : std::vector<int>{};
+}
+
+template <int dim>
+ObstacleDrawing FrontTracker<dim>::obstacles() const {
+  ObstacleDrawing drawing;
+  for (std::size_t k = 0; k < fronts_.size(); ++k) fronts_[k]->draw(static_cast<int>(k), drawing);
+  return drawing;
+}
+
+template <int dim>
 std::vector<FrontField> FrontTracker<dim>::front_fields() const {
   return {{"heap", false}, {"reaction", true}, {"plane_normal", true}};
 }

@@ -140,6 +140,10 @@ class FrontTracker final : public StringModule<dim> {
   std::optional<double> front_tension_at(const StringModel<dim>& model, int node) const override;
   bool events_need_tensions() const override;
   std::vector<RunEvent> run_events() const override { return events_; }
+  ObstacleDrawing obstacles() const override;
+  /// The fronts' checks (the lift-off margins) already negative at the start.
+  std::vector<int> events_failed_at_start(const Eigen::Ref<const Eigen::VectorXd>& g) const override;
+  bool checks_at_start() const override { return num_checks() > 0; }
 
  private:
   int num_checks() const;

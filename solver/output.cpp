@@ -335,7 +335,8 @@ const std::vector<OutputName>& run_output_names() {
   static const std::vector<OutputName> names = {
       // chainsim run (string and reduced models), in the order its summary lists them
       {"nodes.csv"}, {"tension.csv"}, {"energy.csv"}, {"series.csv"}, {"forces.csv"}, {"string.pvd"},
-      {"frames", N::kDirectory, {"frame_*.vtp", "fronts_*.vtp"}, "a directory of ParaView frames"}, {"stats.json"},
+      {"frames", N::kDirectory, {"frame_*.vtp", "fronts_*.vtp", "obstacles.vtp"}, "a directory of ParaView frames"},
+      {"stats.json"},
       // chainsim compare, reduced, canonical, sweep
       {"string_series.csv"}, {"reduced_series.csv"}, {"summary.csv"}, {"summary.json"}, {"sweep.csv"},
       {"figure_data", N::kDirectory, {"*.csv"}, "a directory of figure data"},

@@ -65,6 +65,20 @@ struct RunEvent {
   std::vector<std::pair<std::string, double>> values;
 };
 
+/// What a module draws of the obstacles it models (fixed in space), for the ParaView output
+/// (frames/obstacles.vtp, docs/string_solver.md): vertex cells (a 2D edge or peg, seen end-on) and line
+/// segments (a 3D edge's line, a table's faces), each with the obstacle it belongs to (its front's
+/// index) and what part of it it is. Points in 3D (m; a 2D run's z = 0).
+struct ObstacleDrawing {
+  /// 0 the edge (its point or its line), 1 the table's face, 2 the wedge's other face (the table's side).
+  enum Part { kEdge = 0, kTable = 1, kSide = 2 };
+  std::vector<Eigen::Vector3d> points;
+  std::vector<std::pair<Eigen::Vector3d, Eigen::Vector3d>> segments;
+  std::vector<int> point_obstacle, segment_obstacle;  ///< per cell: the obstacle's index
+  std::vector<int> point_part, segment_part;          ///< per cell: Part
+  bool empty() const { return points.empty() && segments.empty(); }
+};
+
 /// A field of the ParaView fronts that the module adds (a point-data array of fronts_XXXX.vtp).
 struct FrontField {
   std::string name;
@@ -172,6 +186,15 @@ class StringModule {
   virtual void node_contacts(const StringModel<dim>&, std::vector<NodeContact<dim>>&) const {}
   /// The physical events of the run so far (e.g. a chain lifting off an edge), for the run's summary.
   virtual std::vector<RunEvent> run_events() const { return {}; }
+  /// The root functions `g` (events() at the start of the run) that say the run cannot go on from
+  /// its very start: ARKODE finds only sign changes, so a check already negative at t0 (an edge that
+  /// would have to pull the string it is given) is acted on as an event at t0. Returns `found` for
+  /// handle_events (-1 at each such function), or empty when the start is fine.
+  virtual std::vector<int> events_failed_at_start(const Eigen::Ref<const Eigen::VectorXd>& /*g*/) const { return {}; }
+  /// Whether events_failed_at_start can find anything (else the runner does not evaluate events() at t0).
+  virtual bool checks_at_start() const { return false; }
+  /// The obstacles to draw in the ParaView output (none by default: no obstacles.vtp is written).
+  virtual ObstacleDrawing obstacles() const { return {}; }
 };
 
 }  // namespace chainsim

@@ -51,6 +51,32 @@ constexpr double kVtkBinaryBytes = 84, kVtkAsciiBytes = 210;
 // Per frame: in memory, the Frame's own fields and vectors' bookkeeping; on disk, the ParaView files'
 // headers, the .pvd entry, the energy and forces rows.
 constexpr double kMemoryPerFrame = 512, kDiskPerFrame = 4096;
+
+/// A module's obstacles as VTK polydata (frames/obstacles.vtp): the vertex cells and the segments, each
+/// cell with its obstacle's index and its part (cell data "obstacle", "part": ObstacleDrawing::Part).
+VtkPolyline obstacle_polydata(const ObstacleDrawing& d) {
+  VtkPolyline out;
+  const auto nv = static_cast<Eigen::Index>(d.points.size()), ns = static_cast<Eigen::Index>(d.segments.size());
+  out.points.resize(3, nv + 2 * ns);
+  Eigen::MatrixXd obstacle(1, nv + ns), part(1, nv + ns);
+  for (Eigen::Index q = 0; q < nv; ++q) {
+    out.points.col(q) = d.points[static_cast<std::size_t>(q)];
+    out.vertex_cells.push_back(static_cast<int>(q));
+    obstacle(0, q) = d.point_obstacle[static_cast<std::size_t>(q)];
+    part(0, q) = d.point_part[static_cast<std::size_t>(q)];
+  }
+  for (Eigen::Index q = 0; q < ns; ++q) {
+    const auto k = static_cast<std::size_t>(q);
+    const auto a = static_cast<int>(nv + 2 * q);
+    out.points.col(a) = d.segments[k].first;
+    out.points.col(a + 1) = d.segments[k].second;
+    out.segments.emplace_back(a, a + 1);
+    obstacle(0, nv + q) = d.segment_obstacle[k];
+    part(0, nv + q) = d.segment_part[k];
+  }
+  out.cell_data = {{"obstacle", obstacle}, {"part", part}};
+  return out;
+}
 }  // namespace
 
 OutputEstimate StringSolverOptions::estimate_outputs(int nodes, int dim, bool fronts,
@@ -446,6 +472,20 @@ const RunSummary& StringSolver<dim>::run() {
       record_frame(t0, y0);
       if (options_.record_steps) record_sample(t0, y0);
       check_slack(t0, y0);
+      // A check of the module already failed at the start (StringModule::events_failed_at_start):
+      // the run stops at t0 as at that event (ARKODE finds only sign changes).
+      if (model_.module() != nullptr && model_.module()->checks_at_start() && model_.num_events() > 0) {
+        Eigen::VectorXd g(model_.num_events());
+        model_.events(t0, y0, g);
+        const std::vector<int> found = model_.module()->events_failed_at_start(g);
+        if (!found.empty()) {
+          const EventAction action = model_.handle_events(t0, y0, found);
+          CHAINSIM_VERIFY(action.kind == EventAction::Kind::kStop, "a check failed at the start must stop the run");
+          finish("stopped");
+          summary_.stop_reason = action.reason;
+          return summary_;
+        }
+      }
     }
     // 2. Step by step to each output time: constraints (and slack) are checked at accepted steps,
     //    root functions acted on where they vanish.
@@ -566,6 +606,14 @@ class StringSolver<dim>::FrameFiles {
       CHAINSIM_VERIFY(select.nodes, "the ParaView frames need the nodes field");
       ensure_directory(dir / "frames");
       vtk_ = true;
+      // The obstacles (fixed in space): one file, part 2 of the collection at every frame's time.
+      if (fronts_) {
+        const ObstacleDrawing obstacles = model.module()->obstacles();
+        obstacles_ = !obstacles.empty();
+        if (obstacles_)
+          write_vtp(dir / "frames" / "obstacles.vtp", obstacle_polydata(obstacles),
+                    select.vtk_ascii ? VtkEncoding::kAscii : VtkEncoding::kBinary);
+      }
     }
     if (!select.csv) return;
     if (select.nodes && part.nodes_csv) {
@@ -658,6 +706,7 @@ class StringSolver<dim>::FrameFiles {
     const std::string name = fmt::format("frame_{:04d}.vtp", k);
     write_vtp(dir_ / "frames" / name, line, encoding);
     index_.push_back({f.t, "frames/" + name, 0});
+    if (obstacles_) index_.push_back({f.t, "frames/obstacles.vtp", 2});
     if (!fronts_) return;
     // The fronts: a point each, with what a user looks for (the module's fields).
     const auto nf = static_cast<Eigen::Index>(f.fronts.size());
@@ -692,7 +741,7 @@ class StringSolver<dim>::FrameFiles {
   const Chain<dim>& chain_;
   std::vector<LedgerTerm> terms_;
   std::vector<FrontField> front_fields_;
-  bool fronts_ = false, vtk_ = false;
+  bool fronts_ = false, vtk_ = false, obstacles_ = false;
   std::optional<CsvWriter> nodes_, tension_, energy_, forces_;
   std::vector<PvdEntry> index_;
   std::vector<double> row_;

@@ -92,24 +92,25 @@ VtkEncoding parse_vtk_encoding(const std::string& text, const std::string& key) 
 void write_vtp(const std::filesystem::path& path, const VtkPolyline& line, VtkEncoding encoding) {
   const auto np = line.points.cols();
   const auto nc = static_cast<Eigen::Index>(line.segments.size());
+  const Eigen::Index nv = line.vertices ? np : static_cast<Eigen::Index>(line.vertex_cells.size());
   for (const auto& [name, data] : line.point_data)
     CHAINSIM_VERIFY(data.cols() == np, "VTK point data '" + name + "' needs one column per point");
   for (const auto& [name, data] : line.cell_data)
-    CHAINSIM_VERIFY(data.cols() == nc, "VTK cell data '" + name + "' needs one column per segment");
+    CHAINSIM_VERIFY(data.cols() == (line.vertices ? nc : nv + nc),
+                    "VTK cell data '" + name + "' needs one column per cell");
   CHAINSIM_VERIFY(2 * static_cast<double>(nc) < 2147483647.0, "too many VTK line cells for Int32 offsets");
-  CHAINSIM_VERIFY(!line.vertices || (line.segments.empty() && line.cell_data.empty()),
+  CHAINSIM_VERIFY(!line.vertices || (line.segments.empty() && line.cell_data.empty() && line.vertex_cells.empty()),
                   "a vertex set has no line cells and no cell data");
-  std::vector<std::int32_t> connectivity, offsets;
+  std::vector<std::int32_t> connectivity, offsets, vertex_connectivity, vertex_offsets;
   for (const auto& [a, b] : line.segments) {
     connectivity.push_back(a);
     connectivity.push_back(b);
     offsets.push_back(static_cast<std::int32_t>(connectivity.size()));
   }
-  for (Eigen::Index q = 0; line.vertices && q < np; ++q) {
-    connectivity.push_back(static_cast<std::int32_t>(q));
-    offsets.push_back(static_cast<std::int32_t>(connectivity.size()));
+  for (Eigen::Index q = 0; q < nv; ++q) {
+    vertex_connectivity.push_back(line.vertices ? static_cast<std::int32_t>(q) : line.vertex_cells[static_cast<std::size_t>(q)]);
+    vertex_offsets.push_back(static_cast<std::int32_t>(vertex_connectivity.size()));
   }
-  const Eigen::Index nv = line.vertices ? np : 0;
   AtomicFile file(path);
   auto& out = file.stream();
   out << fmt::format("<?xml version=\"1.0\"?>\n"
@@ -122,11 +123,17 @@ void write_vtp(const std::filesystem::path& path, const VtkPolyline& line, VtkEn
   ArrayWriter arrays(out, encoding);
   out << "      <Points>\n";
   arrays.floats("Points", line.points);
-  const char* cells = line.vertices ? "Verts" : "Lines";
-  out << fmt::format("      </Points>\n      <{}>\n", cells);
-  arrays.integers("connectivity", connectivity);
-  arrays.integers("offsets", offsets);
-  out << fmt::format("      </{}>\n      <PointData>\n", cells);
+  out << "      </Points>\n";
+  // The cells: a vertex set's Verts, a line's Lines, or (vertex cells listed besides the segments) both.
+  auto cells = [&](const char* kind, const std::vector<std::int32_t>& conn, const std::vector<std::int32_t>& offs) {
+    out << fmt::format("      <{}>\n", kind);
+    arrays.integers("connectivity", conn);
+    arrays.integers("offsets", offs);
+    out << fmt::format("      </{}>\n", kind);
+  };
+  if (nv > 0 || line.vertices) cells("Verts", vertex_connectivity, vertex_offsets);
+  if (!line.vertices) cells("Lines", connectivity, offsets);
+  out << "      <PointData>\n";
   for (const auto& [name, data] : line.point_data) arrays.floats(name, data);
   out << "      </PointData>\n      <CellData>\n";
   for (const auto& [name, data] : line.cell_data) arrays.floats(name, data);

@@ -26,9 +26,12 @@ struct VtkPolyline {
   Eigen::Matrix3Xd points;                    ///< one column per node (m)
   std::vector<std::pair<int, int>> segments;  ///< node pairs, one per link
   bool vertices = false;                      ///< no lines: one vertex cell per point (cell data: none)
+  /// Points drawn as vertex cells besides the segments (an obstacle's drawing): cell data then has one
+  /// column per vertex cell first, then one per segment (VTK's order of a piece's cells).
+  std::vector<int> vertex_cells;
   /// Named point data: rows = components (1 or 3), one column per point.
   std::vector<std::pair<std::string, Eigen::MatrixXd>> point_data;
-  /// Named cell data: rows = components, one column per segment.
+  /// Named cell data: rows = components, one column per segment (per vertex cell, then per segment).
   std::vector<std::pair<std::string, Eigen::MatrixXd>> cell_data;
 };
 
@@ -45,7 +48,7 @@ void write_vtp(const std::filesystem::path& path, const VtkPolyline& line,
 struct PvdEntry {
   double t = 0;      ///< time (s)
   std::string file;  ///< relative to the .pvd
-  int part = 0;      ///< which part of the scene at that time (0: the string, 1: its fronts)
+  int part = 0;      ///< which part of the scene at that time (0: the string, 1: its fronts, 2: the obstacles)
 };
 /// Writes the ParaView collection.
 void write_pvd(const std::filesystem::path& path, const std::vector<PvdEntry>& frames);

@@ -39,11 +39,12 @@ int run_canonical_command(const CanonicalCommandOptions& options, std::ostream& 
 /// `chainsim compare falling|folded|sliding --nodes N ...`: the string solver (front tracking) and the
 /// reduced ODE on the same problem; writes string_series.csv, reduced_series.csv and summary.json.
 /// `chainsim compare edge --x0 X0 ...`: the chain sliding off a table over an edge against its exact
-/// solution (edge_case.hpp); writes string_series.csv, exact_series.csv and summary.json.
+/// solution (edge_case.hpp); `chainsim compare peg --x0 X0 ...` the heavy Atwood chain over a sharp peg;
+/// both write string_series.csv, exact_series.csv and summary.json.
 struct CompareCommandOptions {
   std::string problem;
   StringCaseSetup setup;  ///< problem is filled in from `problem` (edge: its chain, nodes, t_max, integrator)
-  std::optional<double> x0;  ///< edge only: the hanging fraction at release (default 0.2)
+  std::optional<double> x0;  ///< edge: the hanging fraction at release (default 0.2); peg: the longer side's (0.6)
   std::string out;        ///< output directory; "" = results/compare/<problem>
   bool json = false;
 };

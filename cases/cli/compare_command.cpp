@@ -1,5 +1,5 @@
-// `chainsim compare`: the string solver against the reduced ODE, or (edge) against the exact solution
-// (see commands.hpp).
+// `chainsim compare`: the string solver against the reduced ODE, or (edge, peg) against the exact
+// solution (see commands.hpp).
 #include <filesystem>
 #include <optional>
 #include <ostream>
@@ -16,20 +16,24 @@ namespace chainsim {
 
 namespace {
 
-/// `compare edge`'s setup from the command's options; the options it has no use for are refused.
-EdgeCaseSetup edge_setup(const CompareCommandOptions& options) {
+/// `compare edge`'s and `compare peg`'s setup from the command's options; the options they have no use
+/// for are refused.
+EdgeCaseSetup edge_setup(const CompareCommandOptions& options, PointContactProblem problem) {
   const StringCaseSetup& s = options.setup;
+  const std::string& name = options.problem;
+  const char* x0_range = problem == PointContactProblem::kPeg ? "the longer side's fraction (0.5 < x0 < 1)"
+                                                              : "the hanging fraction (0 < x0 < 1)";
   if (s.eta0)
-    throw InputError(fmt::format("--eta0 = {}: compare edge starts from --x0, the hanging fraction (0 < x0 < 1)",
-                                 *s.eta0));
+    throw InputError(fmt::format("--eta0 = {}: compare {} starts from --x0, {}", *s.eta0, name, x0_range));
   if (s.force != 0)
-    throw InputError(fmt::format("--force = {}: only the folded chain has an end force (compare edge: 0)", s.force));
+    throw InputError(fmt::format("--force = {}: only the folded chain has an end force (compare {}: 0)", s.force, name));
   if (s.eps != StringCaseSetup{}.eps)
-    throw InputError(fmt::format("--eps = {}: compare edge stops at the lift-off and has no cutoff", s.eps));
+    throw InputError(fmt::format("--eps = {}: compare {} stops at the lift-off and has no cutoff", s.eps, name));
   EdgeCaseSetup e;
+  e.problem = problem;
   e.chain = s.chain;
   e.nodes = s.nodes;
-  if (options.x0) e.x0 = *options.x0;
+  e.x0 = options.x0 ? *options.x0 : EdgeCaseSetup::default_x0(problem);
   e.t_max_over_t0 = s.t_max_over_t0;
   e.integrator = s.integrator;
   e.validate();
@@ -39,31 +43,40 @@ EdgeCaseSetup edge_setup(const CompareCommandOptions& options) {
 void print_edge(const nlohmann::json& s, std::ostream& out) {
   auto number = [&](const char* key) { return s[key].is_number() ? fmt::format("{:.12g}", s[key].get<double>()) : "none"; };
   auto error = [&](const char* key) { return s[key].is_number() ? fmt::format("{:.3g}", s[key].get<double>()) : "none"; };
-  out << fmt::format("edge, f = {}, x0 = {}, {} nodes: string solver vs exact solution\n", s["f"].get<double>(),
-                     s["x0"].get<double>(), s["nodes"].get<int>());
+  const bool peg = s["problem"] == "peg";
+  out << fmt::format("{}, f = {}, x0 = {}, {} nodes: string solver vs exact solution\n",
+                     s["problem"].get<std::string>(), s["f"].get<double>(), s["x0"].get<double>(), s["nodes"].get<int>());
   out << fmt::format("  lift-off t (s)   string {}   exact {:.12g}   abs. error {}\n", number("t_lift_off"),
                      s["t_lift_off_exact"].get<double>(), error("abs_err_t_lift_off"));
   out << fmt::format("  lift-off x (m)   string {}   exact {:.12g}   abs. error {}\n", number("x_lift_off"),
                      s["x_lift_off_exact"].get<double>(), error("abs_err_x_lift_off"));
   out << fmt::format("  max |x error|    {:.3g} m (equal times)\n", s["max_abs_err_x"].get<double>());
-  out << fmt::format("  max |T error|    {:.3g} N at the edge ({:.3g} relative to lambda g l)\n",
-                     s["max_abs_err_tension"].get<double>(), s["max_rel_err_tension"].get<double>());
+  out << fmt::format("  max |T error|    {:.3g} N before the {}, {:.3g} N after it ({:.3g} relative to lambda g l)\n",
+                     s["max_abs_err_tension"].get<double>(), peg ? "peg" : "edge",
+                     s["max_abs_err_tension_plus"].get<double>(), s["max_rel_err_tension"].get<double>());
+  out << fmt::format("  max |F0 error|   {:.3g} N (the {}'s reaction)\n", s["max_abs_err_reaction"].get<double>(),
+                     peg ? "peg" : "edge");
+  out << fmt::format("  dissipated       string {:.12g} J   exact {:.12g} J   abs. error {:.3g}\n",
+                     s["dissipated"].get<double>(), s["dissipated_exact"].get<double>(),
+                     s["abs_err_dissipated"].get<double>());
+  if (peg)
+    out << fmt::format("  (the shorter end would reach the peg at t = {:.12g} s)\n", s["t_end_at_peg_exact"].get<double>());
 }
 
 }  // namespace
 
 int run_compare_command(CompareCommandOptions options, std::ostream& out) {
-  const bool edge = options.problem == "edge";
+  const bool edge = options.problem == "edge" || options.problem == "peg";
   std::optional<EdgeCaseSetup> edge_case;
   if (edge) {
-    edge_case = edge_setup(options);
+    edge_case = edge_setup(options, options.problem == "peg" ? PointContactProblem::kPeg : PointContactProblem::kEdge);
   } else {
     if (options.problem != "falling" && options.problem != "folded" && options.problem != "sliding")
-      throw InputError(fmt::format("problem = \"{}\" is not a known problem: allowed falling, folded, sliding, edge",
-                                   options.problem));
+      throw InputError(fmt::format(
+          "problem = \"{}\" is not a known problem: allowed falling, folded, sliding, edge, peg", options.problem));
     if (options.x0)
-      throw InputError(fmt::format("--x0 = {}: only compare edge takes --x0 ({} starts from --eta0)", *options.x0,
-                                   options.problem));
+      throw InputError(fmt::format("--x0 = {}: only compare edge takes --x0, and compare peg ({} starts from --eta0)",
+                                   *options.x0, options.problem));
     options.setup.problem = parse_problem(options.problem);
     options.setup.validate();
   }
@@ -75,7 +88,8 @@ int run_compare_command(CompareCommandOptions options, std::ostream& out) {
   std::optional<Comparison> c;
   std::optional<EdgeComparison> e;
   if (edge) {
-    e = compare_edge_with_exact(*edge_case);
+    e = edge_case->problem == PointContactProblem::kPeg ? compare_peg_with_exact(*edge_case)
+                                                        : compare_edge_with_exact(*edge_case);
     samples_table(e->run).write(dir / "string_series.csv");
     e->exact.write(dir / "exact_series.csv");
   } else {

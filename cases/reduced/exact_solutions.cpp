@@ -340,12 +340,11 @@ double edge_x(double f, double t, double x0, double ell, double g) {
   return solve_for_eta([&](double x) { return edge_time(f, x, x0, ell, g); }, t, x0, 0.0, ell, t_end);
 }
 
-double edge_lift_off_x(double f, double x0, double ell, double g) {
-  check_edge(f, x0, ell, g);
-  // g x (ℓ − x) − ẋ² (ℓ + f (ℓ − x)): g x0 (ℓ − x0) > 0 at x0, −ẋ² ℓ < 0 at ℓ.
-  auto margin = [&](double x) {
-    return g * x * (ell - x) - edge_speed_squared(f, x, x0, ell, g) * (ell + f * (ell - x));
-  };
+namespace {
+
+/// The zero of a lift-off margin in [x0, ℓ] (positive at x0, not positive at ℓ), by TOMS 748 to 1e-14.
+template <class Margin>
+double lift_off_root(const Margin& margin, double x0, double ell) {
   auto narrow_enough = [](double a, double b) {
     return std::abs(b - a) <= kRootTolerance * std::max(std::abs(a), std::abs(b));
   };
@@ -354,6 +353,77 @@ double edge_lift_off_x(double f, double x0, double ell, double g) {
       boost::math::tools::toms748_solve(margin, x0, ell, margin(x0), margin(ell), narrow_enough, iterations);
   CHAINSIM_VERIFY(iterations < kMaxRootIterations, "TOMS 748 did not bracket the lift-off point to 1e-14");
   return 0.5 * (bracket.first + bracket.second);
+}
+
+}  // namespace
+
+double edge_lift_off_x(double f, double x0, double ell, double g) {
+  check_edge(f, x0, ell, g);
+  // g x (ℓ − x) − ẋ² (ℓ + f (ℓ − x)): g x0 (ℓ − x0) > 0 at x0, −ẋ² ℓ < 0 at ℓ.
+  return lift_off_root(
+      [&](double x) { return g * x * (ell - x) - edge_speed_squared(f, x, x0, ell, g) * (ell + f * (ell - x)); }, x0,
+      ell);
+}
+
+// @sect{The heavy Atwood chain over a peg}
+// With u = ẋ², ℓ ẍ = g (2x − ℓ) − 2 f u becomes u_x + (4f/ℓ) u = 2 g (2x − ℓ)/ℓ, integrating factor
+// e^(4fx/ℓ); with u(x0) = 0 and 2ξ − ℓ = (2 x0 − ℓ) + 2 (ξ − x0) under the integral, the two integrals
+// are those of the edge: Δ ψ1(z) and Δ² ψ2(z), z = 4 f Δ/ℓ. The time is the edge's quadrature, with
+// x = x0 + w²: u/w² = (2g/ℓ) ((2 x0 − ℓ) ψ1 + 2 Δ ψ2) is smooth and positive for x0 > ℓ/2.
+
+namespace {
+
+void check_peg(double f, double x0, double ell, double g) {
+  check_dissipation(f);
+  require_in_range("ell", ell, 0.0, 1e100, Bound::kOpen, Bound::kClosed);
+  require_in_range("g", g, 0.0, 1e100, Bound::kOpen, Bound::kClosed);
+  require_in_range("x0", x0, 0.5 * ell, ell, Bound::kOpen, Bound::kOpen);
+}
+
+/// ẋ² / w² with w² = x − x0.
+double peg_speed_squared_over_w2(double f, double w2, double x0, double ell, double g) {
+  const double z = 4 * f * w2 / ell;
+  return 2 * g / ell * ((2 * x0 - ell) * psi1(z) + 2 * w2 * psi2(z));
+}
+
+}  // namespace
+
+double peg_speed_squared(double f, double x, double x0, double ell, double g) {
+  check_peg(f, x0, ell, g);
+  require_in_range("x", x, x0, ell);
+  return (x - x0) * peg_speed_squared_over_w2(f, x - x0, x0, ell, g);
+}
+
+double peg_acceleration(double f, double x, double x0, double ell, double g) {
+  return (g * (2 * x - ell) - 2 * f * peg_speed_squared(f, x, x0, ell, g)) / ell;
+}
+
+double peg_time(double f, double x, double x0, double ell, double g) {
+  check_peg(f, x0, ell, g);
+  require_in_range("x", x, x0, ell);
+  const double w_end = std::sqrt(x - x0);
+  if (w_end == 0.0) return 0.0;
+  auto integrand = [&](double t, double /*tc*/) {
+    const double w = w_end * t;
+    return 2 / std::sqrt(peg_speed_squared_over_w2(f, w * w, x0, ell, g));
+  };
+  return w_end * integrate_unit_interval(integrand, "the peg's 1/sqrt(u)");
+}
+
+double peg_x(double f, double t, double x0, double ell, double g) {
+  const double t_end = peg_time(f, ell, x0, ell, g);
+  require_in_range("t", t, 0.0, t_end);
+  return solve_for_eta([&](double x) { return peg_time(f, x, x0, ell, g); }, t, x0, 0.0, ell, t_end);
+}
+
+double peg_lift_off_x(double f, double x0, double ell, double g) {
+  check_peg(f, x0, ell, g);
+  // (ℓ − x)(g + ẍ) − (1 − f) ẋ², half the reaction per λ: 2 g x0 (ℓ − x0)/ℓ > 0 at x0, −(1 − f) ẋ² at ℓ.
+  auto margin = [&](double x) {
+    return (ell - x) * (g + peg_acceleration(f, x, x0, ell, g)) - (1 - f) * peg_speed_squared(f, x, x0, ell, g);
+  };
+  if (margin(ell) >= 0) return ell;  // f = 1: the peg still pushes when the shorter end arrives (g x > ẋ²)
+  return lift_off_root(margin, x0, ell);
 }
 
 }  // namespace chainsim::exact

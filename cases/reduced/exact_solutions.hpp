@@ -139,4 +139,28 @@ double edge_x(double f, double t, double x0, double ell, double g);
 /// The hanging length x* ∈ (x0, ℓ) at which the chain lifts off the edge (τ⁻ = λ ẋ²).
 double edge_lift_off_x(double f, double x0, double ell, double g);
 
+// ---------------------------------------------------------------------------------------------------
+// The heavy Atwood chain over a sharp peg (docs/model.md §8), physical units: a chain of length ℓ (m)
+// hangs over a peg, x (m) on the longer (falling) side, ℓ − x on the other, released at rest from
+// x0 ∈ (ℓ/2, ℓ); f ∈ [0, 1] the kink's dissipation (a 180° turn: [τ] = 2 f λ ẋ², D = 2 f λ ẋ³). The sides
+// give ℓ ẍ = g (2x − ℓ) − 2 f ẋ², and with Δ = x − x0, z = 4 f Δ/ℓ (ψ1, ψ2 as for the edge):
+//   ẋ² = (2g/ℓ) ((2 x0 − ℓ) Δ ψ1(z) + 2 Δ² ψ2(z))
+// (f = 0: x − ℓ/2 = (x0 − ℓ/2) cosh(√(2g/ℓ) t)). The rising side is pulled by τ⁻ = λ (ℓ − x)(g + ẍ),
+// the falling side by τ⁺ = τ⁻ + 2 f λ ẋ²; the peg's reaction is (τ⁻ + τ⁺ − 2 λ ẋ²) upwards and the
+// chain lifts off where it reaches zero: (ℓ − x)(g + ẍ) = (1 − f) ẋ² (f = 0: (x − ℓ/2)² = ℓ²/8 +
+// (x0 − ℓ/2)²/2); for f < 1 always before the shorter end reaches the peg (x = ℓ).
+// ---------------------------------------------------------------------------------------------------
+
+/// ẋ² (m²/s²) at the longer side's length x ∈ [x0, ℓ]. Ranges: 0 ≤ f ≤ 1, ℓ > 0, g > 0, ℓ/2 < x0 < ℓ.
+double peg_speed_squared(double f, double x, double x0, double ell, double g);
+/// ẍ (m/s²) at x: (g (2x − ℓ) − 2 f ẋ²)/ℓ.
+double peg_acceleration(double f, double x, double x0, double ell, double g);
+/// t(x) = ∫_x0^x dx/ẋ (s), x ∈ [x0, ℓ]; t(ℓ) is when the shorter end reaches the peg.
+double peg_time(double f, double x, double x0, double ell, double g);
+/// x(t) (m), 0 ≤ t ≤ peg_time(f, ℓ, …).
+double peg_x(double f, double t, double x0, double ell, double g);
+/// The longer side's length x* ∈ (x0, ℓ] at which the chain lifts off the peg (the reaction reaches
+/// zero); ℓ if it stays on the peg until the shorter end reaches it (possible only for f = 1).
+double peg_lift_off_x(double f, double x0, double ell, double g);
+
 }  // namespace chainsim::exact

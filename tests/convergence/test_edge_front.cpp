@@ -63,34 +63,27 @@ TableRun table(int links, double f, double x0, double t_end = 10) {
 }
 
 
-/// The heavy Atwood chain over a sharp peg at the origin (2D): a chain of 1 m, 1 kg/m, of `links` links
-/// hangs over the peg, x0 on the + side (straight down from the peg), 1 − x0 on the − side (straight
-/// up to it, on the same vertical), released at rest; the peg's dissipation f.
-RunSummary peg(int links, double f, double x0) {
-  const double ell = 1.0, lambda = 1.0;
-  Points<2> vertices(2, 3);
-  vertices << 0.0, 0.0, 0.0, -(ell - x0), 0.0, -x0;
-  Chain<2> chain = discretize<2>(*polyline_curve<2>(vertices), ell, lambda, links, false);
-  std::vector<std::unique_ptr<Force<2>>> forces;
-  forces.push_back(std::make_unique<Gravity<2>>(Vec<2>(0.0, -kG)));
-  EdgeSpec<2> edge;
-  edge.dissipation = f;
-  edge.s0 = ell - x0;
-  std::vector<std::unique_ptr<FrontKind<2>>> fronts;
-  fronts.push_back(std::make_unique<EdgeFront<2>>(edge));
-  StringModelOptions model_options;
-  model_options.stabilization_time = 0.02 * std::sqrt(ell / kG);
-  StringModel<2> model =
-      make_front_model<2>(std::move(chain), std::move(forces), {}, std::move(fronts), FrontOptions{}, model_options);
-  StringSolverOptions options;
-  options.t_end = 10;
-  options.output_interval = 10;
-  options.record_steps = true;
-  options.integrator.rtol = 1e-11;
-  options.integrator.atol = 1e-13;
-  StringSolver<2> solver(model, options);
-  return solver.run();
+/// The heavy Atwood chain over a sharp peg at the origin (2D), the run of `chainsim compare peg`
+/// (cases/canonical/edge_case.hpp): a chain of 1 m, 1 kg/m, of `links` links hangs over the peg, x0 on
+/// the + side (straight down from the peg), 1 − x0 on the − side (straight up to it, on the same
+/// vertical), released at rest; the peg's dissipation f.
+PegComparison peg_comparison(int links, double f, double x0) {
+  PegCaseSetup setup;
+  setup.problem = PointContactProblem::kPeg;
+  setup.chain.length = 1.0;
+  setup.chain.density = 1.0;
+  setup.chain.gravity = kG;
+  setup.chain.dissipation = f;
+  setup.nodes = links + 1;
+  setup.x0 = x0;
+  setup.t_max_over_t0 = 10 / setup.chain.t0();
+  setup.integrator = IntegratorOptions{};
+  setup.integrator.rtol = 1e-11;
+  setup.integrator.atol = 1e-13;
+  return compare_peg_with_exact(setup);
 }
+
+RunSummary peg(int links, double f, double x0) { return peg_comparison(links, f, x0).run; }
 
 /// The peg's reduced model, ℓ ẍ = g (2x − ℓ) − 2 f ẋ² (docs/model.md §8), x the longer side, integrated
 /// by classical RK4 with step dt until the peg lets go (τ⁻ + τ⁺ = 2 λ ẋ²) or t_max; x(t) by
@@ -191,6 +184,99 @@ TEST_CASE("edge: the heavy Atwood chain over a sharp peg", "[edge][convergence]"
       CHECK(x_error < (f == 0 ? 1e-7 : 1e-6));
       CHECK(std::abs(run.events[0].t - (f == 0 ? t_lift : ref.t_lift)) < 1e-6);
       CHECK(run.relative_energy_drift() < 1e-10);
+    }
+  }
+}
+
+TEST_CASE("peg: exact::peg_* against the closed form (f = 0) and a Runge-Kutta integration (f > 0)", "[edge][peg]") {
+  for (const double x0 : {0.6, 0.75}) {
+    // f = 0: x − ℓ/2 = (x0 − ℓ/2) cosh(√(2g/ℓ) t), lift-off at (x − ℓ/2)² = ℓ²/8 + (x0 − ℓ/2)²/2.
+    const double u0 = x0 - 0.5, w = std::sqrt(2 * kG);
+    const double x_lift0 = 0.5 + std::sqrt(0.125 + 0.5 * u0 * u0);
+    CHECK(exact::peg_lift_off_x(0.0, x0, 1.0, kG) == Approx(x_lift0).epsilon(1e-13));
+    CHECK(exact::peg_time(0.0, x_lift0, x0, 1.0, kG) == Approx(std::acosh((x_lift0 - 0.5) / u0) / w).epsilon(1e-12));
+    for (const double part : {0.2, 0.5, 0.9}) {
+      const double t = part * exact::peg_time(0.0, 1.0, x0, 1.0, kG);
+      CHECK(exact::peg_x(0.0, t, x0, 1.0, kG) == Approx(0.5 + u0 * std::cosh(w * t)).epsilon(1e-12));
+    }
+    // f > 0: RK4 (x to ~1e-12 at dt = 2e-5 s; its lift-off by linear interpolation of the margin, ~1e-9 s).
+    for (const double f : {0.5, 1.0}) {
+      const PegReference ref = peg_reference(f, x0, 2e-5);
+      INFO("x0 = " << x0 << ", f = " << f);
+      for (std::size_t k = 0; k < ref.t.size(); k += ref.t.size() / 7)
+        CHECK(exact::peg_x(f, ref.t[k], x0, 1.0, kG) == Approx(ref.x[k]).margin(1e-10));
+      if (f < 1) {
+        const double x_lift = exact::peg_lift_off_x(f, x0, 1.0, kG);
+        CHECK(x_lift == Approx(ref.x_lift).margin(1e-8));
+        CHECK(exact::peg_time(f, x_lift, x0, 1.0, kG) == Approx(ref.t_lift).margin(1e-8));
+      } else {
+        CHECK(exact::peg_lift_off_x(f, x0, 1.0, kG) == 1.0);  // the peg pushes until the shorter end arrives
+        CHECK(ref.x.back() > 0.999);                           // nor does the reference's margin reach zero
+      }
+    }
+  }
+}
+
+TEST_CASE("peg: compare peg matches the exact solution on every mesh, f = 0 and f > 0, with closed ledgers",
+          "[edge][peg][convergence]") {
+  // As for the edge, each side moves along a straight line and the scheme is exact: what remains is the
+  // integrator's error and the crossings' 3e-8 h shifts, on every mesh.
+  for (const double x0 : {0.6, 0.8}) {
+    for (const double f : {0.0, 0.3, 0.9}) {
+      for (int links : {4, 10, 40, 160}) {
+        const PegComparison c = peg_comparison(links, f, x0);
+        const auto& s = c.summary;
+        INFO("x0 = " << x0 << ", f = " << f << ", " << links << " links: " << s.dump());
+        REQUIRE(s["status"] == "stopped");
+        REQUIRE(c.run.events.size() == 1);
+        CHECK(c.run.events[0].kind == "lift_off");
+        CHECK(c.run.stop_reason.rfind("lifted off the edge at t = ", 0) == 0);
+        CHECK(s["abs_err_t_lift_off"].get<double>() < 1e-7);
+        CHECK(s["abs_err_x_lift_off"].get<double>() < 1e-7);
+        CHECK(s["rel_err_t_stop"].get<double>() < 1e-7);
+        CHECK(s["max_abs_err_x"].get<double>() < 1e-7);
+        CHECK(s["max_abs_err_tension"].get<double>() < 1e-6);
+        CHECK(s["max_abs_err_tension_plus"].get<double>() < 1e-6);
+        CHECK(s["max_abs_err_reaction"].get<double>() < 1e-6);
+        CHECK(s["t_end_at_peg_exact"].get<double>() > s["t_lift_off_exact"].get<double>());
+        // The ledgers close with the kink's dissipation (W_shocks) and the peg's impulse booked, and the
+        // dissipation is the exact energy balance's loss.
+        CHECK(s["energy_residual"].get<double>() < 1e-10);
+        CHECK(s["momentum_residual"].get<double>() < 1e-10);
+        CHECK(s["abs_err_dissipated"].get<double>() < 1e-7);
+        if (f > 0) CHECK(s["dissipated"].get<double>() > 1e-3);
+      }
+    }
+  }
+}
+
+TEST_CASE("edge: compare edge over several x0 and f (summary keys against the exact solution)", "[edge][convergence]") {
+  for (const double x0 : {0.1, 0.5, 0.8}) {
+    for (const double f : {0.0, 0.3, 1.0}) {
+      EdgeCaseSetup setup;
+      setup.chain.length = 1.7;
+      setup.chain.density = 0.5;
+      setup.chain.gravity = kG;
+      setup.chain.dissipation = f;
+      setup.nodes = 42;  // 41 links: the edge inside a link for these x0 (on a node, the start is nudged)
+      setup.x0 = x0;
+      setup.integrator.rtol = 1e-11;
+      setup.integrator.atol = 1e-13;
+      const EdgeComparison c = compare_edge_with_exact(setup);
+      const auto& s = c.summary;
+      INFO("x0 = " << x0 << ", f = " << f << ": " << s.dump());
+      REQUIRE(s["status"] == "stopped");
+      CHECK(s["problem"] == "edge");
+      CHECK(s["abs_err_t_lift_off"].get<double>() < 1e-7);
+      CHECK(s["abs_err_x_lift_off"].get<double>() < 1e-7);
+      CHECK(s["max_abs_err_x"].get<double>() < 1e-7);
+      CHECK(s["max_abs_err_tension"].get<double>() < 1e-6);
+      CHECK(s["max_abs_err_tension_plus"].get<double>() < 1e-6);
+      CHECK(s["max_abs_err_reaction"].get<double>() < 1e-6);
+      CHECK(s["energy_residual"].get<double>() < 1e-10);
+      CHECK(s["momentum_residual"].get<double>() < 1e-10);
+      CHECK(s["abs_err_dissipated"].get<double>() < 1e-7);
+      CHECK(c.exact.rows() == c.run.samples.size());
     }
   }
 }
