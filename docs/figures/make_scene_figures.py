@@ -5,7 +5,7 @@ Usage: /usr/bin/python3 docs/figures/make_scene_figures.py RESULTS_DIR
 where RESULTS_DIR/<scene>/ holds the outputs of
     build/chainsim run cases/scenes/<scene>.toml --out RESULTS_DIR/<scene>
 for shaken_chain, travelling_loop, whip_crack, pendulum_release, folded_chain_ends_apart, swinging_u,
-pendulum_whip and thrown_chain (string scenes; the last three with slack = "allow"), chain_off_table_edge (an edge) and
+pendulum_whip and thrown_chain (string scenes; the last three with slack = "allow"), chain_off_table_edge and chain_over_peg (edges), atwood_pulley (a cylinder) and
 falling_chain, folded_chain, sliding_chain, swinging_sliding_chain, tilted_falling_chain and
 curved_falling_chain (scenes with fronts), and RESULTS_DIR/<scene>_reduced/ the same canonical scenes run with
 model = "reduced". docs/figures/run_scene_figures.sh RESULTS_DIR does all of it (and `chainsim plot` on each
@@ -191,6 +191,43 @@ def chain_off_table_edge(run, ax):
     decorate(ax[1], "t (s)", "m", "the edge pushes while the table part's tension exceeds its momentum flux")
 
 
+def chain_over_peg(run, ax):
+    snapshots(ax[0], run, [0, 0.2, 0.3, 0.4, 0.45, 0.49], "chain over a sharp peg, f = 0.5, released at rest")
+    g, ell, f, x0 = 9.81, 1.0, 0.5, 0.6
+    frames = run.nodes
+    ax[1].plot(frames.times, [-frames.positions(k)[-1, 1] for k in range(len(frames))], lw=2, alpha=0.7,
+               label="longer side x (string solver)")
+    # The reference: l x'' = g (2x - l) - 2 f x'^2 (docs/model.md §8), classical RK4 on a fine step.
+    def acc(x, v):
+        return (g * (2 * x - ell) - 2 * f * v * v) / ell
+    dt, x, v, ts, xs = 1e-4, x0, 0.0, [0.0], [x0]
+    while ts[-1] < frames.times[-1]:
+        k1 = (v, acc(x, v))
+        k2 = (v + dt / 2 * k1[1], acc(x + dt / 2 * k1[0], v + dt / 2 * k1[1]))
+        k3 = (v + dt / 2 * k2[1], acc(x + dt / 2 * k2[0], v + dt / 2 * k2[1]))
+        k4 = (v + dt * k3[1], acc(x + dt * k3[0], v + dt * k3[1]))
+        x += dt / 6 * (k1[0] + 2 * k2[0] + 2 * k3[0] + k4[0])
+        v += dt / 6 * (k1[1] + 2 * k2[1] + 2 * k3[1] + k4[1])
+        ts.append(ts[-1] + dt)
+        xs.append(x)
+    ax[1].plot(ts, xs, "k:", lw=2, label="l x'' = g (2x - l) - 2 f x'^2 (RK4)")
+    ax[1].axhline(0.91776, color="r", lw=0.8, ls="--", label="lift-off x* = 0.91776 m")
+    decorate(ax[1], "t (s)", "m", "the peg pushes until its reaction falls to zero")
+
+
+def atwood_pulley(run, ax):
+    snapshots(ax[0], run, [0, 0.2, 0.3, 0.4, 0.5], "heavy Atwood chain over a smooth pulley, R = 0.1 m")
+    g, ell, u0 = 9.81, 1.0, 0.05
+    frames = run.nodes
+    # u = x1 - l_free/2 = (x1 - x2)/2, with the sides' lengths read off the end nodes' depths.
+    u = [(frames.positions(k)[0, 1] - frames.positions(k)[-1, 1]) / 2 for k in range(len(frames))]
+    ax[1].plot(frames.times, u, lw=2, alpha=0.7, label="u = (x1 - x2)/2 (string solver)")
+    ts = np.linspace(0, frames.times[-1], 200)
+    ax[1].plot(ts, u0 * np.cosh(math.sqrt(2 * g / ell) * ts), "k:", lw=2, label="u0 cosh(sqrt(2g/l) t), exact")
+    ax[1].axhline(0.2583, color="r", lw=0.8, ls="--", label="lift-off u* = 0.2583 m (t* = 0.525 s)")
+    decorate(ax[1], "t (s)", "m", "the wrapped half circle moves with the chain")
+
+
 def slack_panel(ax, run, title):
     """The energy the snaps dissipated (W_snap) against time."""
     e = run.energy
@@ -217,7 +254,7 @@ def thrown_chain(run, ax):
 
 SCENES = [shaken_chain, travelling_loop, whip_crack, pendulum_release, falling_chain, folded_chain, sliding_chain,
           swinging_sliding_chain, tilted_falling_chain, curved_falling_chain, folded_chain_ends_apart,
-          chain_off_table_edge, swinging_u, pendulum_whip, thrown_chain]
+          chain_off_table_edge, swinging_u, pendulum_whip, thrown_chain, chain_over_peg, atwood_pulley]
 
 
 def main():
