@@ -147,6 +147,7 @@ class ContactModule final : public StringModule<dim> {
     if (!changed) return {};
     return {EventAction::Kind::kTransfer, ""};  // the velocities or the held set changed: the integrator restarts
   }
+  bool release_contacts(StringModel<dim>& model, double t) override { return settle(model, t, false); }
   long transfers() const override { return 0; }
   int num_fronts() const override { return 0; }
   std::optional<double> front_tension_at(const StringModel<dim>&, int) const override { return std::nullopt; }
@@ -202,7 +203,7 @@ class ContactModule final : public StringModule<dim> {
     const double K_before = model.kinetic_energy();
     const Vec<dim> p_before = model.momentum();
     model.refresh();
-    model.project(t);
+    model.impact(t);
     model.refresh();
     ledger[1] += model.kinetic_energy() - K_before;
     ledger.template segment<dim>(2) += model.momentum() - p_before;

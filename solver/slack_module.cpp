@@ -137,6 +137,7 @@ class SlackModule final : public StringModule<dim> {
     ledger[kl + 1] += snap.support_work;
     ledger.template segment<dim>(kl + 3) += snap.support_impulse;
     ++snaps_;
+    if (inner_) inner_->release_contacts(model, t);  // held nodes the snap would pull off a surface
     return {EventAction::Kind::kTransfer, ""};  // the velocities changed: the integrator restarts
   }
   long transfers() const override { return inner_ ? inner_->transfers() : 0; }
@@ -145,6 +146,12 @@ class SlackModule final : public StringModule<dim> {
     return inner_ ? inner_->front_tension_at(model, node) : std::nullopt;
   }
   bool events_need_tensions() const override { return inner_ && inner_->events_need_tensions(); }
+  void node_contacts(const StringModel<dim>& model, std::vector<NodeContact<dim>>& out) const override {
+    if (inner_) inner_->node_contacts(model, out);
+  }
+  bool release_contacts(StringModel<dim>& model, double t) override {
+    return inner_ && inner_->release_contacts(model, t);
+  }
   std::vector<RunEvent> run_events() const override {
     return inner_ ? inner_->run_events() : std::vector<RunEvent>{};
   }

@@ -575,6 +575,13 @@ Eigen::VectorXd StringModel<dim>::state_scale() const {
 template <int dim>
 void StringModel<dim>::project(double t) {
   if (!system_) return;
+  if (quadratic_) return project_positions(t);
+  project_positions(t);
+  project_velocities(t);
+}
+
+template <int dim>
+void StringModel<dim>::project_positions(double t) {
   for (const auto& p : prescribed_) {
     x_.col(p.node) = p.path->position(t);
     v_.col(p.node) = p.path->velocity(t);
@@ -615,6 +622,11 @@ void StringModel<dim>::project(double t) {
     exclude_slack_links();
     correct(x_, system_->solve(t));
   }
+}
+
+template <int dim>
+void StringModel<dim>::project_velocities(double t) {
+  auto correct = [&](Points<dim>& target, const Eigen::VectorXd& nu) { add_link_responses(target, nu); };
   // Velocities: one linear projection onto e_j·Δv_j = 0 (held nodes: onto n·v = 0 first, then with
   // their responses w_i P: the mass-weighted projection onto both).
   for (const NodeContact<dim>& c : contacts_) v_.col(c.node) -= c.normal.dot(v_.col(c.node)) * c.normal;
@@ -992,11 +1004,44 @@ typename StringModel<dim>::SnapResult StringModel<dim>::snap(double t) {
     set_slack(nearest, false);
     ++result.caught;
   }
+  const SnapResult impulses = link_impulses(t, options_.snap_restitution);
+  result.dissipated = impulses.dissipated;
+  result.support_work = impulses.support_work;
+  result.support_impulse = impulses.support_impulse;
+  return result;
+}
+
+template <int dim>
+void StringModel<dim>::impact(double t) {
+  if (!allows_slack()) {
+    project(t);
+  } else {
+    // Unilateral links: the positions onto the constraints, the held nodes' normal velocity taken
+    // (Moreau's law, restitution 0), and the links' impulses the snap's complementarity problem at
+    // e = 0 on the same contact-reduced matrix: a link that the landing would push goes slack.
+    project_positions(t);
+    // A link separates (goes slack) faster than kSeparation of the landing's speed, not of the links'
+    // approach speed alone: that is round-off at a tangential touchdown.
+    double speed = 0;
+    for (const NodeContact<dim>& c : contacts_) {
+      speed = std::max(speed, v_.col(c.node).norm());
+      v_.col(c.node) -= c.normal.dot(v_.col(c.node)) * c.normal;
+    }
+    link_impulses(t, 0.0, speed);
+  }
+}
+
+template <int dim>
+typename StringModel<dim>::SnapResult StringModel<dim>::link_impulses(double t, double e, double u_floor) {
+  SnapResult result;
+  const int L = chain_.num_links();
+  links();
   // 2. The impulse problem on the taut links: w = −(1 + e) u⁻ − A P ≥ 0, P ≥ 0, P w = 0 (the
-  //    tension matrix A: a link's rate of lengthening changes by (A P)_j).
-  const double e = options_.snap_restitution;
+  //    tension matrix A: a link's rate of lengthening changes by (A P)_j; with held nodes, the
+  //    contact-reduced one, their responses w_i P_i).
+  const Points<dim> v_before = v_;
   Eigen::VectorXd u_before = Eigen::VectorXd::Zero(L);
-  double u_scale = 0;
+  double u_scale = u_floor;
   system_->zero();
   assemble_matrix();
   for_each_link([&](int j, int u, int) {
@@ -1007,11 +1052,16 @@ typename StringModel<dim>::SnapResult StringModel<dim>::snap(double t) {
   exclude_slack_links();
   const Eigen::VectorXd P = system_->solve_complementarity(
       t, [&](double max_abs) { return options_.slack_tolerance * max_abs; });
-  // 3. The velocities jump; the supports take the impulses at prescribed nodes.
+  // 3. The velocities jump; the supports take the impulses at prescribed nodes, the obstacles the
+  //    normal part of the links' impulses at held nodes (m Δv − the links' impulse; no work: n·v = 0
+  //    before and after).
   add_link_responses(v_, -P);
+  Points<dim> link_impulse = Points<dim>::Zero(dim, chain_.num_nodes());
   for_each_link([&](int j, int u, int) {
     const int a = chain_.link_start(j), b = chain_.link_end(j);
     const Vec<dim> J = P[u] * e_.col(j);  // on node a; −J on node b
+    link_impulse.col(a) += J;
+    link_impulse.col(b) -= J;
     if (path_of_[a] >= 0) {
       result.support_impulse -= J;
       result.support_work -= J.dot(v_.col(a));
@@ -1021,6 +1071,8 @@ typename StringModel<dim>::SnapResult StringModel<dim>::snap(double t) {
       result.support_work += J.dot(v_.col(b));
     }
   });
+  for (const NodeContact<dim>& c : contacts_)
+    result.support_impulse += m_[c.node] * (v_.col(c.node) - v_before.col(c.node)) - link_impulse.col(c.node);
   // 4. The energy dissipated, Σ P_j (u⁻_j + u⁺_j)/2, and the links that separate go slack.
   links();
   for_each_link([&](int j, int u, int) {

@@ -223,6 +223,12 @@ class StringModel final : public OdeSystem {
   /// solve the complementarity problem u⁺ = u⁻ + A P ≤ −e u⁻, P (u⁺ + e u⁻) = 0 (u: rate of
   /// lengthening); the velocities jump, and links that separate afterwards go slack.
   SnapResult snap(double t);
+  /// The impact of nodes landing on obstacles (a contact module has just held them): the state onto
+  /// the constraints of the links and the held nodes, the velocities by a perfectly inelastic impact.
+  /// Bilateral links: the mass-weighted projection (project()). With slack = allow: the held nodes'
+  /// normal velocity is taken, and the links' impulses solve the snap's complementarity problem at
+  /// e = 0 on the contact-reduced matrix (a link the landing would push goes slack).
+  void impact(double t);
   /// At an accepted step (t, y): the taut links shorter than (1 − kSlackGap) h_j (released by the
   /// complementarity problem during the step) become slack; a slack link past its length (a snap not
   /// located) throws NumericalError. O(N), no tension solve.
@@ -358,6 +364,15 @@ class StringModel final : public OdeSystem {
   /// target_a −= w_a ν_j e_j, target_b += w_b ν_j e_j for every link j (and a bent link's end along
   /// e⁺): the mass-weighted response to link multipliers ν (projection: corrections; snap: −P).
   void add_link_responses(Points<dim>& target, const Eigen::VectorXd& nu) const;
+  /// project(t) in two steps: the positions onto the links' lengths and the held nodes' surfaces;
+  /// the velocities onto e_j·Δv_j = 0 and n_i·v_i = 0 (mass-weighted, linear).
+  void project_positions(double t);
+  void project_velocities(double t);
+  /// The impulsive tensions P ≥ 0 of the taut links for restitution e (the snap's complementarity
+  /// problem on the tension matrix, contact-reduced at held nodes): the velocities jump, links that
+  /// separate go slack (faster than kSeparation of the larger of their approach speed and u_floor);
+  /// the dissipated energy, the supports' and obstacles' impulses and work.
+  SnapResult link_impulses(double t, double e, double u_floor = 0);
   /// Excludes the slack links from the assembled tension system (their T = 0).
   void exclude_slack_links();
   template <class Visit>

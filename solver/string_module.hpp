@@ -184,6 +184,9 @@ class StringModule {
   /// The nodes held on obstacles at the current positions and velocities (called by refresh(), after
   /// add_mass_and_forces); none without a contact module.
   virtual void node_contacts(const StringModel<dim>&, std::vector<NodeContact<dim>>&) const {}
+  /// After an impulse the module did not make (a snap of the slack module around it): lets go of the
+  /// held nodes whose contact force would now pull; returns whether one was let go.
+  virtual bool release_contacts(StringModel<dim>&, double) { return false; }
   /// The physical events of the run so far (e.g. a chain lifting off an edge), for the run's summary.
   virtual std::vector<RunEvent> run_events() const { return {}; }
   /// The root functions `g` (events() at the start of the run) that say the run cannot go on from

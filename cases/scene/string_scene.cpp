@@ -21,9 +21,6 @@ std::vector<Obstacle<dim>> contact_obstacles(const SceneSpec& spec) {
     scene_build::fail_at(spec, first, "[[effects.surface]] and [[effects.cylinder]] do not meet fronts (heaps, folds, "
                                       "edges) yet: allowed in a scene without [[effects.heap]], [effects.fold] and "
                                       "[[effects.edge]]");
-  if (spec.solver.slack == "allow")
-    scene_build::fail_at(spec, "solver.slack", "solver.slack = \"allow\" does not meet obstacles ([[effects.surface]], "
-                                               "[[effects.cylinder]]) yet: allowed \"stop\", \"warn\" or \"ignore\"");
   if (spec.elements == "quadratic")
     scene_build::fail_at(spec, "string.elements", "string.elements = \"quadratic\" does not meet obstacles: allowed "
                                                   "\"links\" (the contact holds nodes)");

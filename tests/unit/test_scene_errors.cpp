@@ -421,9 +421,6 @@ TEST_CASE("solver.slack and solver.max_wall_s are parsed and checked, and check_
       {"a string starting inside a surface", kBase + "[[effects.surface]]\npoint = [0.0, -0.5]\nnormal = [0.0, 1.0]\n",
        "s.toml:18:1: node 6 of the string starts 0.1 m inside the obstacle effects.surface[0] (allowed: on or outside its "
        "surface, within 0.001 of a link length)"},
-      {"obstacles with slack = allow", kBase + "[[effects.cylinder]]\ncenter = [0.5, -0.5]\nradius = 0.1\n[solver]\nslack = \"allow\"\n",
-       "s.toml:22:9: solver.slack = \"allow\" does not meet obstacles ([[effects.surface]], [[effects.cylinder]]) yet: "
-       "allowed \"stop\", \"warn\" or \"ignore\""},
       {"obstacles with an implicit method", kBase + "[[effects.cylinder]]\ncenter = [0.5, -0.5]\nradius = 0.1\n[solver]\nmethod = \"dirk3\"\n",
        "s.toml:22:10: solver.method = \"dirk3\" is implicit, and implicit methods do not meet obstacles (their Newton "
        "systems know no contact): allowed an explicit method (\"auto\", \"erk5\", \"erk8\", ...)"},
