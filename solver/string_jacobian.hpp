@@ -32,6 +32,7 @@
 #include <Eigen/Core>
 #include <Eigen/SparseCore>
 
+#include "string_module.hpp"
 #include "tension_system.hpp"
 
 namespace chainsim {
@@ -80,7 +81,7 @@ class StringJacobian {
   using BlockMat = Eigen::SparseMatrix<double, Eigen::RowMajor>;
   StringModel<dim>& model_;
   int nv_ = 0, nt_ = 0;  // dim · free nodes; tension unknowns
-  BlockMat P_, Qx_, Qv_, WGt_;
+  BlockMat P_, Qx_, Qv_, WGt_, Pv_;  // Pv = ∂a/∂v at frozen tensions: a module's loads only
   std::vector<double> a_values_;  // A, in the tension system's pattern (a_pattern_)
   SparsePattern a_pattern_;
   double gamma_ = 0;
@@ -101,7 +102,8 @@ class StringJacobian {
   struct Slots {
     std::vector<int> rows, cols, slot;
   };
-  Slots slots_[4];  // P, Qx, Qv, W Gᵀ
+  Slots slots_[5];  // P, Qx, Qv, W Gᵀ, Pv
+  std::vector<LoadDerivative<dim>> load_derivatives_;  // the module's, at the last linearize()
   /// out = the (rows × cols) matrix of `entries` (duplicates summed): only the values when the
   /// sequence of (row, column) is that of the last call, else the pattern anew (returns true).
   static bool assemble(BlockMat& out, int rows, int cols, const std::vector<Eigen::Triplet<double>>& entries, Slots& s);
