@@ -22,10 +22,14 @@
 /// is short in the order too — where every coupling is within a few nodes: a string without a module
 /// ([solver] linear_solver = "auto" or "banded"); else by KLU (klu_refactor between steps; Eigen's
 /// SparseLU when built without KLU), which "klu" asks for everywhere. The ledgers (W_applied, a module's)
-/// enter no right-hand side: their Newton rows are taken as identity. What the linearisation
-/// leaves out: velocity-dependent forces (drag), the derivative of the applied forces, and a front
-/// module's masses and loads: implicit methods use the linearisation as the preconditioner of GMRES,
-/// whose products J·v come from the right-hand side itself, so those terms are still honoured.
+/// enter no right-hand side: their Newton rows are taken as identity. A module's masses and loads (a
+/// front's partial link and jump conditions) enter through their derivatives
+/// (StringModule::load_derivatives): with δa_k = w_k D δy at frozen tensions, D = ∂F_k + (g − a_k) ∂m_k,
+/// into P, a velocity block Pv (then the first block is I − γ² P − γ Pv) and the rows of the links at k
+/// in Qx and Qv. What the linearisation leaves out: velocity-dependent forces (drag), the derivative of
+/// the applied forces, and a module without load derivatives: implicit methods then use the
+/// linearisation as the preconditioner of GMRES, whose products J·v come from the right-hand side
+/// itself, so those terms are still honoured.
 #include <memory>
 #include <vector>
 
@@ -57,7 +61,7 @@ class StringJacobian {
   /// The same into `out` (state-sized), with the factorisation of A made by linearize().
   void apply(const Eigen::Ref<const Eigen::VectorXd>& d, Eigen::Ref<Eigen::VectorXd> out) const;
   /// True if the model's applied forces are all state-independent (gravity, loads, drivers) and it
-  /// has no module: J is then exact.
+  /// has no module or one with load derivatives: J is then exact.
   bool exact() const { return exact_; }
   /// Factors the augmented system of I − γ J. Throws RecoverableError if it is singular.
   void factor(double gamma);
