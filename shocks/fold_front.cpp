@@ -90,6 +90,18 @@ void FoldFront<dim>::evaluate(const StringModel<dim>& model, FrontState<dim>& s,
 }
 
 template <int dim>
+std::vector<int> FoldFront<dim>::stencil(const StringModel<dim>& model) const {
+  // evaluate() reads arc A's end link and arc B's first link.
+  const ArcRange& A = model.arcs()[static_cast<std::size_t>(this->arc_minus)];
+  const ArcRange& B = model.arcs()[static_cast<std::size_t>(this->arc_plus)];
+  std::vector<int> nodes;
+  for (int i : {A.last - 1, A.last, B.first, B.first + 1})
+    if ((i >= A.first && i <= A.last) || (i >= B.first && i <= B.last))
+      if (!model.is_prescribed(i)) nodes.push_back(i);
+  return nodes;
+}
+
+template <int dim>
 std::optional<double> FoldFront<dim>::tension_at(const StringModel<dim>& model, const FrontState<dim>& s,
                                                  int node) const {
   if (model.arcs()[static_cast<std::size_t>(this->arc_minus)].last == node) return s.tension_minus;

@@ -35,6 +35,8 @@ class FoldFront final : public FrontKind<dim> {
   void check_initial(const FrontState<dim>& state) const override;
   void evaluate(const StringModel<dim>& model, FrontState<dim>& state, Eigen::VectorXd& mass,
                 Points<dim>& force) override;
+  std::vector<int> stencil(const StringModel<dim>& model) const override;
+  bool has_load_derivatives() const override { return true; }
   std::optional<double> tension_at(const StringModel<dim>& model, const FrontState<dim>& state,
                                    int node) const override;
   double potential_moment(const StringModel<dim>& model, const FrontState<dim>& state, const Vec<dim>& g) const override;

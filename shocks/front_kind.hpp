@@ -11,6 +11,7 @@
 ///   - its share of the ledgers: the material it holds outside the arcs (`held_mass`, its first
 ///     moment), and the potential energy of its partial links (`potential_moment`).
 /// Implementations: HeapFront (heap_front.hpp), FoldFront (fold_front.hpp).
+#include <algorithm>
 #include <cmath>
 #include <optional>
 #include <string>
@@ -98,6 +99,21 @@ class FrontKind {
   virtual std::optional<double> tension_at(const StringModel<dim>& model, const FrontState<dim>& state,
                                            int node) const = 0;
 
+  // --- the linearisation (the implicit path's Newton systems) ---------------------------------------
+  /// The free nodes whose positions and velocities evaluate() reads for its masses and loads; they
+  /// include the nodes it loads. Empty: the kind does not say (its loads then stay out of the Newton
+  /// systems, and implicit methods take them through GMRES).
+  virtual std::vector<int> stencil(const StringModel<dim>& /*model*/) const { return {}; }
+  /// Whether the kind gives its stencil (then add_load_derivatives() gives all its derivatives).
+  virtual bool has_load_derivatives() const { return false; }
+  /// Adds the derivatives of evaluate()'s masses and loads with respect to the positions and
+  /// velocities of the stencil's nodes, at the string's current state (after an evaluation, whose
+  /// state it restores). By default central differences of evaluate() itself (consistent to about
+  /// 1e-10 of the loads: the loads are smooth in the stencil between crossings); a kind with its
+  /// derivatives in closed form may override it.
+  virtual void add_load_derivatives(StringModel<dim>& model, FrontState<dim>& state,
+                                    std::vector<LoadDerivative<dim>>& out);
+
   // --- ledgers -----------------------------------------------------------------------------------
   /// Mass the front holds outside the arcs (kg): a heap's content.
   virtual double held_mass(const FrontState<dim>& /*state*/) const { return 0; }
@@ -149,6 +165,64 @@ class FrontKind {
  protected:
   FrontMaterial m_;
 };
+
+template <int dim>
+void FrontKind<dim>::add_load_derivatives(StringModel<dim>& model, FrontState<dim>& state,
+                                          std::vector<LoadDerivative<dim>>& out) {
+  const std::vector<int> nodes = stencil(model);
+  if (nodes.empty()) return;
+  const int n = model.chain().num_nodes();
+  Eigen::VectorXd mass = Eigen::VectorXd::Zero(n);
+  Points<dim> force = Points<dim>::Zero(dim, n);
+  // Steps: ε^(1/3) of the link for positions (central differences: error ~ε^(2/3) of the loads); the
+  // same fraction of the stencil's speed for velocities (the loads are quadratic in them, so the
+  // quotient is exact but for round-off).
+  double speed = 0;
+  for (int i : nodes) speed = std::max(speed, model.v().col(i).norm());
+  const double dx = 6e-6 * this->m_.h, dv = 6e-6 * std::max(speed, 1e-3);
+  const std::size_t first = out.size();
+  for (int k : nodes)
+    for (int i : nodes) {
+      out.emplace_back();
+      out.back().node = k;
+      out.back().of = i;
+      out.emplace_back();
+      out.back().node = k;
+      out.back().of = i;
+      out.back().velocity = true;
+    }
+  const std::size_t per = nodes.size();
+  for (std::size_t c = 0; c < per; ++c) {
+    const int i = nodes[c];
+    for (int velocity = 0; velocity < 2; ++velocity) {
+      Points<dim>& y = velocity ? model.v() : model.x();
+      const double step = velocity ? dv : dx;
+      for (int q = 0; q < dim; ++q) {
+        const double keep = y(q, i);
+        for (int side = 0; side < 2; ++side) {
+          y(q, i) = side ? keep - step : keep + step;
+          try {
+            this->evaluate(model, state, mass, force);
+          } catch (...) {  // a trial state the kind refuses: the string as it was, then the caller decides
+            y(q, i) = keep;
+            throw;
+          }
+          const double sign = side ? -1.0 : 1.0;
+          for (std::size_t r = 0; r < per; ++r) {
+            const int k = nodes[r];
+            LoadDerivative<dim>& d = out[first + 2 * (r * per + c) + static_cast<std::size_t>(velocity)];
+            d.force.col(q) += sign * force.col(k) / (2 * step);
+            d.mass[q] += sign * mass[k] / (2 * step);
+            force.col(k).setZero();
+            mass[k] = 0;
+          }
+        }
+        y(q, i) = keep;
+      }
+    }
+  }
+  this->evaluate(model, state, mass, force);  // the state (and the kind's own) at the unmoved string
+}
 
 /// d / |d|, or a RecoverableError naming `what` when d has no length.
 template <int dim>

@@ -139,6 +139,16 @@ std::optional<double> FrontTracker<dim>::front_tension_at(const StringModel<dim>
 }
 
 template <int dim>
+bool FrontTracker<dim>::has_load_derivatives() const {
+  return std::all_of(fronts_.begin(), fronts_.end(), [](const auto& front) { return front->has_load_derivatives(); });
+}
+
+template <int dim>
+void FrontTracker<dim>::load_derivatives(StringModel<dim>& model, std::vector<LoadDerivative<dim>>& out) {
+  for (std::size_t k = 0; k < fronts_.size(); ++k) fronts_[k]->add_load_derivatives(model, fs_[k], out);
+}
+
+template <int dim>
 bool FrontTracker<dim>::events_need_tensions() const {
   return std::any_of(fronts_.begin(), fronts_.end(), [](const auto& front) { return front->checks_need_tensions(); });
 }

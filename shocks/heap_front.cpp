@@ -321,6 +321,18 @@ void HeapFront<dim>::evaluate(const StringModel<dim>& model, FrontState<dim>& s,
 }
 
 template <int dim>
+std::vector<int> HeapFront<dim>::stencil(const StringModel<dim>& model) const {
+  // heap_geometry reads the end node and up to two nodes into the arc (the interpolant near the front).
+  const End e = end(model);
+  const ArcRange& arc = model.arcs()[static_cast<std::size_t>(e.arc)];
+  const int step = after_ ? -1 : 1;
+  std::vector<int> nodes;
+  for (int k = 0, i = e.node; k < 3 && i >= arc.first && i <= arc.last; ++k, i += step)
+    if (!model.is_prescribed(i)) nodes.push_back(i);
+  return nodes;
+}
+
+template <int dim>
 std::optional<double> HeapFront<dim>::tension_at(const StringModel<dim>& model, const FrontState<dim>& s,
                                                  int node) const {
   if (end(model).node == node) return after_ ? s.tension_minus : s.tension_plus;

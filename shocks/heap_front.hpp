@@ -51,6 +51,8 @@ class HeapFront final : public FrontKind<dim> {
   void initialize(StringModel<dim>& model) override;
   void evaluate(const StringModel<dim>& model, FrontState<dim>& state, Eigen::VectorXd& mass,
                 Points<dim>& force) override;
+  std::vector<int> stencil(const StringModel<dim>& model) const override;
+  bool has_load_derivatives() const override { return true; }
   std::optional<double> tension_at(const StringModel<dim>& model, const FrontState<dim>& state,
                                    int node) const override;
   double held_mass(const FrontState<dim>& state) const override;

@@ -95,8 +95,17 @@ void StringJacobian<dim>::linearize(double t, const Eigen::Ref<const Eigen::Vect
   const Eigen::VectorXd& T = m.system_->solution();
   const int L = chain.num_links();
   std::vector<int> prev(static_cast<std::size_t>(L), -1);
+  std::vector<int> link_to, link_from;  // with a module: the link of the arcs ending, starting at a node
+  if (m.module_) {
+    link_to.assign(static_cast<std::size_t>(chain.num_nodes()), -1);
+    link_from = link_to;
+  }
   m.for_each_link([&](int j, int, int next) {
     if (next >= 0) prev[static_cast<std::size_t>(next)] = j;
+    if (m.module_) {
+      link_to[static_cast<std::size_t>(chain.link_end(j))] = j;
+      link_from[static_cast<std::size_t>(chain.link_start(j))] = j;
+    }
   });
 
   std::vector<Eigen::Triplet<double>> p, qx, qv, wg;
@@ -163,7 +172,35 @@ void StringJacobian<dim>::linearize(double t, const Eigen::Ref<const Eigen::Vect
       if (kb >= 0) wg.emplace_back(dim * kb + q, u, wb * e[q]);
     }
   });
+  // The module's loads (a front's partial-link mass on an arc's end node k and its jump-condition
+  // forces), F_k(x, v) and m_k(x, v): a_k = w_k (F_k + m_k g + … − tension forces), so at frozen
+  // tensions δa_k = w_k D δy with D = ∂F_k + (g − a_k) ∂m_k (g the uniform field, whose force m_k g
+  // follows the mass). D enters P (positions), Pv (velocities) and, through the accelerations of the
+  // links at k (their constraint rows read ∓e_j·a_k), Qx and Qv.
+  std::vector<Eigen::Triplet<double>> pv;
+  if (m.module_ && m.module_->has_load_derivatives()) {
+    std::vector<LoadDerivative<dim>>& loads = load_derivatives_;
+    loads.clear();
+    m.module_->load_derivatives(m, loads);
+    const V g = m.uniform_field();
+    for (const LoadDerivative<dim>& d : loads) {
+      const int k = d.node, rk = m.slot_[static_cast<std::size_t>(k)], ci = m.slot_[static_cast<std::size_t>(d.of)];
+      if (rk < 0 || ci < 0) continue;
+      const Mat D = m.w_[k] * (d.force + (g - m.a_.col(k)) * d.mass);
+      add_block(d.velocity ? pv : p, k, d.of, D);
+      // The links at k: the row of the one ending there reads −e_j·δa_k (r = −e_j·Δb − …), of the one
+      // starting there +e_j·δa_k.
+      for (int side = 0; side < 2; ++side) {
+        const int j = (side ? link_from : link_to)[static_cast<std::size_t>(k)];
+        if (j < 0) continue;
+        const Eigen::Matrix<double, 1, dim> row = (side ? 1.0 : -1.0) * m.e_.col(j).transpose() * D;
+        const int u = m.link_unknown_[static_cast<std::size_t>(j)];
+        for (int q = 0; q < dim; ++q) (d.velocity ? qv : qx).emplace_back(u, dim * ci + q, row[q]);
+      }
+    }
+  }
   bool new_pattern = assemble(P_, nv_, nv_, p, slots_[0]);
+  new_pattern |= assemble(Pv_, nv_, nv_, pv, slots_[4]);
   new_pattern |= assemble(Qx_, nt_, nv_, qx, slots_[1]);
   new_pattern |= assemble(Qv_, nt_, nv_, qv, slots_[2]);
   new_pattern |= assemble(WGt_, nv_, nt_, wg, slots_[3]);
@@ -262,6 +299,7 @@ void StringJacobian<dim>::for_each_entry(double gamma, Emit&& emit) const {
         emit(row0 + static_cast<int>(it.row()), col0 + static_cast<int>(it.col()), scale * it.value());
   };
   add(P_, 0, 0, -gamma * gamma);
+  add(Pv_, 0, 0, -gamma);
   add(WGt_, 0, nv_, gamma);
   add(Qx_, nv_, 0, gamma);
   add(Qv_, nv_, 0, 1.0);
@@ -306,7 +344,7 @@ void StringJacobian<dim>::apply(const Eigen::Ref<const Eigen::VectorXd>& d, Eige
   a_factor_->lu.solve(w.data());
   out.setZero();
   out.head(nv_) = dv;
-  out.segment(nv_, nv_) = P_ * dx - WGt_ * w;
+  out.segment(nv_, nv_) = P_ * dx + Pv_ * dv - WGt_ * w;
 }
 
 template <int dim>
@@ -321,7 +359,7 @@ void StringJacobian<dim>::factor(double gamma) {
   }
   std::vector<Eigen::Triplet<double>>& tr = entries_;
   tr.clear();
-  tr.reserve(static_cast<std::size_t>(nv_ + P_.nonZeros() + WGt_.nonZeros() + Qx_.nonZeros() + Qv_.nonZeros()) +
+  tr.reserve(static_cast<std::size_t>(nv_ + P_.nonZeros() + Pv_.nonZeros() + WGt_.nonZeros() + Qx_.nonZeros() + Qv_.nonZeros()) +
              a_values_.size());
   for_each_entry(gamma, [&](int r, int c, double v) { tr.emplace_back(r, c, v); });
   factor_->factorize(nv_ + nt_, tr);
@@ -410,7 +448,7 @@ bool StringModel<dim>::jacobian_times(const Eigen::Ref<const Eigen::VectorXd>& v
 
 template <int dim>
 bool StringModel<dim>::newton_solver_exact() const {
-  if (module_ || !system_) return false;
+  if (!system_ || (module_ && !module_->has_load_derivatives())) return false;
   for (const auto& force : forces_)
     if (!dynamic_cast<const UniformField<dim>*>(force.get()) && !dynamic_cast<const EndLoad<dim>*>(force.get())) return false;
   return true;

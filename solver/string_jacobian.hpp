@@ -22,16 +22,21 @@
 /// is short in the order too — where every coupling is within a few nodes: a string without a module
 /// ([solver] linear_solver = "auto" or "banded"); else by KLU (klu_refactor between steps; Eigen's
 /// SparseLU when built without KLU), which "klu" asks for everywhere. The ledgers (W_applied, a module's)
-/// enter no right-hand side: their Newton rows are taken as identity. What the linearisation
-/// leaves out: velocity-dependent forces (drag), the derivative of the applied forces, and a front
-/// module's masses and loads: implicit methods use the linearisation as the preconditioner of GMRES,
-/// whose products J·v come from the right-hand side itself, so those terms are still honoured.
+/// enter no right-hand side: their Newton rows are taken as identity. A module's masses and loads (a
+/// front's partial link and jump conditions) enter through their derivatives
+/// (StringModule::load_derivatives): with δa_k = w_k D δy at frozen tensions, D = ∂F_k + (g − a_k) ∂m_k,
+/// into P, a velocity block Pv (then the first block is I − γ² P − γ Pv) and the rows of the links at k
+/// in Qx and Qv. What the linearisation leaves out: velocity-dependent forces (drag), the derivative of
+/// the applied forces, and a module without load derivatives: implicit methods then use the
+/// linearisation as the preconditioner of GMRES, whose products J·v come from the right-hand side
+/// itself, so those terms are still honoured.
 #include <memory>
 #include <vector>
 
 #include <Eigen/Core>
 #include <Eigen/SparseCore>
 
+#include "string_module.hpp"
 #include "tension_system.hpp"
 
 namespace chainsim {
@@ -56,7 +61,7 @@ class StringJacobian {
   /// The same into `out` (state-sized), with the factorisation of A made by linearize().
   void apply(const Eigen::Ref<const Eigen::VectorXd>& d, Eigen::Ref<Eigen::VectorXd> out) const;
   /// True if the model's applied forces are all state-independent (gravity, loads, drivers) and it
-  /// has no module: J is then exact.
+  /// has no module or one with load derivatives: J is then exact.
   bool exact() const { return exact_; }
   /// Factors the augmented system of I − γ J. Throws RecoverableError if it is singular.
   void factor(double gamma);
@@ -80,7 +85,7 @@ class StringJacobian {
   using BlockMat = Eigen::SparseMatrix<double, Eigen::RowMajor>;
   StringModel<dim>& model_;
   int nv_ = 0, nt_ = 0;  // dim · free nodes; tension unknowns
-  BlockMat P_, Qx_, Qv_, WGt_;
+  BlockMat P_, Qx_, Qv_, WGt_, Pv_;  // Pv = ∂a/∂v at frozen tensions: a module's loads only
   std::vector<double> a_values_;  // A, in the tension system's pattern (a_pattern_)
   SparsePattern a_pattern_;
   double gamma_ = 0;
@@ -101,7 +106,8 @@ class StringJacobian {
   struct Slots {
     std::vector<int> rows, cols, slot;
   };
-  Slots slots_[4];  // P, Qx, Qv, W Gᵀ
+  Slots slots_[5];  // P, Qx, Qv, W Gᵀ, Pv
+  std::vector<LoadDerivative<dim>> load_derivatives_;  // the module's, at the last linearize()
   /// out = the (rows × cols) matrix of `entries` (duplicates summed): only the values when the
   /// sequence of (row, column) is that of the last call, else the pattern anew (returns true).
   static bool assemble(BlockMat& out, int rows, int cols, const std::vector<Eigen::Triplet<double>>& entries, Slots& s);

@@ -97,6 +97,17 @@ struct LedgerTerm {
   bool energy() const { return kind != Kind::kQuantity; }
 };
 
+/// The derivative of the mass and force a module puts on node `node` (add_mass_and_forces) with respect
+/// to the position (`velocity` false) or the velocity of node `of`: ∂F/∂y (dim × dim) and ∂m/∂y (a
+/// row). The string's linearisation (solver/string_jacobian.hpp) takes them into its Newton systems.
+template <int dim>
+struct LoadDerivative {
+  int node = -1, of = -1;
+  bool velocity = false;
+  Eigen::Matrix<double, dim, dim> force = Eigen::Matrix<double, dim, dim>::Zero();
+  Eigen::Matrix<double, 1, dim> mass = Eigen::Matrix<double, 1, dim>::Zero();
+};
+
 /// What a module adds to a snapshot: nothing for a string without one.
 template <int dim>
 struct ModuleLedger {
@@ -181,6 +192,13 @@ class StringModule {
   /// Whether the root functions read the tensions (then the string evaluates its tension system
   /// before events(), else it only refreshes the module's masses and forces).
   virtual bool events_need_tensions() const { return false; }
+  /// Whether load_derivatives() gives every derivative of the masses and forces it adds (then the
+  /// string's Newton systems are exact with the module).
+  virtual bool has_load_derivatives() const { return false; }
+  /// Adds the derivatives of add_mass_and_forces() at the string's current state (after an
+  /// evaluation). `model` is not const so that a module may differentiate by moving nodes; it leaves
+  /// the string and its own state as it found them.
+  virtual void load_derivatives(StringModel<dim>& /*model*/, std::vector<LoadDerivative<dim>>& /*out*/) {}
   /// The nodes held on obstacles at the current positions and velocities (called by refresh(), after
   /// add_mass_and_forces); none without a contact module.
   virtual void node_contacts(const StringModel<dim>&, std::vector<NodeContact<dim>>&) const {}

@@ -9,7 +9,7 @@ errors against the reduced ODE; then, per problem, the ratio of the CPU time on 
 coarsest.
 
     /usr/bin/python3 tests/bench/front_crossing_cost.py [--binary build/chainsim] [--nodes 200,800,3200]
-        [--problems falling,folded,sliding]
+        [--problems falling,folded,sliding] [--method erk5]
 
 Not a test: it checks no timing (the counted bound is tests/convergence/test_front_crossing_cost.cpp).
 """
@@ -27,6 +27,7 @@ def main():
     parser.add_argument("--binary", default="build/chainsim")
     parser.add_argument("--nodes", default="200,800,3200")
     parser.add_argument("--problems", default="falling,folded,sliding")
+    parser.add_argument("--method", default=None, help="the compare's --method (default: its own)")
     args = parser.parse_args()
     meshes = [int(n) for n in args.nodes.split(",")]
     print(f"{'problem':8s} {'nodes':>5s} {'process':>8s} {'solver':>8s} {'cpu':>8s} {'cross':>5s} {'steps':>6s} {'rhs':>7s} "
@@ -37,8 +38,10 @@ def main():
             for n in meshes:
                 before = resource.getrusage(resource.RUSAGE_CHILDREN)
                 start = time.perf_counter()
-                run = subprocess.run([args.binary, "compare", problem, "--nodes", str(n), "--json", "--out",
-                                      f"{out}/{problem}{n}"], capture_output=True, text=True)
+                command = [args.binary, "compare", problem, "--nodes", str(n), "--json", "--out", f"{out}/{problem}{n}"]
+                if args.method:
+                    command += ["--method", args.method]
+                run = subprocess.run(command, capture_output=True, text=True)
                 process = time.perf_counter() - start
                 after = resource.getrusage(resource.RUSAGE_CHILDREN)
                 cpu = (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
