@@ -5,7 +5,7 @@ Usage: /usr/bin/python3 docs/figures/make_scene_figures.py RESULTS_DIR
 where RESULTS_DIR/<scene>/ holds the outputs of
     build/chainsim run cases/scenes/<scene>.toml --out RESULTS_DIR/<scene>
 for shaken_chain, travelling_loop, whip_crack, pendulum_release, folded_chain_ends_apart, swinging_u,
-pendulum_whip and thrown_chain (string scenes; the last three with slack = "allow"), chain_off_table_edge and chain_over_peg (edges), atwood_pulley (a cylinder) and
+pendulum_whip and thrown_chain (string scenes; the last three with slack = "allow"), chain_off_table_edge and chain_over_peg (edges), atwood_pulley (a cylinder), chain_landing_at_angle (a surface) and
 falling_chain, folded_chain, sliding_chain, swinging_sliding_chain, tilted_falling_chain and
 curved_falling_chain (scenes with fronts), and RESULTS_DIR/<scene>_reduced/ the same canonical scenes run with
 model = "reduced". docs/figures/run_scene_figures.sh RESULTS_DIR does all of it (and `chainsim plot` on each
@@ -228,6 +228,22 @@ def atwood_pulley(run, ax):
     decorate(ax[1], "t (s)", "m", "the wrapped half circle moves with the chain")
 
 
+def chain_landing_at_angle(run, ax):
+    snapshots(ax[0], run, [0, 0.1, 0.15, 0.2, 0.25, 0.3], 'chain landing at 20 deg on a smooth table, slack = "allow"')
+    g = 9.81
+    frames = run.nodes
+    y0 = frames.positions(0)[:, 1]
+    n = len(y0)
+    mass = np.full(n, 1.0 / (n - 1))  # lumped: 1 kg/m over 1 m, half a link's mass at each end
+    mass[[0, -1]] /= 2
+    # Every node falls freely (no tension) and lands at sqrt(2 y0/g), losing its normal kinetic energy m g y0.
+    ts = np.linspace(0, frames.times[-1], 400)
+    lost = [-np.sum(mass * g * y0 * (np.sqrt(2 * y0 / g) <= t)) for t in ts]
+    ax[1].plot(run.energy["t"], run.energy["W_impacts"], lw=2, alpha=0.7, label="W_impacts (string solver)")
+    ax[1].plot(ts, lost, "k:", lw=1.5, label="- sum of m g y0 over the nodes landed by t (free fall)")
+    decorate(ax[1], "t (s)", "J", "each landing takes the node's normal kinetic energy")
+
+
 def slack_panel(ax, run, title):
     """The energy the snaps dissipated (W_snap) against time."""
     e = run.energy
@@ -254,7 +270,8 @@ def thrown_chain(run, ax):
 
 SCENES = [shaken_chain, travelling_loop, whip_crack, pendulum_release, falling_chain, folded_chain, sliding_chain,
           swinging_sliding_chain, tilted_falling_chain, curved_falling_chain, folded_chain_ends_apart,
-          chain_off_table_edge, swinging_u, pendulum_whip, thrown_chain, chain_over_peg, atwood_pulley]
+          chain_off_table_edge, swinging_u, pendulum_whip, thrown_chain, chain_over_peg, atwood_pulley,
+          chain_landing_at_angle]
 
 
 def main():
