@@ -318,6 +318,24 @@ double edge_speed_squared(double f, double x, double x0, double ell, double g) {
   return (x - x0) * edge_speed_squared_over_w2(f, x - x0, x0, ell, g);
 }
 
+namespace {
+
+/// The time a motion released at rest takes to travel d = x - x0, given its squared speed u as u / w2 of
+/// w2 = x - x0 (finite at the start): t = ∫ dx / sqrt(u) = ∫_0^sqrt(d) 2 dw / sqrt(u / w²), which has no
+/// singularity at the release.
+template <class SpeedOverW2>
+double time_from_rest(double d, SpeedOverW2 speed_squared_over_w2, const char* what) {
+  const double w_end = std::sqrt(d);
+  if (w_end == 0.0) return 0.0;
+  auto integrand = [&](double t, double /*tc*/) {
+    const double w = w_end * t;
+    return 2 / std::sqrt(speed_squared_over_w2(w * w));
+  };
+  return w_end * integrate_unit_interval(integrand, what);
+}
+
+}  // namespace
+
 double edge_acceleration(double f, double x, double x0, double ell, double g) {
   return (g * x - f * edge_speed_squared(f, x, x0, ell, g)) / ell;
 }
@@ -325,13 +343,8 @@ double edge_acceleration(double f, double x, double x0, double ell, double g) {
 double edge_time(double f, double x, double x0, double ell, double g) {
   check_edge(f, x0, ell, g);
   require_in_range("x", x, x0, ell);
-  const double w_end = std::sqrt(x - x0);
-  if (w_end == 0.0) return 0.0;
-  auto integrand = [&](double t, double /*tc*/) {
-    const double w = w_end * t;
-    return 2 / std::sqrt(edge_speed_squared_over_w2(f, w * w, x0, ell, g));
-  };
-  return w_end * integrate_unit_interval(integrand, "the edge's 1/sqrt(u)");
+  return time_from_rest(x - x0, [&](double w2) { return edge_speed_squared_over_w2(f, w2, x0, ell, g); },
+                        "the edge's 1/sqrt(u)");
 }
 
 double edge_x(double f, double t, double x0, double ell, double g) {
@@ -401,13 +414,8 @@ double peg_acceleration(double f, double x, double x0, double ell, double g) {
 double peg_time(double f, double x, double x0, double ell, double g) {
   check_peg(f, x0, ell, g);
   require_in_range("x", x, x0, ell);
-  const double w_end = std::sqrt(x - x0);
-  if (w_end == 0.0) return 0.0;
-  auto integrand = [&](double t, double /*tc*/) {
-    const double w = w_end * t;
-    return 2 / std::sqrt(peg_speed_squared_over_w2(f, w * w, x0, ell, g));
-  };
-  return w_end * integrate_unit_interval(integrand, "the peg's 1/sqrt(u)");
+  return time_from_rest(x - x0, [&](double w2) { return peg_speed_squared_over_w2(f, w2, x0, ell, g); },
+                        "the peg's 1/sqrt(u)");
 }
 
 double peg_x(double f, double t, double x0, double ell, double g) {
