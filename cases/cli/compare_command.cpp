@@ -54,7 +54,7 @@ void print_edge(const nlohmann::json& s, std::ostream& out) {
   out << fmt::format("  max |T error|    {:.3g} N before the {}, {:.3g} N after it ({:.3g} relative to lambda g l)\n",
                      s["max_abs_err_tension"].get<double>(), peg ? "peg" : "edge",
                      s["max_abs_err_tension_plus"].get<double>(), s["max_rel_err_tension"].get<double>());
-  out << fmt::format("  max |F0 error|   {:.3g} N (the {}'s reaction)\n", s["max_abs_err_reaction"].get<double>(),
+  out << fmt::format("  max |F0 error|   {:.3g} N (reaction of the {})\n", s["max_abs_err_reaction"].get<double>(),
                      peg ? "peg" : "edge");
   out << fmt::format("  dissipated       string {:.12g} J   exact {:.12g} J   abs. error {:.3g}\n",
                      s["dissipated"].get<double>(), s["dissipated_exact"].get<double>(),
