@@ -431,7 +431,8 @@ TEST_CASE("slack: the swinging U and the whip close their energy ledgers to roun
   }
 }
 
-TEST_CASE("slack: the swinging U on 201 to 1601 nodes: the state at t = 1 s converges slowly", "[slack][.long]") {
+TEST_CASE("slack: the swinging U on 201 to 1601 nodes: the state at t = 1 s converges slowly",
+          "[slack][convergence][.long]") {
   // The study behind docs/model.md §9 "Does the U converge?" (CHAINSIM_LONG_TESTS; about 3 minutes):
   // the largest distance between the same material point on successive meshes keeps falling, but
   // slowly after the kink forms (measured 6.5e-3, 6.0e-3, 4.5e-3 m: orders 0.12 and 0.41), and W_snap,
