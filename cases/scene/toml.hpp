@@ -9,10 +9,14 @@
 /// The package's CMake target defines TOML_HEADER_ONLY=0 and TOML_SHARED_LIB=1 (its shared library);
 /// the definitions below replace them. Its code compiled here is what the scene code calls (an
 /// executable's own definitions come before a shared library's).
+/// The sanitized build (CHAINSIM_SANITIZE) defines CHAINSIM_TOML_FROM_LIBRARY and keeps the library:
+/// toml++'s inline formatter has undefined behaviour that UBSan would report (CMakeLists.txt).
+#ifndef CHAINSIM_TOML_FROM_LIBRARY
 #undef TOML_HEADER_ONLY
 #undef TOML_SHARED_LIB
 #undef TOML_FLOAT_CHARCONV
 #define TOML_HEADER_ONLY 1
 #define TOML_SHARED_LIB 0
 #define TOML_FLOAT_CHARCONV 1
+#endif
 #include <toml++/toml.h>
