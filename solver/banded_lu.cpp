@@ -32,6 +32,9 @@ constexpr double kRefine = 1e-14;
 
 template <int K>
 class FixedBlockEngine final : public BlockEngine {
+  // The columns are contiguous and unpadded: the solve scatters to and gathers from them as one array.
+  static_assert(sizeof(typename BlockTridiagonal<K>::Column) == K * sizeof(double), "a column is K packed doubles");
+
  public:
   void resize(int blocks, std::vector<double*>& out) override {
     system_.resize(blocks);
@@ -56,13 +59,18 @@ class FixedBlockEngine final : public BlockEngine {
   void solve(double* x, const std::vector<int>& position) override {
     rhs_.back().setZero();  // the identity rows past n
     const std::size_t n = position.size();
-    for (std::size_t k = 0; k < n; ++k) rhs_[static_cast<std::size_t>(position[k] / K)][position[k] % K] = x[k];
+    double* flat = rhs_.front().data();  // place p of the order is entry p (Column: K packed doubles)
+    for (std::size_t k = 0; k < n; ++k) flat[position[k]] = x[k];
     b_ = rhs_;
     system_.solve(rhs_);
     // One step of iterative refinement when the residual is above round-off: the block elimination
     // pivots inside the pivot blocks only, and on stiff Newton matrices (γ²‖P‖ ≫ 1) its residual
     // can reach 1e-8 of ‖b‖ (test_string_jacobian.cpp asks 1e-9); a second solve with the residual,
-    // computed with the blocks themselves, restores it.
+    // computed with the blocks themselves, restores it. On the hanging chain (docs/string_solver.md,
+    // "What remains of a step") this refines nearly every solve, although their normwise backward
+    // error is within a few ε already; the refined solutions are what keeps the step count at 10,000
+    // links near that at 100 (68 steps against 58; skipping the refinement where the componentwise
+    // backward error is below 1e-14 gave 74–84, never refining 83).
     const std::size_t nb = rhs_.size();
     double b_max = 0, r_max = 0;
     for (std::size_t i = 0; i < nb; ++i) {
@@ -76,7 +84,7 @@ class FixedBlockEngine final : public BlockEngine {
       system_.solve(b_);
       for (std::size_t i = 0; i < nb; ++i) rhs_[i] += b_[i];
     }
-    for (std::size_t k = 0; k < n; ++k) x[k] = rhs_[static_cast<std::size_t>(position[k] / K)][position[k] % K];
+    for (std::size_t k = 0; k < n; ++k) x[k] = flat[position[k]];
   }
 
  private:

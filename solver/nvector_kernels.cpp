@@ -52,6 +52,14 @@ sunrealtype wrms_norm(N_Vector x, N_Vector w) {
 
 void scale(sunrealtype c, N_Vector x, N_Vector z) { array(z) = c * array(x); }
 
+// The element-wise operations of ARKODE's error weights and Newton iterations (N_VConst sets the
+// zero initial correction of every Newton solve): exact in any order, so the same values as
+// SUNDIALS' loops.
+void constant(sunrealtype c, N_Vector z) { array(z).setConstant(c); }
+void absolute(N_Vector x, N_Vector z) { array(z) = array(x).abs(); }
+void inverse(N_Vector x, N_Vector z) { array(z) = array(x).inverse(); }
+void add_constant(N_Vector x, sunrealtype b, N_Vector z) { array(z) = array(x) + b; }
+
 }  // namespace
 
 void use_eigen_kernels(N_Vector v) {
@@ -61,6 +69,10 @@ void use_eigen_kernels(N_Vector v) {
   v->ops->nvwsqrsumlocal = weighted_square_sum;
   v->ops->nvwrmsnorm = wrms_norm;
   v->ops->nvscale = scale;
+  v->ops->nvconst = constant;
+  v->ops->nvabs = absolute;
+  v->ops->nvinv = inverse;
+  v->ops->nvaddconst = add_constant;
 }
 
 }  // namespace chainsim

@@ -1,4 +1,5 @@
-// Eigen kernels for the serial N_Vector operations that dominate an explicit step.
+// Eigen kernels for the serial N_Vector operations that dominate an explicit step, and the
+// element-wise ones of an implicit step (constants, error weights).
 //
 // The serial N_Vector of the SUNDIALS package is compiled for a generic CPU and its loops run one
 // scalar at a time (a reduction is one long chain of dependent additions). A profile of erk4 on a

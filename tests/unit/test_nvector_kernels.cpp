@@ -93,4 +93,20 @@ TEST_CASE("Eigen N_Vector kernels agree with the SUNDIALS serial operations", "[
     CHECK(N_VWrmsNorm(v.fast[0], v.fast[1]) == Approx(N_VWrmsNorm(v.plain[0], v.plain[1])).epsilon(1e-13));
     CHECK(N_VWrmsNorm(v.fast[0], v.fast[1]) == Approx(std::sqrt(plain_sum / n)).epsilon(1e-13));
   }
+  SECTION("constant, absolute value, inverse and added constant: the same values, bit for bit") {
+    // ARKODE's error weights (|y|, + atol, 1/·) and Newton's zero initial correction (a constant): each
+    // element is one correctly rounded operation, so the kernels must give SUNDIALS' values exactly
+    // (the explicit scenes' summaries stay bit-identical).
+    N_VConst(0.375, v.plain[0]);
+    N_VConst(0.375, v.fast[0]);
+    N_VAbs(v.plain[1], v.plain[2]);
+    N_VAbs(v.fast[1], v.fast[2]);
+    N_VInv(v.plain[3], v.plain[4]);
+    N_VInv(v.fast[3], v.fast[4]);
+    N_VAddConst(v.plain[5], 1e-7, v.plain[6]);
+    N_VAddConst(v.fast[5], 1e-7, v.fast[6]);
+    for (int k : {0, 2, 4, 6}) CHECK(v.max_difference(k) == 0.0);
+    CHECK(v.fast[0]->ops->nvconst != v.plain[0]->ops->nvconst);  // the kernels are in the table
+    CHECK(v.fast[0]->ops->nvinv != v.plain[0]->ops->nvinv);
+  }
 }
