@@ -173,7 +173,7 @@ class ContactModule final : public StringModule<dim> {
       if (o.mu > 0) {
         out.back().mu = o.mu;
         out.back().stuck = stuck_[i] != 0;
-        if (!stuck_[i]) out.back().slide = slide_direction(o, i, x, v);
+        if (!stuck_[i]) out.back().slide = slide_direction(model, o, i, x, v);
       }
     }
   }
@@ -271,12 +271,14 @@ class ContactModule final : public StringModule<dim> {
   }
   /// The direction node i slides in: the stored one carried with the surface (in 2D, always: the
   /// force keeps its sign through the located stop, so the step that finds it is smooth); in 3D the
-  /// direction of its tangential velocity while that has a positive part along the stored one.
-  Vec<dim> slide_direction(const Obstacle<dim>& o, std::size_t i, const Vec<dim>& x, const Vec<dim>& v) const {
+  /// direction of its tangential velocity while that has a positive part along the stored one and is
+  /// above the stop window (below it, the round-off of a velocity starting from rest would turn it).
+  Vec<dim> slide_direction(const StringModel<dim>& model, const Obstacle<dim>& o, std::size_t i, const Vec<dim>& x,
+                           const Vec<dim>& v) const {
     const Vec<dim> d = o.tangents(x) * dir_.col(static_cast<Eigen::Index>(i));
     if constexpr (dim == 3) {
       const Vec<dim> vt = tangential(o, x, v);
-      if (vt.dot(d) > 0) return vt.normalized();
+      if (vt.dot(d) > 0 && vt.norm() > kStopWindow * speed_scale(model)) return vt.normalized();
     }
     return d;
   }

@@ -426,3 +426,46 @@ TEST_CASE("friction: the heavy Atwood chain at rest on a rough pulley holds iff 
     CHECK(after.drift < 1e-8);
   }
 }
+
+TEST_CASE("friction: in 3D a chain launched up a rough slope stops at the exact time and slides back", "[contact][friction]") {
+  // The incline of the 2D case tilted about the line of steepest slope's normal: the slope rises along
+  // s = (cos α, 0, sin α) in a plane with normal (−sin α, 0, cos α), the chain lies along s, gravity −g z.
+  Incline c;
+  c.alpha = 0.5;
+  c.mu = 0.4;
+  c.v0 = 1.5;
+  const Vec<3> up(std::cos(c.alpha), 0.0, std::sin(c.alpha));
+  for (const double f : {0.999, 2.0}) {
+    const double T = f * c.t_stop();
+    Chain<3> chain = Chain<3>::uniform(c.lambda, c.ell, c.links, false);
+    for (int i = 0; i <= c.links; ++i) {
+      chain.positions().col(i) = (i * c.ell / c.links) * up + Vec<3>(0.0, 0.3, 0.0);
+      chain.velocities().col(i) = c.v0 * up;
+    }
+    std::vector<std::unique_ptr<Force<3>>> forces;
+    forces.push_back(std::make_unique<Gravity<3>>(Vec<3>(0.0, 0.0, -kG)));
+    Obstacle<3> plane;
+    plane.kind = Obstacle<3>::Kind::kPlane;
+    plane.point = Vec<3>::Zero();
+    plane.normal = Vec<3>(-std::sin(c.alpha), 0.0, std::cos(c.alpha));
+    plane.mu = c.mu;
+    plane.name = "slope";
+    StringModel<3> model(std::move(chain), std::move(forces), {}, friction_options(), make_contact_module<3>({plane}));
+    StringSolver<3> solver(model, friction_run(T, T / 4));
+    const RunSummary& s = solver.run();
+    REQUIRE(s.status == "completed");
+    const auto& last = solver.frames().back();
+    double position_error = 0;
+    for (int i = 0; i <= c.links; ++i)
+      position_error = std::max(position_error, (last.x.col(i) - ((i * c.ell / c.links + c.s(T)) * up + Vec<3>(0.0, 0.3, 0.0))).norm());
+    std::printf("\n3D incline launched up (tan a = %.3f, mu = %.2f), t = %.3f t_stop: position error %.3g m, sticks %g, "
+                "slips %g, energy %.3g, momentum %.3g\n",
+                std::tan(c.alpha), c.mu, f, position_error, last.terms["sticks"], last.terms["slips"],
+                s.relative_energy_drift(), s.relative_momentum_residual());
+    CHECK(position_error < 1e-9);
+    CHECK(last.terms["sticks"] == (f < 1 ? 0 : c.links + 1));
+    CHECK(last.terms["slips"] == (f < 1 ? 0 : c.links + 1));
+    CHECK(s.relative_energy_drift() < 1e-8);
+    CHECK(s.relative_momentum_residual() < 1e-8);
+  }
+}
