@@ -595,6 +595,15 @@ class ContactModule final : public StringModule<dim> {
       ++caught;
     }
     if (caught == 0) return false;
+    // The normal impulses the rough obstacles take (−m n·v of each landing node: its links are tangent
+    // to the surface to first order, so the obstacle takes the node's normal momentum).
+    std::vector<double> normal_impulse;
+    if (friction_)
+      for (const auto& [i, k] : landing) {
+        const Obstacle<dim>& o = obstacles_[static_cast<std::size_t>(k)];
+        const Vec<dim> x = model.x().col(i);
+        normal_impulse.push_back(o.mu > 0 ? std::max(0.0, -o.outward(x).dot(model.v().col(i))) * model.masses()[i] : 0.0);
+      }
     const double K_before = model.kinetic_energy();
     const Vec<dim> p_before = model.momentum();
     model.refresh();
@@ -606,11 +615,40 @@ class ContactModule final : public StringModule<dim> {
     settle(model, t, false);
     if (friction_) {
       Eigen::VectorXd book = ledger;
+      landing_friction(model, t, landing, normal_impulse, book);
       classify(model, t, &book);
       ledger = book;
       settle(model, t, false);
     }
     return true;
+  }
+  /// Coulomb's impulse at a landing: each landing node still held on a rough obstacle takes the
+  /// tangential impulse −μ P_n t̂ (at most what stops its tangential motion), and the velocities are
+  /// projected again onto the constraints (the links pass it on along the chain). Its work is booked
+  /// in W_friction, its impulse in the momentum ledger. Without it the landings' normal impulses, O(h)
+  /// in all along a touchdown, would carry no friction: an O(h) error.
+  void landing_friction(StringModel<dim>& model, double t, const std::vector<std::pair<int, int>>& landing,
+                        const std::vector<double>& normal_impulse, Eigen::VectorXd& ledger) {
+    const double K_before = model.kinetic_energy();
+    const Vec<dim> p_before = model.momentum();
+    bool applied = false;
+    for (std::size_t q = 0; q < landing.size(); ++q) {
+      const int i = landing[q].first;
+      if (held_[static_cast<std::size_t>(i)] < 0 || !(normal_impulse[q] > 0)) continue;
+      const Obstacle<dim>& o = obstacle_of(static_cast<std::size_t>(i));
+      const Vec<dim> vt = tangential(o, model.x().col(i), model.v().col(i));
+      const double speed = vt.norm();
+      if (!(speed > 0)) continue;
+      const double dv = std::min(o.mu * normal_impulse[q] / model.masses()[i], speed);
+      model.v().col(i) -= dv * vt / speed;
+      applied = true;
+    }
+    if (!applied) return;
+    model.refresh();
+    model.project(t);
+    model.refresh();
+    ledger[kFriction] += model.kinetic_energy() - K_before;
+    ledger.template segment<dim>(2) += model.momentum() - p_before;
   }
   /// Lets go of the held nodes whose normal force pulls, one at a time, most negative first (each
   /// release changes the others' forces), until none pulls; at a located lift-off (`located`) the one
