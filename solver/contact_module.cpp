@@ -497,12 +497,18 @@ class ContactModule final : public StringModule<dim> {
     }
     return released;
   }
-  /// The direction of the chain at node i, along increasing node index, in the surface's tangent plane.
-  Vec<dim> chain_direction(const StringModel<dim>& model, int i) const {
+  /// The direction of the chain at node i, along increasing node index, in the surface's tangent plane;
+  /// `fallback` (projected) where the chain is normal to the surface there, the surface's first
+  /// tangent if that is normal too.
+  Vec<dim> chain_direction(const StringModel<dim>& model, int i, const Vec<dim>& fallback) const {
     const int n = static_cast<int>(held_.size());
-    const Vec<dim> c = model.x().col(std::min(i + 1, n - 1)) - model.x().col(std::max(i - 1, 0));
-    const Vec<dim> normal = obstacle_of(static_cast<std::size_t>(i)).outward(model.x().col(i));
-    return (c - normal.dot(c) * normal).normalized();
+    const Obstacle<dim>& o = obstacle_of(static_cast<std::size_t>(i));
+    const Vec<dim> normal = o.outward(model.x().col(i));
+    for (const Vec<dim>& c : {Vec<dim>(model.x().col(std::min(i + 1, n - 1)) - model.x().col(std::max(i - 1, 0))), fallback}) {
+      const Vec<dim> t = c - normal.dot(c) * normal;
+      if (t.norm() > 1e-12 * c.norm()) return t.normalized();
+    }
+    return o.tangents(model.x().col(i)).col(0);
   }
   /// Node `node` cannot be held (its cone is left; F_t the force that held it): its block, the stuck
   /// nodes of its run of held rough nodes, slides along the chain, in the direction the force pushed
@@ -517,13 +523,13 @@ class ContactModule final : public StringModule<dim> {
     std::vector<int> block;
     for (int i = first; i <= last; ++i)
       if (stuck_[static_cast<std::size_t>(i)]) block.push_back(i);
-    const double preferred = -ft.dot(chain_direction(model, node)) >= 0 ? 1.0 : -1.0;
+    const double preferred = -ft.dot(chain_direction(model, node, -ft)) >= 0 ? 1.0 : -1.0;
     const double a = acceleration_scale(model);
     for (const double sign : {preferred, -preferred}) {
       for (int i : block) {
         stuck_[static_cast<std::size_t>(i)] = 0;
         dir_.col(i) = obstacle_of(static_cast<std::size_t>(i)).tangents(model.x().col(i)).transpose() *
-                      (sign * chain_direction(model, i));
+                      (sign * chain_direction(model, i, -ft));
       }
       model.refresh();
       Points<dim> x = model.x(), v = model.v();

@@ -469,3 +469,50 @@ TEST_CASE("friction: in 3D a chain launched up a rough slope stops at the exact 
     CHECK(s.relative_momentum_residual() < 1e-8);
   }
 }
+
+TEST_CASE("friction: a chain landing flat on a rough table takes Coulomb's impulse and stops at the exact place",
+          "[contact][friction]") {
+  // Dropped flat from H while moving at v0 along the table: it lands at t_l = √(2H/g) with the normal
+  // impulse M v_n (v_n = √(2gH)), and Coulomb's impulse takes μ M v_n of its tangential momentum:
+  // v1 = v0 − μ v_n; then it decelerates at μ g and sticks at t_l + v1/(μ g). W_impacts = −½ M v_n²,
+  // W_friction = −½ M v0² (all the tangential motion).
+  const double ell = 1.0, lambda = 1.0, H = 0.05, v0 = 0.5, mu = 0.3, T = 0.4;
+  const int links = 20;
+  Chain<2> chain = Chain<2>::uniform(lambda, ell, links, false);
+  for (int i = 0; i <= links; ++i) {
+    chain.positions().col(i) = Vec<2>(i * ell / links, H);
+    chain.velocities().col(i) = Vec<2>(v0, 0.0);
+  }
+  std::vector<std::unique_ptr<Force<2>>> forces;
+  forces.push_back(std::make_unique<Gravity<2>>(Vec<2>(0.0, -kG)));
+  Obstacle<2> table;
+  table.kind = Obstacle<2>::Kind::kPlane;
+  table.point = Vec<2>::Zero();
+  table.normal = Vec<2>(0.0, 1.0);
+  table.mu = mu;
+  table.name = "table";
+  StringModel<2> model(std::move(chain), std::move(forces), {}, friction_options(), make_contact_module<2>({table}));
+  StringSolver<2> solver(model, friction_run(T, T / 4));
+  const RunSummary& s = solver.run();
+  REQUIRE(s.status == "completed");
+  const auto& last = solver.frames().back();
+  const double t_land = std::sqrt(2 * H / kG), vn = std::sqrt(2 * kG * H), v1 = v0 - mu * vn, t_slide = v1 / (mu * kG);
+  const double shift = v0 * t_land + v1 * t_slide - 0.5 * mu * kG * t_slide * t_slide, M = lambda * ell;
+  REQUIRE(t_land + t_slide < T);
+  double position_error = 0, speed = 0;
+  for (int i = 0; i <= links; ++i) {
+    position_error = std::max(position_error, (last.x.col(i) - Vec<2>(i * ell / links + shift, 0.0)).norm());
+    speed = std::max(speed, last.v.col(i).norm());
+  }
+  std::printf("\nflat landing on a rough table (mu = %.2f): position error %.3g m (shift %.9f m), speed %.3g m/s, "
+              "W_impacts %.12g J (exact %.12g), W_friction %.12g J (exact %.12g), energy %.3g, momentum %.3g\n",
+              mu, position_error, shift, speed, last.terms["W_impacts"], -0.5 * M * vn * vn, last.terms["W_friction"],
+              -0.5 * M * v0 * v0, s.relative_energy_drift(), s.relative_momentum_residual());
+  CHECK(position_error < 1e-12);
+  CHECK(speed == 0);
+  CHECK(std::abs(last.terms["W_impacts"] + 0.5 * M * vn * vn) < 1e-12);
+  CHECK(std::abs(last.terms["W_friction"] + 0.5 * M * v0 * v0) < 1e-12);
+  CHECK(last.terms["sticks"] == links + 1);
+  CHECK(s.relative_energy_drift() < 1e-12);
+  CHECK(s.relative_momentum_residual() < 1e-12);
+}
