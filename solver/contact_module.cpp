@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include <Eigen/Geometry>
 #include <fmt/format.h>
 
 #include "mesh/errors.hpp"
@@ -22,6 +23,54 @@ constexpr double kReleaseGap = 2e-7;
 /// A held node's normal force counts as pulling below −kPull of its weight scale m a (a the physical
 /// acceleration scale): round-off is not a lift-off.
 constexpr double kPull = 1e-9;
+/// A sliding node whose tangential speed is within kStopWindow of the speed scale √(a ℓ) at a located
+/// stop has stopped (the state recomputed to the event is within the integration error of the root).
+constexpr double kStopWindow = 1e-5;
+
+/// A closed interval (empty when lo > hi) and a half-plane a x + b y ≤ c: the friction cone of a stuck
+/// node in 2D in the tensions x, y of its two links.
+struct Interval {
+  double lo = 0, hi = 0;
+  bool empty() const { return lo > hi; }
+  double mid() const { return 0.5 * (lo + hi); }
+};
+struct HalfPlane {
+  double a = 0, b = 0, c = 0;
+};
+
+/// The range of y over the convex polygon {x ∈ X, y ∈ Y, a_k x + b_k y ≤ c_k} (its projection, from its
+/// vertices; tol: the absolute slack of a constraint, N).
+Interval project_y(const Interval& X, const Interval& Y, const std::vector<HalfPlane>& cone, double tol) {
+  std::vector<HalfPlane> h = {{1, 0, X.hi}, {-1, 0, -X.lo}, {0, 1, Y.hi}, {0, -1, -Y.lo}};
+  h.insert(h.end(), cone.begin(), cone.end());
+  Interval out{INFINITY, -INFINITY};
+  for (std::size_t p = 0; p < h.size(); ++p)
+    for (std::size_t q = p + 1; q < h.size(); ++q) {
+      const double det = h[p].a * h[q].b - h[q].a * h[p].b;
+      if (!(std::abs(det) > 1e-14 * (std::abs(h[p].a * h[q].b) + std::abs(h[q].a * h[p].b)))) continue;
+      const double x = (h[p].c * h[q].b - h[q].c * h[p].b) / det, y = (h[p].a * h[q].c - h[q].a * h[p].c) / det;
+      bool inside = true;
+      for (const HalfPlane& k : h) inside = inside && k.a * x + k.b * y <= k.c + tol;
+      if (!inside) continue;
+      out.lo = std::min(out.lo, y);
+      out.hi = std::max(out.hi, y);
+    }
+  return out;
+}
+
+/// The x ∈ X with a_k x + b_k y ≤ c_k at a given y.
+Interval range_x(Interval X, double y, const std::vector<HalfPlane>& cone, double tol) {
+  for (const HalfPlane& k : cone) {
+    const double r = k.c - k.b * y;
+    if (k.a > 0)
+      X.hi = std::min(X.hi, (r + tol) / k.a);
+    else if (k.a < 0)
+      X.lo = std::max(X.lo, (r + tol) / k.a);
+    else if (r < -tol)
+      return {1, 0};
+  }
+  return X;
+}
 
 template <int dim>
 Vec<dim> radial(const Obstacle<dim>& o, const Vec<dim>& x) {
@@ -57,14 +106,30 @@ double Obstacle<dim>::curvature(const Vec<dim>& x, const Vec<dim>& v) const {
   return (qv.squaredNorm() - nv * nv) / d;
 }
 
+template <int dim>
+Eigen::Matrix<double, dim, dim - 1> Obstacle<dim>::tangents(const Vec<dim>& x) const {
+  const Vec<dim> n = outward(x);
+  Eigen::Matrix<double, dim, dim - 1> basis;
+  if constexpr (dim == 2) {
+    basis.col(0) = Vec<2>(-n[1], n[0]);
+  } else {
+    const Vec<3> u = kind == Kind::kPlane ? Vec<3>(normal.unitOrthogonal()) : axis;
+    basis.col(0) = u;
+    basis.col(1) = u.cross(n);
+  }
+  return basis;
+}
+
 namespace {
 
 template <int dim>
 class ContactModule final : public StringModule<dim> {
  public:
-  explicit ContactModule(std::vector<Obstacle<dim>> obstacles) : obstacles_(std::move(obstacles)) {}
+  explicit ContactModule(std::vector<Obstacle<dim>> obstacles) : obstacles_(std::move(obstacles)) {
+    for (const Obstacle<dim>& o : obstacles_) friction_ = friction_ || o.mu > 0;
+  }
 
-  // [ W_contact | W_impacts | impulse (dim) ]
+  // [ W_contact | W_impacts | impulse (dim) | W_friction (with friction) ]
   std::vector<ArcRange> initial_arcs(const Chain<dim>& chain) override {
     return {ArcRange{0, chain.num_nodes() - 1, chain.closed()}};
   }
@@ -75,6 +140,9 @@ class ContactModule final : public StringModule<dim> {
     for (int j = 0; j < chain.num_links(); ++j) h_ = std::min(h_, chain.link_length(j));
     held_.assign(static_cast<std::size_t>(n), -1);
     offset_.assign(static_cast<std::size_t>(n), 0.0);
+    stuck_.assign(static_cast<std::size_t>(n), 0);
+    dir_.setZero(dim - 1, n);
+    length_ = chain.length();
     for (int i = 0; i < n; ++i) {
       if (!free_node(model, i)) continue;
       const auto [k, gap] = nearest(model.x().col(i));
@@ -86,6 +154,14 @@ class ContactModule final : public StringModule<dim> {
     }
     model.refresh();
     settle(model, 0.0, false);
+    if (friction_) {
+      // A stuck node cannot be moved by the projection of the initial state (make_consistent): the
+      // state is projected first, and the nodes at rest on rough obstacles stick where it puts them.
+      model.project(0.0);
+      model.chain().positions() = model.x();
+      model.chain().velocities() = model.v();
+      if (classify(model, 0.0, nullptr)) settle(model, 0.0, false);
+    }
   }
   void add_mass_and_forces(const StringModel<dim>&, Eigen::VectorXd&, Points<dim>&) override {}
   void node_contacts(const StringModel<dim>& model, std::vector<NodeContact<dim>>& out) const override {
@@ -94,18 +170,25 @@ class ContactModule final : public StringModule<dim> {
       const Obstacle<dim>& o = obstacles_[static_cast<std::size_t>(held_[i])];
       const Vec<dim> x = model.x().col(static_cast<Eigen::Index>(i)), v = model.v().col(static_cast<Eigen::Index>(i));
       out.push_back({static_cast<int>(i), o.outward(x), o.gap(x), o.curvature(x, v)});
+      if (o.mu > 0) {
+        out.back().mu = o.mu;
+        out.back().stuck = stuck_[i] != 0;
+        if (!stuck_[i]) out.back().slide = slide_direction(model, o, i, x, v);
+      }
     }
   }
-  int num_ledgers() const override { return 2 + dim; }
+  int num_ledgers() const override { return 2 + dim + (friction_ ? 1 : 0); }
   void ledger_rates(const StringModel<dim>& model, Eigen::Ref<Eigen::VectorXd> rates) const override {
     rates[0] = model.contact_power();
     rates[1] = 0;  // the impacts' term jumps at events only
     rates.template segment<dim>(2) = model.external_force();
+    if (friction_) rates[kFriction] = model.friction_power();
   }
   Eigen::VectorXd ledger_scale(double mass, double speed, double) const override {
     Eigen::VectorXd scale(num_ledgers());
     scale.head(2).setConstant(mass * speed * speed);
     scale.template segment<dim>(2).setConstant(mass * speed);
+    if (friction_) scale[kFriction] = mass * speed * speed;
     return scale;
   }
   double potential_correction(const StringModel<dim>&, const Eigen::Ref<const Eigen::VectorXd>&) const override {
@@ -113,18 +196,24 @@ class ContactModule final : public StringModule<dim> {
   }
   std::vector<LedgerTerm> ledger_terms() const override {
     using K = LedgerTerm::Kind;
-    return {{"W_contact", K::kWork}, {"W_impacts", K::kWork}, {"impacts", K::kQuantity}, {"lift_offs", K::kQuantity}};
+    std::vector<LedgerTerm> terms = {
+        {"W_contact", K::kWork}, {"W_impacts", K::kWork}, {"impacts", K::kQuantity}, {"lift_offs", K::kQuantity}};
+    if (friction_)
+      terms.insert(terms.end(), {{"W_friction", K::kWork}, {"sticks", K::kQuantity}, {"slips", K::kQuantity}});
+    return terms;
   }
   std::vector<FrontField> front_fields() const override { return {}; }
   void fill(const StringModel<dim>&, const Eigen::Ref<const Eigen::VectorXd>& ledger,
             ModuleLedger<dim>& out) const override {
     out.fronts.clear();
     out.terms = {ledger[0], ledger[1], static_cast<double>(impacts_), static_cast<double>(lift_offs_)};
+    if (friction_)
+      out.terms.insert(out.terms.end(), {ledger[kFriction], static_cast<double>(sticks_), static_cast<double>(slips_)});
     out.impulse = ledger.template segment<dim>(2);
     out.has_momentum_ledger = true;
     out.support.setZero();
   }
-  int num_events() const override { return 2; }
+  int num_events() const override { return friction_ ? 4 : 2; }
   bool events_need_tensions() const override { return true; }
   void events(const StringModel<dim>& model, Eigen::Ref<Eigen::VectorXd> g) const override {
     // 0: the smallest gap of a free node (landing); 1: the smallest normal force of a held node, per
@@ -137,13 +226,18 @@ class ContactModule final : public StringModule<dim> {
     const double a = acceleration_scale(model);
     for (std::size_t k = 0; k < model.contacts().size(); ++k)
       g[1] = std::min(g[1], model.contact_force(k) / (model.masses()[model.contacts()[k].node] * a));
+    if (friction_) friction_events(model, g);
   }
-  std::vector<int> event_directions() const override { return {-1, -1}; }
+  std::vector<int> event_directions() const override {
+    return friction_ ? std::vector<int>{-1, -1, -1, -1} : std::vector<int>{-1, -1};
+  }
   EventAction handle_events(StringModel<dim>& model, double t, Eigen::Ref<Eigen::VectorXd> ledger,
                             const std::vector<int>& found) override {
     bool changed = false;
     if (found.size() > 0 && found[0] != 0) changed = land(model, t, ledger) || changed;
     if (found.size() > 1 && found[1] != 0) changed = settle(model, t, true) || changed;
+    if (found.size() > 2 && found[2] != 0) changed = stop(model, t, ledger) || changed;
+    if (found.size() > 3 && found[3] != 0) changed = slip(model, t) || changed;
     if (!changed) return {};
     return {EventAction::Kind::kTransfer, ""};  // the velocities or the held set changed: the integrator restarts
   }
@@ -158,6 +252,313 @@ class ContactModule final : public StringModule<dim> {
   std::vector<double> offset_;   // per node: its landing root function's offset (of h)
   double h_ = 1;
   long impacts_ = 0, lift_offs_ = 0;
+  // Friction: whether an obstacle has μ > 0; per node, whether it sticks, and the direction it slides
+  // in (its coordinates in the obstacle's tangents(); zero: not yet classified, or no friction).
+  static constexpr int kFriction = 2 + dim;  // W_friction's place in the ledger
+  bool friction_ = false;
+  std::vector<char> stuck_;
+  Eigen::Matrix<double, dim - 1, Eigen::Dynamic> dir_;
+  double length_ = 1;
+  long sticks_ = 0, slips_ = 0;
+
+  const Obstacle<dim>& obstacle_of(std::size_t i) const { return obstacles_[static_cast<std::size_t>(held_[i])]; }
+  bool sliding(std::size_t i) const {
+    return held_[i] >= 0 && obstacle_of(i).mu > 0 && !stuck_[i] && dir_.col(static_cast<Eigen::Index>(i)).squaredNorm() > 0;
+  }
+  static Vec<dim> tangential(const Obstacle<dim>& o, const Vec<dim>& x, const Vec<dim>& v) {
+    const Vec<dim> n = o.outward(x);
+    return v - n.dot(v) * n;
+  }
+  /// The direction node i slides in: the stored one carried with the surface (in 2D, always: the
+  /// force keeps its sign through the located stop, so the step that finds it is smooth); in 3D the
+  /// direction of its tangential velocity while that has a positive part along the stored one and is
+  /// above the stop window (below it, the round-off of a velocity starting from rest would turn it).
+  Vec<dim> slide_direction(const StringModel<dim>& model, const Obstacle<dim>& o, std::size_t i, const Vec<dim>& x,
+                           const Vec<dim>& v) const {
+    const Vec<dim> d = o.tangents(x) * dir_.col(static_cast<Eigen::Index>(i));
+    if constexpr (dim == 3) {
+      const Vec<dim> vt = tangential(o, x, v);
+      if (vt.dot(d) > 0 && vt.norm() > kStopWindow * speed_scale(model)) return vt.normalized();
+    }
+    return d;
+  }
+  double speed_scale(const StringModel<dim>& model) const { return std::sqrt(acceleration_scale(model) * length_); }
+  /// Root functions 2 and 3: the smallest tangential speed of a sliding node along its direction of
+  /// sliding, per the speed scale (a stop), and the smallest (μ N − |F_t|)/(m a) of a stuck node (a slip).
+  void friction_events(const StringModel<dim>& model, Eigen::Ref<Eigen::VectorXd> g) const {
+    g[2] = 1;
+    const double V = speed_scale(model);
+    for (std::size_t i = 0; i < held_.size(); ++i) {
+      if (!sliding(i)) continue;
+      const Obstacle<dim>& o = obstacle_of(i);
+      const Vec<dim> x = model.x().col(static_cast<Eigen::Index>(i)), v = model.v().col(static_cast<Eigen::Index>(i));
+      g[2] = std::min(g[2], tangential(o, x, v).dot(o.tangents(x) * dir_.col(static_cast<Eigen::Index>(i))) / V);
+    }
+    g[3] = 1;
+    const double a = acceleration_scale(model);
+    for (std::size_t k = 0; k < model.contacts().size(); ++k) {
+      const NodeContact<dim>& c = model.contacts()[k];
+      if (c.stuck)
+        g[3] = std::min(g[3], (c.mu * model.contact_force(k) - model.contact_friction(k).norm()) / (model.masses()[c.node] * a));
+    }
+  }
+  /// Node i sticks: its tangential velocity (within the stop window, or the integration error of a
+  /// located root) is taken, the kinetic energy and momentum that takes booked in W_friction and the impulse.
+  void stick_node(StringModel<dim>& model, std::size_t i, Eigen::VectorXd* ledger) {
+    const Eigen::Index col = static_cast<Eigen::Index>(i);
+    const Vec<dim> vt = tangential(obstacle_of(i), model.x().col(col), model.v().col(col));
+    const double m = model.masses()[col];
+    if (ledger) {
+      (*ledger)[kFriction] -= 0.5 * m * (model.v().col(col).squaredNorm() - (model.v().col(col) - vt).squaredNorm());
+      ledger->template segment<dim>(2) -= m * vt;
+    }
+    model.v().col(col) -= vt;
+    stuck_[i] = 1;
+    dir_.col(col).setZero();
+    ++sticks_;
+  }
+  /// The held nodes on rough obstacles not yet classified (just landed, or at the start) slide along
+  /// their tangential velocity, or stick if it is within the stop window; then the stuck nodes that
+  /// the cone cannot hold slip (unstick). Returns whether anything changed.
+  bool classify(StringModel<dim>& model, double t, Eigen::VectorXd* ledger) {
+    bool changed = false;
+    const double V = speed_scale(model);
+    for (std::size_t i = 0; i < held_.size(); ++i) {
+      const Eigen::Index col = static_cast<Eigen::Index>(i);
+      if (held_[i] < 0 || !(obstacle_of(i).mu > 0) || stuck_[i] || dir_.col(col).squaredNorm() > 0) continue;
+      const Obstacle<dim>& o = obstacle_of(i);
+      const Vec<dim> x = model.x().col(col), vt = tangential(o, x, model.v().col(col));
+      if (vt.norm() > kStopWindow * V)
+        dir_.col(col) = o.tangents(x).transpose() * vt.normalized();
+      else
+        stick_node(model, i, ledger);
+      changed = true;
+    }
+    model.refresh();
+    return unstick(model, t, false) || changed;
+  }
+  /// A located stop: the sliding nodes whose speed along their direction has reached zero stick (in 3D
+  /// a node whose velocity has turned across its stored direction without stopping takes its new
+  /// direction); then classify() lets go of the stuck nodes the cone cannot hold.
+  bool stop(StringModel<dim>& model, double t, Eigen::Ref<Eigen::VectorXd> ledger) {
+    const double V = speed_scale(model);
+    Eigen::VectorXd book = ledger;
+    int caught = 0, closest = -1;
+    double closest_g = INFINITY;
+    for (std::size_t i = 0; i < held_.size(); ++i) {
+      if (!sliding(i)) continue;
+      const Eigen::Index col = static_cast<Eigen::Index>(i);
+      const Obstacle<dim>& o = obstacle_of(i);
+      const Vec<dim> x = model.x().col(col), vt = tangential(o, x, model.v().col(col));
+      const Vec<dim> d = o.tangents(x) * dir_.col(col);
+      const double g = vt.dot(d) / V;
+      if (g <= kStopWindow) {
+        if ((vt - vt.dot(d) * d).norm() <= kStopWindow * V)
+          stick_node(model, i, &book);
+        else
+          dir_.col(col) = o.tangents(x).transpose() * vt.normalized();
+        ++caught;
+      } else if (g < closest_g) {
+        closest_g = g;
+        closest = static_cast<int>(i);
+      }
+    }
+    if (caught == 0 && closest >= 0 && closest_g < kCatchWindow) {
+      stick_node(model, static_cast<std::size_t>(closest), &book);
+      ++caught;
+    }
+    if (caught == 0) return false;
+    classify(model, t, &book);
+    ledger = book;
+    settle(model, t, false);
+    return true;
+  }
+  /// A located slip: in 2D the locked tensions are chosen again inside the cones; if a node still
+  /// leaves its cone it slips, and if none does the one whose |F_t| has reached μ N goes, then every
+  /// other that the cone cannot hold.
+  bool slip(StringModel<dim>& model, double t) {
+    // In 2D the locked tensions may first move inside the cones (the cones hold with other tensions).
+    Points<dim> x = model.x(), v = model.v();
+    model.evaluate(t, x, v);
+    const bool rebalanced = balance_locked(model);
+    if (!unstick(model, t, false) && !rebalanced && !unstick(model, t, true)) return false;
+    settle(model, t, false);
+    return true;
+  }
+  /// The friction cone of stuck node i (contacts()[k]) in the tensions x of the link ending at it
+  /// (direction ep) and y of the link starting at it (en): its holding force H = −(F + y en − x ep)
+  /// has |t·H| ≤ μ n·H, two half-planes (F the applied force).
+  static std::vector<HalfPlane> cone(const StringModel<dim>& model, std::size_t k, const Vec<dim>& ep, const Vec<dim>& en) {
+    const NodeContact<dim>& c = model.contacts()[k];
+    const Vec<dim> F = model.contact_applied(k), t = Vec<dim>(-c.normal[1], c.normal[0]);
+    std::vector<HalfPlane> h;
+    for (const double sign : {1.0, -1.0}) {
+      const Vec<dim> q = sign * t - c.mu * c.normal;  // q·H ≤ 0
+      h.push_back({q.dot(ep), -q.dot(en), q.dot(F)});
+    }
+    return h;
+  }
+  /// 2D: the tensions of the locked links (between stuck nodes: statically indeterminate) chosen inside
+  /// every stuck node's friction cone where that is possible, segment by segment: a forward pass
+  /// carries the interval of tensions each link can have with the cones of the nodes before it held
+  /// (the capstan inequality, node by node), a backward pass picks the middle of what the node after
+  /// it allows. A segment with no admissible tensions keeps its own (unstick() then lets a node slip).
+  /// Returns whether it changed a tension. 3D keeps the tensions the links had when they locked.
+  bool balance_locked(StringModel<dim>& model) const {
+    if constexpr (dim != 2) {
+      return false;
+    } else {
+      const Chain<dim>& chain = model.chain();
+      const int L = chain.num_links();
+      if (chain.closed()) return false;
+      std::vector<int> contact_of(static_cast<std::size_t>(chain.num_nodes()), -1);
+      for (std::size_t k = 0; k < model.contacts().size(); ++k) contact_of[static_cast<std::size_t>(model.contacts()[k].node)] = static_cast<int>(k);
+      auto e = [&](int j) -> Vec<dim> {
+        if (j < 0 || j >= L) return Vec<dim>::Zero();
+        return (model.x().col(chain.link_end(j)) - model.x().col(chain.link_start(j))).normalized();
+      };
+      auto boundary = [&](int j) { return j < 0 || j >= L ? 0.0 : model.link_tension(j); };
+      auto node_cone = [&](int i) {
+        const int k = contact_of[static_cast<std::size_t>(i)];
+        return k >= 0 && model.contacts()[static_cast<std::size_t>(k)].stuck ? cone(model, static_cast<std::size_t>(k), e(i - 1), e(i))
+                                                                             : std::vector<HalfPlane>{};
+      };
+      const double scale = std::max(model.physical_scales().tension, 1e-300);
+      bool changed = false;
+      for (int p = 0; p < L;) {
+        if (!model.link_locked(p)) {
+          ++p;
+          continue;
+        }
+        int q = p;
+        while (q < L && model.link_locked(q)) ++q;  // links p..q−1 locked, nodes p..q
+        double top = std::max(std::abs(boundary(p - 1)), std::abs(boundary(q)));
+        for (int j = p; j < q; ++j) top = std::max(top, std::abs(model.locked_tension(j)));
+        const Interval Y{0.0, 4 * std::max(top, scale)};
+        const double tol = 1e-12 * Y.hi;
+        std::vector<Interval> S;
+        Interval X{boundary(p - 1), boundary(p - 1)};
+        bool feasible = true;
+        for (int i = p; i < q && feasible; ++i) {
+          X = project_y(X, Y, node_cone(i), tol);
+          S.push_back(X);
+          feasible = !X.empty();
+        }
+        if (feasible) {
+          double y = boundary(q);
+          for (int i = q; i > p && feasible; --i) {  // node i: link i−1 from the interval S[i−1−p]
+            const Interval J = range_x(S[static_cast<std::size_t>(i - 1 - p)], y, node_cone(i), tol);
+            feasible = !J.empty();
+            if (!feasible) break;
+            y = std::clamp(J.mid(), J.lo, J.hi);
+            if (model.locked_tension(i - 1) != y) changed = true;
+            model.set_locked_tension(i - 1, y);
+          }
+        }
+        p = q;
+      }
+      return changed;
+    }
+  }
+  /// The stuck nodes whose holding force leaves the cone (|F_t| > μ N beyond round-off) slip, the
+  /// worst first, each with its block: the run of consecutive nodes held on rough obstacles around it
+  /// (an inextensible chain held on a surface moves only as a block: a node between two stuck ones
+  /// cannot move). At a located slip (`located`) the one at the cone's edge to the root's accuracy
+  /// goes first. Returns whether one slipped.
+  bool unstick(StringModel<dim>& model, double t, bool located) {
+    bool released = false;
+    for (std::size_t pass = 0; pass <= held_.size(); ++pass) {
+      Points<dim> x = model.x(), v = model.v();
+      model.evaluate(t, x, v);
+      if (balance_locked(model)) {
+        x = model.x();
+        v = model.v();
+        model.evaluate(t, x, v);
+      }
+      const double a = acceleration_scale(model);
+      int worst = -1;
+      double worst_excess = 0;
+      Vec<dim> worst_force = Vec<dim>::Zero();
+      const double floor = located && !released ? -kCatchWindow : kPull;
+      for (std::size_t k = 0; k < model.contacts().size(); ++k) {
+        const NodeContact<dim>& c = model.contacts()[k];
+        const Vec<dim> ft = model.contact_friction(k);
+        if (!c.stuck || !(model.contact_force(k) > 0) || !(ft.norm() > 0)) continue;
+        const double excess = (ft.norm() - c.mu * model.contact_force(k)) / (model.masses()[c.node] * a);
+        if (excess > floor && (worst < 0 || excess > worst_excess)) {
+          worst_excess = excess;
+          worst = c.node;
+          worst_force = ft;
+        }
+      }
+      if (worst < 0) break;
+      slip_block(model, t, worst, worst_force);
+      released = true;
+    }
+    return released;
+  }
+  /// The direction of the chain at node i, along increasing node index, in the surface's tangent plane;
+  /// `fallback` (projected) where the chain is normal to the surface there, the surface's first
+  /// tangent if that is normal too.
+  Vec<dim> chain_direction(const StringModel<dim>& model, int i, const Vec<dim>& fallback) const {
+    const int n = static_cast<int>(held_.size());
+    const Obstacle<dim>& o = obstacle_of(static_cast<std::size_t>(i));
+    const Vec<dim> normal = o.outward(model.x().col(i));
+    for (const Vec<dim>& c : {Vec<dim>(model.x().col(std::min(i + 1, n - 1)) - model.x().col(std::max(i - 1, 0))), fallback}) {
+      const Vec<dim> t = c - normal.dot(c) * normal;
+      if (t.norm() > 1e-12 * c.norm()) return t.normalized();
+    }
+    return o.tangents(model.x().col(i)).col(0);
+  }
+  /// Node `node` cannot be held (its cone is left; F_t the force that held it): its block, the stuck
+  /// nodes of its run of held rough nodes, slides along the chain, in the direction the force pushed
+  /// the node first, and if the block's accelerations along it come out negative (inconsistent) the
+  /// other way. If neither is consistent (Coulomb's law has no sliding solution there) the run stops.
+  void slip_block(StringModel<dim>& model, double t, int node, const Vec<dim>& ft) {
+    const int n = static_cast<int>(held_.size());
+    auto rough = [&](int i) { return i >= 0 && i < n && held_[static_cast<std::size_t>(i)] >= 0 && obstacle_of(static_cast<std::size_t>(i)).mu > 0; };
+    int first = node, last = node;
+    while (rough(first - 1)) --first;
+    while (rough(last + 1)) ++last;
+    std::vector<int> block;
+    for (int i = first; i <= last; ++i)
+      if (stuck_[static_cast<std::size_t>(i)]) block.push_back(i);
+    const double preferred = -ft.dot(chain_direction(model, node, -ft)) >= 0 ? 1.0 : -1.0;
+    const double a = acceleration_scale(model);
+    for (const double sign : {preferred, -preferred}) {
+      for (int i : block) {
+        stuck_[static_cast<std::size_t>(i)] = 0;
+        dir_.col(i) = obstacle_of(static_cast<std::size_t>(i)).tangents(model.x().col(i)).transpose() *
+                      (sign * chain_direction(model, i, -ft));
+      }
+      model.refresh();
+      Points<dim> x = model.x(), v = model.v();
+      bool consistent = true;
+      try {
+        model.evaluate(t, x, v);
+        for (int i : block) {
+          const Vec<dim> d = obstacle_of(static_cast<std::size_t>(i)).tangents(model.x().col(i)) * dir_.col(i);
+          consistent = consistent && model.accelerations().col(i).dot(d) >= -kPull * a;
+        }
+      } catch (const NumericalError&) {
+        consistent = false;
+      }
+      if (consistent) {
+        slips_ += static_cast<long>(block.size());
+        return;
+      }
+    }
+    for (int i : block) {
+      stuck_[static_cast<std::size_t>(i)] = 1;
+      dir_.col(i).setZero();
+    }
+    model.refresh();
+    throw NumericalError(fmt::format("stuck on {} at t = {:.9g} s, node {}: the friction cone cannot hold it (|F_t| = "
+                                     "{:.6g} N beyond mu N), and its block of {} nodes cannot slide either way "
+                                     "(Coulomb's law has no consistent motion here)",
+                                     obstacle_of(static_cast<std::size_t>(node)).name, t, node, ft.norm(), block.size()),
+                         t);
+  }
 
   static bool free_node(const StringModel<dim>& model, int i) { return model.in_arc(i) && !model.is_prescribed(i); }
   std::pair<int, double> nearest(const Vec<dim>& x) const {
@@ -200,6 +601,15 @@ class ContactModule final : public StringModule<dim> {
       ++caught;
     }
     if (caught == 0) return false;
+    // The normal impulses the rough obstacles take (−m n·v of each landing node: its links are tangent
+    // to the surface to first order, so the obstacle takes the node's normal momentum).
+    std::vector<double> normal_impulse;
+    if (friction_)
+      for (const auto& [i, k] : landing) {
+        const Obstacle<dim>& o = obstacles_[static_cast<std::size_t>(k)];
+        const Vec<dim> x = model.x().col(i);
+        normal_impulse.push_back(o.mu > 0 ? std::max(0.0, -o.outward(x).dot(model.v().col(i))) * model.masses()[i] : 0.0);
+      }
     const double K_before = model.kinetic_energy();
     const Vec<dim> p_before = model.momentum();
     model.refresh();
@@ -209,7 +619,42 @@ class ContactModule final : public StringModule<dim> {
     ledger.template segment<dim>(2) += model.momentum() - p_before;
     ++impacts_;
     settle(model, t, false);
+    if (friction_) {
+      Eigen::VectorXd book = ledger;
+      landing_friction(model, t, landing, normal_impulse, book);
+      classify(model, t, &book);
+      ledger = book;
+      settle(model, t, false);
+    }
     return true;
+  }
+  /// Coulomb's impulse at a landing: each landing node still held on a rough obstacle takes the
+  /// tangential impulse −μ P_n t̂ (at most what stops its tangential motion), and the velocities are
+  /// projected again onto the constraints (the links pass it on along the chain). Its work is booked
+  /// in W_friction, its impulse in the momentum ledger. Without it the landings' normal impulses, O(h)
+  /// in all along a touchdown, would carry no friction: an O(h) error.
+  void landing_friction(StringModel<dim>& model, double t, const std::vector<std::pair<int, int>>& landing,
+                        const std::vector<double>& normal_impulse, Eigen::VectorXd& ledger) {
+    const double K_before = model.kinetic_energy();
+    const Vec<dim> p_before = model.momentum();
+    bool applied = false;
+    for (std::size_t q = 0; q < landing.size(); ++q) {
+      const int i = landing[q].first;
+      if (held_[static_cast<std::size_t>(i)] < 0 || !(normal_impulse[q] > 0)) continue;
+      const Obstacle<dim>& o = obstacle_of(static_cast<std::size_t>(i));
+      const Vec<dim> vt = tangential(o, model.x().col(i), model.v().col(i));
+      const double speed = vt.norm();
+      if (!(speed > 0)) continue;
+      const double dv = std::min(o.mu * normal_impulse[q] / model.masses()[i], speed);
+      model.v().col(i) -= dv * vt / speed;
+      applied = true;
+    }
+    if (!applied) return;
+    model.refresh();
+    model.project(t);
+    model.refresh();
+    ledger[kFriction] += model.kinetic_energy() - K_before;
+    ledger.template segment<dim>(2) += model.momentum() - p_before;
   }
   /// Lets go of the held nodes whose normal force pulls, one at a time, most negative first (each
   /// release changes the others' forces), until none pulls; at a located lift-off (`located`) the one
@@ -243,6 +688,10 @@ class ContactModule final : public StringModule<dim> {
       if (worst < 0) break;
       held_[static_cast<std::size_t>(worst)] = -1;
       offset_[static_cast<std::size_t>(worst)] = kReleaseGap;
+      if (friction_) {
+        stuck_[static_cast<std::size_t>(worst)] = 0;
+        dir_.col(worst).setZero();
+      }
       ++lift_offs_;
       released = true;
       model.refresh();

@@ -16,7 +16,13 @@
 ///   - the ledgers W_contact (J: the work of the contact forces, zero on the exact solution; it books
 ///     the drift control's share), W_impacts (J, ≤ 0: the kinetic energy the landings took) and the
 ///     impulse of all external forces (the momentum ledger p − p0 − impulse, closed across impacts);
-///   - the recorded quantities impacts and lift_offs (series.csv): how many landings and lift-offs.
+///   - the recorded quantities impacts and lift_offs (series.csv): how many landings and lift-offs;
+///   - Coulomb friction on obstacles with μ > 0 (docs/model.md §10, "Friction"): a held node slides
+///     (force −μ N t̂, NodeContact::slide) or sticks (held completely, NodeContact::stuck); two more
+///     root functions, a sliding node's tangential speed along its direction of sliding (a stop:
+///     the node sticks if the force that holds it is inside the cone, |F_t| ≤ μ N) and the smallest
+///     μ N − |F_t| of a stuck node (a slip); the ledger W_friction (J, ≤ 0) and the quantities sticks
+///     and slips. Without friction none of this exists: the module is the smooth one, bit for bit.
 #include <memory>
 #include <string>
 #include <vector>
@@ -34,12 +40,17 @@ struct Obstacle {
   Vec<dim> normal = Vec<dim>::Zero();  ///< plane: its unit normal, towards the side the string is on
   Vec<dim> axis = Vec<dim>::Zero();    ///< cylinder in 3D: its unit axis (unused in 2D)
   double radius = 0;                   ///< cylinder (m)
+  double mu = 0;                       ///< Coulomb's coefficient of friction (≥ 0; 0: smooth)
   std::string name;                    ///< for messages: "effects.surface[0]"
   /// The signed distance of x from the surface (m), > 0 outside, its outward unit normal there, and
   /// the gap's second derivative at zero acceleration for a velocity v (m/s²).
   double gap(const Vec<dim>& x) const;
   Vec<dim> outward(const Vec<dim>& x) const;
   double curvature(const Vec<dim>& x, const Vec<dim>& v) const;
+  /// An orthonormal basis of the surface's tangent space at x, carried along with the surface (2D:
+  /// the outward normal turned by +90°; 3D plane: a fixed basis; 3D cylinder: the axis and axis × n),
+  /// in which a sliding node keeps the direction it slides in.
+  Eigen::Matrix<double, dim, dim - 1> tangents(const Vec<dim>& x) const;
 };
 
 /// The contact module of `obstacles` (non-empty). A node that starts within kInitialContact of its

@@ -361,16 +361,97 @@ void StringModel<dim>::assemble_matrix() {
   });
   if (!bends_.empty()) bend_couplings();
   if (!contacts_.empty()) contact_couplings();
+  if (contact_stuck_) lock_stuck_links();
+}
+
+template <int dim>
+std::pair<int, int> StringModel<dim>::node_links(int i) const {
+  const int L = chain_.num_links();
+  return {i > 0 ? i - 1 : (chain_.closed() ? L - 1 : -1), i < L ? i : -1};
+}
+
+template <int dim>
+void StringModel<dim>::contact_friction_forces() {
+  // Sliding: −μ N t̂, and the links' share of it in the acceleration, μ w (n·f) t̂ (the applied forces'
+  // share is in b_i). Sticking: the tangential part of the force that holds the node, −(m b_i + f_i).
+  contact_friction_.setZero(dim, static_cast<Eigen::Index>(contacts_.size()));
+  for (std::size_t k = 0; k < contacts_.size(); ++k) {
+    const NodeContact<dim>& c = contacts_[k];
+    if (!(c.mu > 0)) continue;
+    const int i = c.node;
+    Vec<dim> f;
+    if (c.stuck) {
+      const Vec<dim> hold = -(m_[i] * Vec<dim>(contact_b_.col(static_cast<Eigen::Index>(k))) + tension_force_.col(i));
+      f = hold - c.normal.dot(hold) * c.normal;
+    } else {
+      f = -c.mu * contact_force_[k] * c.slide;
+      a_.col(i) += w_[i] * c.mu * c.normal.dot(tension_force_.col(i)) * c.slide;
+    }
+    contact_friction_.col(static_cast<Eigen::Index>(k)) = f;
+    external_ += f;
+  }
+}
+
+template <int dim>
+void StringModel<dim>::friction_couplings() {
+  // A sliding node responds with w (P + μ t̂ nᵀ): to contact_couplings' w P add μ w t̂ nᵀ, whose entries
+  // in its links' rows are −μ w (e·t̂)(n·e) on the diagonals and μ w (e·t̂)(n·e') across, not symmetric.
+  for (const NodeContact<dim>& c : contacts_) {
+    if (!(c.mu > 0) || c.stuck) continue;
+    const int i = c.node;
+    const auto [jm, jp] = node_links(i);
+    const int um = jm >= 0 ? link_unknown_[static_cast<std::size_t>(jm)] : -1;
+    const int up = jp >= 0 ? link_unknown_[static_cast<std::size_t>(jp)] : -1;
+    const double wmu = w_[i] * c.mu;
+    if (um >= 0) system_->add_diagonal(um, -wmu * e_.col(jm).dot(c.slide) * c.normal.dot(e_.col(jm)));
+    if (up >= 0) system_->add_diagonal(up, -wmu * e_.col(jp).dot(c.slide) * c.normal.dot(e_.col(jp)));
+    if (um >= 0 && up >= 0)
+      system_->add_couplings(um, wmu * e_.col(jm).dot(c.slide) * c.normal.dot(e_.col(jp)),
+                             wmu * e_.col(jp).dot(c.slide) * c.normal.dot(e_.col(jm)));
+  }
+}
+
+template <int dim>
+void StringModel<dim>::update_locked_links() {
+  if (!contact_stuck_) {
+    locked_.clear();
+    return;
+  }
+  const std::size_t L = static_cast<std::size_t>(chain_.num_links());
+  locked_.resize(L, 0);
+  locked_tension_.resize(L, 0.0);
+  last_tension_.resize(L, 0.0);
+  for (std::size_t j = 0; j < L; ++j) {
+    const bool now = w_[chain_.link_start(static_cast<int>(j))] == 0 && w_[chain_.link_end(static_cast<int>(j))] == 0;
+    if (now && !locked_[j]) locked_tension_[j] = last_tension_[j];
+    locked_[j] = now ? 1 : 0;
+  }
+}
+
+template <int dim>
+void StringModel<dim>::lock_stuck_links() {
+  for_each_link([&](int j, int u, int) {
+    if (!locked_[static_cast<std::size_t>(j)]) return;
+    system_->add_diagonal(u, -(1.0 / m_[chain_.link_start(j)] + 1.0 / m_[chain_.link_end(j)]));
+  });
+}
+
+template <int dim>
+void StringModel<dim>::locked_rhs() {
+  for_each_link([&](int j, int u, int) {
+    if (!locked_[static_cast<std::size_t>(j)]) return;
+    const double s = 1.0 / m_[chain_.link_start(j)] + 1.0 / m_[chain_.link_end(j)];
+    system_->rhs(u) = -s * locked_tension_[static_cast<std::size_t>(j)];
+  });
 }
 
 template <int dim>
 void StringModel<dim>::contact_couplings() {
   // Node i held with normal n: its response to a force f is w_i P f, P = I − n nᵀ. In the rows of its
   // links jm (ending at i) and jp (starting at i) the entries w_i e·e' become w_i (e·e' − (e·n)(e'·n)).
-  const int L = chain_.num_links();
   for (const NodeContact<dim>& c : contacts_) {
     const int i = c.node;
-    const int jm = i > 0 ? i - 1 : (chain_.closed() ? L - 1 : -1), jp = i < L ? i : -1;
+    const auto [jm, jp] = node_links(i);
     const int um = jm >= 0 ? link_unknown_[static_cast<std::size_t>(jm)] : -1;
     const int up = jp >= 0 ? link_unknown_[static_cast<std::size_t>(jp)] : -1;
     if (um >= 0) system_->add_diagonal(um, w_[i] * std::pow(e_.col(jm).dot(c.normal), 2));
@@ -383,13 +464,25 @@ void StringModel<dim>::contact_couplings() {
 template <int dim>
 void StringModel<dim>::constrain_contact_nodes() {
   contact_bn_.resize(contacts_.size());
+  if (contact_friction_on_) contact_b_.resize(dim, static_cast<Eigen::Index>(contacts_.size()));
   for (std::size_t k = 0; k < contacts_.size(); ++k) {
     const NodeContact<dim>& c = contacts_[k];
     const int i = c.node;
+    if (c.stuck) {
+      // Held completely: a_i = 0; its applied acceleration (w_i is 0 here) for the force that holds it.
+      const Vec<dim> bi = (force_.col(i) + force_nc(i) + module_force_.col(i)) / m_[i];
+      contact_bn_[k] = c.normal.dot(bi);
+      contact_b_.col(static_cast<Eigen::Index>(k)) = bi;
+      b_.col(i).setZero();
+      continue;
+    }
     // g'' = n·a + curvature = −2α g' − β² g: the surface's normal acceleration with the drift control.
     const double target = -c.curvature - 2 * alpha_ * c.normal.dot(v_.col(i)) - beta2_ * c.gap;
     contact_bn_[k] = c.normal.dot(b_.col(i));
+    if (contact_friction_on_) contact_b_.col(static_cast<Eigen::Index>(k)) = b_.col(i);
     b_.col(i) += (target - contact_bn_[k]) * c.normal;
+    // Sliding: the applied forces' share of the friction, −μ w N t̂ (the links' share is in the matrix).
+    if (c.mu > 0) b_.col(i) -= c.mu * (target - contact_bn_[k]) * c.slide;
   }
 }
 
@@ -401,6 +494,15 @@ double StringModel<dim>::place_contact_nodes() {
     worst = std::max(worst, std::abs(c.gap) / h_min_);
   }
   return worst;
+}
+
+template <int dim>
+double StringModel<dim>::friction_power() const {
+  double p = 0;
+  if (!contact_friction_on_) return p;
+  for (std::size_t k = 0; k < contacts_.size(); ++k)
+    p += contact_friction_.col(static_cast<Eigen::Index>(k)).dot(v_.col(contacts_[k].node));
+  return p;
 }
 
 template <int dim>
@@ -421,6 +523,15 @@ void StringModel<dim>::refresh() {
     if (slot_[i] >= 0) w_[i] = 1.0 / m_[i];
   contacts_.clear();
   module_->node_contacts(*this, contacts_);
+  contact_friction_on_ = contact_stuck_ = false;
+  for (const NodeContact<dim>& c : contacts_) {
+    if (c.mu > 0) contact_friction_on_ = true;
+    if (c.stuck) {
+      contact_stuck_ = true;
+      w_[c.node] = 0;  // held completely
+    }
+  }
+  if (contact_stuck_ || !locked_.empty()) update_locked_links();
 }
 
 template <int dim>
@@ -462,6 +573,7 @@ double StringModel<dim>::evaluate_current(double t) {
     links();
     system_->zero();
     assemble_matrix();
+    if (contact_friction_on_) friction_couplings();
     beta2_ = capped_beta2();  // the drift control's position term, capped (capped_beta2)
     if (!contacts_.empty()) constrain_contact_nodes();
     for_each_link([&](int j, int u, int) {
@@ -482,7 +594,12 @@ double StringModel<dim>::evaluate_current(double t) {
       system_->rhs(u) = -va.squaredNorm() / bend.l_minus - vb.squaredNorm() / bend.l_plus -
                         (ep.dot(b_.col(b)) - em.dot(b_.col(a))) - stab;
     }
+    if (contact_stuck_) locked_rhs();
     const Eigen::VectorXd& T = solve_tensions(t);
+    if (contact_friction_on_) {
+      last_tension_.resize(static_cast<std::size_t>(chain_.num_links()), 0.0);
+      for_each_link([&](int j, int u, int) { last_tension_[static_cast<std::size_t>(j)] = T[u]; });
+    }
     for_each_link([&](int j, int u, int) {
       tension_force_.col(chain_.link_start(j)) += T[u] * e_.col(j);
       tension_force_.col(chain_.link_end(j)) -= T[u] * e_.col(j);
@@ -525,6 +642,7 @@ double StringModel<dim>::evaluate_current(double t) {
       contact_force_[k] = m_[i] * (target - contact_bn_[k]) - fn;
       external_ += contact_force_[k] * c.normal;
     }
+    if (contact_friction_on_) contact_friction_forces();
   }
   return power;
 }
@@ -899,10 +1017,9 @@ void StringModel<dim>::add_link_responses(Points<dim>& target, const Eigen::Vect
   if (contacts_.empty()) return;
   // A held node responds with w_i P: take back the normal part of its response (the links at it
   // are the only ones that moved it, so its response is its links' terms above).
-  const int L = chain_.num_links();
   for (const NodeContact<dim>& c : contacts_) {
     const int i = c.node;
-    const int jm = i > 0 ? i - 1 : (chain_.closed() ? L - 1 : -1), jp = i < L ? i : -1;
+    const auto [jm, jp] = node_links(i);
     Vec<dim> response = Vec<dim>::Zero();
     if (jm >= 0 && link_unknown_[static_cast<std::size_t>(jm)] >= 0) response += nu[link_unknown_[static_cast<std::size_t>(jm)]] * e_.col(jm);
     if (jp >= 0 && link_unknown_[static_cast<std::size_t>(jp)] >= 0) response -= nu[link_unknown_[static_cast<std::size_t>(jp)]] * e_.col(jp);

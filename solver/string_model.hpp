@@ -297,6 +297,21 @@ class StringModel final : public OdeSystem {
   /// After an evaluation: Σ_k N_k n_k · v_k, the power of the contact forces (W; zero on the surface,
   /// up to the drift control).
   double contact_power() const;
+  /// After an evaluation: the friction force (N) of contacts()[k] on its node: −μ N t̂ while it
+  /// slides, the tangential force that holds it while it sticks, zero on a smooth obstacle.
+  Vec<dim> contact_friction(std::size_t k) const { return contact_friction_.col(static_cast<Eigen::Index>(k)); }
+  /// After an evaluation: Σ_k (friction force)·v_k, the power of friction (W, ≤ 0).
+  double friction_power() const;
+  /// After an evaluation, for a contact with friction: the applied force on its node, m_i b_i (N).
+  Vec<dim> contact_applied(std::size_t k) const {
+    return m_[contacts_[k].node] * Vec<dim>(contact_b_.col(static_cast<Eigen::Index>(k)));
+  }
+  /// A link between two nodes that cannot move (NodeContact::stuck, or prescribed) is locked: its
+  /// tension is statically indeterminate and kept at the value set here (by default the one it had
+  /// when it locked); the contact module chooses one inside the friction cones of its nodes.
+  bool link_locked(int j) const { return !locked_.empty() && locked_[static_cast<std::size_t>(j)] != 0; }
+  void set_locked_tension(int j, double T) { locked_tension_[static_cast<std::size_t>(j)] = T; }
+  double locked_tension(int j) const { return locked_tension_[static_cast<std::size_t>(j)]; }
   /// The sum of the uniform fields the forces declare (Force::uniform_field; gravity's g, zero
   /// without one): the weight per unit mass in the physical scales, and what the module books for
   /// material not lumped on nodes.
@@ -412,6 +427,27 @@ class StringModel final : public OdeSystem {
   // and n·b of their unconstrained accelerations (evaluate_current).
   std::vector<NodeContact<dim>> contacts_;
   std::vector<double> contact_force_, contact_bn_;
+  // Friction (contacts with μ > 0): the held nodes' unconstrained accelerations b_i and their friction
+  // forces after an evaluation; whether any contact has friction or sticks (refresh()).
+  Points<dim> contact_b_, contact_friction_;
+  bool contact_friction_on_ = false, contact_stuck_ = false;
+  /// evaluate_current, after assemble_matrix: the sliding nodes' responses w (P + μ t̂ nᵀ): the
+  /// non-symmetric part μ w (e·t̂)(n·e') of their links' rows (the projections keep w P).
+  void friction_couplings();
+  /// A link whose two nodes cannot move (stuck, or stuck and prescribed) is locked: its tension is
+  /// statically indeterminate, and it keeps the one it had when it locked (continuity in time). Its
+  /// row becomes −s T_j = −s T_lock (s = 1/m_a + 1/m_b): lock_stuck_links (assemble_matrix) writes
+  /// the diagonal, locked_rhs (evaluate_current) the right side; refresh() locks and unlocks.
+  std::vector<char> locked_;
+  std::vector<double> locked_tension_, last_tension_;
+  void lock_stuck_links();
+  void locked_rhs();
+  void update_locked_links();
+  /// The links ending at node i and starting at it (−1 where there is none).
+  std::pair<int, int> node_links(int i) const;
+  /// evaluate_current, after the contact forces: each friction node's force (contact_friction_) and
+  /// a sliding node's acceleration from its links' share of it.
+  void contact_friction_forces();
   /// evaluate_current: each held node's b_i becomes P b_i + c_i n (P = I − n nᵀ, c_i the normal
   /// acceleration the surface asks, with the drift control of its gap).
   void constrain_contact_nodes();

@@ -131,6 +131,14 @@ struct NodeContact {
   /// The gap's second derivative at zero acceleration (m/s²): |Q v|² − (n·v)² over the distance
   /// from a cylinder's axis (Q the projection normal to the axis), 0 for a plane.
   double curvature = 0;
+  /// Coulomb friction (docs/model.md §10, "Friction"): the obstacle's μ (0: smooth, and the two fields
+  /// below are unused). Sliding: the friction force is −μ N t̂, t̂ = `slide` (the unit tangential
+  /// direction of the node's motion), and the node's response becomes w (P + μ t̂ nᵀ). Sticking
+  /// (`stuck`): the node is held completely (inverse mass 0, acceleration 0), and the tangential
+  /// force that takes is StringModel::contact_friction.
+  double mu = 0;
+  Vec<dim> slide = Vec<dim>::Zero();
+  bool stuck = false;
 };
 
 /// What an event means.

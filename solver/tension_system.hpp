@@ -140,6 +140,13 @@ class TensionSystem {
     values_[next_slot_[u]] = value;
     values_[prev_slot_of_next_[u]] = value;
   }
+  /// Adds a non-symmetric coupling: A(u, v) += upper, A(v, u) += lower, v the next link of u's arc
+  /// (a sliding node's friction, docs/model.md §10). Every backend solves the non-symmetric system:
+  /// Thomas' algorithm and Sherman–Morrison read A(u, v) and A(v, u) apart, KLU and SparseLU are LU.
+  void add_couplings(int u, double upper, double lower) {
+    values_[next_slot_[u]] += upper;
+    values_[prev_slot_of_next_[u]] += lower;
+  }
   /// Right side b(u).
   double& rhs(int u) { return rhs_[u]; }
   /// Position of entry (row, col) in the value array.

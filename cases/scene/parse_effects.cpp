@@ -49,25 +49,29 @@ void parse_edges(const Section& effects, Context& ctx) {
   }
 }
 
+/// An obstacle's `mu`: Coulomb's coefficient of friction, finite and ≥ 0 (0, the default: smooth).
+double friction_coefficient(const Section& e) { return e.number_in("mu", 0.0, 0.0, INFINITY); }
+
 /// [[effects.surface]] and [[effects.cylinder]]: the rigid obstacles the string touches along arcs
 /// (solver/contact_module.hpp; their geometry is checked against the dimension in scene_parts.cpp).
 void parse_obstacles(const Section& effects, Context& ctx) {
   const auto surfaces = table_array(effects, "surface", "surface");
   for (std::size_t k = 0; k < surfaces.size(); ++k) {
-    Section e(*surfaces[k], fmt::format("effects.surface[{}]", k), ctx, {"point", "normal"});
+    Section e(*surfaces[k], fmt::format("effects.surface[{}]", k), ctx, {"point", "normal", "mu"});
     if (!e.has("point")) e.missing("point", "m, a point of the plane");
     if (!e.has("normal")) e.missing("normal", "a vector normal to the plane (any length > 0), pointing to the side the string is on");
-    ctx.spec.effects.surfaces.push_back(SurfaceEntry{e.vector("point"), e.vector("normal")});
+    ctx.spec.effects.surfaces.push_back(SurfaceEntry{e.vector("point"), e.vector("normal"), friction_coefficient(e)});
   }
   const auto cylinders = table_array(effects, "cylinder", "cylinder");
   for (std::size_t k = 0; k < cylinders.size(); ++k) {
-    Section e(*cylinders[k], fmt::format("effects.cylinder[{}]", k), ctx, {"center", "radius", "axis"});
+    Section e(*cylinders[k], fmt::format("effects.cylinder[{}]", k), ctx, {"center", "radius", "axis", "mu"});
     if (!e.has("center")) e.missing("center", "m, the centre of the circle (2D) or a point of the axis (3D)");
     if (!e.has("radius")) e.missing("radius", "m, > 0");
     CylinderEntry cylinder;
     cylinder.center = e.vector("center");
     cylinder.radius = *e.positive("radius");
     if (e.has("axis")) cylinder.axis = e.vector("axis");
+    cylinder.mu = friction_coefficient(e);
     ctx.spec.effects.cylinders.push_back(cylinder);
   }
 }

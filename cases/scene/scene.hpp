@@ -98,6 +98,7 @@ struct PlaneEntry {
 struct SurfaceEntry {
   std::vector<double> point;   ///< a point of the plane (m)
   std::vector<double> normal;  ///< its normal, towards the string's side (any length > 0)
+  double mu = 0;               ///< Coulomb's coefficient of friction (≥ 0; 0: smooth)
 };
 
 /// A rigid smooth cylinder (a circle in 2D): a pulley, a peg with a radius: [[effects.cylinder]].
@@ -105,6 +106,7 @@ struct CylinderEntry {
   std::vector<double> center;  ///< the centre (2D) or a point of the axis (3D) (m)
   double radius = 0;           ///< m, > 0
   std::optional<std::vector<double>> axis;  ///< 3D: the axis (any length > 0); 2D: not given
+  double mu = 0;                            ///< Coulomb's coefficient of friction (≥ 0; 0: smooth)
 };
 
 /// A stop event: [[stop.front]].

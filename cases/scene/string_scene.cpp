@@ -11,6 +11,23 @@ using scene_build::at_key;
 
 namespace {
 
+/// Friction does not meet unilateral links: the links' complementarity problem (block principal
+/// pivoting) needs the symmetric contact-reduced matrix, and a sliding node makes it non-symmetric.
+void refuse_friction_with_slack(const SceneSpec& spec) {
+  if (spec.solver.slack != "allow") return;
+  const auto& fx = spec.effects;
+  auto refuse = [&](const std::string& key, double mu) {
+    scene_build::fail_at(spec, key, fmt::format("{} = {:g} with solver.slack = \"allow\": friction does not meet "
+                                                "unilateral links (their complementarity problem needs the "
+                                                "symmetric tension matrix of smooth obstacles): allowed mu = 0, or "
+                                                "solver.slack = \"stop\"", key, mu));
+  };
+  for (std::size_t k = 0; k < fx.surfaces.size(); ++k)
+    if (fx.surfaces[k].mu > 0) refuse(fmt::format("effects.surface[{}].mu", k), fx.surfaces[k].mu);
+  for (std::size_t k = 0; k < fx.cylinders.size(); ++k)
+    if (fx.cylinders[k].mu > 0) refuse(fmt::format("effects.cylinder[{}].mu", k), fx.cylinders[k].mu);
+}
+
 /// The scene's obstacles (solver/contact_module.hpp), each checked at its key; and what they do not
 /// meet refused at the key at fault.
 template <int dim>
@@ -39,6 +56,7 @@ std::vector<Obstacle<dim>> contact_obstacles(const SceneSpec& spec) {
                                                   scene_build::text_of(spec, key), what));
     return Vec<dim>(u.normalized());
   };
+  refuse_friction_with_slack(spec);
   std::vector<Obstacle<dim>> obstacles;
   for (std::size_t k = 0; k < fx.surfaces.size(); ++k) {
     const std::string key = fmt::format("effects.surface[{}]", k);
@@ -47,6 +65,7 @@ std::vector<Obstacle<dim>> contact_obstacles(const SceneSpec& spec) {
     o.name = key;
     o.point = scene_build::as_vec<dim>(spec, fx.surfaces[k].point, key + ".point");
     o.normal = unit(fx.surfaces[k].normal, key + ".normal", "a normal");
+    o.mu = fx.surfaces[k].mu;
     obstacles.push_back(o);
   }
   for (std::size_t k = 0; k < fx.cylinders.size(); ++k) {
@@ -57,6 +76,7 @@ std::vector<Obstacle<dim>> contact_obstacles(const SceneSpec& spec) {
     o.name = key;
     o.point = scene_build::as_vec<dim>(spec, c.center, key + ".center");
     o.radius = c.radius;
+    o.mu = c.mu;
     if constexpr (dim == 3) {
       if (!c.axis) scene_build::fail_at(spec, key, fmt::format("{}.axis is missing: in 3D a cylinder needs its axis, a "
                                                                "finite nonzero vector [ax, ay, az]", key));
@@ -107,11 +127,14 @@ StringScene<dim> build_string_scene(const SceneSpec& spec) {
   if (spec.has_obstacles()) {
     // The obstacles as the run's summary (and stats.json, which the plot tool reads) lists them.
     nlohmann::json obstacles = nlohmann::json::array();
-    for (const SurfaceEntry& e : spec.effects.surfaces)
+    for (const SurfaceEntry& e : spec.effects.surfaces) {
       obstacles.push_back({{"kind", "surface"}, {"point", e.point}, {"normal", e.normal}});
+      if (e.mu > 0) obstacles.back()["mu"] = e.mu;
+    }
     for (const CylinderEntry& e : spec.effects.cylinders) {
       obstacles.push_back({{"kind", "cylinder"}, {"center", e.center}, {"radius", e.radius}});
       if (e.axis) obstacles.back()["axis"] = *e.axis;
+      if (e.mu > 0) obstacles.back()["mu"] = e.mu;
     }
     scene.description["obstacles"] = obstacles;
   }

@@ -5,7 +5,7 @@ Usage: /usr/bin/python3 docs/figures/make_scene_figures.py RESULTS_DIR
 where RESULTS_DIR/<scene>/ holds the outputs of
     build/chainsim run cases/scenes/<scene>.toml --out RESULTS_DIR/<scene>
 for shaken_chain, travelling_loop, whip_crack, pendulum_release, folded_chain_ends_apart, swinging_u,
-pendulum_whip and thrown_chain (string scenes; the last three with slack = "allow"), chain_off_table_edge and chain_over_peg (edges), atwood_pulley (a cylinder), chain_landing_at_angle (a surface) and
+pendulum_whip and thrown_chain (string scenes; the last three with slack = "allow"), chain_off_table_edge and chain_over_peg (edges), atwood_pulley and atwood_rough_pulley (cylinders), chain_landing_at_angle (a surface) and
 falling_chain, folded_chain, sliding_chain, swinging_sliding_chain, tilted_falling_chain and
 curved_falling_chain (scenes with fronts), and RESULTS_DIR/<scene>_reduced/ the same canonical scenes run with
 model = "reduced". docs/figures/run_scene_figures.sh RESULTS_DIR does all of it (and `chainsim plot` on each
@@ -228,6 +228,39 @@ def atwood_pulley(run, ax):
     decorate(ax[1], "t (s)", "m", "the wrapped half circle moves with the chain")
 
 
+def atwood_rough_pulley(run, ax):
+    snapshots(ax[0], run, [0, 0.2, 0.3, 0.4, 0.5], "heavy Atwood chain over a rough pulley, R = 0.1 m, mu = 0.1")
+    g, ell, R, mu, x1 = 9.81, 1.0, 0.1, 0.1, 0.45
+    x2 = ell - math.pi * R - x1
+    E, c = math.exp(mu * math.pi), 2 * mu / (1 + mu * mu)
+    frames = run.nodes
+    u = [(frames.positions(k)[0, 1] - frames.positions(k)[-1, 1]) / 2 for k in range(len(frames))]
+    X = np.asarray(u) - u[0]
+    ax[1].plot(frames.times, X, lw=2, alpha=0.7, label="X = displacement towards x1 (string solver)")
+
+    def acc(x, v, mu_, e_, c_):  # the capstan ODE of docs/model.md section 10 (sliding towards x1)
+        a1, a2 = x1 + x, x2 - x
+        if mu_ == 0:
+            return g * (a1 - a2) / ell
+        return (g * (a1 - e_ * a2 - R * c_ * (1 + e_)) + (e_ - 1) * v * v) / (a1 + e_ * a2 + R * (e_ - 1) / mu_)
+
+    # On a smooth pulley the shorter side would lift off at 0.352 s (docs/model.md section 10): drawn to there.
+    for mu_, e_, c_, t_end, style, label in [(mu, E, c, frames.times[-1], "k:", "capstan ODE (RK4)"),
+                                             (0.0, 1.0, 0.0, 0.352, "g--", "smooth pulley, to its lift-off at 0.352 s")]:
+        ts, xs, x, v, dt = [0.0], [0.0], 0.0, 0.0, t_end / 2000
+        for _ in range(2000):
+            k1 = (v, acc(x, v, mu_, e_, c_))
+            k2 = (v + dt / 2 * k1[1], acc(x + dt / 2 * k1[0], v + dt / 2 * k1[1], mu_, e_, c_))
+            k3 = (v + dt / 2 * k2[1], acc(x + dt / 2 * k2[0], v + dt / 2 * k2[1], mu_, e_, c_))
+            k4 = (v + dt * k3[1], acc(x + dt * k3[0], v + dt * k3[1], mu_, e_, c_))
+            x += dt / 6 * (k1[0] + 2 * k2[0] + 2 * k3[0] + k4[0])
+            v += dt / 6 * (k1[1] + 2 * k2[1] + 2 * k3[1] + k4[1])
+            ts.append(ts[-1] + dt)
+            xs.append(x)
+        ax[1].plot(ts, xs, style, lw=1.5, label=label)
+    decorate(ax[1], "t (s)", "m", "beyond the capstan bound (x1 = 0.45 m > 0.4161 m) it slides")
+
+
 def chain_landing_at_angle(run, ax):
     snapshots(ax[0], run, [0, 0.1, 0.15, 0.2, 0.25, 0.3], 'chain landing at 20 deg on a smooth table, slack = "allow"')
     g = 9.81
@@ -271,7 +304,7 @@ def thrown_chain(run, ax):
 SCENES = [shaken_chain, travelling_loop, whip_crack, pendulum_release, falling_chain, folded_chain, sliding_chain,
           swinging_sliding_chain, tilted_falling_chain, curved_falling_chain, folded_chain_ends_apart,
           chain_off_table_edge, swinging_u, pendulum_whip, thrown_chain, chain_over_peg, atwood_pulley,
-          chain_landing_at_angle]
+          atwood_rough_pulley, chain_landing_at_angle]
 
 
 def main():

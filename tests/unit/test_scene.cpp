@@ -257,9 +257,13 @@ TEST_CASE("the example scenes parse, run and close their energy ledger", "[unit]
       continue;
     }
     if (spec.has_obstacles()) {
-      // Contact along arcs (docs/model.md §10): two root functions (landing, lift-off), W_impacts booked.
-      // Measured relative drift 1.3e-10 (atwood_pulley), 9e-17 (chain_landing_on_table); momentum <= 3e-15.
-      CHECK(s.root_functions == 2);
+      // Contact along arcs (docs/model.md §10): two root functions (landing, lift-off), W_impacts booked;
+      // with friction two more (stop, slip), W_friction booked. Measured relative drift 1.3e-10
+      // (atwood_pulley), 9e-17 (chain_landing_on_table), 3.3e-11 (atwood_rough_pulley); momentum <= 3e-15.
+      bool rough = false;
+      for (const SurfaceEntry& e : spec.effects.surfaces) rough = rough || e.mu > 0;
+      for (const CylinderEntry& e : spec.effects.cylinders) rough = rough || e.mu > 0;
+      CHECK(s.root_functions == (rough ? 4 : 2));
       CHECK(s.relative_energy_drift() < 2e-9);
       CHECK(s.relative_momentum_residual() < 1e-12);
       CHECK(s.max_constraint_violation < 1e-8);

@@ -424,6 +424,16 @@ TEST_CASE("solver.slack and solver.max_wall_s are parsed and checked, and check_
       {"obstacles with an implicit method", kBase + "[[effects.cylinder]]\ncenter = [0.5, -0.5]\nradius = 0.1\n[solver]\nmethod = \"dirk3\"\n",
        "s.toml:22:10: solver.method = \"dirk3\" is implicit, and implicit methods do not meet obstacles (their Newton "
        "systems know no contact): allowed an explicit method (\"auto\", \"erk5\", \"erk8\", ...)"},
+      {"a negative mu", kBase + "[[effects.cylinder]]\ncenter = [0.5, -0.5]\nradius = 0.1\nmu = -0.2\n",
+       "s.toml:21:6: effects.cylinder[0].mu = -0.2 is out of range: allowed mu >= 0"},
+      {"an infinite mu", kBase + "[[effects.surface]]\npoint = [0.0, -2.0]\nnormal = [0.0, 1.0]\nmu = inf\n",
+       "s.toml:21:6: effects.surface[0].mu = inf must be a finite number"},
+      {"a mu that is not a number", kBase + "[[effects.surface]]\npoint = [0.0, -2.0]\nnormal = [0.0, 1.0]\nmu = nan\n",
+       "s.toml:21:6: effects.surface[0].mu = nan must be a finite number"},
+      {"friction with slack = allow", kBase + "[[effects.cylinder]]\ncenter = [0.5, -0.5]\nradius = 0.1\nmu = 0.3\n[solver]\nslack = \"allow\"\n",
+       "s.toml:21:6: effects.cylinder[0].mu = 0.3 with solver.slack = \"allow\": friction does not meet unilateral links "
+       "(their complementarity problem needs the symmetric tension matrix of smooth obstacles): allowed mu = 0, or "
+       "solver.slack = \"stop\""},
       {"no wall time", kBase + "\n[solver]\nmax_wall_s = 0\n",
        "s.toml:20:14: solver.max_wall_s = 0 is out of range: allowed max_wall_s > 0"},
       {"a negative wall time", kBase + "\n[solver]\nmax_wall_s = -5.0\n",
