@@ -17,6 +17,12 @@
 ///     the drift control's share), W_impacts (J, ≤ 0: the kinetic energy the landings took) and the
 ///     impulse of all external forces (the momentum ledger p − p0 − impulse, closed across impacts);
 ///   - the recorded quantities impacts and lift_offs (series.csv): how many landings and lift-offs.
+/// A string with fronts (heaps, folds, edges) keeps its front tracker: this module wraps it
+/// (wrapping_module.hpp), passes its layout, masses, forces, ledgers, events and fronts through, and
+/// adds the held nodes, its ledgers and root functions after the tracker's (docs/model.md §10, "Contact
+/// with fronts"). A plane may end at an edge front (a table and its edge): it then holds only the nodes
+/// on the table's side of the edge in the material (Obstacle::carries), and only where it exists.
+#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
@@ -35,6 +41,15 @@ struct Obstacle {
   Vec<dim> axis = Vec<dim>::Zero();    ///< cylinder in 3D: its unit axis (unused in 2D)
   double radius = 0;                   ///< cylinder (m)
   std::string name;                    ///< for messages: "effects.surface[0]"
+  /// A plane bounded by an edge (a table): the unit direction in the plane, normal to the edge's line,
+  /// from the edge (at `point`) into the table; zero for an unbounded plane. Beyond the edge there is
+  /// no surface: gap() is the distance from the edge's line there.
+  Vec<dim> inward = Vec<dim>::Zero();
+  Vec<dim> edge_axis = Vec<dim>::Zero();  ///< a bounded plane in 3D: its edge's unit line (zero in 2D)
+  /// Which nodes the obstacle may hold (all when empty): a table bounded by an edge front holds the
+  /// nodes on its side of the edge in the material (the front moves a node across when it passes).
+  std::function<bool(int node)> carries;
+  bool may_hold(int node) const { return !carries || carries(node); }
   /// The signed distance of x from the surface (m), > 0 outside, its outward unit normal there, and
   /// the gap's second derivative at zero acceleration for a velocity v (m/s²).
   double gap(const Vec<dim>& x) const;
@@ -42,10 +57,12 @@ struct Obstacle {
   double curvature(const Vec<dim>& x, const Vec<dim>& v) const;
 };
 
-/// The contact module of `obstacles` (non-empty). A node that starts within kInitialContact of its
-/// length h from a surface is held on it; one further inside is refused (InputError).
+/// The contact module of `obstacles` (non-empty) around `inner`, the fronts' module (nullptr: a string
+/// without fronts). A node that starts within kInitialContact of its length h from a surface is held
+/// on it; one further inside is refused (InputError).
 template <int dim>
-std::unique_ptr<StringModule<dim>> make_contact_module(std::vector<Obstacle<dim>> obstacles);
+std::unique_ptr<StringModule<dim>> make_contact_module(std::vector<Obstacle<dim>> obstacles,
+                                                       std::unique_ptr<StringModule<dim>> inner = nullptr);
 
 /// A node this share of a link length from a surface at the start is on it (the discretized shape is
 /// a polygon inscribed in a curved one); further inside, the scene is refused.

@@ -9,18 +9,9 @@ namespace chainsim {
 
 using scene_build::at_key;
 
-namespace {
-
-/// The scene's obstacles (solver/contact_module.hpp), each checked at its key; and what they do not
-/// meet refused at the key at fault.
 template <int dim>
 std::vector<Obstacle<dim>> contact_obstacles(const SceneSpec& spec) {
   const auto& fx = spec.effects;
-  const std::string first = fx.surfaces.empty() ? "effects.cylinder[0]" : "effects.surface[0]";
-  if (spec.has_fronts())
-    scene_build::fail_at(spec, first, "[[effects.surface]] and [[effects.cylinder]] do not meet fronts (heaps, folds, "
-                                      "edges) yet: allowed in a scene without [[effects.heap]], [effects.fold] and "
-                                      "[[effects.edge]]");
   if (spec.elements == "quadratic")
     scene_build::fail_at(spec, "string.elements", "string.elements = \"quadratic\" does not meet obstacles: allowed "
                                                   "\"links\" (the contact holds nodes)");
@@ -68,7 +59,24 @@ std::vector<Obstacle<dim>> contact_obstacles(const SceneSpec& spec) {
     }
     obstacles.push_back(o);
   }
+  if (fx.plane && fx.plane->surface) {
+    // The heaps' plane as a surface too (a chain falling onto a table: its heap and its landings).
+    Obstacle<dim> o;
+    o.kind = Obstacle<dim>::Kind::kPlane;
+    o.name = "effects.plane";
+    o.point = scene_build::as_vec<dim>(spec, fx.plane->point, "effects.plane.point");
+    o.normal = unit(fx.plane->normal, "effects.plane.normal", "a normal");
+    obstacles.push_back(o);
+  }
   return obstacles;
+}
+
+namespace {
+
+/// The key a refusal of the contact module's initial layout is located at.
+std::string obstacle_key(const SceneSpec& spec) {
+  if (!spec.effects.surfaces.empty()) return "effects.surface";
+  return spec.effects.cylinders.empty() ? "effects.plane" : "effects.cylinder";
 }
 
 }  // namespace
@@ -95,7 +103,7 @@ StringScene<dim> build_string_scene(const SceneSpec& spec) {
     std::unique_ptr<StringModule<dim>> contact;
     if (spec.has_obstacles()) {
       contact = make_contact_module<dim>(contact_obstacles<dim>(spec));
-      fit_key = spec.effects.surfaces.empty() ? "effects.cylinder" : "effects.surface";
+      fit_key = obstacle_key(spec);
     }
     scene.model = at_key(spec, fit_key, [&] {
       auto model = std::make_unique<StringModel<dim>>(std::move(parts.chain), std::move(parts.forces),
@@ -107,12 +115,17 @@ StringScene<dim> build_string_scene(const SceneSpec& spec) {
   if (spec.has_obstacles()) {
     // The obstacles as the run's summary (and stats.json, which the plot tool reads) lists them.
     nlohmann::json obstacles = nlohmann::json::array();
-    for (const SurfaceEntry& e : spec.effects.surfaces)
+    for (const SurfaceEntry& e : spec.effects.surfaces) {
       obstacles.push_back({{"kind", "surface"}, {"point", e.point}, {"normal", e.normal}});
+      if (e.edge) obstacles.back()["edge"] = fmt::format("edge{}", *e.edge);
+    }
     for (const CylinderEntry& e : spec.effects.cylinders) {
       obstacles.push_back({{"kind", "cylinder"}, {"center", e.center}, {"radius", e.radius}});
       if (e.axis) obstacles.back()["axis"] = *e.axis;
     }
+    if (spec.effects.plane && spec.effects.plane->surface)
+      obstacles.push_back({{"kind", "surface"}, {"point", spec.effects.plane->point},
+                           {"normal", spec.effects.plane->normal}, {"plane", true}});
     scene.description["obstacles"] = obstacles;
   }
   // The model's part of the description, read back from it as the run's summary reads it.
@@ -122,6 +135,8 @@ StringScene<dim> build_string_scene(const SceneSpec& spec) {
   return scene;
 }
 
+template std::vector<Obstacle<2>> contact_obstacles<2>(const SceneSpec&);
+template std::vector<Obstacle<3>> contact_obstacles<3>(const SceneSpec&);
 template StringScene<2> build_string_scene<2>(const SceneSpec&);
 template StringScene<3> build_string_scene<3>(const SceneSpec&);
 
