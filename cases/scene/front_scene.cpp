@@ -209,7 +209,10 @@ std::unique_ptr<StringModel<dim>> build_front_model(const SceneSpec& spec, scene
     hs.dissipation = heap.dissipation;
     hs.pot = heap.pot;
     hs.s0 = heap.s0;
-    if (heap.on_plane) hs.plane_normal = *plane_normal;
+    if (heap.on_plane) {
+      hs.plane_normal = *plane_normal;
+      hs.plane_surface = fx.plane->surface;
+    }
     heaps.push_back(hs);
   }
   if (plane_normal) {
