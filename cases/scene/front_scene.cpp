@@ -111,13 +111,17 @@ TableSide<dim> table_side(const SceneSpec& spec, std::size_t k, const EdgeSpec<d
   const Vec<dim> tm = (curve.point(edge.s0) - curve.point(edge.s0 - d)).normalized();
   const Vec<dim> tp = (curve.point(edge.s0 + d) - curve.point(edge.s0)).normalized();
   const bool on_before = std::abs(tm.dot(n)) <= kFoldAngleTolerance, on_after = std::abs(tp.dot(n)) <= kFoldAngleTolerance;
+  auto shown = [](Vec<dim> v) {  // the tangents of a polyline, without the round-off of their differences
+    for (int c = 0; c < dim; ++c)
+      if (std::abs(v[c]) < 1e-9) v[c] = 0;
+    return show<dim>(v);
+  };
   if (on_before == on_after)
     fail_at(spec, key + ".edge",
-            fmt::format("{}.edge = {}: the string {} the surface on both sides of {} (tangents {} before it, {} after "
+            fmt::format("{}.edge = {}: the string lies along the surface on {} of {} (tangents {} before it, {} after "
                         "it, normal {}); allowed a table the string lies along on one side of its edge and leaves on "
                         "the other",
-                        key, e, on_before ? "lies along" : "does not lie along", edge_key, show<dim>(tm),
-                        show<dim>(tp), show<dim>(n)));
+                        key, e, on_before ? "both sides" : "neither side", edge_key, shown(tm), shown(tp), shown(n)));
   // The other side turns to the table's far side of its plane (it hangs below the table).
   const double other = on_before ? tp.dot(n) : -tm.dot(n);
   if (!(other < 0))

@@ -236,3 +236,45 @@ t_end = 0.25
   CHECK(run.relative_energy_drift() < 1e-10);
   CHECK(run.relative_momentum_residual() < 1e-10);
 }
+
+TEST_CASE("table and edge: inconsistent tables are refused at their keys, file:line", "[unit][scene][contact]") {
+  const std::string base = real_table_scene(41, "");
+  auto with = [&](const std::string& from, const std::string& to) {
+    std::string text = base;
+    const std::size_t at = text.find(from);
+    REQUIRE(at != std::string::npos);
+    return text.replace(at, from.size(), to);
+  };
+  auto error_of = [](const std::string& text) -> std::string {
+    try {
+      build_string_scene<2>(parse_scene_text(text, "s.toml"));
+    } catch (const InputError& e) {
+      return e.what();
+    }
+    return "";
+  };
+  CHECK(error_of(base).empty());
+  // [[effects.surface]] is on lines 13-16 of the base: point 14, normal 15, edge 16; [[effects.edge]] 11-12.
+  CHECK(error_of(with("edge = 0", "edge = 1")) == "s.toml:16:8: effects.surface[0].edge = 1 is out of range: allowed 0 <= edge <= 0");
+  CHECK(error_of(with("[[effects.edge]]\npoint = [0.0, 0.0]\n", "")) ==
+        "s.toml:14:8: effects.surface[0].edge = 0 names an [[effects.edge]], and the scene has none: allowed only with "
+        "[[effects.edge]] (the index of the edge the table ends at, 0 for the first)");
+  CHECK(error_of(with("edge = 0\n", "edge = 0\n[[effects.surface]]\npoint = [0.0, 0.0]\nnormal = [0.0, 1.0]\nedge = 0\n")) ==
+        "s.toml:20:8: effects.surface[1].edge = 0: effects.surface[0] already ends at effects.edge[0]; allowed one table "
+        "per edge");
+  CHECK(error_of(with("point = [0.0, 0.0]\nnormal", "point = [0.0, 0.01]\nnormal")) ==
+        "s.toml:14:9: effects.surface[0].point = [0.0, 0.01]: the surface passes 0.01 m from the point of effects.edge[0] "
+        "it ends at; allowed within 1e-06 m (1e-6 of the string's length): the table's plane goes through its edge");
+  CHECK(error_of(with("normal = [0.0, 1.0]", "normal = [0.0, -1.0]")) ==
+        "s.toml:15:10: effects.surface[0].normal = [0.0, -1.0]: the string leaves the table at effects.edge[0] towards "
+        "the side the normal points to; the normal points away from the table, to the side the string lies on, and the "
+        "string past the edge turns down, over the edge");
+  CHECK(error_of(with("normal = [0.0, 1.0]", "normal = [1.0, 1.0]")) ==
+        "s.toml:16:8: effects.surface[0].edge = 0: the string lies along the surface on neither side of "
+        "effects.edge[0] (tangents [1, 0] before it, [0, -1] after it, normal [0.707107, 0.707107]); allowed a table the "
+        "string lies along on one side of its edge and leaves on the other");
+  CHECK(error_of(with("point = [0.0, 0.0]\n[[effects.surface]]", "point = [0.0, 0.0]\ntable = \"before\"\n[[effects.surface]]")) ==
+        "s.toml:13:9: effects.edge[0].table = \"before\" holds the table's part of the string with a known load, and "
+        "effects.surface[0].edge = 0 makes that table a contact surface: allowed table = \"none\" with a surface that ends "
+        "at the edge (or no surface)");
+}
