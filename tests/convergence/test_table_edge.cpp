@@ -22,6 +22,7 @@
 #include "cases/canonical/edge_case.hpp"
 #include "cases/reduced/exact_solutions.hpp"
 #include "cases/scene/scene.hpp"
+#include "cases/scene/scene_json.hpp"
 #include "solver/string_solver.hpp"
 
 using namespace chainsim;
@@ -277,4 +278,38 @@ TEST_CASE("table and edge: inconsistent tables are refused at their keys, file:l
         "s.toml:13:9: effects.edge[0].table = \"before\" holds the table's part of the string with a known load, and "
         "effects.surface[0].edge = 0 makes that table a contact surface: allowed table = \"none\" with a surface that ends "
         "at the edge (or no surface)");
+}
+
+TEST_CASE("table and edge: a surface's edge and a plane's surface are written back to scene_effective",
+          "[unit][scene][contact]") {
+  std::string text = real_table_scene(41, "");
+  const SceneSpec spec = parse_scene_text(text, "s.toml");
+  const nlohmann::json effective = scene_to_json(spec);
+  CHECK(effective["effects"]["surface"][0]["edge"] == 0);
+  const std::string heap = R"(model = "string"
+[string]
+length = 1.0
+nodes = 21
+[shape]
+kind = "polyline"
+points = [[0.0, 1.0], [0.0, 0.0]]
+[effects.gravity]
+g = [0.0, -9.81]
+[[effects.heap]]
+side = "end"
+s0 = 1.0
+point = [0.0, 0.0]
+on_plane = true
+[effects.plane]
+point = [0.0, 0.0]
+normal = [0.0, 1.0]
+surface = true
+[stop]
+t_end = 0.1
+)";
+  const nlohmann::json plane = scene_to_json(parse_scene_text(heap, "h.toml"));
+  CHECK(plane["effects"]["plane"]["surface"] == true);
+  std::string plain = heap;
+  plain.replace(plain.find("surface = true\n"), 15, "");
+  CHECK(!scene_to_json(parse_scene_text(plain, "h2.toml"))["effects"]["plane"].contains("surface"));
 }
