@@ -313,3 +313,42 @@ t_end = 0.1
   plain.replace(plain.find("surface = true\n"), 15, "");
   CHECK(!scene_to_json(parse_scene_text(plain, "h2.toml"))["effects"]["plane"].contains("surface"));
 }
+
+TEST_CASE("table and edge: in 3D, a table ending at an edge's line", "[contact][edge]") {
+  // The same chain in the plane z = 0.1, the edge's line along z, the table y = 0 given through a point
+  // away from the edge along its line: the lift-off of the edge at exact::edge_time(x*).
+  const std::string text = R"(model = "string"
+[string]
+length = 1.0
+nodes = 41
+dimension = 3
+[shape]
+kind = "polyline"
+points = [[-0.8, 0.0, 0.1], [0.0, 0.0, 0.1], [0.0, -0.2, 0.1]]
+[effects.gravity]
+g = [0.0, -9.81, 0.0]
+[[effects.edge]]
+point = [0.0, 0.0, 0.1]
+direction = [0.0, 0.0, 2.0]
+[[effects.surface]]
+point = [0.0, 0.0, 5.0]
+normal = [0.0, 1.0, 0.0]
+edge = 0
+[solver]
+method = "erk5"
+rtol = 1e-9
+atol = 1e-11
+[stop]
+t_end = 2.0
+)";
+  StringScene<3> scene = build_string_scene<3>(parse_scene_text(text, "t3d.toml"));
+  StringSolver<3> solver(*scene.model, scene.solver);
+  solver.run();
+  const RunSummary& run = solver.summary();
+  REQUIRE(run.status == "stopped");
+  REQUIRE(run.events.size() == 1);
+  const double t_star = exact::edge_time(0.0, exact::edge_lift_off_x(0.0, 0.2, 1.0, kG), 0.2, 1.0, kG);
+  CHECK(std::abs(run.events[0].t - t_star) < 1e-7);
+  CHECK(run.relative_energy_drift() < 1e-10);
+  CHECK(run.relative_momentum_residual() < 1e-10);
+}
