@@ -402,6 +402,11 @@ std::unique_ptr<StringModel<dim>> build_front_model(const SceneSpec& spec, scene
     }
   });
   scene.front_names = ordered_names;
+  for (const TableSide<dim>& table : tables) {  // where each table ends (the plot tool draws it up to there)
+    nlohmann::json& o = d["obstacles"][table.surface];
+    o["edge_point"] = to_array<dim>(edges[table.edge].point);
+    o["inward"] = to_array<dim>(table.inward);
+  }
   d["fronts"] = nlohmann::json::array();
   for (std::size_t k = 0; k < ordered_names.size(); ++k) {
     const FrontKind<dim>& front = *kind_of[k];

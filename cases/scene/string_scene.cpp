@@ -91,6 +91,23 @@ StringScene<dim> build_string_scene(const SceneSpec& spec) {
   scene.output = spec.output.select;
   scene.description = {{"model", "string"}, {"fronts", nlohmann::json::array()}, {"num_fronts", 0}};
 
+  if (spec.has_obstacles()) {
+    // The obstacles as the run's summary (and stats.json, which the plot tool reads) lists them (a table
+    // that ends at an edge: build_front_model adds where it ends, edge_point and inward).
+    nlohmann::json obstacles = nlohmann::json::array();
+    for (const SurfaceEntry& e : spec.effects.surfaces) {
+      obstacles.push_back({{"kind", "surface"}, {"point", e.point}, {"normal", e.normal}});
+      if (e.edge) obstacles.back()["edge"] = fmt::format("edge{}", *e.edge);
+    }
+    for (const CylinderEntry& e : spec.effects.cylinders) {
+      obstacles.push_back({{"kind", "cylinder"}, {"center", e.center}, {"radius", e.radius}});
+      if (e.axis) obstacles.back()["axis"] = *e.axis;
+    }
+    if (spec.effects.plane && spec.effects.plane->surface)
+      obstacles.push_back({{"kind", "surface"}, {"point", spec.effects.plane->point},
+                           {"normal", spec.effects.plane->normal}, {"plane", true}});
+    scene.description["obstacles"] = obstacles;
+  }
   if (spec.has_fronts()) {
     scene.model = build_front_model<dim>(spec, parts, scene);
   } else {
@@ -111,22 +128,6 @@ StringScene<dim> build_string_scene(const SceneSpec& spec) {
       model->make_consistent(0.0);
       return model;
     });
-  }
-  if (spec.has_obstacles()) {
-    // The obstacles as the run's summary (and stats.json, which the plot tool reads) lists them.
-    nlohmann::json obstacles = nlohmann::json::array();
-    for (const SurfaceEntry& e : spec.effects.surfaces) {
-      obstacles.push_back({{"kind", "surface"}, {"point", e.point}, {"normal", e.normal}});
-      if (e.edge) obstacles.back()["edge"] = fmt::format("edge{}", *e.edge);
-    }
-    for (const CylinderEntry& e : spec.effects.cylinders) {
-      obstacles.push_back({{"kind", "cylinder"}, {"center", e.center}, {"radius", e.radius}});
-      if (e.axis) obstacles.back()["axis"] = *e.axis;
-    }
-    if (spec.effects.plane && spec.effects.plane->surface)
-      obstacles.push_back({{"kind", "surface"}, {"point", spec.effects.plane->point},
-                           {"normal", spec.effects.plane->normal}, {"plane", true}});
-    scene.description["obstacles"] = obstacles;
   }
   // The model's part of the description, read back from it as the run's summary reads it.
   RunSummary built;
