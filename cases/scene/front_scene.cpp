@@ -137,6 +137,11 @@ TableSide<dim> table_side(const SceneSpec& spec, std::size_t k, const EdgeSpec<d
   side.inward = on_before ? Vec<dim>(-tm) : tp;
   if constexpr (dim == 3) side.inward -= side.inward.dot(edge.axis) * edge.axis;
   side.inward -= side.inward.dot(n) * n;
+  if (!(side.inward.norm() > kFoldAngleTolerance))
+    fail_at(spec, key + ".edge",
+            fmt::format("{}.edge = {}: the string on the table runs along the line of {} (tangent {}): allowed a table "
+                        "the string crosses the edge's line from",
+                        key, e, edge_key, shown(on_before ? tm : tp)));
   side.inward.normalize();
   return side;
 }

@@ -351,4 +351,15 @@ t_end = 2.0
   CHECK(std::abs(run.events[0].t - t_star) < 1e-7);
   CHECK(run.relative_energy_drift() < 1e-10);
   CHECK(run.relative_momentum_residual() < 1e-10);
+  // A table part that runs along the edge's line has no side of the line to lie on: refused.
+  std::string along = text;
+  along.replace(along.find("[[-0.8, 0.0, 0.1]"), 17, "[[0.0, 0.0, -0.7]");
+  try {
+    build_string_scene<3>(parse_scene_text(along, "t3d.toml"));
+    FAIL("a table along its edge's line was not refused");
+  } catch (const InputError& e) {
+    CHECK(std::string(e.what()) == "t3d.toml:17:8: effects.surface[0].edge = 0: the string on the table runs along the "
+                                   "line of effects.edge[0] (tangent [0, 0, 1]): allowed a table the string crosses the "
+                                   "edge's line from");
+  }
 }
