@@ -340,7 +340,25 @@ std::optional<RunEvent> EdgeFront<dim>::check_event(const StringModel<dim>& mode
   return e;
 }
 
+template <int dim>
+Obstacle<dim> edge_table(const EdgeFront<dim>& edge, const Vec<dim>& normal, const Vec<dim>& inward, bool before,
+                         const Vec<dim>& edge_axis, std::string name) {
+  Obstacle<dim> o;
+  o.kind = Obstacle<dim>::Kind::kPlane;
+  o.name = std::move(name);
+  o.point = edge.point();
+  o.normal = normal;
+  o.inward = inward;
+  o.edge_axis = edge_axis;
+  const EdgeFront<dim>* front = &edge;
+  o.carries = before ? std::function<bool(int)>([front](int i) { return i <= front->link(); })
+                     : std::function<bool(int)>([front](int i) { return i > front->link(); });
+  return o;
+}
+
 template class EdgeFront<2>;
 template class EdgeFront<3>;
+template Obstacle<2> edge_table<2>(const EdgeFront<2>&, const Vec<2>&, const Vec<2>&, bool, const Vec<2>&, std::string);
+template Obstacle<3> edge_table<3>(const EdgeFront<3>&, const Vec<3>&, const Vec<3>&, bool, const Vec<3>&, std::string);
 
 }  // namespace chainsim

@@ -25,6 +25,7 @@
 #include <string>
 
 #include "shocks/front_kind.hpp"
+#include "solver/contact_module.hpp"
 
 namespace chainsim {
 
@@ -115,5 +116,15 @@ class EdgeFront final : public FrontKind<dim> {
   Vec<dim> t_minus_ = Vec<dim>::Zero(), t_plus_ = Vec<dim>::Zero();
   double jump_ = 0;
 };
+
+/// A table that ends at `edge` (docs/model.md §10, "A table bounded by its edge"): the plane through the
+/// edge's point with the outward unit normal `normal`, existing only on the side `inward` (a unit
+/// direction in the plane, normal to the edge's line, from the edge into the table), holding the nodes
+/// on the table's side of the edge in the material (before it: s < s0; else after it) — the side the
+/// edge front's bent link leaves them on. The contact module holds them (make_contact_module, with the
+/// edge's front tracker as its inner module); the edge keeps its table = kNone. `edge` must outlive it.
+template <int dim>
+Obstacle<dim> edge_table(const EdgeFront<dim>& edge, const Vec<dim>& normal, const Vec<dim>& inward, bool before,
+                         const Vec<dim>& edge_axis, std::string name);
 
 }  // namespace chainsim

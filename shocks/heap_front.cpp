@@ -186,6 +186,7 @@ HeapFront<dim>::HeapFront(const HeapSpec<dim>& spec)
   this->expected_s0 = spec.s0;
   if (spec.plane_normal) {
     on_plane_ = true;
+    plane_surface_ = spec.plane_surface;
     normal_ = *spec.plane_normal;  // checked and made unit in cut(), after the layout's own checks
   }
 }
@@ -288,7 +289,7 @@ void HeapFront<dim>::evaluate(const StringModel<dim>& model, FrontState<dim>& s,
       last_curvature_ = geo.curvature;
     }
     for (const ArcRange& arc : model.arcs())
-      for (int i = arc.first; i <= arc.last; ++i)
+      for (int i = arc.first; i <= arc.last && !plane_surface_; ++i)
         if (normal_.dot(x.col(i) - point_) < 0)
           throw RecoverableError(fmt::format("node {} has gone through the heap's plane away from the contact", i));
   }

@@ -25,6 +25,10 @@ struct HeapSpec {
   /// It draws material at τ = (1 + f) λ v² and loses (½ + f) λ v³ ≥ 0 (jump::heap_shock_power). A pinned pot
   /// has a mouth: the nodes it gives out leave along the direction the initial string leaves its point in.
   bool pot = false;
+  /// A heap on a plane that is also a contact surface of the string ([effects.plane] surface = true;
+  /// solver/contact_module.hpp): a node that reaches the plane away from the contact lands on it (the
+  /// contact module's event) rather than being refused as gone through it.
+  bool plane_surface = false;
 };
 
 /// Throws InputError unless the heap's f is allowed: 0 ≤ f ≤ 1, or −½ ≤ f ≤ 1 for a pot, which must
@@ -77,6 +81,7 @@ class HeapFront final : public FrontKind<dim> {
   double s0_ = 0;
   Vec<dim> point_ = Vec<dim>::Zero();
   bool on_plane_ = false;
+  bool plane_surface_ = false;  ///< the plane is a contact surface: other nodes land on it
   Vec<dim> normal_ = Vec<dim>::Zero();
   Vec<dim> last_direction_ = Vec<dim>::Zero();  ///< on a plane, once the arc has no full link left:
                                                 ///< the direction its partial link keeps

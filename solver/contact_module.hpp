@@ -23,6 +23,12 @@
 ///     the node sticks if the force that holds it is inside the cone, |F_t| ≤ μ N) and the smallest
 ///     μ N − |F_t| of a stuck node (a slip); the ledger W_friction (J, ≤ 0) and the quantities sticks
 ///     and slips. Without friction none of this exists: the module is the smooth one, bit for bit.
+/// A string with fronts (heaps, folds, edges) keeps its front tracker: this module wraps it
+/// (wrapping_module.hpp), passes its layout, masses, forces, ledgers, events and fronts through, and
+/// adds the held nodes, its ledgers and root functions after the tracker's (docs/model.md §10, "Contact
+/// with fronts"). A plane may end at an edge front (a table and its edge): it then holds only the nodes
+/// on the table's side of the edge in the material (Obstacle::carries), and only where it exists.
+#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
@@ -42,6 +48,15 @@ struct Obstacle {
   double radius = 0;                   ///< cylinder (m)
   double mu = 0;                       ///< Coulomb's coefficient of friction (≥ 0; 0: smooth)
   std::string name;                    ///< for messages: "effects.surface[0]"
+  /// A plane bounded by an edge (a table): the unit direction in the plane, normal to the edge's line,
+  /// from the edge (at `point`) into the table; zero for an unbounded plane. Beyond the edge there is
+  /// no surface: gap() is the distance from the edge's line there.
+  Vec<dim> inward = Vec<dim>::Zero();
+  Vec<dim> edge_axis = Vec<dim>::Zero();  ///< a bounded plane in 3D: its edge's unit line (zero in 2D)
+  /// Which nodes the obstacle may hold (all when empty): a table bounded by an edge front holds the
+  /// nodes on its side of the edge in the material (the front moves a node across when it passes).
+  std::function<bool(int node)> carries;
+  bool may_hold(int node) const { return !carries || carries(node); }
   /// The signed distance of x from the surface (m), > 0 outside, its outward unit normal there, and
   /// the gap's second derivative at zero acceleration for a velocity v (m/s²).
   double gap(const Vec<dim>& x) const;
@@ -53,10 +68,12 @@ struct Obstacle {
   Eigen::Matrix<double, dim, dim - 1> tangents(const Vec<dim>& x) const;
 };
 
-/// The contact module of `obstacles` (non-empty). A node that starts within kInitialContact of its
-/// length h from a surface is held on it; one further inside is refused (InputError).
+/// The contact module of `obstacles` (non-empty) around `inner`, the fronts' module (nullptr: a string
+/// without fronts). A node that starts within kInitialContact of its length h from a surface is held
+/// on it; one further inside is refused (InputError).
 template <int dim>
-std::unique_ptr<StringModule<dim>> make_contact_module(std::vector<Obstacle<dim>> obstacles);
+std::unique_ptr<StringModule<dim>> make_contact_module(std::vector<Obstacle<dim>> obstacles,
+                                                       std::unique_ptr<StringModule<dim>> inner = nullptr);
 
 /// A node this share of a link length from a surface at the start is on it (the discretized shape is
 /// a polygon inscribed in a curved one); further inside, the scene is refused.

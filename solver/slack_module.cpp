@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "string_model.hpp"
+#include "wrapping_module.hpp"
 
 namespace chainsim {
 
@@ -30,23 +31,20 @@ double link_power(const StringModel<dim>& model) {
 }
 
 template <int dim>
-class SlackModule final : public StringModule<dim> {
+class SlackModule final : public WrappingModule<dim> {
+  using WrappingModule<dim>::inner_;
+  using WrappingModule<dim>::inner_ledgers;
+  using WrappingModule<dim>::inner_events;
+
  public:
-  explicit SlackModule(std::unique_ptr<StringModule<dim>> inner) : inner_(std::move(inner)) {}
+  explicit SlackModule(std::unique_ptr<StringModule<dim>> inner) : WrappingModule<dim>(std::move(inner)) {}
 
   // Ledgers: [ the inner module's | W_snap | W_snap_supports | W_links | impulse (dim) ]. Without an inner module
   // the impulse is that of all external forces (its rate the string's external force, its jumps the
   // supports' impulses at snaps); with one (fronts), the inner module integrates the external forces'
   // impulse and this one holds only the snaps' support impulses, added to it in fill().
-  std::vector<ArcRange> initial_arcs(const Chain<dim>& chain) override {
-    if (inner_) return inner_->initial_arcs(chain);
-    return {ArcRange{0, chain.num_nodes() - 1, chain.closed()}};
-  }
   void initialize(StringModel<dim>& model) override {
     if (inner_) inner_->initialize(model);
-  }
-  void add_mass_and_forces(const StringModel<dim>& model, Eigen::VectorXd& mass, Points<dim>& force) override {
-    if (inner_) inner_->add_mass_and_forces(model, mass, force);
   }
   int num_ledgers() const override { return inner_ledgers() + 3 + dim; }
   void ledger_rates(const StringModel<dim>& model, Eigen::Ref<Eigen::VectorXd> rates) const override {
@@ -85,9 +83,6 @@ class SlackModule final : public StringModule<dim> {
                                {"snaps", K::kQuantity}});
     return terms;
   }
-  std::vector<FrontField> front_fields() const override {
-    return inner_ ? inner_->front_fields() : std::vector<FrontField>{};
-  }
   void fill(const StringModel<dim>& model, const Eigen::Ref<const Eigen::VectorXd>& ledger,
             ModuleLedger<dim>& out) const override {
     const int k = inner_ledgers();
@@ -117,19 +112,11 @@ class SlackModule final : public StringModule<dim> {
   EventAction handle_events(StringModel<dim>& model, double t, Eigen::Ref<Eigen::VectorXd> ledger,
                             const std::vector<int>& found) override {
     const int k = inner_events(), kl = inner_ledgers();
-    EventAction action;
     // The fronts' events first (a crossing rebuilds the arcs; a slack link that leaves them is taut
     // again, StringModel::rebuild), then the snap on the layout they leave.
-    if (inner_) {
-      const std::vector<int> inner_found(found.begin(), found.begin() + k);
-      bool any = false;
-      for (int f : inner_found) any = any || f != 0;
-      if (any) {
-        action = inner_->handle_events(model, t, ledger.head(kl), inner_found);
-        if (action.kind == EventAction::Kind::kStop) return action;
-        if (action.kind == EventAction::Kind::kTransfer) model.refresh();
-      }
-    }
+    const EventAction action = this->handle_inner_events(model, t, ledger, found);
+    if (action.kind == EventAction::Kind::kStop) return action;
+    if (action.kind == EventAction::Kind::kTransfer) model.refresh();
     if (found[static_cast<std::size_t>(k)] == 0) return action;
     const typename StringModel<dim>::SnapResult snap = model.snap(t);
     if (snap.caught == 0) return action;
@@ -140,11 +127,6 @@ class SlackModule final : public StringModule<dim> {
     if (inner_) inner_->release_contacts(model, t);  // held nodes the snap would pull off a surface
     return {EventAction::Kind::kTransfer, ""};  // the velocities changed: the integrator restarts
   }
-  long transfers() const override { return inner_ ? inner_->transfers() : 0; }
-  int num_fronts() const override { return inner_ ? inner_->num_fronts() : 0; }
-  std::optional<double> front_tension_at(const StringModel<dim>& model, int node) const override {
-    return inner_ ? inner_->front_tension_at(model, node) : std::nullopt;
-  }
   bool events_need_tensions() const override { return inner_ && inner_->events_need_tensions(); }
   void node_contacts(const StringModel<dim>& model, std::vector<NodeContact<dim>>& out) const override {
     if (inner_) inner_->node_contacts(model, out);
@@ -152,14 +134,7 @@ class SlackModule final : public StringModule<dim> {
   bool release_contacts(StringModel<dim>& model, double t) override {
     return inner_ && inner_->release_contacts(model, t);
   }
-  std::vector<RunEvent> run_events() const override {
-    return inner_ ? inner_->run_events() : std::vector<RunEvent>{};
-  }
  private:
-  int inner_ledgers() const { return inner_ ? inner_->num_ledgers() : 0; }
-  int inner_events() const { return inner_ ? inner_->num_events() : 0; }
-
-  std::unique_ptr<StringModule<dim>> inner_;
   long snaps_ = 0;
   mutable bool counting_ = false;  // W_links: a link has been released
 };

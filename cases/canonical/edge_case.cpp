@@ -63,13 +63,23 @@ EdgeComparison compare_over_point(const EdgeCaseSetup& setup, const PointProblem
   edge.point = Vec<2>::Zero();
   edge.dissipation = f;
   edge.s0 = ell - x0;
-  if (setup.problem == PointContactProblem::kEdge) edge.table = EdgeSpec<2>::Table::kBefore;
+  const bool table_surface = setup.problem == PointContactProblem::kEdge && setup.table_surface;
+  if (setup.problem == PointContactProblem::kEdge && !table_surface) edge.table = EdgeSpec<2>::Table::kBefore;
   std::vector<std::unique_ptr<FrontKind<2>>> fronts;
   fronts.push_back(std::make_unique<EdgeFront<2>>(edge));
   StringModelOptions model_options;
   model_options.stabilization_time = 0.02 * std::sqrt(ell / g);  // as a scene's default
-  StringModel<2> model = make_front_model<2>(std::move(chain), std::move(forces), {}, std::move(fronts),
-                                             FrontOptions{}, model_options);
+  // The table y = 0, x < 0 as a surface that ends at the edge: the contact module around the fronts.
+  std::unique_ptr<StringModule<2>> module;
+  if (table_surface) {
+    const FrontKind<2>& edge_front = *fronts.front();
+    std::vector<Obstacle<2>> table{edge_table<2>(dynamic_cast<const EdgeFront<2>&>(edge_front), Vec<2>(0.0, 1.0),
+                                                 Vec<2>(-1.0, 0.0), true, Vec<2>::Zero(), "table")};
+    module = make_contact_module<2>(std::move(table), std::make_unique<FrontTracker<2>>(std::move(fronts), FrontOptions{}));
+  } else {
+    module = std::make_unique<FrontTracker<2>>(std::move(fronts), FrontOptions{});
+  }
+  StringModel<2> model(std::move(chain), std::move(forces), {}, model_options, std::move(module));
   StringSolverOptions options;
   options.integrator = setup.integrator;
   options.t_end = setup.t_max_over_t0 * t0;

@@ -25,6 +25,9 @@ struct EdgeCaseSetup {
   /// edge: the hanging fraction at release, 0 < x0 < 1; peg: the longer side's fraction, 0.5 < x0 < 1.
   double x0 = 0.2;
   double t_max_over_t0 = 50.0;  ///< safety stop (the chain lifts off well before)
+  /// edge: the table is a contact surface that ends at the edge (its nodes held by their contact
+  /// forces, docs/model.md §10) rather than the edge's known load (table = "before", §8).
+  bool table_surface = false;
   IntegratorOptions integrator = StringCaseSetup::default_integrator();
   /// x0's default for a problem (edge 0.2, peg 0.6).
   static double default_x0(PointContactProblem problem) { return problem == PointContactProblem::kPeg ? 0.6 : 0.2; }

@@ -70,6 +70,82 @@ std::string fit_key_of(const SceneSpec& spec, const std::optional<FoldSpec>& fol
   return spec.effects.edges.empty() ? "effects.fold" : "effects.edge[0]";
 }
 
+/// A table that ends at an edge ([[effects.surface]] edge = k): the side of the edge it lies on in the
+/// material, and the direction from the edge into it.
+template <int dim>
+struct TableSide {
+  std::size_t surface = 0, edge = 0;
+  bool before = true;  ///< the table holds the string before the edge (s < s0), else after it
+  Vec<dim> inward = Vec<dim>::Zero();
+};
+
+/// Checks a table against its edge and the initial shape (refusals located at the table's keys).
+template <int dim>
+TableSide<dim> table_side(const SceneSpec& spec, std::size_t k, const EdgeSpec<dim>& edge, const Curve<dim>& curve,
+                          double ell) {
+  const SurfaceEntry& entry = spec.effects.surfaces[k];
+  const std::size_t e = static_cast<std::size_t>(*entry.edge);
+  const std::string key = fmt::format("effects.surface[{}]", k), edge_key = fmt::format("effects.edge[{}]", e);
+  const std::string& table = spec.effects.edges[e].table;
+  if (table != "none")
+    fail_at(spec, edge_key + ".table",
+            fmt::format("{}.table = \"{}\" holds the table's part of the string with a known load, and {}.edge = {} "
+                        "makes that table a contact surface: allowed table = \"none\" with a surface that ends at the "
+                        "edge (or no surface)",
+                        edge_key, table, key, e));
+  const Vec<dim> n = as_vec<dim>(spec, entry.normal, key + ".normal").stableNormalized();
+  const double off = n.dot(edge.point - as_vec<dim>(spec, entry.point, key + ".point"));
+  if (!(std::abs(off) <= kPlaceTolerance * ell))
+    fail_at(spec, key + ".point",
+            fmt::format("{}.point = {}: the surface passes {:.6g} m from the point of {} it ends at; allowed within "
+                        "{:g} m (1e-6 of the string's length): the table's plane goes through its edge",
+                        key, text_of(spec, key + ".point"), std::abs(off), edge_key, kPlaceTolerance * ell));
+  if constexpr (dim == 3) {
+    if (!(std::abs(edge.axis.dot(n)) <= kFoldAngleTolerance))
+      fail_at(spec, key + ".normal",
+              fmt::format("{}.normal = {} is not normal to the line of {} (direction {}): the table's edge lies in "
+                          "its plane",
+                          key, text_of(spec, key + ".normal"), edge_key, show<dim>(edge.axis)));
+  }
+  const double d = std::min({kTangentStep * ell, 0.5 * edge.s0, 0.5 * (ell - edge.s0)});
+  const Vec<dim> tm = (curve.point(edge.s0) - curve.point(edge.s0 - d)).normalized();
+  const Vec<dim> tp = (curve.point(edge.s0 + d) - curve.point(edge.s0)).normalized();
+  const bool on_before = std::abs(tm.dot(n)) <= kFoldAngleTolerance, on_after = std::abs(tp.dot(n)) <= kFoldAngleTolerance;
+  auto shown = [](Vec<dim> v) {  // the tangents of a polyline, without the round-off of their differences
+    for (int c = 0; c < dim; ++c)
+      if (std::abs(v[c]) < 1e-9) v[c] = 0;
+    return show<dim>(v);
+  };
+  if (on_before == on_after)
+    fail_at(spec, key + ".edge",
+            fmt::format("{}.edge = {}: the string lies along the surface on {} of {} (tangents {} before it, {} after "
+                        "it, normal {}); allowed a table the string lies along on one side of its edge and leaves on "
+                        "the other",
+                        key, e, on_before ? "both sides" : "neither side", edge_key, shown(tm), shown(tp), shown(n)));
+  // The other side turns to the table's far side of its plane (it hangs below the table).
+  const double other = on_before ? tp.dot(n) : -tm.dot(n);
+  if (!(other < 0))
+    fail_at(spec, key + ".normal",
+            fmt::format("{}.normal = {}: the string leaves the table at {} towards the side the normal points to; "
+                        "the normal points away from the table, to the side the string lies on, and the string past "
+                        "the edge turns down, over the edge",
+                        key, text_of(spec, key + ".normal"), edge_key));
+  TableSide<dim> side;
+  side.surface = k;
+  side.edge = e;
+  side.before = on_before;
+  side.inward = on_before ? Vec<dim>(-tm) : tp;
+  if constexpr (dim == 3) side.inward -= side.inward.dot(edge.axis) * edge.axis;
+  side.inward -= side.inward.dot(n) * n;
+  if (!(side.inward.norm() > kFoldAngleTolerance))
+    fail_at(spec, key + ".edge",
+            fmt::format("{}.edge = {}: the string on the table runs along the line of {} (tangent {}): allowed a table "
+                        "the string crosses the edge's line from",
+                        key, e, edge_key, shown(on_before ? tm : tp)));
+  side.inward.normalize();
+  return side;
+}
+
 }  // namespace
 
 template <int dim>
@@ -142,7 +218,10 @@ std::unique_ptr<StringModel<dim>> build_front_model(const SceneSpec& spec, scene
     hs.dissipation = heap.dissipation;
     hs.pot = heap.pot;
     hs.s0 = heap.s0;
-    if (heap.on_plane) hs.plane_normal = *plane_normal;
+    if (heap.on_plane) {
+      hs.plane_normal = *plane_normal;
+      hs.plane_surface = fx.plane->surface;
+    }
     heaps.push_back(hs);
   }
   if (plane_normal) {
@@ -244,6 +323,12 @@ std::unique_ptr<StringModel<dim>> build_front_model(const SceneSpec& spec, scene
     edges.push_back(edge);
   }
 
+  // 4c. Tables that end at an edge.
+  std::vector<TableSide<dim>> tables;
+  for (std::size_t k = 0; k < fx.surfaces.size(); ++k)
+    if (fx.surfaces[k].edge)
+      tables.push_back(table_side<dim>(spec, k, edges[static_cast<std::size_t>(*fx.surfaces[k].edge)], *parts.curve, ell));
+
   // 5. Stop events: a front reaching a material coordinate inside the string.
   const std::vector<std::string> names = scene_build::front_names(spec);
   const std::vector<int> stop_fronts = scene_build::front_stop_indices(spec);
@@ -282,8 +367,12 @@ std::unique_ptr<StringModel<dim>> build_front_model(const SceneSpec& spec, scene
       std::vector<std::unique_ptr<FrontKind<dim>>> hf = heap_and_fold_fronts<dim>(heaps, fold, ell, parts.chain.link_length(0));
       std::size_t n = 0;
       for (auto& kind : hf) all.emplace_back(std::move(kind), names[n++]);
-      for (std::size_t k = 0; k < edges.size(); ++k)
-        all.emplace_back(std::make_unique<EdgeFront<dim>>(edges[k]), names[n++]);
+      std::vector<const EdgeFront<dim>*> edge_fronts;  // held by the tracker
+      for (std::size_t k = 0; k < edges.size(); ++k) {
+        auto edge = std::make_unique<EdgeFront<dim>>(edges[k]);
+        edge_fronts.push_back(edge.get());
+        all.emplace_back(std::move(edge), names[n++]);
+      }
       std::stable_sort(all.begin(), all.end(),
                        [](const auto& p, const auto& q) { return p.first->expected_s0 < q.first->expected_s0; });
       for (auto& [kind, name] : all) {
@@ -295,8 +384,21 @@ std::unique_ptr<StringModel<dim>> build_front_model(const SceneSpec& spec, scene
         stop.front = static_cast<int>(std::find(ordered_names.begin(), ordered_names.end(),
                                                 names[static_cast<std::size_t>(stop.front)]) -
                                       ordered_names.begin());
-      return std::make_unique<StringModel<dim>>(make_front_model<dim>(
-          std::move(parts.chain), std::move(parts.forces), std::move(parts.prescribed), std::move(kinds), options, mo));
+      if (!spec.has_obstacles())
+        return std::make_unique<StringModel<dim>>(make_front_model<dim>(
+            std::move(parts.chain), std::move(parts.forces), std::move(parts.prescribed), std::move(kinds), options, mo));
+      // Obstacles too: the contact module wraps the front tracker (solver/contact_module.hpp). A table
+      // that ends at an edge holds the nodes on its side of the edge front's bent link.
+      std::vector<Obstacle<dim>> obstacles = contact_obstacles<dim>(spec);
+      for (const TableSide<dim>& table : tables) {
+        Obstacle<dim>& o = obstacles[table.surface];
+        o = edge_table<dim>(*edge_fronts[table.edge], o.normal, table.inward, table.before, edges[table.edge].axis,
+                            o.name);
+      }
+      return std::make_unique<StringModel<dim>>(
+          std::move(parts.chain), std::move(parts.forces), std::move(parts.prescribed), mo,
+          make_contact_module<dim>(std::move(obstacles),
+                                   std::make_unique<FrontTracker<dim>>(std::move(kinds), options)));
     } catch (const RecoverableError& e) {  // a degenerate front geometry found while placing the fronts
       throw InputError(fmt::format("{}: {}", fit_key, e.what()));
     } catch (const InputError& e) {
@@ -305,6 +407,11 @@ std::unique_ptr<StringModel<dim>> build_front_model(const SceneSpec& spec, scene
     }
   });
   scene.front_names = ordered_names;
+  for (const TableSide<dim>& table : tables) {  // where each table ends (the plot tool draws it up to there)
+    nlohmann::json& o = d["obstacles"][table.surface];
+    o["edge_point"] = to_array<dim>(edges[table.edge].point);
+    o["inward"] = to_array<dim>(table.inward);
+  }
   d["fronts"] = nlohmann::json::array();
   for (std::size_t k = 0; k < ordered_names.size(); ++k) {
     const FrontKind<dim>& front = *kind_of[k];

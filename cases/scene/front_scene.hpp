@@ -27,6 +27,7 @@
 #include "cases/scene/scene.hpp"
 #include "shocks/edge_front.hpp"
 #include "shocks/front_tracker.hpp"
+#include "solver/contact_module.hpp"
 #include "solver/string_solver.hpp"
 
 namespace chainsim {
@@ -46,6 +47,13 @@ struct SceneParts;
 template <int dim>
 std::unique_ptr<StringModel<dim>> build_front_model(const SceneSpec& spec, scene_build::SceneParts<dim>& parts,
                                                     StringScene<dim>& scene);
+
+/// The scene's obstacles ([[effects.surface]], [[effects.cylinder]], [effects.plane] with surface =
+/// true; solver/contact_module.hpp), each checked at its key, in that order; and what they do not meet
+/// (quadratic elements, implicit methods) refused at the key at fault. A surface's `edge` is left to
+/// build_front_model, which bounds it at its edge front.
+template <int dim>
+std::vector<Obstacle<dim>> contact_obstacles(const SceneSpec& spec);
 
 /// Builds the model of a scene with fronts (spec.has_fronts(), dim = spec.dimension): build_string_scene.
 template <int dim>

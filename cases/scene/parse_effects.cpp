@@ -57,10 +57,24 @@ double friction_coefficient(const Section& e) { return e.number_in("mu", 0.0, 0.
 void parse_obstacles(const Section& effects, Context& ctx) {
   const auto surfaces = table_array(effects, "surface", "surface");
   for (std::size_t k = 0; k < surfaces.size(); ++k) {
-    Section e(*surfaces[k], fmt::format("effects.surface[{}]", k), ctx, {"point", "normal", "mu"});
+    Section e(*surfaces[k], fmt::format("effects.surface[{}]", k), ctx, {"point", "normal", "mu", "edge"});
     if (!e.has("point")) e.missing("point", "m, a point of the plane");
     if (!e.has("normal")) e.missing("normal", "a vector normal to the plane (any length > 0), pointing to the side the string is on");
-    ctx.spec.effects.surfaces.push_back(SurfaceEntry{e.vector("point"), e.vector("normal"), friction_coefficient(e)});
+    SurfaceEntry surface{e.vector("point"), e.vector("normal"), friction_coefficient(e), std::nullopt};
+    if (e.has("edge")) {
+      const long long edges = static_cast<long long>(ctx.spec.effects.edges.size());
+      if (edges == 0)
+        e.fail("edge", fmt::format("{} = {} names an [[effects.edge]], and the scene has none: allowed only with "
+                                   "[[effects.edge]] (the index of the edge the table ends at, 0 for the first)",
+                                   e.full("edge"), e.text("edge")));
+      surface.edge = e.integer_in("edge", 0, edges - 1);
+      for (std::size_t j = 0; j < ctx.spec.effects.surfaces.size(); ++j)
+        if (ctx.spec.effects.surfaces[j].edge == surface.edge)
+          e.fail("edge", fmt::format("{} = {}: effects.surface[{}] already ends at effects.edge[{}]; allowed one "
+                                     "table per edge",
+                                     e.full("edge"), *surface.edge, j, *surface.edge));
+    }
+    ctx.spec.effects.surfaces.push_back(surface);
   }
   const auto cylinders = table_array(effects, "cylinder", "cylinder");
   for (std::size_t k = 0; k < cylinders.size(); ++k) {
@@ -103,13 +117,13 @@ void parse_effects(const Section& top, Context& ctx) {
     check_fold_dissipation(fx.fold->dissipation, SceneFrontKeys(ctx.spec));
   }
   if (s.has("plane")) {
-    Section p(subtable(s, "plane"), "effects.plane", ctx, {"point", "normal"});
+    Section p(subtable(s, "plane"), "effects.plane", ctx, {"point", "normal", "surface"});
     if (!p.has("point")) p.missing("point", "m, a point of the plane");
     if (!p.has("normal")) p.missing("normal", "a vector normal to the plane, pointing to the string's side");
-    fx.plane = PlaneEntry{p.vector("point"), p.vector("normal")};
+    fx.plane = PlaneEntry{p.vector("point"), p.vector("normal"), p.boolean("surface").value_or(false)};
   }
-  // The plane is the table of a heap: it exists for on_plane heaps only (the string itself does not
-  // collide with it), and an on_plane heap needs it.
+  // The plane is the table of a heap: it exists for on_plane heaps only (the string itself collides
+  // with it only with surface = true), and an on_plane heap needs it.
   bool on_plane = false;
   for (std::size_t k = 0; k < fx.heaps.size(); ++k) {
     on_plane = on_plane || fx.heaps[k].on_plane;
@@ -120,7 +134,7 @@ void parse_effects(const Section& top, Context& ctx) {
   }
   if (fx.plane && !on_plane)
     throw InputError(fmt::format("{}: [effects.plane] is the table under a heap, but no [[effects.heap]] has on_plane = "
-                                 "true (the string itself does not collide with the plane)",
+                                 "true (for a table the string lies on and lands on, without a heap, write [[effects.surface]])",
                                  ctx.spec.where("effects.plane")));
 }
 

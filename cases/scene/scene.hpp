@@ -91,6 +91,7 @@ struct EdgeEntry {
 struct PlaneEntry {
   std::vector<double> point;   ///< a point of the plane (m)
   std::vector<double> normal;  ///< its normal, towards the string's side (any length > 0)
+  bool surface = false;        ///< the plane is also a contact surface of the string (as [[effects.surface]])
 };
 
 /// A rigid smooth plane the string lies on, slides over, lands on and lifts off: [[effects.surface]]
@@ -99,6 +100,8 @@ struct SurfaceEntry {
   std::vector<double> point;   ///< a point of the plane (m)
   std::vector<double> normal;  ///< its normal, towards the string's side (any length > 0)
   double mu = 0;               ///< Coulomb's coefficient of friction (≥ 0; 0: smooth)
+  /// The [[effects.edge]] (its index) the surface ends at: a table bounded by its edge.
+  std::optional<long long> edge;
 };
 
 /// A rigid smooth cylinder (a circle in 2D): a pulley, a peg with a radius: [[effects.cylinder]].
@@ -175,7 +178,9 @@ struct SceneSpec {
     std::vector<CylinderEntry> cylinders;        ///< [[effects.cylinder]]
   } effects;
   /// The scene has a surface or a cylinder: the string runs with the contact module.
-  bool has_obstacles() const { return !effects.surfaces.empty() || !effects.cylinders.empty(); }
+  bool has_obstacles() const {
+    return !effects.surfaces.empty() || !effects.cylinders.empty() || (effects.plane && effects.plane->surface);
+  }
   /// The scene has a heap, a fold or an edge: the string runs with front tracking.
   bool has_fronts() const { return !effects.heaps.empty() || effects.fold.has_value() || !effects.edges.empty(); }
   // [solver]

@@ -82,7 +82,10 @@ json effects_json(const SceneSpec::Effects& fx) {
     }
   }
   if (fx.fold) j["fold"] = {{"s0", fx.fold->s0}, {"f", fx.fold->dissipation}};
-  if (fx.plane) j["plane"] = {{"point", fx.plane->point}, {"normal", fx.plane->normal}};
+  if (fx.plane) {
+    j["plane"] = {{"point", fx.plane->point}, {"normal", fx.plane->normal}};
+    if (fx.plane->surface) j["plane"]["surface"] = true;
+  }
   if (!fx.edges.empty()) {
     j["edge"] = json::array();
     for (const EdgeEntry& e : fx.edges) {
@@ -92,7 +95,10 @@ json effects_json(const SceneSpec::Effects& fx) {
   }
   if (!fx.surfaces.empty()) {
     j["surface"] = json::array();
-    for (const SurfaceEntry& e : fx.surfaces) j["surface"].push_back({{"point", e.point}, {"normal", e.normal}});
+    for (const SurfaceEntry& e : fx.surfaces) {
+      j["surface"].push_back({{"point", e.point}, {"normal", e.normal}});
+      if (e.edge) j["surface"].back()["edge"] = *e.edge;
+    }
   }
   if (!fx.cylinders.empty()) {
     j["cylinder"] = json::array();

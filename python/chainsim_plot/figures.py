@@ -214,9 +214,10 @@ class Layout:
                 continue
             self._plane_trace(ax, f.point, f.plane_normal, proj, extra, "plane (table)" if label else None)
 
-    def _plane_trace(self, ax, point, normal, proj, extra, label):
+    def _plane_trace(self, ax, point, normal, proj, extra, label, edge=None):
         """A plane through `point` with `normal`, as its trace on the projection `proj` (only where the
-        projection sees it edge-on); False where it does not."""
+        projection sees it edge-on); False where it does not. A table that ends at an edge (`edge`: its
+        point and the direction from it into the table) is drawn from the edge into the table only."""
         a, b = proj
         n = np.asarray(normal, dtype=float)
         if self.dim == 3 and abs(n[3 - a - b]) > 1e-9 * np.linalg.norm(n):
@@ -226,6 +227,12 @@ class Layout:
         if d[0] < 0:
             d = -d
         p = np.asarray(point, dtype=float)[[a, b]]
+        if edge is not None:
+            e = np.asarray(edge[0], dtype=float)[[a, b]]
+            inward = np.asarray(edge[1], dtype=float)[[a, b]]
+            if np.linalg.norm(inward) > 0:
+                self._face(ax, np.array([e, e + (1.2 * self.size + extra) * inward / np.linalg.norm(inward)]), label)
+                return True
         centre = p + np.dot(0.5 * (self.lo[[a, b]] + self.hi[[a, b]]) - p, d) * d
         half = 0.6 * self.size
         self._face(ax, np.array([centre - half * d, centre + (half + extra) * d]), label)
@@ -247,7 +254,8 @@ class Layout:
             count[kind] += 1
             lab = kind if label and first[kind] else None
             if kind == "surface":
-                if not self._plane_trace(ax, o["point"], o["normal"], proj, extra, lab):
+                edge = (o["edge_point"], o["inward"]) if "inward" in o else None
+                if not self._plane_trace(ax, o["point"], o["normal"], proj, extra, lab, edge):
                     continue
                 ax.lines[-1].set_gid(gid)
             else:

@@ -92,6 +92,8 @@ def run_dir(kind):
         args = ["run", scene("atwood_pulley", 21, {r"(?m)^t_end = .*": "t_end = 0.1"}), "--out", out]
     elif kind == "landing":
         args = ["run", scene("chain_landing_on_table", 11, {r"(?m)^t_end = .*": "t_end = 0.15"}), "--out", out]
+    elif kind == "real_table":
+        args = ["run", scene("chain_off_real_table", 21), "--out", out]
     elif kind == "string3d":
         path = os.path.join(ROOT, "pendulum3d.toml")
         with open(path, "w") as fh:
@@ -557,6 +559,19 @@ def test_reader_surface_and_cylinder_drawn_as_obstacles():
         assert sorted(drawn) == ["obstacle surface0"]
         x, y = drawn["obstacle surface0"].get_data()
         assert np.allclose(y, 0, atol=1e-12) and x[0] < 0 and x[1] > 1.0
+        plt.close(fig)
+
+
+def test_reader_table_ending_at_its_edge_drawn_up_to_the_edge():
+    """A table that ends at its edge (cases/scenes/chain_off_real_table.toml: the plane y = 0 for x < 0, its
+    edge at the origin): the surface is drawn from the edge along -x only, never past the edge (x > 0)."""
+    import matplotlib.pyplot as plt
+    for fig in drawn_figures(run_dir("real_table")):
+        drawn = obstacle_artists(fig)
+        assert "obstacle surface0" in drawn and "obstacle edge0" in drawn
+        x, y = drawn["obstacle surface0"].get_data()
+        assert np.allclose(y, 0, atol=1e-12)
+        assert np.allclose(x[0], 0, atol=1e-12) and x[1] < -0.8 and max(x) <= 1e-12
         plt.close(fig)
 
 

@@ -311,7 +311,7 @@ TEST_CASE("bad scenes with fronts, and scenes the reduced model does not fit, ar
       {"a heap on a plane without a plane", edit(F, "[effects.plane]\npoint = [0.0, 0.0]\nnormal = [0.0, 1.0]\n", ""),
        "s.toml:19:12: effects.heap[0].on_plane = true needs [effects.plane] (point, normal): the table the heap lies on"},
       {"a plane under no heap", edit(F, "on_plane = true", "on_plane = false"),
-       "s.toml:21:1: [effects.plane] is the table under a heap, but no [[effects.heap]] has on_plane = true (the string itself does not collide with the plane)"},
+       "s.toml:21:1: [effects.plane] is the table under a heap, but no [[effects.heap]] has on_plane = true (for a table the string lies on and lands on, without a heap, write [[effects.surface]])"},
       {"a heap not on its plane", edit(F, "[effects.plane]\npoint = [0.0, 0.0]", "[effects.plane]\npoint = [0.0, 0.1]"),
        "s.toml:18:9: effects.heap[0].point = [0.0, 0.0] is not on its plane: it is 0.1 m from effects.plane (through [0, 0.1] with normal [0, 1])"},
       {"a plane facing away from the string", edit(F, "normal = [0.0, 1.0]", "normal = [0.0, -1.0]"),

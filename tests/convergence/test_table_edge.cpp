@@ -1,0 +1,365 @@
+// Obstacles together with fronts (docs/model.md §10 "Contact with fronts"): the contact module wraps the
+// front tracker. Each run against an independent reference:
+//  - the chain sliding off a smooth table over its edge, the table a real one-sided surface that ends at
+//    the edge ([[effects.surface]] edge = 0): x(t) and the lift-off of the edge against the exact solution
+//    (exact::edge_*, through `compare edge`'s machinery with table_surface), for f = 0 and f > 0 on four
+//    meshes, with the energy and momentum ledgers closed with the edge's and the table's terms;
+//  - the table part's normal forces: each held node's N equals its weight m_i g, and their sum λ g times
+//    the material length on the table;
+//  - a table part thrown up by an end load: it lifts off the table and lands on it again, and the run
+//    ends at the edge's lift-off with the ledgers closed, every held node on the table, no NaN;
+//  - a heap on a plane that is also a surface ([effects.plane] surface = true): a V-shaped chain falling
+//    with f = 1 (no tension: every node falls freely) into the heap at one end while its other arm lands
+//    on the table node by node: the heap's mass λ g t²/2, each landed node where it fell, W_impacts the
+//    landed nodes' potential energy, the ledgers closed (with slack = "allow": slack, contact, fronts).
+#include <cmath>
+#include <string>
+
+#include <fmt/format.h>
+
+#include <catch2/catch.hpp>
+
+#include "cases/canonical/edge_case.hpp"
+#include "cases/reduced/exact_solutions.hpp"
+#include "cases/scene/scene.hpp"
+#include "cases/scene/scene_json.hpp"
+#include "solver/string_solver.hpp"
+
+using namespace chainsim;
+
+namespace {
+
+constexpr double kG = 9.81;
+
+/// The scene of cases/scenes/chain_off_real_table.toml, its end load and slack policy given.
+std::string real_table_scene(int nodes, const std::string& extra) {
+  return fmt::format(R"(model = "string"
+[string]
+length = 1.0
+density = 1.0
+nodes = {}
+[shape]
+kind = "polyline"
+points = [[-0.8, 0.0], [0.0, 0.0], [0.0, -0.2]]
+[effects.gravity]
+g = [0.0, -9.81]
+[[effects.edge]]
+point = [0.0, 0.0]
+[[effects.surface]]
+point = [0.0, 0.0]
+normal = [0.0, 1.0]
+edge = 0
+[solver]
+method = "erk5"
+rtol = 1e-9
+atol = 1e-11
+{}
+[output]
+interval = 0.05
+[stop]
+t_end = 2.0
+)",
+                     nodes, extra);
+}
+
+bool finite_run(const RunSummary& run) {
+  for (const StepSample& s : run.samples)
+    if (!std::isfinite(s.kinetic) || !std::isfinite(s.potential) || !std::isfinite(s.drift)) return false;
+  return true;
+}
+
+}  // namespace
+
+TEST_CASE("table and edge: a chain sliding off a real table matches exact::edge_* on every mesh, f = 0 and f > 0",
+          "[contact][edge][convergence]") {
+  for (double f : {0.0, 0.5}) {
+    const double ell = 1.0, x0 = 0.2;
+    const double t_star = exact::edge_time(f, exact::edge_lift_off_x(f, x0, ell, kG), x0, ell, kG);
+    if (f == 0)  // the closed form: x* = (ℓ + √(ℓ² + 8 x0²))/4, x = x0 cosh(√(g/ℓ) t)
+      CHECK(t_star == Approx(std::acosh((ell + std::sqrt(ell * ell + 8 * x0 * x0)) / 4 / x0) / std::sqrt(kG / ell))
+                          .epsilon(1e-12));
+    for (int nodes : {5, 12, 42, 82}) {
+      CAPTURE(f, nodes);
+      EdgeCaseSetup setup;
+      setup.chain.dissipation = f;
+      setup.nodes = nodes;
+      setup.x0 = x0;
+      setup.table_surface = true;
+      const EdgeComparison c = compare_edge_with_exact(setup);
+      const nlohmann::json& s = c.summary;
+      REQUIRE(s["status"] == "stopped");
+      REQUIRE(c.run.events.size() == 1);
+      CHECK(c.run.events[0].kind == "lift_off");
+      CHECK(c.run.stop_reason.rfind("lifted off the edge at t = ", 0) == 0);
+      CHECK(std::abs(c.run.events[0].t - t_star) < 1e-7);
+      CHECK(s["abs_err_x_lift_off"].get<double>() < 1e-7);
+      CHECK(s["max_abs_err_x"].get<double>() < 1e-7);
+      CHECK(s["max_abs_err_tension"].get<double>() < 1e-6);
+      CHECK(s["max_abs_err_reaction"].get<double>() < 1e-6);
+      CHECK(s["abs_err_dissipated"].get<double>() < 1e-7);
+      // The ledgers with the edge's (W_shocks, its impulse) and the table's (W_contact, W_impacts, its
+      // contact forces' impulse) terms.
+      CHECK(c.run.relative_energy_drift() < 1e-10);
+      CHECK(c.run.relative_momentum_residual() < 1e-10);
+      const StepSample& last = c.run.samples.back();
+      CHECK(last.terms["impacts"] == 0);
+      CHECK(last.terms["lift_offs"] == 0);  // the table part stays on the table
+      CHECK(std::abs(last.terms["W_contact"]) < 1e-9);
+      if (f > 0) CHECK(last.terms["W_shocks"] < -0.01);
+    }
+  }
+}
+
+TEST_CASE("table and edge: the table holds its part of the chain with its weight, N_i = m_i g", "[contact][edge]") {
+  SceneSpec spec = parse_scene_text(real_table_scene(41, ""), "real_table");
+  StringScene<2> scene = build_string_scene<2>(spec);
+  StringModel<2>& model = *scene.model;
+  scene.solver.t_end = 0.3;
+  StringSolver<2> solver(model, scene.solver);
+  solver.run();
+  const RunSummary& run = solver.summary();
+  REQUIRE(run.status == "completed");
+  const double s0 = run.samples.back().fronts[0].s0;  // the material length on the table
+  Points<2> x = model.x(), v = model.v();
+  model.evaluate(0.3, x, v);
+  const double h = 1.0 / 40;
+  REQUIRE(!model.contacts().empty());
+  double total = 0;
+  int last_held = -1;
+  for (std::size_t k = 0; k < model.contacts().size(); ++k) {
+    const int i = model.contacts()[k].node;
+    CAPTURE(i);
+    CHECK(model.x()(1, i) == Approx(0.0).margin(1e-12));
+    CHECK(model.contact_force(k) == Approx(model.masses()[i] * kG).epsilon(1e-9));
+    total += model.contact_force(k);
+    last_held = std::max(last_held, i);
+  }
+  // Every node before the edge is held (nodes 0 .. ⌊s0/h⌋), none after it; ΣN = λ g s0.
+  CHECK(static_cast<int>(model.contacts().size()) == static_cast<int>(std::floor(s0 / h)) + 1);
+  CHECK(last_held == static_cast<int>(std::floor(s0 / h)));
+  CHECK(total == Approx(1.0 * kG * s0).epsilon(1e-9));
+}
+
+TEST_CASE("table and edge: the table part lifts off the table and lands on it again, ledgers closed",
+          "[contact][edge][hard]") {
+  // An end load on the table's free end, 1.5 (1 + sin 6t) N upwards, throws it up off the table and
+  // lets it fall back while the hanging part pulls the chain over the edge (slack = "warn": the links of
+  // a landing part may push, as in docs/model.md §10 "Limits").
+  std::string text = real_table_scene(61, "slack = \"warn\"");
+  text.replace(text.find("[effects.gravity]"), 0,
+               "[ends]\nstart = { kind = \"loaded\", force = [0.0, 1.5], amplitude = [0.0, 1.5], omega = 6.0 }\n");
+  text.replace(text.find("length = 1.0"), 12, "length = 1.5");
+  text.replace(text.find("[[-0.8, 0.0]"), 12, "[[-1.2, 0.0]");
+  text.replace(text.find("[0.0, -0.2]]"), 12, "[0.0, -0.3]]");
+  SceneSpec spec = parse_scene_text(text, "thrown_table_part");
+  StringScene<2> scene = build_string_scene<2>(spec);
+  StringSolver<2> solver(*scene.model, scene.solver);
+  solver.run();
+  const RunSummary& run = solver.summary();
+  REQUIRE(run.status == "stopped");
+  CHECK(run.stop_reason.rfind("lifted off the edge at t = ", 0) == 0);
+  CHECK(finite_run(run));
+  const StepSample& last = run.samples.back();
+  CHECK(last.terms["lift_offs"] >= 5);
+  CHECK(last.terms["impacts"] >= 1);
+  CHECK(last.terms["W_impacts"] < 0);
+  CHECK(run.relative_energy_drift() < 1e-9);
+  CHECK(run.relative_momentum_residual() < 1e-12);
+  const StringModel<2>& model = *scene.model;
+  for (const NodeContact<2>& c : model.contacts()) CHECK(model.x()(1, c.node) == Approx(0.0).margin(1e-9));
+  for (int i = 0; i < model.chain().num_nodes(); ++i)
+    if (model.x()(0, i) < -1e-9) CHECK(model.x()(1, i) > -1e-9);  // nothing under the table
+}
+
+TEST_CASE("heap on a surface: a chain falls into a heap on the table while its other arm lands on the table",
+          "[contact][heap]") {
+  // A V: from the free end (0.3, 0.1) up to (0, 0.5) and down to the heap at the origin. f = 1: the heap
+  // pulls with τ = (1 − f) λ ẏ² = 0, so the string carries no tension and every node falls freely until
+  // it lands (the tilted arm, on the table) or is taken into the heap (the vertical arm).
+  const std::string text = R"(model = "string"
+[string]
+length = 1.0
+density = 1.0
+nodes = 81
+[shape]
+kind = "polyline"
+points = [[0.3, 0.1], [0.0, 0.5], [0.0, 0.0]]
+[effects.gravity]
+g = [0.0, -9.81]
+[[effects.heap]]
+side = "end"
+s0 = 1.0
+f = 1.0
+point = [0.0, 0.0]
+on_plane = true
+[effects.plane]
+point = [0.0, 0.0]
+normal = [0.0, 1.0]
+surface = true
+[solver]
+method = "erk5"
+rtol = 1e-9
+atol = 1e-11
+slack = "allow"
+[output]
+interval = 0.05
+[stop]
+t_end = 0.25
+)";
+  SceneSpec spec = parse_scene_text(text, "v_into_heap");
+  StringScene<2> scene = build_string_scene<2>(spec);
+  const Points<2> x0 = scene.model->x();
+  StringSolver<2> solver(*scene.model, scene.solver);
+  solver.run();
+  const RunSummary& run = solver.summary();
+  REQUIRE(run.status == "completed");
+  const double t = 0.25, fall = 0.5 * kG * t * t, h = 1.0 / 80;
+  const StepSample& last = run.samples.back();
+  CHECK(last.terms["heap_mass"] == Approx(fall).margin(2 * h));  // to the partial link's material
+  const StringModel<2>& model = *scene.model;
+  double landed_potential = 0;
+  int landed = 0;
+  for (int i = 0; i <= 40; ++i) {  // the tilted arm
+    CAPTURE(i);
+    const double y0 = x0(1, i);
+    CHECK(model.x()(0, i) == Approx(x0(0, i)).margin(1e-12));
+    if (y0 <= fall) {
+      CHECK(model.x()(1, i) == Approx(0.0).margin(1e-12));
+      landed_potential += model.chain().mass(i) * kG * y0;
+      ++landed;
+    } else {
+      CHECK(model.x()(1, i) == Approx(y0 - fall).margin(1e-9));
+    }
+  }
+  CHECK(landed == 21);
+  CHECK(last.terms["impacts"] >= 1);
+  CHECK(last.terms["W_impacts"] == Approx(-landed_potential).epsilon(1e-9));
+  CHECK(run.relative_energy_drift() < 1e-10);
+  CHECK(run.relative_momentum_residual() < 1e-10);
+}
+
+TEST_CASE("table and edge: inconsistent tables are refused at their keys, file:line", "[unit][scene][contact]") {
+  const std::string base = real_table_scene(41, "");
+  auto with = [&](const std::string& from, const std::string& to) {
+    std::string text = base;
+    const std::size_t at = text.find(from);
+    REQUIRE(at != std::string::npos);
+    return text.replace(at, from.size(), to);
+  };
+  auto error_of = [](const std::string& text) -> std::string {
+    try {
+      build_string_scene<2>(parse_scene_text(text, "s.toml"));
+    } catch (const InputError& e) {
+      return e.what();
+    }
+    return "";
+  };
+  CHECK(error_of(base).empty());
+  // [[effects.surface]] is on lines 13-16 of the base: point 14, normal 15, edge 16; [[effects.edge]] 11-12.
+  CHECK(error_of(with("edge = 0", "edge = 1")) == "s.toml:16:8: effects.surface[0].edge = 1 is out of range: allowed 0 <= edge <= 0");
+  CHECK(error_of(with("[[effects.edge]]\npoint = [0.0, 0.0]\n", "")) ==
+        "s.toml:14:8: effects.surface[0].edge = 0 names an [[effects.edge]], and the scene has none: allowed only with "
+        "[[effects.edge]] (the index of the edge the table ends at, 0 for the first)");
+  CHECK(error_of(with("edge = 0\n", "edge = 0\n[[effects.surface]]\npoint = [0.0, 0.0]\nnormal = [0.0, 1.0]\nedge = 0\n")) ==
+        "s.toml:20:8: effects.surface[1].edge = 0: effects.surface[0] already ends at effects.edge[0]; allowed one table "
+        "per edge");
+  CHECK(error_of(with("point = [0.0, 0.0]\nnormal", "point = [0.0, 0.01]\nnormal")) ==
+        "s.toml:14:9: effects.surface[0].point = [0.0, 0.01]: the surface passes 0.01 m from the point of effects.edge[0] "
+        "it ends at; allowed within 1e-06 m (1e-6 of the string's length): the table's plane goes through its edge");
+  CHECK(error_of(with("normal = [0.0, 1.0]", "normal = [0.0, -1.0]")) ==
+        "s.toml:15:10: effects.surface[0].normal = [0.0, -1.0]: the string leaves the table at effects.edge[0] towards "
+        "the side the normal points to; the normal points away from the table, to the side the string lies on, and the "
+        "string past the edge turns down, over the edge");
+  CHECK(error_of(with("normal = [0.0, 1.0]", "normal = [1.0, 1.0]")) ==
+        "s.toml:16:8: effects.surface[0].edge = 0: the string lies along the surface on neither side of "
+        "effects.edge[0] (tangents [1, 0] before it, [0, -1] after it, normal [0.707107, 0.707107]); allowed a table the "
+        "string lies along on one side of its edge and leaves on the other");
+  CHECK(error_of(with("point = [0.0, 0.0]\n[[effects.surface]]", "point = [0.0, 0.0]\ntable = \"before\"\n[[effects.surface]]")) ==
+        "s.toml:13:9: effects.edge[0].table = \"before\" holds the table's part of the string with a known load, and "
+        "effects.surface[0].edge = 0 makes that table a contact surface: allowed table = \"none\" with a surface that ends "
+        "at the edge (or no surface)");
+}
+
+TEST_CASE("table and edge: a surface's edge and a plane's surface are written back to scene_effective",
+          "[unit][scene][contact]") {
+  std::string text = real_table_scene(41, "");
+  const SceneSpec spec = parse_scene_text(text, "s.toml");
+  const nlohmann::json effective = scene_to_json(spec);
+  CHECK(effective["effects"]["surface"][0]["edge"] == 0);
+  const std::string heap = R"(model = "string"
+[string]
+length = 1.0
+nodes = 21
+[shape]
+kind = "polyline"
+points = [[0.0, 1.0], [0.0, 0.0]]
+[effects.gravity]
+g = [0.0, -9.81]
+[[effects.heap]]
+side = "end"
+s0 = 1.0
+point = [0.0, 0.0]
+on_plane = true
+[effects.plane]
+point = [0.0, 0.0]
+normal = [0.0, 1.0]
+surface = true
+[stop]
+t_end = 0.1
+)";
+  const nlohmann::json plane = scene_to_json(parse_scene_text(heap, "h.toml"));
+  CHECK(plane["effects"]["plane"]["surface"] == true);
+  std::string plain = heap;
+  plain.replace(plain.find("surface = true\n"), 15, "");
+  CHECK(!scene_to_json(parse_scene_text(plain, "h2.toml"))["effects"]["plane"].contains("surface"));
+}
+
+TEST_CASE("table and edge: in 3D, a table ending at an edge's line", "[contact][edge]") {
+  // The same chain in the plane z = 0.1, the edge's line along z, the table y = 0 given through a point
+  // away from the edge along its line: the lift-off of the edge at exact::edge_time(x*).
+  const std::string text = R"(model = "string"
+[string]
+length = 1.0
+nodes = 41
+dimension = 3
+[shape]
+kind = "polyline"
+points = [[-0.8, 0.0, 0.1], [0.0, 0.0, 0.1], [0.0, -0.2, 0.1]]
+[effects.gravity]
+g = [0.0, -9.81, 0.0]
+[[effects.edge]]
+point = [0.0, 0.0, 0.1]
+direction = [0.0, 0.0, 2.0]
+[[effects.surface]]
+point = [0.0, 0.0, 5.0]
+normal = [0.0, 1.0, 0.0]
+edge = 0
+[solver]
+method = "erk5"
+rtol = 1e-9
+atol = 1e-11
+[stop]
+t_end = 2.0
+)";
+  StringScene<3> scene = build_string_scene<3>(parse_scene_text(text, "t3d.toml"));
+  StringSolver<3> solver(*scene.model, scene.solver);
+  solver.run();
+  const RunSummary& run = solver.summary();
+  REQUIRE(run.status == "stopped");
+  REQUIRE(run.events.size() == 1);
+  const double t_star = exact::edge_time(0.0, exact::edge_lift_off_x(0.0, 0.2, 1.0, kG), 0.2, 1.0, kG);
+  CHECK(std::abs(run.events[0].t - t_star) < 1e-7);
+  CHECK(run.relative_energy_drift() < 1e-10);
+  CHECK(run.relative_momentum_residual() < 1e-10);
+  // A table part that runs along the edge's line has no side of the line to lie on: refused.
+  std::string along = text;
+  along.replace(along.find("[[-0.8, 0.0, 0.1]"), 17, "[[0.0, 0.0, -0.7]");
+  try {
+    build_string_scene<3>(parse_scene_text(along, "t3d.toml"));
+    FAIL("a table along its edge's line was not refused");
+  } catch (const InputError& e) {
+    CHECK(std::string(e.what()) == "t3d.toml:17:8: effects.surface[0].edge = 0: the string on the table runs along the "
+                                   "line of effects.edge[0] (tangent [0, 0, 1]): allowed a table the string crosses the "
+                                   "edge's line from");
+  }
+}
