@@ -16,7 +16,8 @@
 ///   - the ledgers W_contact (J: the work of the contact forces, zero on the exact solution; it books
 ///     the drift control's share), W_impacts (J, ≤ 0: the kinetic energy the landings took) and the
 ///     impulse of all external forces (the momentum ledger p − p0 − impulse, closed across impacts);
-///   - the recorded quantities impacts and lift_offs (series.csv): how many landings and lift-offs.
+///   - the recorded quantities impacts and lift_offs (series.csv): how many landings and lift-offs;
+///   - its drawing for the ParaView output (Obstacle::draw).
 #include <memory>
 #include <string>
 #include <vector>
@@ -40,6 +41,11 @@ struct Obstacle {
   double gap(const Vec<dim>& x) const;
   Vec<dim> outward(const Vec<dim>& x) const;
   double curvature(const Vec<dim>& x, const Vec<dim>& v) const;
+  /// Adds its drawing for the ParaView output (ObstacleDrawing, cell data obstacle = `index`), sized to
+  /// `nodes` (the string's, m) plus `margin` (m): a plane's segment (2D) or rectangle (3D) spanning their
+  /// projections on it; a cylinder's circle (2D, a polyline), or in 3D its two end circles, at the ends
+  /// of their projections on its axis, joined by a few generators.
+  void draw(int index, const Points<dim>& nodes, double margin, ObstacleDrawing& drawing) const;
 };
 
 /// The contact module of `obstacles` (non-empty). A node that starts within kInitialContact of its

@@ -155,6 +155,7 @@ class SlackModule final : public StringModule<dim> {
   std::vector<RunEvent> run_events() const override {
     return inner_ ? inner_->run_events() : std::vector<RunEvent>{};
   }
+  ObstacleDrawing obstacles() const override { return inner_ ? inner_->obstacles() : ObstacleDrawing{}; }
  private:
   int inner_ledgers() const { return inner_ ? inner_->num_ledgers() : 0; }
   int inner_events() const { return inner_ ? inner_->num_events() : 0; }
