@@ -93,7 +93,8 @@ PulleyComparison compare_pulley_with_exact(const PulleyCaseSetup& setup) {
   double err_x = 0, err_short = 0, err_long = 0, sum_short = 0, sum_long = 0;
   long tension_steps = 0;
   // The lift-off: the first zero of the string's margin τ2 − λ ẋ² (its tension where the shorter side
-  // meets the pulley, its speed), interpolated linearly between the steps where it changes sign.
+  // meets the pulley, its speed) averaged over one landing period, interpolated linearly between the steps
+  // where the average changes sign.
   std::optional<double> t_lift_off, x_lift_off;
   double t_prev = 0, margin_prev = 0;
   bool have_prev = false;
@@ -149,7 +150,7 @@ PulleyComparison compare_pulley_with_exact(const PulleyCaseSetup& setup) {
     const Exact e = exact_at(s.t);
     c.exact.add_row({s.t, 0.5 * free + e.u, e.u_dot, e.u, e.tau2, e.tau1, (e.tau2 - lambda * e.u_dot * e.u_dot) / R});
   }
-  // 3. The summary: the lift-off event's x from the state at the stop (the last frame).
+  // 3. The summary: the string's lift-off and the errors up to it.
   std::optional<MeasuredLiftOff> lift_off;
   if (t_lift_off) lift_off = MeasuredLiftOff{*t_lift_off, *x_lift_off};
   c.summary = exact_comparison_summary(c.run, "pulley", setup.nodes, t_lift, 0.5 * free + u_lift, lift_off, err_x);
