@@ -185,15 +185,9 @@ double EdgeFront<dim>::potential_moment(const StringModel<dim>& model, const Fro
 
 template <int dim>
 void EdgeFront<dim>::draw(int index, ObstacleDrawing& drawing) const {
-  auto in_3d = [](const Vec<dim>& v) {
-    Eigen::Vector3d p = Eigen::Vector3d::Zero();
-    p.head(dim) = v;
-    return p;
-  };
+  auto in_3d = [](const Vec<dim>& v) { return ObstacleDrawing::in_3d<dim>(v); };
   auto segment = [&](const Eigen::Vector3d& from, const Eigen::Vector3d& to, int part) {
-    drawing.segments.emplace_back(from, to);
-    drawing.segment_obstacle.push_back(index);
-    drawing.segment_part.push_back(part);
+    drawing.add_segment(from, to, index, part);
   };
   const double ell = this->m_.ell;
   const Eigen::Vector3d p = in_3d(point_), axis = in_3d(axis_);

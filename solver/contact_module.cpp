@@ -140,6 +140,62 @@ Eigen::Matrix<double, dim, dim - 1> Obstacle<dim>::tangents(const Vec<dim>& x) c
   return basis;
 }
 
+template <int dim>
+void Obstacle<dim>::draw(int index, const Points<dim>& nodes, double margin, ObstacleDrawing& drawing) const {
+  constexpr int kCircleSegments = 64, kGenerators = 8;
+  auto in_3d = [](const Vec<dim>& v) { return ObstacleDrawing::in_3d<dim>(v); };
+  auto segment = [&](const Eigen::Vector3d& from, const Eigen::Vector3d& to, int part) {
+    drawing.add_segment(from, to, index, part);
+  };
+  // The range of the nodes' projections on the unit direction e from the obstacle's point, plus the margin.
+  auto span = [&](const Eigen::Vector3d& e) {
+    double lo = INFINITY, hi = -INFINITY;
+    for (Eigen::Index i = 0; i < nodes.cols(); ++i) {
+      const double s = e.dot(in_3d(Vec<dim>(nodes.col(i) - point)));
+      lo = std::min(lo, s);
+      hi = std::max(hi, s);
+    }
+    return std::make_pair(lo - margin, hi + margin);
+  };
+  const Eigen::Vector3d c = in_3d(point);
+  // Two unit vectors normal to `a` and to each other (a plane's normal in 2D: e1 in the plane, e2 = z).
+  auto normal_pair = [&](const Eigen::Vector3d& a) {
+    Eigen::Vector3d e1 = dim == 2 ? Eigen::Vector3d(-a.y(), a.x(), 0.0) : a.unitOrthogonal();
+    return std::make_pair(e1, Eigen::Vector3d(a.cross(e1)));
+  };
+  if (kind == Kind::kPlane) {
+    const auto [e1, e2] = normal_pair(in_3d(normal));
+    const auto [a0, a1] = span(e1);
+    if (dim == 2) {
+      segment(c + a0 * e1, c + a1 * e1, ObstacleDrawing::kSurface);
+      return;
+    }
+    const auto [b0, b1] = span(e2);
+    const Eigen::Vector3d corners[4] = {c + a0 * e1 + b0 * e2, c + a1 * e1 + b0 * e2, c + a1 * e1 + b1 * e2,
+                                        c + a0 * e1 + b1 * e2};
+    for (int k = 0; k < 4; ++k) segment(corners[k], corners[(k + 1) % 4], ObstacleDrawing::kSurface);
+    return;
+  }
+  const Eigen::Vector3d a = dim == 2 ? Eigen::Vector3d(0.0, 0.0, 1.0) : in_3d(axis);
+  const auto [e1, e2] = dim == 2 ? std::make_pair(Eigen::Vector3d(1.0, 0.0, 0.0), Eigen::Vector3d(0.0, 1.0, 0.0))
+                                 : normal_pair(a);
+  auto rim = [&](double phi) { return radius * (std::cos(phi) * e1 + std::sin(phi) * e2); };
+  const double step = 2 * kPi / kCircleSegments;
+  if (dim == 2) {
+    for (int k = 0; k < kCircleSegments; ++k)
+      segment(c + rim(k * step), c + rim((k + 1) * step), ObstacleDrawing::kCylinder);
+    return;
+  }
+  const auto [z0, z1] = span(a);
+  for (const double z : {z0, z1})
+    for (int k = 0; k < kCircleSegments; ++k)
+      segment(c + z * a + rim(k * step), c + z * a + rim((k + 1) * step), ObstacleDrawing::kCylinder);
+  for (int k = 0; k < kGenerators; ++k) {
+    const Eigen::Vector3d r = rim(k * 2 * kPi / kGenerators);
+    segment(c + z0 * a + r, c + z1 * a + r, ObstacleDrawing::kGenerator);
+  }
+}
+
 namespace {
 
 template <int dim>
@@ -164,6 +220,7 @@ class ContactModule final : public WrappingModule<dim> {
     const int n = chain.num_nodes();
     h_ = INFINITY;
     for (int j = 0; j < chain.num_links(); ++j) h_ = std::min(h_, chain.link_length(j));
+    drawn_nodes_ = model.x();
     held_.assign(static_cast<std::size_t>(n), -1);
     offset_.assign(static_cast<std::size_t>(n), 0.0);
     stuck_.assign(static_cast<std::size_t>(n), 0);
@@ -300,6 +357,14 @@ class ContactModule final : public WrappingModule<dim> {
     return {EventAction::Kind::kTransfer, ""};  // the velocities or the held set changed: the integrator restarts
   }
   bool release_contacts(StringModel<dim>& model, double t) override { return settle(model, t, false); }
+  /// The inner module's drawing (an edge's), then each obstacle sized to the string's initial nodes
+  /// plus a tenth of its length.
+  ObstacleDrawing obstacles() const override {
+    ObstacleDrawing drawing = inner_ ? inner_->obstacles() : ObstacleDrawing{};
+    for (std::size_t k = 0; k < obstacles_.size(); ++k)
+      obstacles_[k].draw(static_cast<int>(k), drawn_nodes_, 0.1 * length_, drawing);
+    return drawing;
+  }
 
  private:
   std::vector<Obstacle<dim>> obstacles_;
@@ -313,7 +378,7 @@ class ContactModule final : public WrappingModule<dim> {
   bool friction_ = false;
   std::vector<char> stuck_;
   Eigen::Matrix<double, dim - 1, Eigen::Dynamic> dir_;
-  double length_ = 1;
+  double length_ = 1;  // the string's length (m)
   long sticks_ = 0, slips_ = 0;
 
   const Obstacle<dim>& obstacle_of(std::size_t i) const { return obstacles_[static_cast<std::size_t>(held_[i])]; }
@@ -614,6 +679,7 @@ class ContactModule final : public WrappingModule<dim> {
                                      obstacle_of(static_cast<std::size_t>(node)).name, t, node, ft.norm(), block.size()),
                          t);
   }
+  Points<dim> drawn_nodes_;  // the string's initial nodes, which the obstacles' drawing spans
 
   static bool free_node(const StringModel<dim>& model, int i) { return model.in_arc(i) && !model.is_prescribed(i); }
   /// Node i is held now: on an obstacle, free (a front may have taken it into a heap), and on the

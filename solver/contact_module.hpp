@@ -17,6 +17,7 @@
 ///     the drift control's share), W_impacts (J, ≤ 0: the kinetic energy the landings took) and the
 ///     impulse of all external forces (the momentum ledger p − p0 − impulse, closed across impacts);
 ///   - the recorded quantities impacts and lift_offs (series.csv): how many landings and lift-offs;
+///   - its drawing for the ParaView output (Obstacle::draw);
 ///   - Coulomb friction on obstacles with μ > 0 (docs/model.md §10, "Friction"): a held node slides
 ///     (force −μ N t̂, NodeContact::slide) or sticks (held completely, NodeContact::stuck); two more
 ///     root functions, a sliding node's tangential speed along its direction of sliding (a stop:
@@ -66,6 +67,11 @@ struct Obstacle {
   /// the outward normal turned by +90°; 3D plane: a fixed basis; 3D cylinder: the axis and axis × n),
   /// in which a sliding node keeps the direction it slides in.
   Eigen::Matrix<double, dim, dim - 1> tangents(const Vec<dim>& x) const;
+  /// Adds its drawing for the ParaView output (ObstacleDrawing, cell data obstacle = `index`), sized to
+  /// `nodes` (the string's, m) plus `margin` (m): a plane's segment (2D) or rectangle (3D) spanning their
+  /// projections on it; a cylinder's circle (2D, a polyline), or in 3D its two end circles, at the ends
+  /// of their projections on its axis, joined by a few generators.
+  void draw(int index, const Points<dim>& nodes, double margin, ObstacleDrawing& drawing) const;
 };
 
 /// The contact module of `obstacles` (non-empty) around `inner`, the fronts' module (nullptr: a string

@@ -67,16 +67,32 @@ struct RunEvent {
 
 /// What a module draws of the obstacles it models (fixed in space), for the ParaView output
 /// (frames/obstacles.vtp, docs/string_solver.md): vertex cells (a 2D edge or peg, seen end-on) and line
-/// segments (a 3D edge's line, a table's faces), each with the obstacle it belongs to (its front's
-/// index) and what part of it it is. Points in 3D (m; a 2D run's z = 0).
+/// segments (a 3D edge's line, a table's faces, a surface's outline, a cylinder's circles), each with the
+/// obstacle it belongs to (an edge: its front's index; a surface or cylinder: its index in the contact
+/// module's list) and what part of it it is. Points in 3D (m; a 2D run's z = 0).
 struct ObstacleDrawing {
-  /// 0 the edge (its point or its line), 1 the table's face, 2 the wedge's other face (the table's side).
-  enum Part { kEdge = 0, kTable = 1, kSide = 2 };
+  /// 0 the edge (its point or its line), 1 the table's face, 2 the wedge's other face (the table's side),
+  /// 3 a surface ([[effects.surface]]: a segment in 2D, a rectangle's sides in 3D), 4 a cylinder
+  /// ([[effects.cylinder]]: its circle in 2D, its two end circles in 3D), 5 a cylinder's generator (3D).
+  enum Part { kEdge = 0, kTable = 1, kSide = 2, kSurface = 3, kCylinder = 4, kGenerator = 5 };
   std::vector<Eigen::Vector3d> points;
   std::vector<std::pair<Eigen::Vector3d, Eigen::Vector3d>> segments;
   std::vector<int> point_obstacle, segment_obstacle;  ///< per cell: the obstacle's index
   std::vector<int> point_part, segment_part;          ///< per cell: Part
   bool empty() const { return points.empty() && segments.empty(); }
+  /// A segment cell of obstacle `obstacle`, part `part`.
+  void add_segment(const Eigen::Vector3d& from, const Eigen::Vector3d& to, int obstacle, int part) {
+    segments.emplace_back(from, to);
+    segment_obstacle.push_back(obstacle);
+    segment_part.push_back(part);
+  }
+  /// A point of the string's space as drawn (z = 0 in 2D).
+  template <int dim>
+  static Eigen::Vector3d in_3d(const Vec<dim>& v) {
+    Eigen::Vector3d p = Eigen::Vector3d::Zero();
+    p.head(dim) = v;
+    return p;
+  }
 };
 
 /// A field of the ParaView fronts that the module adds (a point-data array of fronts_XXXX.vtp).

@@ -80,17 +80,8 @@ EdgeComparison compare_over_point(const EdgeCaseSetup& setup, const PointProblem
     module = std::make_unique<FrontTracker<2>>(std::move(fronts), FrontOptions{});
   }
   StringModel<2> model(std::move(chain), std::move(forces), {}, model_options, std::move(module));
-  StringSolverOptions options;
-  options.integrator = setup.integrator;
-  options.t_end = setup.t_max_over_t0 * t0;
-  options.output_interval = options.t_end;
-  options.record_steps = true;
-  StringSolver<2> solver(model, options);
-  try {
-    solver.run();
-  } catch (const NumericalError&) {  // the run's status says "failed" and why
-  }
-  EdgeComparison c{solver.summary(),
+  StringSolver<2> solver(model, exact_comparison_run(setup.integrator, setup.t_max_over_t0 * t0));
+  EdgeComparison c{run_to_stop(solver),
                    CsvTable({"t", "x", "x_dot", p.tension_minus_column, "tension_plus", "reaction_x", "reaction_y"}),
                    {}};
   // x(t), the tensions on both sides of the point and its reaction (forces.csv's R_front0), at every step.
@@ -109,29 +100,18 @@ EdgeComparison compare_over_point(const EdgeCaseSetup& setup, const PointProblem
     c.exact.add_row({s.t, x_exact, e.x_dot, e.tension_minus, e.tension_plus, e.reaction.x(), e.reaction.y()});
   }
   const double t_lift = p.time(p.x_lift);
-  c.summary = to_json(c.run);
-  c.summary["problem"] = p.name;
-  c.summary["nodes"] = setup.nodes;
-  c.summary["f"] = f;
-  c.summary["x0"] = setup.x0;
+  // The string's lift-off: the edge front's event, which stops the run (its last step ends there).
+  std::optional<MeasuredLiftOff> lift_off;
+  const auto lift = std::find_if(c.run.events.begin(), c.run.events.end(),
+                                 [](const RunEvent& e) { return e.kind == "lift_off"; });
+  if (lift != c.run.events.end() && !c.run.samples.empty())
+    lift_off = MeasuredLiftOff{lift->t, ell - c.run.samples.back().fronts[0].s0};
+  c.summary = exact_comparison_summary(c.run, p.name, setup.nodes, t_lift, p.x_lift, lift_off, err_x);
   c.summary["t_stop_over_t0"] = c.run.t_stop / t0;
   c.summary["t_stop_over_t0_exact"] = t_lift / t0;
   c.summary["rel_err_t_stop"] = std::abs(c.run.t_stop - t_lift) / t_lift;
-  c.summary["t_lift_off_exact"] = t_lift;
-  c.summary["x_lift_off_exact"] = p.x_lift;
-  const auto lift = std::find_if(c.run.events.begin(), c.run.events.end(),
-                                 [](const RunEvent& e) { return e.kind == "lift_off"; });
-  if (lift != c.run.events.end() && !c.run.samples.empty()) {
-    const double x = ell - c.run.samples.back().fronts[0].s0;  // the last step ends at the event
-    c.summary["t_lift_off"] = lift->t;
-    c.summary["abs_err_t_lift_off"] = std::abs(lift->t - t_lift);
-    c.summary["x_lift_off"] = x;
-    c.summary["abs_err_x_lift_off"] = std::abs(x - p.x_lift);
-  } else {
-    for (const char* key : {"t_lift_off", "abs_err_t_lift_off", "x_lift_off", "abs_err_x_lift_off"})
-      c.summary[key] = nullptr;
-  }
-  c.summary["max_abs_err_x"] = err_x;
+  c.summary["f"] = f;
+  c.summary["x0"] = setup.x0;
   c.summary["max_abs_err_tension"] = err_tension;
   c.summary["max_rel_err_tension"] = err_tension / setup.chain.P0();
   c.summary["max_abs_err_tension_plus"] = err_tension_plus;

@@ -12,6 +12,7 @@
 #include <nlohmann/json.hpp>
 
 #include "cases/canonical/canonical_string.hpp"
+#include "cases/canonical/contact_compare.hpp"
 
 namespace chainsim {
 
@@ -37,12 +38,12 @@ struct EdgeCaseSetup {
 using PegCaseSetup = EdgeCaseSetup;  ///< with problem = PointContactProblem::kPeg
 
 /// The string run and its comparison with the exact solution. Summary keys (besides the string run's,
-/// among them energy_residual, momentum_residual and events):
-///   problem = "edge" | "peg", nodes, f, x0 (edge: hanging fraction; peg: the longer side's),
-///   t_stop_over_t0, t_stop_over_t0_exact, rel_err_t_stop   the stop (lift-off) time in units of t0,
-///   t_lift_off, t_lift_off_exact, abs_err_t_lift_off       the lift-off event's time (s),
-///   x_lift_off, x_lift_off_exact, abs_err_x_lift_off       x there (m: edge the hanging length, peg the longer side),
-///   max_abs_err_x        max over the steps of |x − exact x(t)| (m),
+/// among them energy_residual, momentum_residual and events): those of every comparison
+/// (exact_comparison_summary, contact_compare.hpp: problem = "edge" | "peg", nodes, the lift-off
+/// event's t and x against the exact ones, max_abs_err_x; x is the edge's hanging length, the peg's
+/// longer side), and
+///   f, x0 (edge: hanging fraction; peg: the longer side's),
+///   t_stop_over_t0, t_stop_over_t0_exact, rel_err_t_stop   the stop (the lift-off) time in units of t0,
 ///   max_abs_err_tension  max over the steps of |τ⁻ − exact τ⁻| (N): the tension before the point, with x, ẍ exact
 ///                        (edge: the table part's pull λ (ℓ − x) ẍ; peg: the rising side's λ (ℓ − x)(g + ẍ)),
 ///   max_rel_err_tension  the same over λ g ℓ,
@@ -52,13 +53,9 @@ using PegCaseSetup = EdgeCaseSetup;  ///< with problem = PointContactProblem::kP
 ///                        −W_shocks of the run, and the exact energy balance's loss at the exact stop,
 ///   peg only: t_end_at_peg_exact   when the shorter end would reach the peg (s; after the lift-off for f < 1).
 /// With no lift-off (a failed run, or the safety stop) the lift-off keys of the string are null.
-struct EdgeComparison {
-  RunSummary run;
-  /// At the string's step times: t, x, x_dot, the tension before the point (edge: tension_edge, peg:
-  /// tension_minus), tension_plus, reaction_x, reaction_y (the exact solution's).
-  CsvTable exact{std::vector<std::string>{}};
-  nlohmann::json summary;
-};
+/// exact: at the string's step times, t, x, x_dot, the tension before the point (edge: tension_edge,
+/// peg: tension_minus), tension_plus, reaction_x, reaction_y (the exact solution's).
+using EdgeComparison = ExactComparison;
 using PegComparison = EdgeComparison;
 
 /// setup.problem must be kEdge (the chain sliding off a table over an edge).

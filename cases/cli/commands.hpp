@@ -40,11 +40,14 @@ int run_canonical_command(const CanonicalCommandOptions& options, std::ostream& 
 /// reduced ODE on the same problem; writes string_series.csv, reduced_series.csv and summary.json.
 /// `chainsim compare edge --x0 X0 ...`: the chain sliding off a table over an edge against its exact
 /// solution (edge_case.hpp); `chainsim compare peg --x0 X0 ...` the heavy Atwood chain over a sharp peg;
-/// both write string_series.csv, exact_series.csv and summary.json.
+/// `chainsim compare pulley --u0 U0 --R R ...` the heavy Atwood chain over a smooth pulley (pulley_case.hpp);
+/// all three write string_series.csv, exact_series.csv and summary.json.
 struct CompareCommandOptions {
   std::string problem;
   StringCaseSetup setup;  ///< problem is filled in from `problem` (edge: its chain, nodes, t_max, integrator)
   std::optional<double> x0;  ///< edge: the hanging fraction at release (default 0.2); peg: the longer side's (0.6)
+  std::optional<double> u0;      ///< pulley: the offset at release (m; default 0.05)
+  std::optional<double> radius;  ///< pulley: the pulley's radius R (m; default 0.1)
   std::string out;        ///< output directory; "" = results/compare/<problem>
   bool json = false;
 };

@@ -1,5 +1,5 @@
-// `chainsim compare`: the string solver against the reduced ODE, or (edge, peg) against the exact
-// solution (see commands.hpp).
+// `chainsim compare`: the string solver against the reduced ODE, or (edge, peg, pulley) against the
+// exact solution (see commands.hpp).
 #include <filesystem>
 #include <optional>
 #include <ostream>
@@ -8,6 +8,7 @@
 #include <nlohmann/json.hpp>
 
 #include "cases/canonical/edge_case.hpp"
+#include "cases/canonical/pulley_case.hpp"
 #include "cases/cli/commands.hpp"
 #include "mesh/errors.hpp"
 #include "solver/output.hpp"
@@ -15,6 +16,14 @@
 namespace chainsim {
 
 namespace {
+
+/// --u0 and --R belong to compare pulley alone.
+void refuse_pulley_options(const CompareCommandOptions& options) {
+  if (options.u0)
+    throw InputError(fmt::format("--u0 = {}: only compare pulley takes --u0 (compare {})", *options.u0, options.problem));
+  if (options.radius)
+    throw InputError(fmt::format("--R = {}: only compare pulley takes --R (compare {})", *options.radius, options.problem));
+}
 
 /// `compare edge`'s and `compare peg`'s setup from the command's options; the options they have no use
 /// for are refused.
@@ -29,6 +38,7 @@ EdgeCaseSetup edge_setup(const CompareCommandOptions& options, PointContactProbl
     throw InputError(fmt::format("--force = {}: only the folded chain has an end force (compare {}: 0)", s.force, name));
   if (s.eps != StringCaseSetup{}.eps)
     throw InputError(fmt::format("--eps = {}: compare {} stops at the lift-off and has no cutoff", s.eps, name));
+  refuse_pulley_options(options);
   EdgeCaseSetup e;
   e.problem = problem;
   e.chain = s.chain;
@@ -40,17 +50,45 @@ EdgeCaseSetup edge_setup(const CompareCommandOptions& options, PointContactProbl
   return e;
 }
 
-void print_edge(const nlohmann::json& s, std::ostream& out) {
+/// `compare pulley`'s setup from the command's options; the options it has no use for are refused.
+PulleyCaseSetup pulley_setup(const CompareCommandOptions& options) {
+  const StringCaseSetup& s = options.setup;
+  if (s.eta0) throw InputError(fmt::format("--eta0 = {}: compare pulley starts from --u0 (m, 0 < u0 < (l - pi R)/2)", *s.eta0));
+  if (options.x0) throw InputError(fmt::format("--x0 = {}: compare pulley starts from --u0 (m, 0 < u0 < (l - pi R)/2)", *options.x0));
+  if (s.force != 0)
+    throw InputError(fmt::format("--force = {}: only the folded chain has an end force (compare pulley: 0)", s.force));
+  if (s.eps != StringCaseSetup{}.eps)
+    throw InputError(fmt::format("--eps = {}: compare pulley stops at the lift-off and has no cutoff", s.eps));
+  if (s.chain.dissipation != StringCaseSetup{}.chain.dissipation)
+    throw InputError(fmt::format("--f = {}: compare pulley has no f (a smooth pulley; its touchdowns are perfectly "
+                                 "inelastic node impacts, docs/model.md section 10)", s.chain.dissipation));
+  PulleyCaseSetup p;
+  p.chain = s.chain;
+  p.nodes = s.nodes;
+  if (options.u0) p.u0 = *options.u0;
+  if (options.radius) p.radius = *options.radius;
+  p.t_max_over_t0 = s.t_max_over_t0;
+  p.integrator = s.integrator;
+  p.validate();
+  return p;
+}
+
+/// The lines every comparison with an exact solution prints: its title, the lift-off's t and x, x(t).
+void print_exact_comparison(const nlohmann::json& s, const std::string& setup, std::ostream& out) {
   auto number = [&](const char* key) { return s[key].is_number() ? fmt::format("{:.12g}", s[key].get<double>()) : "none"; };
   auto error = [&](const char* key) { return s[key].is_number() ? fmt::format("{:.3g}", s[key].get<double>()) : "none"; };
-  const bool peg = s["problem"] == "peg";
-  out << fmt::format("{}, f = {}, x0 = {}, {} nodes: string solver vs exact solution\n",
-                     s["problem"].get<std::string>(), s["f"].get<double>(), s["x0"].get<double>(), s["nodes"].get<int>());
+  out << fmt::format("{}, {}, {} nodes: string solver vs exact solution\n", s["problem"].get<std::string>(), setup,
+                     s["nodes"].get<int>());
   out << fmt::format("  lift-off t (s)   string {}   exact {:.12g}   abs. error {}\n", number("t_lift_off"),
                      s["t_lift_off_exact"].get<double>(), error("abs_err_t_lift_off"));
   out << fmt::format("  lift-off x (m)   string {}   exact {:.12g}   abs. error {}\n", number("x_lift_off"),
                      s["x_lift_off_exact"].get<double>(), error("abs_err_x_lift_off"));
   out << fmt::format("  max |x error|    {:.3g} m (equal times)\n", s["max_abs_err_x"].get<double>());
+}
+
+void print_edge(const nlohmann::json& s, std::ostream& out) {
+  const bool peg = s["problem"] == "peg";
+  print_exact_comparison(s, fmt::format("f = {}, x0 = {}", s["f"].get<double>(), s["x0"].get<double>()), out);
   out << fmt::format("  max |T error|    {:.3g} N before the {}, {:.3g} N after it ({:.3g} relative to lambda g l)\n",
                      s["max_abs_err_tension"].get<double>(), peg ? "peg" : "edge",
                      s["max_abs_err_tension_plus"].get<double>(), s["max_rel_err_tension"].get<double>());
@@ -63,20 +101,34 @@ void print_edge(const nlohmann::json& s, std::ostream& out) {
     out << fmt::format("  (the shorter end would reach the peg at t = {:.12g} s)\n", s["t_end_at_peg_exact"].get<double>());
 }
 
+void print_pulley(const nlohmann::json& s, std::ostream& out) {
+  print_exact_comparison(s, fmt::format("u0 = {} m, R = {} m", s["u0"].get<double>(), s["R"].get<double>()), out);
+  out << fmt::format("  max |T error|    {:.3g} N where the shorter side meets the pulley, {:.3g} N where the longer "
+                     "leaves it ({:.3g} relative to lambda g l); means {:.3g} N, {:.3g} N\n",
+                     s["max_abs_err_tension_short"].get<double>(), s["max_abs_err_tension_long"].get<double>(),
+                     s["max_rel_err_tension"].get<double>(), s["mean_abs_err_tension_short"].get<double>(),
+                     s["mean_abs_err_tension_long"].get<double>());
+}
+
 }  // namespace
 
 int run_compare_command(CompareCommandOptions options, std::ostream& out) {
-  const bool edge = options.problem == "edge" || options.problem == "peg";
+  const bool pulley = options.problem == "pulley";
+  const bool edge = options.problem == "edge" || options.problem == "peg" || pulley;  // against an exact solution
   std::optional<EdgeCaseSetup> edge_case;
-  if (edge) {
+  std::optional<PulleyCaseSetup> pulley_case;
+  if (pulley) {
+    pulley_case = pulley_setup(options);
+  } else if (edge) {
     edge_case = edge_setup(options, options.problem == "peg" ? PointContactProblem::kPeg : PointContactProblem::kEdge);
   } else {
     if (options.problem != "falling" && options.problem != "folded" && options.problem != "sliding")
       throw InputError(fmt::format(
-          "problem = \"{}\" is not a known problem: allowed falling, folded, sliding, edge, peg", options.problem));
+          "problem = \"{}\" is not a known problem: allowed falling, folded, sliding, edge, peg, pulley", options.problem));
     if (options.x0)
       throw InputError(fmt::format("--x0 = {}: only compare edge takes --x0, and compare peg ({} starts from --eta0)",
                                    *options.x0, options.problem));
+    refuse_pulley_options(options);
     options.setup.problem = parse_problem(options.problem);
     options.setup.validate();
   }
@@ -86,10 +138,11 @@ int run_compare_command(CompareCommandOptions options, std::ostream& out) {
   const RunDirectory run_dir(dir);  // held until the outputs are written
   run_dir.clear();
   std::optional<Comparison> c;
-  std::optional<EdgeComparison> e;
+  std::optional<ExactComparison> e;
   if (edge) {
-    e = edge_case->problem == PointContactProblem::kPeg ? compare_peg_with_exact(*edge_case)
-                                                        : compare_edge_with_exact(*edge_case);
+    e = pulley                                                ? compare_pulley_with_exact(*pulley_case)
+        : edge_case->problem == PointContactProblem::kPeg ? compare_peg_with_exact(*edge_case)
+                                                          : compare_edge_with_exact(*edge_case);
     samples_table(e->run).write(dir / "string_series.csv");
     e->exact.write(dir / "exact_series.csv");
   } else {
@@ -110,7 +163,9 @@ int run_compare_command(CompareCommandOptions options, std::ostream& out) {
     }
     out << json_text(j) << '\n';
   } else {
-    if (edge) {
+    if (pulley) {
+      print_pulley(s, out);
+    } else if (edge) {
       print_edge(s, out);
     } else {
       out << fmt::format("{} chain, f = {}, {} nodes: string solver vs reduced ODE\n", options.problem,

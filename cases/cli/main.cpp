@@ -140,9 +140,9 @@ int main(int argc, char** argv) {
   // --- chainsim compare ------------------------------------------------------------------------
   chainsim::CompareCommandOptions compare;
   auto* cmd_compare = app.add_subcommand(
-      "compare", "Solve a canonical problem with the string solver (front tracking) and with its reduced ODE (edge, peg: "
-                 "its exact solution), and compare them");
-  cmd_compare->add_option("problem", compare.problem, "falling | folded | sliding | edge | peg")->required();
+      "compare", "Solve a canonical problem with the string solver (front tracking) and with its reduced ODE (edge, peg, "
+                 "pulley: its exact solution), and compare them");
+  cmd_compare->add_option("problem", compare.problem, "falling | folded | sliding | edge | peg | pulley")->required();
   auto& cs = compare.setup;
   cmd_compare->add_option("--nodes", cs.nodes, "nodes of the string, 4 <= N <= 200001")->capture_default_str();
   cmd_compare->add_option("--f", cs.chain.dissipation, "shock dissipation parameter f, 0 <= f <= 1")->capture_default_str();
@@ -155,6 +155,8 @@ int main(int argc, char** argv) {
   cmd_compare->add_option("--gravity", cs.chain.gravity, "gravitational acceleration g (m/s^2), > 0")->capture_default_str();
   cmd_compare->add_option("--t-max", cs.t_max_over_t0, "safety stop time, in units of t0")->capture_default_str();
   cmd_compare->add_option("--x0", compare.x0, "edge: hanging fraction at release, 0 < x0 < 1 (default 0.2); peg: the longer side's fraction, 0.5 < x0 < 1 (default 0.6)");
+  cmd_compare->add_option("--u0", compare.u0, "pulley: the offset at release (m), 0 < u0 < (l - pi R)/2 (default 0.05)");
+  cmd_compare->add_option("--R", compare.radius, "pulley: the pulley's radius (m), 0 < pi R < l (default 0.1)");
   add_integrator_options(*cmd_compare, cs.integrator);
   cmd_compare->add_option("--out", compare.out, "output directory (default results/compare/<problem>)");
   cmd_compare->add_flag("--json", compare.json, "print the summary as one JSON object on stdout");

@@ -54,6 +54,7 @@
 #include <boost/math/quadrature/tanh_sinh.hpp>
 #include <boost/math/tools/toms748_solve.hpp>
 
+#include "mesh/chain.hpp"
 #include "mesh/errors.hpp"
 
 namespace chainsim::exact {
@@ -432,6 +433,26 @@ double peg_lift_off_x(double f, double x0, double ell, double g) {
   };
   if (margin(ell) >= 0) return ell;  // f = 1: the peg still pushes when the shorter end arrives (g x > ẋ²)
   return lift_off_root(margin, x0, ell);
+}
+
+double pulley_u(double t, double u0, double ell, double g) { return u0 * std::cosh(std::sqrt(2 * g / ell) * t); }
+
+double pulley_u_dot(double t, double u0, double ell, double g) {
+  const double omega = std::sqrt(2 * g / ell);
+  return u0 * omega * std::sinh(omega * t);
+}
+
+double pulley_time(double u, double u0, double ell, double g) {
+  CHAINSIM_VERIFY(u0 > 0 && u >= u0, "pulley_time needs u >= u0 > 0");
+  return std::acosh(u / u0) / std::sqrt(2 * g / ell);
+}
+
+double pulley_lift_off_u(double u0, double radius, double ell) {
+  const double free = ell - kPi * radius;
+  CHAINSIM_VERIFY(radius > 0 && free > 0 && u0 > 0 && u0 < 0.5 * free, "pulley_lift_off_u: out of range");
+  const double b = kPi * radius, c = 0.5 * ell * free + 2 * u0 * u0;
+  // 4 u² + b u − c = 0, c > 0: the positive root, written without cancellation.
+  return 2 * c / (b + std::sqrt(b * b + 16 * c));
 }
 
 }  // namespace chainsim::exact

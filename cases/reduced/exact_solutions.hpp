@@ -163,4 +163,27 @@ double peg_x(double f, double t, double x0, double ell, double g);
 /// zero); ℓ if it stays on the peg until the shorter end reaches it (possible only for f = 1).
 double peg_lift_off_x(double f, double x0, double ell, double g);
 
+// ---------------------------------------------------------------------------------------------------
+// The heavy Atwood chain over a smooth pulley of radius R (docs/model.md §10), physical units: a chain of
+// length ℓ (m) hangs over a pulley, x1 on the longer side, x2 on the shorter, the half circle πR between
+// (x1 + x2 = ℓ_free = ℓ − πR); the whole chain moves along itself, so ℓ ẍ1 = g (x1 − x2), and with
+// u = x1 − ℓ_free/2 released at rest from u0 ∈ (0, ℓ_free/2), ω = √(2g/ℓ):
+//   u = u0 cosh(ω t),   ẋ² = ω² (u² − u0²),   ẍ = ω² u.
+// The shorter side meets the pulley (φ = 0) with τ2 = λ x2 (g + ẍ), the longer leaves it (φ = π) with
+// τ1 = λ x1 (g − ẍ); the contact force per length on the wrapped arc is (τ2 − λ ẋ²)/R + λ ẍ φ + 2 λ g sin φ,
+// smallest at φ = 0, and the shorter side lifts off where τ2 = λ ẋ²:
+//   4 u² + π R u − (ℓ ℓ_free/2 + 2 u0²) = 0,   u* = (−πR + √(π²R² + 8 ℓ ℓ_free + 32 u0²))/8,
+//   t* = arccosh(u*/u0)/ω   (R → 0: the sharp peg's u*² = ℓ²/8 + u0²/2 at f = 0).
+// ---------------------------------------------------------------------------------------------------
+
+/// u(t) = u0 cosh(ω t) (m). Ranges: ℓ > 0, g > 0, u0 > 0.
+double pulley_u(double t, double u0, double ell, double g);
+/// u̇(t) = u0 ω sinh(ω t) (m/s).
+double pulley_u_dot(double t, double u0, double ell, double g);
+/// The time at which u reaches u ≥ u0 (s): arccosh(u/u0)/ω.
+double pulley_time(double u, double u0, double ell, double g);
+/// u* (m), the lift-off of the shorter side (the positive root above). Ranges: R > 0, πR < ℓ,
+/// 0 < u0 < ℓ_free/2; u* < ℓ_free/2 (the shorter end has not reached the pulley).
+double pulley_lift_off_u(double u0, double radius, double ell);
+
 }  // namespace chainsim::exact

@@ -21,38 +21,16 @@
 #include "cases/scene/scene.hpp"
 #include "solver/contact_module.hpp"
 #include "solver/string_solver.hpp"
+#include "tests/convergence/contact_test_support.hpp"
 
 using namespace chainsim;
+using chainsim::test::contact_options;
+using chainsim::test::contact_run;
+using chainsim::test::table;
 
 namespace {
 
 constexpr double kG = 9.81;
-
-StringSolverOptions slack_contact_run(double t_end, double interval, double rtol = 1e-10) {
-  StringSolverOptions so;
-  so.integrator.rtol = rtol;
-  so.integrator.atol = 1e-3 * rtol;
-  so.integrator.method = "erk5";
-  so.t_end = t_end;
-  so.output_interval = interval;
-  return so;
-}
-
-StringModelOptions slack_contact_options() {
-  StringModelOptions mo;
-  mo.stabilization_time = 0.05;
-  mo.slack = SlackPolicy::kAllow;
-  return mo;
-}
-
-Obstacle<2> smooth_table() {
-  Obstacle<2> o;
-  o.kind = Obstacle<2>::Kind::kPlane;
-  o.point = Vec<2>(0.0, 0.0);
-  o.normal = Vec<2>(0.0, 1.0);
-  o.name = "table";
-  return o;
-}
 
 struct TiltedLanding {
   double W_impacts = 0, W_snap = 0, lost = 0, K_end = 0, px_error = 0, height = 0, speed_error = 0, drift = 0;
@@ -73,12 +51,12 @@ TiltedLanding tilted_landing(int links, double theta, double vx) {
   }
   std::vector<std::unique_ptr<Force<2>>> forces;
   forces.push_back(std::make_unique<Gravity<2>>(Vec<2>(0.0, -kG)));
-  StringModel<2> model(std::move(chain), std::move(forces), {}, slack_contact_options(),
-                       make_contact_module<2>({smooth_table()}));
+  StringModel<2> model(std::move(chain), std::move(forces), {}, contact_options(SlackPolicy::kAllow),
+                       make_contact_module<2>({table()}));
   TiltedLanding r;
   r.last_landing = std::sqrt(2 * (low + ell * std::sin(theta)) / kG);
   const double T = 1.3 * r.last_landing;
-  StringSolver<2> solver(model, slack_contact_run(T, T / 4));
+  StringSolver<2> solver(model, contact_run(T, T / 4));
   const RunSummary& s = solver.run();
   r.status = s.status;
   const auto& first = solver.frames().front();

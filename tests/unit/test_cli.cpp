@@ -442,6 +442,59 @@ TEST_CASE("paths and --set keys that are not UTF-8 give JSON with U+FFFD and the
   CHECK_THAT(error["error"].get<std::string>(), Catch::Matchers::Contains("'string.\xef\xbf\xbd' is not a scene key"));
 }
 
+TEST_CASE("chainsim compare pulley --json: the heavy Atwood chain over a pulley against exact::pulley_*, and bad "
+          "input", "[unit][cli][pulley]") {
+  // The command's defaults (101 nodes, u0 = 0.05 m, R = 0.1 m): the bounds of test_contact.cpp's
+  // "compare pulley" on 101 nodes; u* from the quadratic 4u² + πRu − (ℓ ℓ_free/2 + 2u0²) = 0 solved here.
+  const std::string out = temp_dir("cli_compare_pulley");
+  const Result r = run("compare pulley --json --out " + out, true);
+  REQUIRE(r.status == 0);
+  const auto j = nlohmann::json::parse(r.output);
+  CAPTURE(r.output);
+  for (const char* key : {"t_lift_off", "t_lift_off_exact", "abs_err_t_lift_off", "x_lift_off", "x_lift_off_exact",
+                          "abs_err_x_lift_off", "max_abs_err_x", "max_abs_err_tension_short", "max_abs_err_tension_long",
+                          "mean_abs_err_tension_short", "mean_abs_err_tension_long", "max_rel_err_tension",
+                          "tension_steps", "u_lift_off_exact", "energy_residual", "momentum_residual", "nodes", "u0",
+                          "R"})
+    CHECK(j.contains(key));
+  CHECK(j["problem"] == "pulley");
+  const double pi = 3.141592653589793, free = 1 - pi * 0.1, c = 0.5 * free + 2 * 0.05 * 0.05;
+  CHECK(j["u_lift_off_exact"].get<double>() == Approx((-pi * 0.1 + std::sqrt(pi * pi * 0.01 + 16 * c)) / 8).epsilon(1e-12));
+  CHECK(j["x_lift_off_exact"].get<double>() == Approx(0.5 * free + j["u_lift_off_exact"].get<double>()).epsilon(1e-14));
+  CHECK(j["abs_err_t_lift_off"].get<double>() < 1e-3);
+  CHECK(j["abs_err_x_lift_off"].get<double>() < 2e-3);
+  CHECK(j["max_abs_err_x"].get<double>() < 5e-4);
+  CHECK(j["mean_abs_err_tension_short"].get<double>() < 0.02);
+  CHECK(j["energy_residual"].get<double>() < 1e-8);
+  CHECK(j["momentum_residual"].get<double>() < 1e-12);
+  for (const char* file : {"string_series.csv", "exact_series.csv", "summary.json"})
+    CHECK(std::filesystem::exists(out + "/" + file));
+  CHECK_THAT(chainsim::test::read(std::filesystem::path(out) / "exact_series.csv"),
+             Catch::Matchers::StartsWith("t,x,x_dot,u,tension_short,tension_long,lift_off_margin\n"));
+  const std::string bad = " --out " + temp_dir("cli_compare_pulley_bad");
+  struct Case {
+    const char* args;
+    const char* message;
+  };
+  const Case cases[] = {
+      {"compare pulley --u0 0", "chainsim: error: --u0 = 0 is out of range: allowed 0 < u0 < 0.34292"},
+      {"compare pulley --u0 0.35", "chainsim: error: --u0 = 0.35 is out of range: allowed 0 < u0 < 0.34292"},
+      {"compare pulley --R 0", "chainsim: error: --R = 0 is out of range: allowed 0 < R < 0.31830"},
+      {"compare pulley --R 0.4", "chainsim: error: --R = 0.4 is out of range: allowed 0 < R < 0.31830"},
+      {"compare pulley --x0 0.3", "chainsim: error: --x0 = 0.3: compare pulley starts from --u0"},
+      {"compare pulley --f 0.5", "chainsim: error: --f = 0.5: compare pulley has no f"},
+      {"compare pulley --nodes 2", "chainsim: error: --nodes = 2 is out of range: allowed 3 <= nodes <= 200001"},
+      {"compare edge --u0 0.1", "chainsim: error: --u0 = 0.1: only compare pulley takes --u0"},
+      {"compare folded --R 0.1", "chainsim: error: --R = 0.1: only compare pulley takes --R"},
+  };
+  for (const Case& k : cases) {
+    CAPTURE(k.args);
+    const Result b = run(std::string(k.args) + bad);
+    CHECK(b.status == 2);
+    CHECK_THAT(b.output, Catch::Matchers::StartsWith(k.message));
+  }
+}
+
 TEST_CASE("chainsim compare edge --json: the chain off a table's edge against exact::edge_*, and bad input",
           "[unit][cli][edge]") {
   // The bounds of test_edge_front.cpp ("a chain sliding off a table matches exact::edge_*"), here with the

@@ -5,6 +5,7 @@
 #include <filesystem>
 #include <fstream>
 #include <limits>
+#include <sstream>
 #include <string>
 
 #include <catch2/catch.hpp>
@@ -164,4 +165,69 @@ TEST_CASE("ParaView output: a run with an edge draws it in frames/obstacles.vtp,
   plain.write(dir / "plain", plain.summary());
   CHECK_FALSE(std::filesystem::exists(dir / "plain" / "frames" / "obstacles.vtp"));
   CHECK(file_text(dir / "plain" / "string.pvd").find("part=\"2\"") == std::string::npos);
+}
+
+TEST_CASE("ParaView output: surfaces and cylinders are drawn in frames/obstacles.vtp", "[unit][vtk][contact]") {
+  // 2D: the Atwood pulley (a circle of 64 segments, part 4, obstacle 1) over a floor y = −1 (one segment,
+  // part 3, obstacle 0, spanning the string's x ∈ [−0.1, 0.1] plus 0.1 ℓ on each side: x from 0.2 to −0.2).
+  const auto dir = chainsim::test::temp_dir("vtk_contact");
+  {
+    SceneRun<2> run(parse_scene(std::string(CHAINSIM_SOURCE_DIR) + "/cases/scenes/atwood_pulley.toml",
+                                {"string.nodes=21", "stop.t_end=0.02", "output.vtk_encoding=ascii",
+                                 "effects.surface[0].point=[0.0, -1.0]", "effects.surface[0].normal=[0.0, 1.0]"}));
+    REQUIRE_FALSE(run.run().has_value());
+    run.write(dir / "2d", run.summary());
+    const std::string vtp = file_text(dir / "2d" / "frames" / "obstacles.vtp");
+    CHECK_THAT(vtp, Contains("NumberOfPoints=\"130\" NumberOfVerts=\"0\" NumberOfLines=\"65\""));
+    // the floor's segment first, then the circle from (R, 0)
+    const auto points = vtp.find('>', vtp.find("Name=\"Points\"")) + 1;
+    std::istringstream first(vtp.substr(points, 400));
+    double p[9];
+    for (double& c : p) first >> c;
+    const double expected[9] = {0.2, -1, 0, -0.2, -1, 0, 0.1, 0, 0};
+    for (int k = 0; k < 9; ++k) CHECK(std::abs(p[k] - expected[k]) < 1e-12);
+    CHECK(count_of(file_text(dir / "2d" / "string.pvd"), "part=\"2\" file=\"frames/obstacles.vtp\"") ==
+          run.solver().frames().size());
+  }
+  // 3D: a chain lying on the table y = 0 along x ∈ [0, 1] (the table's rectangle: 4 segments, part 3),
+  // under a cylinder along z (two end circles at z = ±0.1, 128 segments, part 4, and 8 generators, part 5).
+  const std::string toml = R"(model = "string"
+[string]
+dimension = 3
+nodes = 11
+[shape]
+kind = "polyline"
+points = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0]]
+[effects.gravity]
+g = [0.0, -9.81, 0.0]
+[[effects.surface]]
+point = [0.0, 0.0, 0.0]
+normal = [0.0, 1.0, 0.0]
+[[effects.cylinder]]
+center = [0.5, 1.0, 0.0]
+radius = 0.2
+axis = [0.0, 0.0, 1.0]
+[output]
+vtk_encoding = "ascii"
+[stop]
+t_end = 0.01
+)";
+  const auto scene = dir / "table3d.toml";
+  std::ofstream(scene) << toml;
+  SceneRun<3> run(parse_scene(scene.string(), {}));
+  REQUIRE_FALSE(run.run().has_value());
+  run.write(dir / "3d", run.summary());
+  const std::string vtp = file_text(dir / "3d" / "frames" / "obstacles.vtp");
+  CHECK_THAT(vtp, Contains("NumberOfPoints=\"280\" NumberOfVerts=\"0\" NumberOfLines=\"140\""));
+  // the parts: 4 × 3, 128 × 4, 8 × 5 (cell data "part", ascii: one value per cell, in order)
+  const auto at = vtp.find("Name=\"part\"");
+  REQUIRE(at != std::string::npos);
+  const auto begin = vtp.find('>', at) + 1, end = vtp.find('<', begin);
+  std::istringstream parts(vtp.substr(begin, end - begin));
+  int counts[6] = {0, 0, 0, 0, 0, 0}, value = 0;
+  while (parts >> value)
+    if (value >= 0 && value < 6) ++counts[value];
+  CHECK(counts[3] == 4);
+  CHECK(counts[4] == 128);
+  CHECK(counts[5] == 8);
 }

@@ -1,0 +1,170 @@
+// The heavy Atwood chain over a smooth pulley on the string solver: see pulley_case.hpp.
+#include "cases/canonical/pulley_case.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <deque>
+#include <memory>
+
+#include <fmt/format.h>
+
+#include "cases/reduced/exact_solutions.hpp"
+#include "mesh/discretize.hpp"
+#include "mesh/errors.hpp"
+#include "solver/contact_module.hpp"
+
+namespace chainsim {
+
+void PulleyCaseSetup::validate() const {
+  chain.validate();
+  if (nodes < 3 || nodes > 200001)
+    throw InputError(fmt::format("--nodes = {} is out of range: allowed 3 <= nodes <= 200001", nodes));
+  require_in_range("--R", radius, 0.0, chain.length / kPi, Bound::kOpen, Bound::kOpen);  // πR < ℓ
+  // u0 = 0: at rest (unstable); u0 = ℓ_free/2: no shorter side.
+  require_in_range("--u0", u0, 0.0, 0.5 * (chain.length - kPi * radius), Bound::kOpen, Bound::kOpen);
+  require_in_range("t_max_over_t0", t_max_over_t0, 0.0, INFINITY, Bound::kOpen);
+  integrator.validate();
+}
+
+namespace {
+
+/// The run goes on to this multiple of the exact lift-off time t*, so that the string's lift-off (the
+/// zero of its margin, which the landings of the shorter side's nodes move by a few steps) is in it.
+constexpr double kPastLiftOff = 1.1;
+
+/// The tension where a hanging side meets the pulley's horizontal diameter (y = 0), extrapolated
+/// linearly in height from the two highest links of the side that lie wholly below it, found going up
+/// from its end node `end` by `step` (+1 from node 0, the shorter side's end; −1 from the last node);
+/// NaN if there are not two.
+double tension_at_pulley(const Points<2>& x, const Eigen::VectorXd& tension, int end, int step) {
+  const int links = static_cast<int>(tension.size());
+  auto link_of = [&](int node) { return step > 0 ? node : node - 1; };  // the link from `node` up the side
+  int top = -1;  // the node at the top of the highest wholly-below link
+  for (int i = end + step; i >= 0 && i <= links && x(1, i) < 0; i += step) top = i;
+  if (top < 0 || std::abs(top - end) < 2) return std::nan("");
+  const int j = link_of(top - step), k = link_of(top - 2 * step);
+  auto mid = [&](int link) { return 0.5 * (x(1, link) + x(1, link + 1)); };
+  const double y1 = mid(j), y0 = mid(k);
+  return tension[j] + (tension[j] - tension[k]) / (y1 - y0) * (0 - y1);
+}
+
+}  // namespace
+
+PulleyComparison compare_pulley_with_exact(const PulleyCaseSetup& setup) {
+  setup.validate();
+  const double ell = setup.chain.length, lambda = setup.chain.density, g = setup.chain.gravity;
+  const double R = setup.radius, u0 = setup.u0, t0 = setup.chain.t0(), free = ell - kPi * R;
+  const double x1 = 0.5 * free + u0, x2 = 0.5 * free - u0;
+  // 1. Up the shorter side at x = −R, over the pulley (two fillets of radius R: the half circle about
+  //    the origin, nodes on it), down the longer side at x = +R.
+  Points<2> vertices(2, 4);
+  vertices << -R, -R, R, R, -x2, R, R, -x1;
+  const int links = setup.nodes - 1;
+  Chain<2> chain = discretize<2>(*rounded_polyline_curve<2>(vertices, R), ell, lambda, links, false);
+  std::vector<std::unique_ptr<Force<2>>> forces;
+  forces.push_back(std::make_unique<Gravity<2>>(Vec<2>(0.0, -g)));
+  Obstacle<2> pulley;
+  pulley.kind = Obstacle<2>::Kind::kCylinder;
+  pulley.radius = R;
+  pulley.name = "pulley";
+  StringModelOptions model_options;
+  model_options.stabilization_time = 0.02 * std::sqrt(ell / g);  // as a scene's default
+  StringModel<2> model(std::move(chain), std::move(forces), {}, model_options,
+                       make_contact_module<2>({pulley}));
+  const double u_lift = exact::pulley_lift_off_u(u0, R, ell);
+  const double t_lift = exact::pulley_time(u_lift, u0, ell, g);
+  StringSolver<2> solver(
+      model, exact_comparison_run(setup.integrator, std::min(kPastLiftOff * t_lift, setup.t_max_over_t0 * t0)));
+  // 2. At every accepted step: u = half the difference of the ends' heights, and the tensions where
+  //    the sides meet the pulley, against the exact solution at the same time.
+  const double omega2 = 2 * g / ell;
+  auto u_of = [&](const Points<2>& x) { return 0.5 * (x(1, 0) - x(1, links)); };
+  PulleyComparison c{{},
+                     CsvTable({"t", "x", "x_dot", "u", "tension_short", "tension_long", "lift_off_margin"}),
+                     {}};
+  struct Exact {
+    double u, u_dot, tau2, tau1;
+  };
+  auto exact_at = [&](double t) {
+    const double u = exact::pulley_u(t, u0, ell, g), xdd = omega2 * u;
+    return Exact{u, exact::pulley_u_dot(t, u0, ell, g), lambda * (0.5 * free - u) * (g + xdd),
+                 lambda * (0.5 * free + u) * (g - xdd)};
+  };
+  double err_x = 0, err_short = 0, err_long = 0, sum_short = 0, sum_long = 0;
+  long tension_steps = 0;
+  // The lift-off: the first zero of the string's margin τ2 − λ ẋ² (its tension where the shorter side
+  // meets the pulley, its speed) averaged over one landing period, interpolated linearly between the steps
+  // where the average changes sign.
+  std::optional<double> t_lift_off, x_lift_off;
+  double t_prev = 0, margin_prev = 0;
+  bool have_prev = false;
+  struct Sample {
+    double t, margin, u;  // a step's time, τ2 − λ ẋ² and u of the string
+  };
+  std::deque<Sample> history;  // over the last window
+  const double h = ell / links;
+  auto compare_at = [&](double t, const Points<2>& x, const Points<2>& v, const Eigen::VectorXd& tension) {
+    if (t_lift_off) return;  // the exact solution holds up to the lift-off
+    const auto [u, u_dot, tau2, tau1] = exact_at(t);
+    const double u_string = u_of(x);
+    err_x = std::max(err_x, std::abs(u_string - u));
+    const double T2 = tension_at_pulley(x, tension, 0, +1), T1 = tension_at_pulley(x, tension, links, -1);
+    if (std::isnan(T1) || std::isnan(T2)) return;
+    err_short = std::max(err_short, std::abs(T2 - tau2));
+    err_long = std::max(err_long, std::abs(T1 - tau1));
+    sum_short += std::abs(T2 - tau2);
+    sum_long += std::abs(T1 - tau1);
+    ++tension_steps;
+    const double speed = 0.5 * (v(1, 0) - v(1, links)), raw = T2 - lambda * speed * speed;
+    // Each node that lands on the shorter side shakes the tension (docs/model.md §10): the margin is
+    // averaged over the time the chain takes to move one link, h/ẋ (trapezoids over the steps in it),
+    // which delays a straight line by half that time.
+    history.push_back({t, raw, u_string});
+    const double window = speed > 0 ? h / speed : INFINITY;
+    if (!(history.back().t - history.front().t >= window)) return;
+    while (history.size() > 2 && history.back().t - history[1].t >= window) history.pop_front();
+    double area = 0;
+    for (std::size_t k = 1; k < history.size(); ++k)
+      area += 0.5 * (history[k].margin + history[k - 1].margin) * (history[k].t - history[k - 1].t);
+    const double span = history.back().t - history.front().t, margin = area / span;
+    if (have_prev && margin_prev > 0 && margin <= 0) {
+      // The average's zero, moved back by the half window; x there from the steps around that time.
+      const double t_zero = t_prev + margin_prev / (margin_prev - margin) * (t - t_prev) - 0.5 * span;
+      auto after = std::find_if(history.begin(), history.end(), [&](const Sample& q) { return q.t >= t_zero; });
+      if (after == history.begin()) ++after;
+      const Sample& q1 = *after;
+      const Sample& q0 = *(after - 1);
+      t_lift_off = t_zero;
+      x_lift_off = 0.5 * free + q0.u + (q1.u - q0.u) * (t_zero - q0.t) / (q1.t - q0.t);
+    }
+    t_prev = t;
+    margin_prev = margin;
+    have_prev = true;
+  };
+  solver.on_step = [&](double t, const Eigen::VectorXd& y) {
+    const auto snap = model.snapshot(t, y);
+    compare_at(t, snap.x, snap.v, snap.tension);
+  };
+  c.run = run_to_stop(solver);
+  for (const StepSample& s : c.run.samples) {  // the exact solution at the rows of string_series.csv
+    const Exact e = exact_at(s.t);
+    c.exact.add_row({s.t, 0.5 * free + e.u, e.u_dot, e.u, e.tau2, e.tau1, (e.tau2 - lambda * e.u_dot * e.u_dot) / R});
+  }
+  // 3. The summary: the string's lift-off and the errors up to it.
+  std::optional<MeasuredLiftOff> lift_off;
+  if (t_lift_off) lift_off = MeasuredLiftOff{*t_lift_off, *x_lift_off};
+  c.summary = exact_comparison_summary(c.run, "pulley", setup.nodes, t_lift, 0.5 * free + u_lift, lift_off, err_x);
+  c.summary["u0"] = u0;
+  c.summary["R"] = R;
+  c.summary["u_lift_off_exact"] = u_lift;
+  c.summary["max_abs_err_tension_short"] = err_short;
+  c.summary["max_abs_err_tension_long"] = err_long;
+  const double steps = static_cast<double>(std::max(1L, tension_steps));
+  c.summary["mean_abs_err_tension_short"] = sum_short / steps;
+  c.summary["mean_abs_err_tension_long"] = sum_long / steps;
+  c.summary["max_rel_err_tension"] = std::max(err_short, err_long) / setup.chain.P0();
+  c.summary["tension_steps"] = tension_steps;
+  return c;
+}
+
+}  // namespace chainsim

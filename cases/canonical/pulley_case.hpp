@@ -1,0 +1,50 @@
+#pragma once
+/// @file pulley_case.hpp
+/// The heavy Atwood chain over a smooth pulley on the string solver against its exact solution
+/// (docs/model.md §10, cases/reduced/exact_solutions.hpp exact::pulley_*): `chainsim compare pulley`.
+/// A chain of length ℓ hangs over a fixed smooth pulley of radius R at the origin (a circle: the contact
+/// module, solver/contact_module.hpp), x2 = ℓ_free/2 − u0 on the left (the shorter side), x1 = ℓ_free/2 +
+/// u0 on the right, the half circle πR between (ℓ_free = ℓ − πR), released at rest. It runs until the
+/// shorter side lifts off the pulley (the contact module's first lift-off event, ContactOptions::
+/// stop_at_lift_off; or the safety stop t_max_over_t0 t0): u = u0 cosh(√(2g/ℓ) t), the tensions
+/// λ x2 (g + ẍ) and λ x1 (g − ẍ) where the sides meet the pulley, and the lift-off where the shorter
+/// side's falls to λ ẋ².
+#include "cases/canonical/canonical_string.hpp"
+#include "cases/canonical/contact_compare.hpp"
+
+namespace chainsim {
+
+struct PulleyCaseSetup {
+  ChainParameters chain;        ///< ℓ, λ, g (its dissipation is not used: the pulley is smooth)
+  int nodes = 101;              ///< nodes of the string, 3 <= nodes <= 200001
+  double u0 = 0.05;             ///< the offset at release (m): 0 < u0 < ℓ_free/2 (the shorter side hangs)
+  double radius = 0.1;          ///< the pulley's radius R (m): 0 < πR < ℓ
+  double t_max_over_t0 = 50.0;  ///< safety stop (the chain lifts off well before)
+  IntegratorOptions integrator = StringCaseSetup::default_integrator();
+  /// InputError naming the option (--nodes, --u0, --R, ...), its value and the allowed range.
+  void validate() const;
+};
+
+/// The string run and its comparison with the exact solution. Summary keys (besides the string run's,
+/// among them energy_residual, momentum_residual and events): those of every comparison
+/// (exact_comparison_summary, contact_compare.hpp: problem = "pulley", nodes, the stop and the first
+/// lift-off's t and x against t*, x* = ℓ_free/2 + u*, max_abs_err_x; x is the longer side's hanging
+/// length ℓ_free/2 + u, u half the difference of the two ends' heights), and
+///   u0, R                       the setup (m),
+///   u_lift_off_exact            u* (m),
+///   max_abs_err_tension_short   max over the steps of |τ2 − λ x2 (g + ẍ)| (N): the tension where the
+///                               shorter side meets the pulley, extrapolated linearly in height to the
+///                               pulley's centre (y = 0) from the two hanging links below its first
+///                               held node; x, ẍ exact,
+///   max_abs_err_tension_long    the same for τ1 = λ x1 (g − ẍ) where the longer side leaves it (N),
+///   mean_abs_err_tension_short, mean_abs_err_tension_long   their means over the steps (N),
+///   max_rel_err_tension         the larger maximum over λ g ℓ,
+///   tension_steps               the steps at which both were measured (each side needs two hanging links
+///                               below the pulley).
+/// exact: at the string's step times, t, x, x_dot, u, tension_short, tension_long (N), and
+/// lift_off_margin = (τ2 − λ ẋ²)/R (N/m), the contact force per length where the shorter side meets the
+/// pulley: it reaches zero at the lift-off.
+using PulleyComparison = ExactComparison;
+PulleyComparison compare_pulley_with_exact(const PulleyCaseSetup& setup);
+
+}  // namespace chainsim
