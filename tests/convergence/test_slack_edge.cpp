@@ -225,7 +225,7 @@ TEMPLATE_TEST_CASE_SIG("slack over an edge: a heavy Atwood chain whose rising si
 
 TEST_CASE("slack over an edge: a snap that leaves the peg unable to push stops the run at the snap as a lift-off",
           "[slack][edge][hard]") {
-  // 40 links balanced over a peg (20 on each side: at rest, the peg pushing with 2 τ = λ g ℓ), the − side's
+  // 40 links nearly balanced over a peg (0.48 and 0.52 m of material on its sides, at rest), the − side's
   // lowest 6 links bunched and thrown down at 30 m/s: their snaps yank the chain over the peg, whose
   // margin, (τ − λ ṡ0²)(1 − cos θ), a snap makes negative (0.15 kg at 30 m/s gives the 1 kg chain up to
   // 4.5 m/s, against √(τ/λ) ≈ 2.2 m/s): ARKODE restarts after the snap and would not see that sign change,
