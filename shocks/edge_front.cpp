@@ -142,20 +142,37 @@ void EdgeFront<dim>::evaluate(const StringModel<dim>& model, FrontState<dim>& s,
   // a step over a crossing must end within that distance, where the crossing's root is located.
   if (g_minus(model) < -kOvershoot * h || g_plus(model) < -kOvershoot * h)
     throw RecoverableError(fmt::format("a node of link {} has passed the edge within a step", a));
-  // ṡ0 = dl⁻/dt = −dl⁺/dt (the bent link keeps l⁻ + l⁺ = h): the − side gains material at ṡ0.
-  const double s0_dot = -t_plus_.dot(v.col(b));
-  jump_ = jump::pinned_tension_plus<dim>(0.0, t_minus_, t_plus_, this->dissipation, lambda, s0_dot);
-  s.s0 = model.chain().node_coordinate(a) + lm;
+  slack_ = model.link_slack(a);
+  double s0_dot = 0, l_minus = lm, l_plus = lp;
+  if (!slack_) {
+    // ṡ0 = dl⁻/dt = −dl⁺/dt (the bent link keeps l⁻ + l⁺ = h): the − side gains material at ṡ0.
+    s0_dot = -t_plus_.dot(v.col(b));
+    jump_ = jump::pinned_tension_plus<dim>(0.0, t_minus_, t_plus_, this->dissipation, lambda, s0_dot);
+  } else {
+    // A slack bent link (slack = allow; docs/model.md §9 "Slack over an edge"): the string no longer
+    // presses on the edge, and checks() stops the run at once (a lift-off). Until then: no tension on
+    // either side, so no kink and no jump; its material h shared in proportion to the two partial
+    // lengths (the link's mass stays λ h; the split is the taut one where l⁻ + l⁺ reaches h), ṡ0 the
+    // rate at which that share moves from a to b.
+    const double L = lm + lp;
+    l_minus = h * lm / L;
+    l_plus = h - l_minus;
+    const double lm_dot = -t_minus_.dot(v.col(a)), lp_dot = t_plus_.dot(v.col(b));
+    s0_dot = h * (lm_dot * lp - lm * lp_dot) / (L * L);
+    jump_ = 0;
+  }
+  s.s0 = model.chain().node_coordinate(a) + l_minus;
   s.s0_dot = s0_dot;
-  s.l_minus = lm;
-  s.l_plus = lp;
+  s.l_minus = l_minus;
+  s.l_plus = l_plus;
   s.direction = t_minus_;
   s.position = point_;
-  s.power_shock = -jump::pinned_dissipation_rate<dim>(t_minus_, t_plus_, this->dissipation, lambda, s0_dot);
+  s.power_shock =
+      slack_ ? 0.0 : -jump::pinned_dissipation_rate<dim>(t_minus_, t_plus_, this->dissipation, lambda, s0_dot);
   s.power_heap = 0;
   // The partial links' masses (the bent link's lumped halves replaced), the jump as a load on b.
-  mass[a] += lambda * (lm - 0.5 * h);
-  mass[b] += lambda * (lp - 0.5 * h);
+  mass[a] += lambda * (l_minus - 0.5 * h);
+  mass[b] += lambda * (l_plus - 0.5 * h);
   force.col(b) -= jump_ * t_plus_;
   // What the edge's support gives the string besides the bent link's T (e⁻ − e⁺), which the string
   // books itself: the load, the table's support, and the momentum of the material moved from a to b.
@@ -302,17 +319,29 @@ EventAction EdgeFront<dim>::cross(StringModel<dim>& model, const FrontState<dim>
 template <int dim>
 Vec<dim> EdgeFront<dim>::recorded_reaction(const StringModel<dim>& model, const FrontState<dim>& s) const {
   const double tm = tension_minus(model);
-  if (!std::isfinite(tm)) return Vec<dim>::Zero();
+  if (!std::isfinite(tm) || slack_) return Vec<dim>::Zero();  // a slack bent link does not press on the edge
   return jump::pinned_reaction<dim>(t_minus_, t_plus_, tm, tm + jump_, this->m_.lambda, s.s0_dot);
 }
 
 template <int dim>
 void EdgeFront<dim>::checks(const StringModel<dim>& model, const FrontState<dim>& s, double* g) const {
+  // A slack bent link (slack = allow) does not press on the edge: the string has left it. The margin,
+  // τ (1 − cos θ) − λ ṡ0² |[t]|²/2 for f = 0, reaches zero as the link's tension falls and the lift-off is
+  // located there; the link goes slack first only where ṡ0 = 0 exactly (or when a snap leaves it slack, or
+  // it was laid slack), and then this check is negative: the run stops at once (docs/model.md §9).
+  if (slack_) {
+    g[0] = -1;
+    return;
+  }
   g[0] = jump::pinned_lift_off_margin<dim>(recorded_reaction(model, s), t_minus_, t_plus_, axis_);
 }
 
 template <int dim>
 std::string EdgeFront<dim>::check_failed(const StringModel<dim>& model, const FrontState<dim>& s, double t) const {
+  if (slack_)
+    return fmt::format("lifted off the edge at t = {:.9g} s: the link bent over the edge at {} (link {}) has gone slack, "
+                       "so the string no longer presses on the edge (s0 = {:.9g} m)",
+                       t, show<dim>(point_), link_, s.s0);
   return fmt::format("lifted off the edge at t = {:.9g} s: the edge at {} would have to pull the string (its reaction "
                      "F0 = {} N leaves the edge's normal cone; tensions {:.6g} N before and {:.6g} N after it, "
                      "material speed {:.6g} m/s, s0 = {:.9g} m)",

@@ -17,6 +17,11 @@
 /// The edge's reaction F0 = −[τ t] + λ ṡ0² [t] (jump::pinned_reaction) is what forces.csv shows
 /// (R_front<k>). It can only push: its root function is jump::pinned_lift_off_margin, and where it
 /// reaches zero the chain lifts off the edge and the run stops (an event of the summary).
+/// With slack = "allow" the bent link is a unilateral link like the others (the complementarity problem
+/// may release it, a snap may catch it: its length l⁻ + l⁺, its rate d(l⁻ + l⁺)/dt, the edge taking the
+/// impulse P (e⁻ − e⁺)); the lift-off margin reaches zero before its tension does unless ṡ0 = 0, and a
+/// bent link found slack (released at ṡ0 = 0, left slack by a snap, or laid slack) is a lift-off too:
+/// the string no longer presses on the edge (docs/model.md §9 "Slack over an edge").
 /// Crossing: when node a comes within kCross h of x0 (material flowing from the − side to the +
 /// side) it passes to the other side, put just past x0 (x0 + kMirror kCross h t⁺) with its velocity rotated from
 /// t⁻ to t⁺ (its speed kept: no energy lost), and the link before it is bent instead; the same the
@@ -115,6 +120,7 @@ class EdgeFront final : public FrontKind<dim> {
   // Of the last evaluation: the tangents on either side, the tension jump [τ] (N).
   Vec<dim> t_minus_ = Vec<dim>::Zero(), t_plus_ = Vec<dim>::Zero();
   double jump_ = 0;
+  bool slack_ = false;  ///< the bent link was slack at the last evaluation (slack = allow)
 };
 
 /// A table that ends at `edge` (docs/model.md §10, "A table bounded by its edge"): the plane through the

@@ -3,6 +3,8 @@
 
 #include <cmath>
 
+#include <fmt/format.h>
+
 #include "string_model.hpp"
 #include "wrapping_module.hpp"
 
@@ -23,6 +25,10 @@ double link_power(const StringModel<dim>& model) {
   for (int j = 0; j < chain.num_links(); ++j) {
     const double T = model.link_tension(j);
     if (!(T != 0) || std::isnan(T)) continue;  // slack, released, or in no arc
+    if (model.link_bent(j)) {  // over an edge: its length runs over the point
+      power -= T * model.link_rate(j);
+      continue;
+    }
     const int a = chain.link_start(j), b = chain.link_end(j);
     const Vec<dim> dx = model.x().col(b) - model.x().col(a);
     power -= T * dx.dot(model.v().col(b) - model.v().col(a)) / chain.link_length(j);
@@ -124,7 +130,26 @@ class SlackModule final : public WrappingModule<dim> {
     ledger[kl + 1] += snap.support_work;
     ledger.template segment<dim>(kl + 3) += snap.support_impulse;
     ++snaps_;
-    if (inner_) inner_->release_contacts(model, t);  // held nodes the snap would pull off a surface
+    if (inner_) {
+      inner_->release_contacts(model, t);  // held nodes the snap would pull off a surface
+      // ARKODE restarts from the state after the snap and finds only sign changes from there: a check of
+      // the fronts that the snap has made fail (an edge that would now have to pull the string) is acted
+      // on here, as at the start of a run.
+      if (inner_->checks_at_start()) {
+        model.evaluate(t, model.x(), model.v());
+        Eigen::VectorXd g(k);
+        inner_->events(model, g);
+        const std::vector<int> failed = inner_->events_failed_at_start(g);
+        if (!failed.empty()) {
+          EventAction stop = inner_->handle_events(model, t, ledger.head(kl), failed);
+          if (stop.kind == EventAction::Kind::kStop) {
+            --snaps_;  // the run stops on the state before it (the runner records that state)
+            stop.reason = fmt::format("at the snap taut at t = {:.9g} s: {}", t, stop.reason);
+            return stop;
+          }
+        }
+      }
+    }
     return {EventAction::Kind::kTransfer, ""};  // the velocities changed: the integrator restarts
   }
   bool events_need_tensions() const override { return inner_ && inner_->events_need_tensions(); }

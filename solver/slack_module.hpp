@@ -16,7 +16,10 @@
 ///   - the recorded quantity snaps (series.csv): the number of snaps so far.
 /// A string with fronts (heaps, folds) keeps its front tracker: this module wraps it, passes its layout,
 /// masses, forces, ledgers, events and fronts through, and adds its own ledgers and root function after
-/// the tracker's (docs/model.md §9 "Slack next to a front").
+/// the tracker's (docs/model.md §9 "Slack next to a front"). A link bent over an edge is unilateral like the
+/// others (its length l⁻ + l⁺, the edge taking its impulses); after a snap the fronts' checks are evaluated on
+/// the new state, and one that the snap made fail (an edge that would now pull) stops the run (docs/model.md §9
+/// "Slack over an edge").
 #include <memory>
 
 #include "string_module.hpp"

@@ -256,7 +256,6 @@ void StringModel<dim>::links() {
 template <int dim>
 void StringModel<dim>::bend_link(int link, const Vec<dim>& point) {
   if (quadratic_) throw InputError("a link bent over a point (an edge) needs link elements ([string] elements = \"links\")");
-  if (allows_slack()) throw InputError("a link bent over a point (an edge) does not meet solver.slack = \"allow\"");
   if (link < 0 || link >= chain_.num_links()) throw InputError(fmt::format("bend_link: no link {}", link));
   for (Bend& b : bends_)
     if (b.link == link) {
@@ -298,6 +297,28 @@ template <int dim>
 double StringModel<dim>::bend_rate(const Bend& bend) const {
   const int a = chain_.link_start(bend.link), b = chain_.link_end(bend.link);
   return bend.e_plus.dot(v_.col(b)) - e_.col(bend.link).dot(v_.col(a));
+}
+
+template <int dim>
+const typename StringModel<dim>::Bend* StringModel<dim>::bend_of(int link) const {
+  for (const Bend& bend : bends_)
+    if (bend.link == link) return &bend;
+  return nullptr;
+}
+
+template <int dim>
+double StringModel<dim>::current_length(int j) const {
+  const Vec<dim>& a = x_.col(chain_.link_start(j));
+  const Vec<dim>& b = x_.col(chain_.link_end(j));
+  if (const Bend* bend = bends_.empty() ? nullptr : bend_of(j))  // its length runs over its point
+    return (bend->point - a).norm() + (b - bend->point).norm();
+  return (b - a).norm();
+}
+
+template <int dim>
+double StringModel<dim>::link_rate(int j) const {
+  if (const Bend* bend = bends_.empty() ? nullptr : bend_of(j)) return bend_rate(*bend);
+  return e_.col(j).dot(dv_.col(j));
 }
 
 template <int dim>
@@ -777,8 +798,7 @@ double StringModel<dim>::make_consistent(double t0) {
     v_.col(p.node) = p.path->velocity(t0);
   }
   for (int j = 0; j < chain_.num_links(); ++j)
-    if (link_slack(j) && !((x_.col(chain_.link_end(j)) - x_.col(chain_.link_start(j))).norm() <
-                           (1 - kSlackGap) * chain_.link_length(j)))
+    if (link_slack(j) && !(current_length(j) < (1 - kSlackGap) * chain_.link_length(j)))
       throw InputError(fmt::format("link {} is declared slack but is not shorter than its length {:g} m",
                                    j, chain_.link_length(j)));
   const Points<dim> x_start = x_, v_start = v_;
@@ -1063,8 +1083,7 @@ double StringModel<dim>::slack_gap() const {
   for (int j = 0; j < chain_.num_links(); ++j) {
     if (!slack_[static_cast<std::size_t>(j)]) continue;
     const double h = chain_.link_length(j);
-    const double l = (x_.col(chain_.link_end(j)) - x_.col(chain_.link_start(j))).norm();
-    g = std::min(g, (h - l) / h + slack_offset_[static_cast<std::size_t>(j)]);
+    g = std::min(g, (h - current_length(j)) / h + slack_offset_[static_cast<std::size_t>(j)]);
   }
   return g;
 }
@@ -1080,7 +1099,7 @@ void StringModel<dim>::accept_step(double t, const Eigen::Ref<const Eigen::Vecto
   for (int j = 0; j < chain_.num_links(); ++j) {
     if (link_unknown_[static_cast<std::size_t>(j)] < 0) continue;  // in no arc: a front holds it
     const double h = chain_.link_length(j);
-    const double gap = (h - (x_.col(chain_.link_end(j)) - x_.col(chain_.link_start(j))).norm()) / h;
+    const double gap = (h - current_length(j)) / h;
     if (!link_slack(j)) {
       if (gap > kSlackGap) set_slack(j, true);
     } else if (gap + slack_offset_[static_cast<std::size_t>(j)] < -kSlackGap) {
@@ -1162,7 +1181,7 @@ typename StringModel<dim>::SnapResult StringModel<dim>::link_impulses(double t, 
   system_->zero();
   assemble_matrix();
   for_each_link([&](int j, int u, int) {
-    u_before[j] = e_.col(j).dot(dv_.col(j));
+    u_before[j] = link_rate(j);
     system_->rhs(u) = -(1 + e) * u_before[j];
     if (!link_slack(j)) u_scale = std::max(u_scale, std::abs(u_before[j]));
   });
@@ -1176,16 +1195,21 @@ typename StringModel<dim>::SnapResult StringModel<dim>::link_impulses(double t, 
   Points<dim> link_impulse = Points<dim>::Zero(dim, chain_.num_nodes());
   for_each_link([&](int j, int u, int) {
     const int a = chain_.link_start(j), b = chain_.link_end(j);
-    const Vec<dim> J = P[u] * e_.col(j);  // on node a; −J on node b
+    const Vec<dim> J = P[u] * e_.col(j);  // on node a; −J on node b (−P e⁺ for a link bent over a point)
+    const Bend* bend = bends_.empty() ? nullptr : bend_of(j);
+    const Vec<dim> Jb = bend ? Vec<dim>(P[u] * bend->e_plus) : J;
+    // The point a link is bent over takes P (e⁻ − e⁺) from the string's side: an external impulse (no work,
+    // the point is fixed), as its force T (e⁻ − e⁺) is an external force (bend_reaction).
+    if (bend) result.support_impulse += J - Jb;
     link_impulse.col(a) += J;
-    link_impulse.col(b) -= J;
+    link_impulse.col(b) -= Jb;
     if (path_of_[a] >= 0) {
       result.support_impulse -= J;
       result.support_work -= J.dot(v_.col(a));
     }
     if (path_of_[b] >= 0) {
-      result.support_impulse += J;
-      result.support_work += J.dot(v_.col(b));
+      result.support_impulse += Jb;
+      result.support_work += Jb.dot(v_.col(b));
     }
   });
   for (const NodeContact<dim>& c : contacts_)
@@ -1193,7 +1217,7 @@ typename StringModel<dim>::SnapResult StringModel<dim>::link_impulses(double t, 
   // 4. The energy dissipated, Σ P_j (u⁻_j + u⁺_j)/2, and the links that separate go slack.
   links();
   for_each_link([&](int j, int u, int) {
-    const double u_after = e_.col(j).dot(dv_.col(j));
+    const double u_after = link_rate(j);
     result.dissipated += 0.5 * P[u] * (u_before[j] + u_after);
     if (!link_slack(j) && u_after < -kSeparation * u_scale) {
       set_slack(j, true);

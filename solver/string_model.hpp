@@ -284,6 +284,10 @@ class StringModel final : public OdeSystem {
   }
   /// Straightens every bent link.
   void clear_bends() { bends_.clear(); }
+  /// Link `link` is bent over a point (bend_link).
+  bool link_bent(int link) const { return !bends_.empty() && bend_of(link) != nullptr; }
+  /// Link j's rate of lengthening after an evaluation (m/s): e_j·Δv_j, a bent link's d(l⁻ + l⁺)/dt.
+  double link_rate(int j) const;
   /// The force the points of the bent links exert on the string after an evaluation (N): Σ T (e⁻ − e⁺).
   Vec<dim> bend_reaction() const;
   /// The tension of link `link` after an evaluation (N): its multiplier; NaN for a link in no arc.
@@ -458,6 +462,9 @@ class StringModel final : public OdeSystem {
   void bend_links();               // links(): the bent links' lengths and directions
   void bend_couplings();           // assemble_matrix(): their couplings at the end node
   double bend_rate(const Bend& bend) const;  // d(l⁻ + l⁺)/dt
+  const Bend* bend_of(int link) const;       // the bend of a link, or null
+  /// Link j's length at x_ (a bent link's runs over its point: l⁻ + l⁺), without links().
+  double current_length(int j) const;
   Eigen::VectorXd base_mass_;    // lumped masses of the arcs' links
   Eigen::VectorXd m_;            // current masses (base + module)
   Eigen::VectorXd w_;            // 1/m_i for free nodes, 0 otherwise

@@ -279,12 +279,6 @@ SceneParts<dim> build_scene_parts(const SceneSpec& spec) {
                                     : SlackPolicy::kStop;
   mo.snap_restitution = so.snap_restitution;
   if (mo.slack == SlackPolicy::kAllow) {
-    if (!spec.effects.edges.empty())
-      at_key(spec, "solver.slack", [&] {
-        throw InputError("solver.slack = \"allow\" does not meet edges yet ([[effects.edge]]: a link bent over the "
-                         "edge has no slack state): a scene with an edge takes slack = \"stop\", \"warn\" or "
-                         "\"ignore\"; heaps and folds take \"allow\"");
-      });
     if (spec.elements == "quadratic")
       at_key(spec, "solver.slack", [&] {
         throw InputError("solver.slack = \"allow\" needs link elements: string.elements = \"quadratic\" has no "

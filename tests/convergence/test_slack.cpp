@@ -359,10 +359,13 @@ Points<2> swinging_u(int nodes, double t_end, RunSummary& summary, double& w_sna
 
 }  // namespace
 
-TEST_CASE("slack: the swinging U converges under mesh refinement at t = 1 s", "[slack]") {
+TEST_CASE("slack: the swinging U on 51 to 401 nodes: the differences of the state at t = 1 s fall", "[slack]") {
   // The issue's U: polyline [[0,0],[0.3,-0.4],[0.6,-0.4],[0.3,0]], corner_radius 0.12, lambda 0.1,
   // g 9.81, both ends fixed, slack = "allow", perfectly inelastic snaps. With slack = "stop" it stopped
-  // at t = 0.38..0.46 s (not converged); here the state at t = 1 s converges. Measured (max over the
+  // at t = 0.38..0.46 s (not converged); here it runs to t = 1 s, and on these meshes the differences of
+  // its state there fall. They are not shown to converge beyond: on 401 -> 801 nodes the largest falls
+  // only to 6.0e-3 m and the RMS rises (2.1e-3 -> 2.3e-3 m), the error spread over the chain rather than
+  // at the kink (docs/model.md §9 "Where the U's error sits"). Measured (max over the
   // coarse mesh's nodes of the distance to the same material point on the next mesh):
   // 1.29e-2, 9.8e-3, 6.5e-3 m for 51 -> 101 -> 201 -> 401 nodes: observed order 0.39, then 0.59
   // (about first order at best: each snap is an O(h) event of the discrete chain). W_snap falls with
@@ -393,14 +396,14 @@ TEST_CASE("slack: the swinging U converges under mesh refinement at t = 1 s", "[
   CHECK(differences.back() < 0.01);
 }
 
-TEST_CASE("slack: allow is refused with edges and with quadratic elements, located at the key", "[slack]") {
+TEST_CASE("slack: allow is refused with quadratic elements, located at the key; fronts and edges take it", "[slack]") {
   const std::filesystem::path scenes = std::filesystem::path(CHAINSIM_SOURCE_DIR) / "cases" / "scenes";
-  // Heaps and folds take allow (tests/convergence/test_slack_fronts.cpp); an edge does not yet.
+  // Heaps, folds (tests/convergence/test_slack_fronts.cpp) and edges (tests/convergence/test_slack_edge.cpp)
+  // take allow.
   CHECK_NOTHROW(build_string_scene<2>(parse_scene(scenes / "folded_chain.toml", {"solver.slack=allow"})));
   CHECK_NOTHROW(build_string_scene<2>(parse_scene(scenes / "falling_chain.toml", {"solver.slack=allow"})));
-  const SceneSpec edge = parse_scene(scenes / "chain_off_table_edge.toml", {"solver.slack=allow"});
-  CHECK_THROWS_WITH(build_string_scene<2>(edge),
-                    Catch::Matchers::Contains("solver.slack") && Catch::Matchers::Contains("does not meet edges yet"));
+  CHECK_NOTHROW(build_string_scene<2>(parse_scene(scenes / "chain_off_table_edge.toml", {"solver.slack=allow"})));
+  CHECK_NOTHROW(build_string_scene<2>(parse_scene(scenes / "chain_over_peg.toml", {"solver.slack=allow"})));
   const SceneSpec quadratic =
       parse_scene(scenes / "swinging_u.toml", {"string.elements=quadratic", "string.nodes=101"});
   CHECK_THROWS_WITH(build_string_scene<2>(quadratic), Catch::Matchers::Contains("needs link elements"));
@@ -431,7 +434,7 @@ TEST_CASE("slack: the swinging U and the whip close their energy ledgers to roun
   }
 }
 
-TEST_CASE("slack: the swinging U on 201 to 1601 nodes: the state at t = 1 s converges slowly",
+TEST_CASE("slack: the swinging U on 201 to 1601 nodes: the largest differences at t = 1 s fall slowly",
           "[slack][convergence][.long]") {
   // The study behind docs/model.md §9 "Does the U converge?" (CHAINSIM_LONG_TESTS; about 3 minutes):
   // the largest distance between the same material point on successive meshes keeps falling, but
