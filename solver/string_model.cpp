@@ -238,8 +238,8 @@ void StringModel<dim>::fill_moving(double t, const Eigen::Ref<const Eigen::Vecto
 
 template <int dim>
 void StringModel<dim>::links() {
-  x_max_ = 0;
-  for_each_link([&](int j, int, int) {
+  double x_max = 0;  // a local: the stores of the loop are doubles too, and would reload a member
+  for_each_link([&](int j, int, int next) {
     const int a = chain_.link_start(j), b = chain_.link_end(j);
     dx_.col(j) = x_.col(b) - x_.col(a);
     dv_.col(j) = v_.col(b) - v_.col(a);
@@ -248,8 +248,11 @@ void StringModel<dim>::links() {
       throw RecoverableError(fmt::format("link {} has collapsed to length {:g}", j, l));
     l_[j] = l;
     e_.col(j) = dx_.col(j) / l;
-    x_max_ = std::max({x_max_, x_.col(a).cwiseAbs().maxCoeff(), x_.col(b).cwiseAbs().maxCoeff()});
+    // every node of the arcs once: each link's start, and the end of an open arc's last link
+    x_max = std::max(x_max, x_.col(a).cwiseAbs().maxCoeff());
+    if (next < 0) x_max = std::max(x_max, x_.col(b).cwiseAbs().maxCoeff());
   });
+  x_max_ = x_max;
   if (!bends_.empty()) bend_links();
 }
 
@@ -335,9 +338,17 @@ double StringModel<dim>::capped_beta2() const {
   // position term and no artificial tension, however short τ_b (β² = 1/τ_b² turned its round-off
   // into T = −1.5e165 N with τ_b = 1e-91 s). Ordinary runs are far below the cap (falling chain:
   // β² δ h = 1.7e-10 m/s² against 1e-5 m/s²) and keep β² = 1/τ_b².
-  const double a_physical = physical_scales().tension / (chain_.density() * chain_.length());
+  // physical_scales() is a pass over the nodes (10 k instructions at 250 links, at every right-hand
+  // side). Its tension is the weight λ|g|ℓ plus terms ≥ 0, and rounding is monotone, so the cap
+  // computed from the weight alone is a lower bound of the cap: when β² is below it, the cap does
+  // not bind and β² is the same number without the pass.
+  const double lambda_ell = chain_.density() * chain_.length();
   const double h_ref = std::isfinite(h_min_) ? h_min_ : chain_.length();
-  return std::min(beta_ * beta_, kDriftRoundoff * a_physical / (constraint_tolerance() * h_ref));
+  const double beta2 = beta_ * beta_, denominator = constraint_tolerance() * h_ref;
+  const double weight = chain_.density() * uniform_field().norm() * chain_.length();  // as physical_scales()
+  if (beta2 <= kDriftRoundoff * (weight / lambda_ell) / denominator) return beta2;
+  const double a_physical = physical_scales().tension / lambda_ell;
+  return std::min(beta2, kDriftRoundoff * a_physical / denominator);
 }
 
 template <int dim>
@@ -356,7 +367,7 @@ void StringModel<dim>::assemble_matrix() {
   // link j with the next link of its arc goes through their shared node b = link_end(j).
   for_each_link([&](int j, int u, int next) {
     const int a = chain_.link_start(j), b = chain_.link_end(j);
-    system_->add_diagonal(u, -(w_[a] + w_[b]));
+    system_->set_diagonal(u, -(w_[a] + w_[b]));  // its first write (zero() is optional: evaluate_current)
     if (next >= 0) system_->set_coupling(u, w_[b] * e_.col(j).dot(e_.col(next)));
   });
   if (!bends_.empty()) bend_couplings();
@@ -424,6 +435,27 @@ void StringModel<dim>::refresh() {
 }
 
 template <int dim>
+void StringModel<dim>::tension_forces_of_string(const Eigen::VectorXd& T) {
+  // The whole string is one arc, link j = unknown j from node j to node j + 1 (to node 0 for the last
+  // link of a closed string). Node by node, with each node's two terms in the order of the link-by-link
+  // sum T_j e_j at the start, −T_j e_j at the end from zero (for_each_link): the same numbers, without
+  // zeroing the array and writing every node twice.
+  const int n = chain_.num_nodes(), L = chain_.num_links();
+  if (L == 0) {
+    tension_force_.setZero();
+    return;
+  }
+  const auto te = [&](int j) { return Vec<dim>(T[j] * e_.col(j)); };
+  tension_force_.col(0) = Vec<dim>(Vec<dim>::Zero() + te(0));
+  if (chain_.closed()) tension_force_.col(0) -= te(L - 1);
+  for (int i = 1; i < n; ++i) {
+    Vec<dim> f = Vec<dim>::Zero() - te(i - 1);
+    if (i < L) f += te(i);
+    tension_force_.col(i) = f;
+  }
+}
+
+template <int dim>
 double StringModel<dim>::evaluate(double t, const Points<dim>& x, const Points<dim>& v) {
   x_ = x;
   v_ = v;
@@ -452,7 +484,6 @@ double StringModel<dim>::evaluate_current(double t) {
     }
   }
   // 2. Link geometry and the tension system.
-  tension_force_.setZero();
   if (quadratic_) {
     x_max_ = x_.cwiseAbs().maxCoeff();
     beta2_ = capped_beta2();
@@ -460,14 +491,17 @@ double StringModel<dim>::evaluate_current(double t) {
     tension_force_ = quadratic_->tension_forces();
   } else if (system_) {
     links();
-    system_->zero();
+    // Every value and right side is set below (the arcs' diagonals, couplings and right sides) unless
+    // bent links, held nodes or excluded (slack) links add to them: only those need the zeroing.
+    if (!bends_.empty() || !contacts_.empty() || allows_slack() || system_->has_exclusions()) system_->zero();
     assemble_matrix();
     beta2_ = capped_beta2();  // the drift control's position term, capped (capped_beta2)
     if (!contacts_.empty()) constrain_contact_nodes();
+    const double two_alpha = 2 * alpha_, half_beta2 = beta2_ * 0.5;  // the products the sum began with
     for_each_link([&](int j, int u, int) {
       const int a = chain_.link_start(j), b = chain_.link_end(j);
       const double h = chain_.link_length(j), l = l_[j];
-      const double stab = 2 * alpha_ * dx_.col(j).dot(dv_.col(j)) + beta2_ * 0.5 * (l * l - h * h);
+      const double stab = two_alpha * dx_.col(j).dot(dv_.col(j)) + half_beta2 * (l * l - h * h);
       system_->rhs(u) = -dv_.col(j).squaredNorm() / l - e_.col(j).dot(b_.col(b) - b_.col(a)) - stab / l;
     });
     for (const Bend& bend : bends_) {
@@ -483,14 +517,21 @@ double StringModel<dim>::evaluate_current(double t) {
                         (ep.dot(b_.col(b)) - em.dot(b_.col(a))) - stab;
     }
     const Eigen::VectorXd& T = solve_tensions(t);
-    for_each_link([&](int j, int u, int) {
-      tension_force_.col(chain_.link_start(j)) += T[u] * e_.col(j);
-      tension_force_.col(chain_.link_end(j)) -= T[u] * e_.col(j);
-    });
+    if (!module_ && bends_.empty()) {
+      tension_forces_of_string(T);
+    } else {
+      tension_force_.setZero();
+      for_each_link([&](int j, int u, int) {
+        tension_force_.col(chain_.link_start(j)) += T[u] * e_.col(j);
+        tension_force_.col(chain_.link_end(j)) -= T[u] * e_.col(j);
+      });
+    }
     for (const Bend& bend : bends_) {
       const int u = link_unknown_[static_cast<std::size_t>(bend.link)];
       if (u >= 0) tension_force_.col(chain_.link_end(bend.link)) += T[u] * (e_.col(bend.link) - bend.e_plus);
     }
+  } else {
+    tension_force_.setZero();  // no link in any arc (every node held, or single-node arcs)
   }
   // 3. Accelerations, the supports' reactions and the power of everything not booked in V.
   double power = 0;

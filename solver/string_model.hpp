@@ -358,6 +358,9 @@ class StringModel final : public OdeSystem {
   /// Positions and velocities of the nodes in an arc at (t, y) into x, v (the others untouched).
   void fill_moving(double t, const Eigen::Ref<const Eigen::VectorXd>& y, Points<dim>& x, Points<dim>& v) const;
   double evaluate_current(double t);
+  /// evaluate_current without a module or bent links: the tension forces T_j e_j − T_{j−1} e_{j−1} of
+  /// the nodes from the tensions T (per link), in one pass.
+  void tension_forces_of_string(const Eigen::VectorXd& T);
   /// The tension solve of an evaluation: the linear system, or with slack = allow the
   /// complementarity problem on the taut links (slack ones excluded).
   const Eigen::VectorXd& solve_tensions(double t);
