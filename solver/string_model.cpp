@@ -159,6 +159,7 @@ void StringModel<dim>::rebuild() {
   num_free_ = 0;
   for (int i = 0; i < n; ++i)
     if (in_arc(i) && path_of_[i] < 0) slot_[i] = num_free_++;
+  find_free_runs();
   // Each arc with a link owns a block of unknowns; its links' masses are lumped on their nodes.
   base_mass_ = Eigen::VectorXd::Zero(n);
   link_unknown_.assign(static_cast<std::size_t>(L), -1);
@@ -220,19 +221,32 @@ void StringModel<dim>::unpack(double t, const Eigen::Ref<const Eigen::VectorXd>&
 template <int dim>
 void StringModel<dim>::fill_moving(double t, const Eigen::Ref<const Eigen::VectorXd>& y, Points<dim>& x,
                                    Points<dim>& v) const {
-  const int n = chain_.num_nodes();
   const int voff = dim * num_free_;
-  for (int i = 0; i < n; ++i) {
-    if (arc_of_[i] < 0) continue;
+  for (const FreeRun& run : free_runs_) {
+    Eigen::Map<Eigen::VectorXd>(x.col(run.node).data(), dim * run.count) = y.segment(dim * run.slot, dim * run.count);
+    Eigen::Map<Eigen::VectorXd>(v.col(run.node).data(), dim * run.count) =
+        y.segment(voff + dim * run.slot, dim * run.count);
+  }
+  for (const int i : prescribed_in_arcs_) {
+    const EndPath<dim>& path = *prescribed_[static_cast<std::size_t>(path_of_[i])].path;
+    x.col(i) = path.position(t);
+    v.col(i) = path.velocity(t);
+  }
+}
+
+template <int dim>
+void StringModel<dim>::find_free_runs() {
+  free_runs_.clear();
+  prescribed_in_arcs_.clear();
+  for (int i = 0; i < chain_.num_nodes(); ++i) {
     const int k = slot_[i];
-    if (k >= 0) {
-      x.col(i) = y.template segment<dim>(dim * k);
-      v.col(i) = y.template segment<dim>(voff + dim * k);
-    } else {
-      const EndPath<dim>& path = *prescribed_[static_cast<std::size_t>(path_of_[i])].path;
-      x.col(i) = path.position(t);
-      v.col(i) = path.velocity(t);
-    }
+    if (k >= 0 && !free_runs_.empty() && free_runs_.back().node + free_runs_.back().count == i &&
+        free_runs_.back().slot + free_runs_.back().count == k)
+      ++free_runs_.back().count;
+    else if (k >= 0)
+      free_runs_.push_back({i, k, 1});
+    else if (arc_of_[i] >= 0)
+      prescribed_in_arcs_.push_back(i);
   }
 }
 
@@ -472,17 +486,16 @@ double StringModel<dim>::evaluate_current(double t) {
   force_.setZero();
   force_nc_.setZero();
   for (const auto& force : forces_) force->add_force(state, force->conservative() ? force_ : force_nc_);
-  for (int i = 0; i < n; ++i) {
-    if (arc_of_[i] < 0) continue;
-    if (path_of_[i] < 0) {
+  for (const FreeRun& run : free_runs_) {
+    for (int i = run.node, end = run.node + run.count; i < end; ++i) {
       if (module_)
         b_.col(i) = w_[i] * (force_.col(i) + force_nc(i) + module_force_.col(i));
       else
         b_.col(i) = w_[i] * (force_.col(i) + force_nc(i));
-    } else {
-      b_.col(i) = prescribed_[static_cast<std::size_t>(path_of_[i])].path->acceleration(t);
     }
   }
+  for (const int i : prescribed_in_arcs_)
+    b_.col(i) = prescribed_[static_cast<std::size_t>(path_of_[i])].path->acceleration(t);
   // 2. Link geometry and the tension system.
   if (quadratic_) {
     x_max_ = x_.cwiseAbs().maxCoeff();
@@ -536,21 +549,33 @@ double StringModel<dim>::evaluate_current(double t) {
   // 3. Accelerations, the supports' reactions and the power of everything not booked in V.
   double power = 0;
   if (module_) external_.setZero();
-  for (int i = 0; i < n; ++i) {
-    if (arc_of_[i] < 0) continue;
-    if (path_of_[i] < 0) {
-      a_.col(i) = quadratic_ ? Vec<dim>(quadratic_->accelerations().col(i)) : Vec<dim>(b_.col(i) + w_[i] * tension_force_.col(i));
-      power += force_nc(i).dot(v_.col(i));
-    } else {
-      a_.col(i) = b_.col(i);
-      // the support's reaction R_i = m a − F − T − (module force); drag on it is applied work too
-      auto reaction = reaction_.col(path_of_[i]);
-      reaction = (quadratic_ ? Vec<dim>(quadratic_->inertia().col(i)) : Vec<dim>(m_[i] * a_.col(i))) - force_.col(i) - force_nc(i) - tension_force_.col(i);
-      if (module_) reaction -= module_force_.col(i);
-      power += (reaction + force_nc(i)).dot(v_.col(i));
+  const auto prescribed_node = [&](int i) {
+    a_.col(i) = b_.col(i);
+    // the support's reaction R_i = m a − F − T − (module force); drag on it is applied work too
+    auto reaction = reaction_.col(path_of_[i]);
+    reaction = (quadratic_ ? Vec<dim>(quadratic_->inertia().col(i)) : Vec<dim>(m_[i] * a_.col(i))) - force_.col(i) - force_nc(i) - tension_force_.col(i);
+    if (module_) reaction -= module_force_.col(i);
+    power += (reaction + force_nc(i)).dot(v_.col(i));
+  };
+  if (!module_ && !quadratic_ && force_nc_.cols() == 0) {
+    // A free node's power term is force_nc·v = ±0 here, which leaves the sum as it is (it starts at
+    // +0 and is never −0): the free nodes' accelerations in runs, then the prescribed nodes in order.
+    for (const FreeRun& run : free_runs_)
+      for (int i = run.node, end = run.node + run.count; i < end; ++i)
+        a_.col(i) = b_.col(i) + w_[i] * tension_force_.col(i);
+    for (const int i : prescribed_in_arcs_) prescribed_node(i);
+  } else {
+    for (int i = 0; i < n; ++i) {
+      if (arc_of_[i] < 0) continue;
+      if (path_of_[i] < 0) {
+        a_.col(i) = quadratic_ ? Vec<dim>(quadratic_->accelerations().col(i)) : Vec<dim>(b_.col(i) + w_[i] * tension_force_.col(i));
+        power += force_nc(i).dot(v_.col(i));
+      } else {
+        prescribed_node(i);
+      }
+      if (module_)
+        external_ += force_.col(i) + force_nc(i) + (path_of_[i] >= 0 ? Vec<dim>(reaction_.col(path_of_[i])) : Vec<dim>::Zero());
     }
-    if (module_)
-      external_ += force_.col(i) + force_nc(i) + (path_of_[i] >= 0 ? Vec<dim>(reaction_.col(path_of_[i])) : Vec<dim>::Zero());
   }
   if (module_ && !bends_.empty()) external_ += bend_reaction();  // the points the links are bent over
   if (!contacts_.empty()) {
@@ -574,12 +599,11 @@ template <int dim>
 void StringModel<dim>::rhs(double t, const Eigen::Ref<const Eigen::VectorXd>& y, Eigen::Ref<Eigen::VectorXd> ydot) {
   unpack_state(t, y);
   const double power = evaluate_current(t);
-  const int n = chain_.num_nodes(), voff = dim * num_free_;
-  for (int i = 0; i < n; ++i) {
-    const int k = slot_[i];
-    if (k < 0) continue;
-    ydot.template segment<dim>(dim * k) = v_.col(i);
-    ydot.template segment<dim>(voff + dim * k) = a_.col(i);
+  const int voff = dim * num_free_;
+  for (const FreeRun& run : free_runs_) {
+    ydot.segment(dim * run.slot, dim * run.count) = Eigen::Map<const Eigen::VectorXd>(v_.col(run.node).data(), dim * run.count);
+    ydot.segment(voff + dim * run.slot, dim * run.count) =
+        Eigen::Map<const Eigen::VectorXd>(a_.col(run.node).data(), dim * run.count);
   }
   ydot[work_index()] = power;
   if (module_) module_->ledger_rates(*this, ydot.segment(work_index() + 1, num_ledgers_));

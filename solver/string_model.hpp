@@ -355,6 +355,15 @@ class StringModel final : public OdeSystem {
   void assemble_matrix();
   Eigen::VectorXd pack(const Eigen::Ref<const Eigen::VectorXd>& ledgers) const;
   void unpack_state(double t, const Eigen::Ref<const Eigen::VectorXd>& y);
+  /// The free nodes as runs of consecutive nodes with consecutive slots (one run for a string with a
+  /// fixed end), and the prescribed nodes in an arc: what fill_moving() and rhs() copy, found by
+  /// rebuild() from slot_ and arc_of_.
+  struct FreeRun {
+    int node = 0, slot = 0, count = 0;
+  };
+  std::vector<FreeRun> free_runs_;
+  std::vector<int> prescribed_in_arcs_;
+  void find_free_runs();
   /// Positions and velocities of the nodes in an arc at (t, y) into x, v (the others untouched).
   void fill_moving(double t, const Eigen::Ref<const Eigen::VectorXd>& y, Points<dim>& x, Points<dim>& v) const;
   double evaluate_current(double t);
