@@ -476,13 +476,23 @@ void StringModel<dim>::tension_forces_of_string(const Eigen::VectorXd& T) {
     tension_force_.setZero();
     return;
   }
-  const auto te = [&](int j) { return Vec<dim>(T[j] * e_.col(j)); };
-  tension_force_.col(0) = Vec<dim>(Vec<dim>::Zero() + te(0));
-  if (chain_.closed()) tension_force_.col(0) -= te(L - 1);
+  // Raw pointers in locals, as in links(); T_j e_j carried from one node to the next.
+  using CMap = Eigen::Map<const Vec<dim>>;
+  const double* const e = e_.data();
+  const double* const tension = T.data();
+  double* const out = tension_force_.data();
+  const auto te = [&](int j) { return Vec<dim>(tension[j] * CMap(e + dim * j)); };
+  Vec<dim> previous = te(0);
+  Eigen::Map<Vec<dim>> first(out);
+  first = Vec<dim>::Zero() + previous;
+  if (chain_.closed()) first -= te(L - 1);
   for (int i = 1; i < n; ++i) {
-    Vec<dim> f = Vec<dim>::Zero() - te(i - 1);
-    if (i < L) f += te(i);
-    tension_force_.col(i) = f;
+    Vec<dim> f = Vec<dim>::Zero() - previous;
+    if (i < L) {
+      previous = te(i);
+      f += previous;
+    }
+    Eigen::Map<Vec<dim>>(out + dim * i) = f;
   }
 }
 
@@ -503,12 +513,19 @@ double StringModel<dim>::evaluate_current(double t) {
   force_.setZero();
   force_nc_.setZero();
   for (const auto& force : forces_) force->add_force(state, force->conservative() ? force_ : force_nc_);
+  // b_i = w_i (F_i + F_nc,i [+ the module's force]) over raw pointers in locals (as in links()); +0
+  // stands for F_nc,i without such a force (force_nc()).
+  using CMap = Eigen::Map<const Vec<dim>>;
+  using Map = Eigen::Map<Vec<dim>>;
+  const double *const w = w_.data(), *const f = force_.data();
+  const double* const f_nc = force_nc_.cols() ? force_nc_.data() : nullptr;
+  const double* const f_module = module_ ? module_force_.data() : nullptr;
+  double* const b_of = b_.data();
   for (const FreeRun& run : free_runs_) {
     for (int i = run.node, end = run.node + run.count; i < end; ++i) {
-      if (module_)
-        b_.col(i) = w_[i] * (force_.col(i) + force_nc(i) + module_force_.col(i));
-      else
-        b_.col(i) = w_[i] * (force_.col(i) + force_nc(i));
+      Vec<dim> sum = CMap(f + dim * i) + (f_nc ? Vec<dim>(CMap(f_nc + dim * i)) : Vec<dim>::Zero());
+      if (f_module) sum += CMap(f_module + dim * i);
+      Map(b_of + dim * i) = w[i] * sum;
     }
   }
   for (const int i : prescribed_in_arcs_)
@@ -577,9 +594,11 @@ double StringModel<dim>::evaluate_current(double t) {
   if (!module_ && !quadratic_ && force_nc_.cols() == 0) {
     // A free node's power term is force_nc·v = ±0 here, which leaves the sum as it is (it starts at
     // +0 and is never −0): the free nodes' accelerations in runs, then the prescribed nodes in order.
+    const double* const tf = tension_force_.data();
+    double* const a_of = a_.data();
     for (const FreeRun& run : free_runs_)
       for (int i = run.node, end = run.node + run.count; i < end; ++i)
-        a_.col(i) = b_.col(i) + w_[i] * tension_force_.col(i);
+        Map(a_of + dim * i) = CMap(b_of + dim * i) + w[i] * CMap(tf + dim * i);
     for (const int i : prescribed_in_arcs_) prescribed_node(i);
   } else {
     for (int i = 0; i < n; ++i) {
