@@ -159,6 +159,7 @@ void StringModel<dim>::rebuild() {
   num_free_ = 0;
   for (int i = 0; i < n; ++i)
     if (in_arc(i) && path_of_[i] < 0) slot_[i] = num_free_++;
+  find_free_runs();
   // Each arc with a link owns a block of unknowns; its links' masses are lumped on their nodes.
   base_mass_ = Eigen::VectorXd::Zero(n);
   link_unknown_.assign(static_cast<std::size_t>(L), -1);
@@ -220,36 +221,69 @@ void StringModel<dim>::unpack(double t, const Eigen::Ref<const Eigen::VectorXd>&
 template <int dim>
 void StringModel<dim>::fill_moving(double t, const Eigen::Ref<const Eigen::VectorXd>& y, Points<dim>& x,
                                    Points<dim>& v) const {
-  const int n = chain_.num_nodes();
   const int voff = dim * num_free_;
-  for (int i = 0; i < n; ++i) {
-    if (arc_of_[i] < 0) continue;
+  for (const FreeRun& run : free_runs_) {
+    Eigen::Map<Eigen::VectorXd>(x.col(run.node).data(), dim * run.count) = y.segment(dim * run.slot, dim * run.count);
+    Eigen::Map<Eigen::VectorXd>(v.col(run.node).data(), dim * run.count) =
+        y.segment(voff + dim * run.slot, dim * run.count);
+  }
+  for (const int i : prescribed_in_arcs_) {
+    const EndPath<dim>& path = *prescribed_[static_cast<std::size_t>(path_of_[i])].path;
+    x.col(i) = path.position(t);
+    v.col(i) = path.velocity(t);
+  }
+}
+
+template <int dim>
+void StringModel<dim>::find_free_runs() {
+  free_runs_.clear();
+  prescribed_in_arcs_.clear();
+  for (int i = 0; i < chain_.num_nodes(); ++i) {
     const int k = slot_[i];
-    if (k >= 0) {
-      x.col(i) = y.template segment<dim>(dim * k);
-      v.col(i) = y.template segment<dim>(voff + dim * k);
-    } else {
-      const EndPath<dim>& path = *prescribed_[static_cast<std::size_t>(path_of_[i])].path;
-      x.col(i) = path.position(t);
-      v.col(i) = path.velocity(t);
-    }
+    if (k >= 0 && !free_runs_.empty() && free_runs_.back().node + free_runs_.back().count == i &&
+        free_runs_.back().slot + free_runs_.back().count == k)
+      ++free_runs_.back().count;
+    else if (k >= 0)
+      free_runs_.push_back({i, k, 1});
+    else if (arc_of_[i] >= 0)
+      prescribed_in_arcs_.push_back(i);
   }
 }
 
 template <int dim>
 void StringModel<dim>::links() {
-  x_max_ = 0;
-  for_each_link([&](int j, int, int) {
-    const int a = chain_.link_start(j), b = chain_.link_end(j);
-    dx_.col(j) = x_.col(b) - x_.col(a);
-    dv_.col(j) = v_.col(b) - v_.col(a);
-    const double l = dx_.col(j).norm();
-    if (!(l > kCollapsedLink * chain_.link_length(j)) || !std::isfinite(l))
-      throw RecoverableError(fmt::format("link {} has collapsed to length {:g}", j, l));
-    l_[j] = l;
-    e_.col(j) = dx_.col(j) / l;
-    x_max_ = std::max({x_max_, x_.col(a).cwiseAbs().maxCoeff(), x_.col(b).cwiseAbs().maxCoeff()});
-  });
+  // The links of the arcs in for_each_link's order, written as plain loops over raw pointers held in
+  // locals: Eigen's vector stores may alias anything, so a lambda's captures and the members would be
+  // reloaded after each of them (17.6 k instructions a call at 250 links; the same numbers).
+  using CMap = Eigen::Map<const Vec<dim>>;
+  using Map = Eigen::Map<Vec<dim>>;
+  const double* const x = x_.data();
+  const double* const v = v_.data();
+  double* const dx = dx_.data();
+  double* const dv = dv_.data();
+  double* const e = e_.data();
+  double* const l_of = l_.data();
+  const double* const h = chain_.link_lengths().data();
+  const int num_nodes = chain_.num_nodes();
+  double x_max = 0;
+  for (const ArcRange& arc : arcs_) {
+    const int nl = arc.num_links();
+    for (int q = 0; q < nl; ++q) {
+      const int j = arc.first + q, a = j, b = j + 1 == num_nodes ? 0 : j + 1;  // chain_.link_start, link_end
+      Map dxj(dx + dim * j);
+      dxj = CMap(x + dim * b) - CMap(x + dim * a);
+      Map(dv + dim * j) = CMap(v + dim * b) - CMap(v + dim * a);
+      const double l = dxj.norm();
+      if (!(l > kCollapsedLink * h[j]) || !std::isfinite(l))
+        throw RecoverableError(fmt::format("link {} has collapsed to length {:g}", j, l));
+      l_of[j] = l;
+      Map(e + dim * j) = dxj / l;
+      // every node of the arcs once: each link's start, and the end of an open arc's last link
+      x_max = std::max(x_max, CMap(x + dim * a).cwiseAbs().maxCoeff());
+      if (q + 1 == nl && !arc.closed) x_max = std::max(x_max, CMap(x + dim * b).cwiseAbs().maxCoeff());
+    }
+  }
+  x_max_ = x_max;
   if (!bends_.empty()) bend_links();
 }
 
@@ -356,9 +390,17 @@ double StringModel<dim>::capped_beta2() const {
   // position term and no artificial tension, however short τ_b (β² = 1/τ_b² turned its round-off
   // into T = −1.5e165 N with τ_b = 1e-91 s). Ordinary runs are far below the cap (falling chain:
   // β² δ h = 1.7e-10 m/s² against 1e-5 m/s²) and keep β² = 1/τ_b².
-  const double a_physical = physical_scales().tension / (chain_.density() * chain_.length());
+  // physical_scales() is a pass over the nodes (10 k instructions at 250 links, at every right-hand
+  // side). Its tension is the weight λ|g|ℓ plus terms ≥ 0, and rounding is monotone, so the cap
+  // computed from the weight alone is a lower bound of the cap: when β² is below it, the cap does
+  // not bind and β² is the same number without the pass.
+  const double lambda_ell = chain_.density() * chain_.length();
   const double h_ref = std::isfinite(h_min_) ? h_min_ : chain_.length();
-  return std::min(beta_ * beta_, kDriftRoundoff * a_physical / (constraint_tolerance() * h_ref));
+  const double beta2 = beta_ * beta_, denominator = constraint_tolerance() * h_ref;
+  const double weight = chain_.density() * uniform_field().norm() * chain_.length();  // as physical_scales()
+  if (beta2 <= kDriftRoundoff * (weight / lambda_ell) / denominator) return beta2;
+  const double a_physical = physical_scales().tension / lambda_ell;
+  return std::min(beta2, kDriftRoundoff * a_physical / denominator);
 }
 
 template <int dim>
@@ -377,7 +419,7 @@ void StringModel<dim>::assemble_matrix() {
   // link j with the next link of its arc goes through their shared node b = link_end(j).
   for_each_link([&](int j, int u, int next) {
     const int a = chain_.link_start(j), b = chain_.link_end(j);
-    system_->add_diagonal(u, -(w_[a] + w_[b]));
+    system_->set_diagonal(u, -(w_[a] + w_[b]));  // its first write (zero() is optional: evaluate_current)
     if (next >= 0) system_->set_coupling(u, w_[b] * e_.col(j).dot(e_.col(next)));
   });
   if (!bends_.empty()) bend_couplings();
@@ -556,6 +598,37 @@ void StringModel<dim>::refresh() {
 }
 
 template <int dim>
+void StringModel<dim>::tension_forces_of_string(const Eigen::VectorXd& T) {
+  // The whole string is one arc, link j = unknown j from node j to node j + 1 (to node 0 for the last
+  // link of a closed string). Node by node, with each node's two terms in the order of the link-by-link
+  // sum T_j e_j at the start, −T_j e_j at the end from zero (for_each_link): the same numbers, without
+  // zeroing the array and writing every node twice.
+  const int n = chain_.num_nodes(), L = chain_.num_links();
+  if (L == 0) {
+    tension_force_.setZero();
+    return;
+  }
+  // Raw pointers in locals, as in links(); T_j e_j carried from one node to the next.
+  using CMap = Eigen::Map<const Vec<dim>>;
+  const double* const e = e_.data();
+  const double* const tension = T.data();
+  double* const out = tension_force_.data();
+  const auto te = [&](int j) { return Vec<dim>(tension[j] * CMap(e + dim * j)); };
+  Vec<dim> previous = te(0);
+  Eigen::Map<Vec<dim>> first(out);
+  first = Vec<dim>::Zero() + previous;
+  if (chain_.closed()) first -= te(L - 1);
+  for (int i = 1; i < n; ++i) {
+    Vec<dim> f = Vec<dim>::Zero() - previous;
+    if (i < L) {
+      previous = te(i);
+      f += previous;
+    }
+    Eigen::Map<Vec<dim>>(out + dim * i) = f;
+  }
+}
+
+template <int dim>
 double StringModel<dim>::evaluate(double t, const Points<dim>& x, const Points<dim>& v) {
   x_ = x;
   v_ = v;
@@ -572,19 +645,24 @@ double StringModel<dim>::evaluate_current(double t) {
   force_.setZero();
   force_nc_.setZero();
   for (const auto& force : forces_) force->add_force(state, force->conservative() ? force_ : force_nc_);
-  for (int i = 0; i < n; ++i) {
-    if (arc_of_[i] < 0) continue;
-    if (path_of_[i] < 0) {
-      if (module_)
-        b_.col(i) = w_[i] * (force_.col(i) + force_nc(i) + module_force_.col(i));
-      else
-        b_.col(i) = w_[i] * (force_.col(i) + force_nc(i));
-    } else {
-      b_.col(i) = prescribed_[static_cast<std::size_t>(path_of_[i])].path->acceleration(t);
+  // b_i = w_i (F_i + F_nc,i [+ the module's force]) over raw pointers in locals (as in links()); +0
+  // stands for F_nc,i without such a force (force_nc()).
+  using CMap = Eigen::Map<const Vec<dim>>;
+  using Map = Eigen::Map<Vec<dim>>;
+  const double *const w = w_.data(), *const f = force_.data();
+  const double* const f_nc = force_nc_.cols() ? force_nc_.data() : nullptr;
+  const double* const f_module = module_ ? module_force_.data() : nullptr;
+  double* const b_of = b_.data();
+  for (const FreeRun& run : free_runs_) {
+    for (int i = run.node, end = run.node + run.count; i < end; ++i) {
+      Vec<dim> sum = CMap(f + dim * i) + (f_nc ? Vec<dim>(CMap(f_nc + dim * i)) : Vec<dim>::Zero());
+      if (f_module) sum += CMap(f_module + dim * i);
+      Map(b_of + dim * i) = w[i] * sum;
     }
   }
+  for (const int i : prescribed_in_arcs_)
+    b_.col(i) = prescribed_[static_cast<std::size_t>(path_of_[i])].path->acceleration(t);
   // 2. Link geometry and the tension system.
-  tension_force_.setZero();
   if (quadratic_) {
     x_max_ = x_.cwiseAbs().maxCoeff();
     beta2_ = capped_beta2();
@@ -592,15 +670,18 @@ double StringModel<dim>::evaluate_current(double t) {
     tension_force_ = quadratic_->tension_forces();
   } else if (system_) {
     links();
-    system_->zero();
+    // Every value and right side is set below (the arcs' diagonals, couplings and right sides) unless
+    // bent links, held nodes or excluded (slack) links add to them: only those need the zeroing.
+    if (!bends_.empty() || !contacts_.empty() || allows_slack() || system_->has_exclusions()) system_->zero();
     assemble_matrix();
     if (contact_friction_on_) friction_couplings();
     beta2_ = capped_beta2();  // the drift control's position term, capped (capped_beta2)
     if (!contacts_.empty()) constrain_contact_nodes();
+    const double two_alpha = 2 * alpha_, half_beta2 = beta2_ * 0.5;  // the products the sum began with
     for_each_link([&](int j, int u, int) {
       const int a = chain_.link_start(j), b = chain_.link_end(j);
       const double h = chain_.link_length(j), l = l_[j];
-      const double stab = 2 * alpha_ * dx_.col(j).dot(dv_.col(j)) + beta2_ * 0.5 * (l * l - h * h);
+      const double stab = two_alpha * dx_.col(j).dot(dv_.col(j)) + half_beta2 * (l * l - h * h);
       system_->rhs(u) = -dv_.col(j).squaredNorm() / l - e_.col(j).dot(b_.col(b) - b_.col(a)) - stab / l;
     });
     for (const Bend& bend : bends_) {
@@ -621,33 +702,54 @@ double StringModel<dim>::evaluate_current(double t) {
       last_tension_.resize(static_cast<std::size_t>(chain_.num_links()), 0.0);
       for_each_link([&](int j, int u, int) { last_tension_[static_cast<std::size_t>(j)] = T[u]; });
     }
-    for_each_link([&](int j, int u, int) {
-      tension_force_.col(chain_.link_start(j)) += T[u] * e_.col(j);
-      tension_force_.col(chain_.link_end(j)) -= T[u] * e_.col(j);
-    });
+    if (!module_ && bends_.empty()) {
+      tension_forces_of_string(T);
+    } else {
+      tension_force_.setZero();
+      for_each_link([&](int j, int u, int) {
+        tension_force_.col(chain_.link_start(j)) += T[u] * e_.col(j);
+        tension_force_.col(chain_.link_end(j)) -= T[u] * e_.col(j);
+      });
+    }
     for (const Bend& bend : bends_) {
       const int u = link_unknown_[static_cast<std::size_t>(bend.link)];
       if (u >= 0) tension_force_.col(chain_.link_end(bend.link)) += T[u] * (e_.col(bend.link) - bend.e_plus);
     }
+  } else {
+    tension_force_.setZero();  // no link in any arc (every node held, or single-node arcs)
   }
   // 3. Accelerations, the supports' reactions and the power of everything not booked in V.
   double power = 0;
   if (module_) external_.setZero();
-  for (int i = 0; i < n; ++i) {
-    if (arc_of_[i] < 0) continue;
-    if (path_of_[i] < 0) {
-      a_.col(i) = quadratic_ ? Vec<dim>(quadratic_->accelerations().col(i)) : Vec<dim>(b_.col(i) + w_[i] * tension_force_.col(i));
-      power += force_nc(i).dot(v_.col(i));
-    } else {
-      a_.col(i) = b_.col(i);
-      // the support's reaction R_i = m a − F − T − (module force); drag on it is applied work too
-      auto reaction = reaction_.col(path_of_[i]);
-      reaction = (quadratic_ ? Vec<dim>(quadratic_->inertia().col(i)) : Vec<dim>(m_[i] * a_.col(i))) - force_.col(i) - force_nc(i) - tension_force_.col(i);
-      if (module_) reaction -= module_force_.col(i);
-      power += (reaction + force_nc(i)).dot(v_.col(i));
+  const auto prescribed_node = [&](int i) {
+    a_.col(i) = b_.col(i);
+    // the support's reaction R_i = m a − F − T − (module force); drag on it is applied work too
+    auto reaction = reaction_.col(path_of_[i]);
+    reaction = (quadratic_ ? Vec<dim>(quadratic_->inertia().col(i)) : Vec<dim>(m_[i] * a_.col(i))) - force_.col(i) - force_nc(i) - tension_force_.col(i);
+    if (module_) reaction -= module_force_.col(i);
+    power += (reaction + force_nc(i)).dot(v_.col(i));
+  };
+  if (!module_ && !quadratic_ && force_nc_.cols() == 0) {
+    // A free node's power term is force_nc·v = ±0 here, which leaves the sum as it is (it starts at
+    // +0 and is never −0): the free nodes' accelerations in runs, then the prescribed nodes in order.
+    const double* const tf = tension_force_.data();
+    double* const a_of = a_.data();
+    for (const FreeRun& run : free_runs_)
+      for (int i = run.node, end = run.node + run.count; i < end; ++i)
+        Map(a_of + dim * i) = CMap(b_of + dim * i) + w[i] * CMap(tf + dim * i);
+    for (const int i : prescribed_in_arcs_) prescribed_node(i);
+  } else {
+    for (int i = 0; i < n; ++i) {
+      if (arc_of_[i] < 0) continue;
+      if (path_of_[i] < 0) {
+        a_.col(i) = quadratic_ ? Vec<dim>(quadratic_->accelerations().col(i)) : Vec<dim>(b_.col(i) + w_[i] * tension_force_.col(i));
+        power += force_nc(i).dot(v_.col(i));
+      } else {
+        prescribed_node(i);
+      }
+      if (module_)
+        external_ += force_.col(i) + force_nc(i) + (path_of_[i] >= 0 ? Vec<dim>(reaction_.col(path_of_[i])) : Vec<dim>::Zero());
     }
-    if (module_)
-      external_ += force_.col(i) + force_nc(i) + (path_of_[i] >= 0 ? Vec<dim>(reaction_.col(path_of_[i])) : Vec<dim>::Zero());
   }
   if (module_ && !bends_.empty()) external_ += bend_reaction();  // the points the links are bent over
   if (!contacts_.empty()) {
@@ -672,12 +774,11 @@ template <int dim>
 void StringModel<dim>::rhs(double t, const Eigen::Ref<const Eigen::VectorXd>& y, Eigen::Ref<Eigen::VectorXd> ydot) {
   unpack_state(t, y);
   const double power = evaluate_current(t);
-  const int n = chain_.num_nodes(), voff = dim * num_free_;
-  for (int i = 0; i < n; ++i) {
-    const int k = slot_[i];
-    if (k < 0) continue;
-    ydot.template segment<dim>(dim * k) = v_.col(i);
-    ydot.template segment<dim>(voff + dim * k) = a_.col(i);
+  const int voff = dim * num_free_;
+  for (const FreeRun& run : free_runs_) {
+    ydot.segment(dim * run.slot, dim * run.count) = Eigen::Map<const Eigen::VectorXd>(v_.col(run.node).data(), dim * run.count);
+    ydot.segment(voff + dim * run.slot, dim * run.count) =
+        Eigen::Map<const Eigen::VectorXd>(a_.col(run.node).data(), dim * run.count);
   }
   ydot[work_index()] = power;
   if (module_) module_->ledger_rates(*this, ydot.segment(work_index() + 1, num_ledgers_));

@@ -374,9 +374,21 @@ class StringModel final : public OdeSystem {
   void assemble_matrix();
   Eigen::VectorXd pack(const Eigen::Ref<const Eigen::VectorXd>& ledgers) const;
   void unpack_state(double t, const Eigen::Ref<const Eigen::VectorXd>& y);
+  /// The free nodes as runs of consecutive nodes with consecutive slots (one run for a string with a
+  /// fixed end), and the prescribed nodes in an arc: what fill_moving() and rhs() copy, found by
+  /// rebuild() from slot_ and arc_of_.
+  struct FreeRun {
+    int node = 0, slot = 0, count = 0;
+  };
+  std::vector<FreeRun> free_runs_;
+  std::vector<int> prescribed_in_arcs_;
+  void find_free_runs();
   /// Positions and velocities of the nodes in an arc at (t, y) into x, v (the others untouched).
   void fill_moving(double t, const Eigen::Ref<const Eigen::VectorXd>& y, Points<dim>& x, Points<dim>& v) const;
   double evaluate_current(double t);
+  /// evaluate_current without a module or bent links: the tension forces T_j e_j − T_{j−1} e_{j−1} of
+  /// the nodes from the tensions T (per link), in one pass.
+  void tension_forces_of_string(const Eigen::VectorXd& T);
   /// The tension solve of an evaluation: the linear system, or with slack = allow the
   /// complementarity problem on the taut links (slack ones excluded).
   const Eigen::VectorXd& solve_tensions(double t);

@@ -130,10 +130,14 @@ class TensionSystem {
   const std::string& backend_name() const { return backend_name_; }
 
   // --- numeric assembly (every right-hand side) ---------------------------------------------
-  /// Sets every matrix value and the right side to zero.
+  /// Sets every matrix value and the right side to zero. An assembly that sets every diagonal
+  /// (set_diagonal), coupling and right side, with no unknown excluded, may skip it.
   void zero();
+  bool has_exclusions() const { return num_excluded_ > 0; }
   /// A(u, u) += value.
   void add_diagonal(int u, double value) { values_[diag_slot_[u]] += value; }
+  /// A(u, u) = value, as zero() then add_diagonal() give it (0.0 + value: +0 for −0), without zero().
+  void set_diagonal(int u, double value) { values_[diag_slot_[u]] = 0.0 + value; }
   /// Sets the symmetric coupling A(u, v) = A(v, u) = value between link u and the next link v of its
   /// arc (the first link, for the last link of a closed arc).
   void set_coupling(int u, double value) {
