@@ -396,7 +396,7 @@ TEST_CASE("slack: the swinging U on 51 to 401 nodes: the differences of the stat
   CHECK(differences.back() < 0.01);
 }
 
-TEST_CASE("slack: allow is refused with quadratic elements, located at the key; fronts and edges take it", "[slack]") {
+TEST_CASE("slack: allow is refused with quadratic elements (located at the key) and fronts and edges take it", "[slack]") {
   const std::filesystem::path scenes = std::filesystem::path(CHAINSIM_SOURCE_DIR) / "cases" / "scenes";
   // Heaps, folds (tests/convergence/test_slack_fronts.cpp) and edges (tests/convergence/test_slack_edge.cpp)
   // take allow.
