@@ -1,6 +1,8 @@
 #pragma once
 // What the contact tests share (solver/contact_module.hpp; docs/model.md §10): the smooth table, the
 // model's options and the run's, so that each test file builds its chains on the same obstacles.
+#include <cmath>
+
 #include "solver/contact_module.hpp"
 #include "solver/string_solver.hpp"
 
@@ -33,6 +35,26 @@ inline StringModelOptions contact_options(SlackPolicy slack = StringModelOptions
   mo.stabilization_time = 0.05;
   mo.slack = slack;
   return mo;
+}
+
+/// A chain over a pulley of radius R about the origin (2D), by arc length s from its left end: up the
+/// left side (x = −R) for x2, over the half circle πR, down the right side (x = +R). Its point and unit
+/// tangent at s.
+inline Vec<2> pulley_path_point(double R, double x2, double s) {
+  if (s <= x2) return Vec<2>(-R, s - x2);
+  if (s <= x2 + kPi * R) {
+    const double phi = (s - x2) / R;
+    return Vec<2>(-R * std::cos(phi), R * std::sin(phi));
+  }
+  return Vec<2>(R, -(s - x2 - kPi * R));
+}
+inline Vec<2> pulley_path_tangent(double R, double x2, double s) {
+  if (s <= x2) return Vec<2>(0.0, 1.0);
+  if (s <= x2 + kPi * R) {
+    const double phi = (s - x2) / R;
+    return Vec<2>(std::sin(phi), std::cos(phi));
+  }
+  return Vec<2>(0.0, -1.0);
 }
 
 }  // namespace chainsim::test

@@ -148,22 +148,8 @@ struct Atwood {
   double free() const { return x1 + x2; }
   double omega() const { return std::sqrt(2 * kG / ell); }
   double u0() const { return 0.5 * (x1 - x2); }
-  Vec<2> at(double s) const {
-    if (s <= x2) return Vec<2>(-R, s - x2);
-    if (s <= x2 + kPulleyPi * R) {
-      const double phi = (s - x2) / R;
-      return Vec<2>(-R * std::cos(phi), R * std::sin(phi));
-    }
-    return Vec<2>(R, -(s - x2 - kPulleyPi * R));
-  }
-  Vec<2> tangent(double s) const {
-    if (s <= x2) return Vec<2>(0.0, 1.0);
-    if (s <= x2 + kPulleyPi * R) {
-      const double phi = (s - x2) / R;
-      return Vec<2>(std::sin(phi), std::cos(phi));
-    }
-    return Vec<2>(0.0, -1.0);
-  }
+  Vec<2> at(double s) const { return test::pulley_path_point(R, x2, s); }
+  Vec<2> tangent(double s) const { return test::pulley_path_tangent(R, x2, s); }
   /// u = (x1 − x2)/2: ü = (2g/ℓ) u, u(0) = u0, u̇(0) = v0.
   double u(double t) const { return u0() * std::cosh(omega() * t) + v0 / omega() * std::sinh(omega() * t); }
   double u_dot(double t) const {

@@ -27,29 +27,13 @@
 #include "solver/contact_module.hpp"
 #include "solver/string_solver.hpp"
 #include "solver/tension_system.hpp"
+#include "tests/convergence/contact_test_support.hpp"
 
 using namespace chainsim;
 
 namespace {
 
 constexpr double kG = 9.81;
-constexpr double kPi = 3.141592653589793;
-
-StringSolverOptions friction_run(double t_end, double interval, double rtol = 1e-10) {
-  StringSolverOptions so;
-  so.integrator.rtol = rtol;
-  so.integrator.atol = 1e-3 * rtol;
-  so.integrator.method = "erk5";
-  so.t_end = t_end;
-  so.output_interval = interval;
-  return so;
-}
-
-StringModelOptions friction_options() {
-  StringModelOptions mo;
-  mo.stabilization_time = 0.05;
-  return mo;
-}
 
 }  // namespace
 
@@ -144,8 +128,8 @@ InclineRun incline_run(const Incline& c, double t_end) {
   plane.normal = Vec<2>(-std::sin(c.alpha), std::cos(c.alpha));
   plane.mu = c.mu;
   plane.name = "slope";
-  StringModel<2> model(std::move(chain), std::move(forces), {}, friction_options(), make_contact_module<2>({plane}));
-  StringSolver<2> solver(model, friction_run(t_end, t_end / 4));
+  StringModel<2> model(std::move(chain), std::move(forces), {}, test::contact_options(), make_contact_module<2>({plane}));
+  StringSolver<2> solver(model, test::contact_run(t_end, t_end / 4));
   const RunSummary& s = solver.run();
   REQUIRE(s.status == "completed");
   InclineRun r;
@@ -288,22 +272,8 @@ struct RoughAtwood {
     return {X + dt / 6 * (k1.first + 2 * k2.first + 2 * k3.first + k4.first),
             V + dt / 6 * (k1.second + 2 * k2.second + 2 * k3.second + k4.second)};
   }
-  Vec<2> at(double s) const {
-    if (s <= x2) return Vec<2>(-R, s - x2);
-    if (s <= x2 + kPi * R) {
-      const double phi = (s - x2) / R;
-      return Vec<2>(-R * std::cos(phi), R * std::sin(phi));
-    }
-    return Vec<2>(R, -(s - x2 - kPi * R));
-  }
-  Vec<2> tangent(double s) const {
-    if (s <= x2) return Vec<2>(0.0, 1.0);
-    if (s <= x2 + kPi * R) {
-      const double phi = (s - x2) / R;
-      return Vec<2>(std::sin(phi), std::cos(phi));
-    }
-    return Vec<2>(0.0, -1.0);
-  }
+  Vec<2> at(double s) const { return test::pulley_path_point(R, x2, s); }
+  Vec<2> tangent(double s) const { return test::pulley_path_tangent(R, x2, s); }
 };
 
 RoughAtwood rough_atwood(double x1, double v0) {
@@ -332,8 +302,8 @@ RoughAtwoodRun rough_atwood_run(const RoughAtwood& a, int links, double t_end) {
   pulley.radius = a.R;
   pulley.mu = a.mu;
   pulley.name = "pulley";
-  StringModel<2> model(std::move(chain), std::move(forces), {}, friction_options(), make_contact_module<2>({pulley}));
-  StringSolver<2> solver(model, friction_run(t_end, t_end / 4, 1e-11));
+  StringModel<2> model(std::move(chain), std::move(forces), {}, test::contact_options(), make_contact_module<2>({pulley}));
+  StringSolver<2> solver(model, test::contact_run(t_end, t_end / 4, 1e-11));
   const RunSummary& s = solver.run();
   REQUIRE(s.status == "completed");
   const auto& first = solver.frames().front();
@@ -452,8 +422,8 @@ TEST_CASE("friction: in 3D a chain launched up a rough slope stops at the exact 
     plane.normal = Vec<3>(-std::sin(c.alpha), 0.0, std::cos(c.alpha));
     plane.mu = c.mu;
     plane.name = "slope";
-    StringModel<3> model(std::move(chain), std::move(forces), {}, friction_options(), make_contact_module<3>({plane}));
-    StringSolver<3> solver(model, friction_run(T, T / 4));
+    StringModel<3> model(std::move(chain), std::move(forces), {}, test::contact_options(), make_contact_module<3>({plane}));
+    StringSolver<3> solver(model, test::contact_run(T, T / 4));
     const RunSummary& s = solver.run();
     REQUIRE(s.status == "completed");
     const auto& last = solver.frames().back();
@@ -493,8 +463,8 @@ TEST_CASE("friction: a chain landing flat on a rough table takes Coulomb's impul
   table.normal = Vec<2>(0.0, 1.0);
   table.mu = mu;
   table.name = "table";
-  StringModel<2> model(std::move(chain), std::move(forces), {}, friction_options(), make_contact_module<2>({table}));
-  StringSolver<2> solver(model, friction_run(T, T / 4));
+  StringModel<2> model(std::move(chain), std::move(forces), {}, test::contact_options(), make_contact_module<2>({table}));
+  StringSolver<2> solver(model, test::contact_run(T, T / 4));
   const RunSummary& s = solver.run();
   REQUIRE(s.status == "completed");
   const auto& last = solver.frames().back();
