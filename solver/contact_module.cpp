@@ -296,15 +296,7 @@ class ContactModule final : public WrappingModule<dim> {
   void fill(const StringModel<dim>& model, const Eigen::Ref<const Eigen::VectorXd>& ledger,
             ModuleLedger<dim>& out) const override {
     const int k = inner_ledgers();
-    if (inner_) {
-      inner_->fill(model, ledger.head(k), out);
-      out.impulse += ledger.template segment<dim>(k + 2);
-    } else {
-      out.fronts.clear();
-      out.terms.clear();
-      out.impulse = ledger.template segment<dim>(k + 2);
-      out.support.setZero();
-    }
+    this->fill_inner(model, ledger, ledger.template segment<dim>(k + 2), out);
     out.terms.insert(out.terms.end(),
                      {ledger[k], ledger[k + 1], static_cast<double>(impacts_), static_cast<double>(lift_offs_)});
     if (friction_)

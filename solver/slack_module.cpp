@@ -92,15 +92,7 @@ class SlackModule final : public WrappingModule<dim> {
   void fill(const StringModel<dim>& model, const Eigen::Ref<const Eigen::VectorXd>& ledger,
             ModuleLedger<dim>& out) const override {
     const int k = inner_ledgers();
-    if (inner_) {
-      inner_->fill(model, ledger.head(k), out);
-      out.impulse += ledger.template segment<dim>(k + 3);
-    } else {
-      out.fronts.clear();
-      out.terms.clear();
-      out.impulse = ledger.template segment<dim>(k + 3);
-      out.support.setZero();
-    }
+    this->fill_inner(model, ledger, ledger.template segment<dim>(k + 3), out);
     out.terms.insert(out.terms.end(), {ledger[k], ledger[k + 1], ledger[k + 2], static_cast<double>(snaps_)});
     out.has_momentum_ledger = true;
   }

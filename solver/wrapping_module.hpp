@@ -63,6 +63,21 @@ class WrappingModule : public StringModule<dim> {
     if (!any) return {};
     return inner_->handle_events(model, t, ledger.head(inner_ledgers()), inner_found);
   }
+  /// The inner module's part of a snapshot (none without one: no fronts, no terms, no support), with
+  /// the impulse this module books (`own_impulse`) added to the inner module's impulse; the wrapper's own
+  /// terms go after the inner module's.
+  void fill_inner(const StringModel<dim>& model, const Eigen::Ref<const Eigen::VectorXd>& ledger,
+                  const Vec<dim>& own_impulse, ModuleLedger<dim>& out) const {
+    if (inner_) {
+      inner_->fill(model, ledger.head(inner_ledgers()), out);
+      out.impulse += own_impulse;
+    } else {
+      out.fronts.clear();
+      out.terms.clear();
+      out.impulse = own_impulse;
+      out.support.setZero();
+    }
+  }
 
   std::unique_ptr<StringModule<dim>> inner_;
 };
