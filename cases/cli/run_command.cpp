@@ -12,7 +12,7 @@
 //
 //   $ chainsim run cases/scenes/falling_chain.toml --out results/falling
 //   scene      cases/scenes/falling_chain.toml (2D, 101 nodes, open)
-//   fronts     heap_end (f = 0.5, on a plane); 3 root functions (2 per front + 1 stop event)
+//   fronts     heap_end (f = 0.5, on a plane); 3 root functions, 1 of them stop event
 //   ...
 //   stop       the heap_end front reached s0 = 0.01 m at t = 0.38232 s
 //
@@ -115,7 +115,8 @@ int run_string_scene(const SceneSpec& spec, const std::filesystem::path& dir, bo
                                     f["f"].get<double>(), f["s0"].get<double>(), where));
       }
       const int stops = static_cast<int>(description["stop_events"].size());
-      out << fmt::format("fronts     {}; {} root functions (2 per front + {} stop event{})\n", join_words(names),
+      // The count is the run's (each kind of front has its own, and obstacles and slack links add theirs).
+      out << fmt::format("fronts     {}; {} root functions, {} of them stop event{}\n", join_words(names),
                          s.root_functions, stops, stops == 1 ? "" : "s");
     }
     out << fmt::format("effects    {}; {}{} root functions\n", s.effects.empty() ? "none" : join_words(s.effects),

@@ -254,8 +254,8 @@ struct StringScene {
   double characteristic_time = 0;  ///< t_char used for the default stabilization time (s)
   std::vector<std::string> front_names;  ///< "heap_start", "fold", "heap_end": those built, in order of s
   /// What was built, read back from the model: "model": "string", the model's part of the summary
-  /// (model_json: dimension, nodes, links, effects, prescribed, root_functions (2 per front + stop
-  /// events), tension_unknowns, stabilization_time), fronts (name, kind, side, f, s0, point, on_plane,
+  /// (model_json: dimension, nodes, links, effects, prescribed, root_functions (the fronts', the stop
+  /// events' and the other modules'), tension_unknowns, stabilization_time), fronts (name, kind, side, f, s0, point, on_plane,
   /// plane_normal, pot; [] without fronts), num_fronts and, with fronts, stop_events.
   nlohmann::json description;
   bool has_fronts() const { return !front_names.empty(); }
