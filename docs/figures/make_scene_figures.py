@@ -192,7 +192,8 @@ def edge_slide(run, ax, title, subtitle):
     ax[1].plot(ts, x0 * np.cosh(math.sqrt(g / ell) * ts), "k:", lw=2, label="x0 cosh(sqrt(g/l) t), exact for f = 0")
     x_star = (ell + math.sqrt(ell * ell + 8 * x0 * x0)) / 4
     t_star = math.acosh(x_star / x0) / math.sqrt(g / ell)
-    ax[1].axhline(x_star, color="r", lw=0.8, ls="--", label=f"lift-off length x* = {x_star:.4f} m (t* = {t_star:.4f} s)")
+    ax[1].axhline(x_star, color="r", lw=0.8, ls="--",
+                  label=f"lift-off length x* = {x_star:.4f} m (t* = {t_star:.4f} s)")
     for e in run.summary.get("events", []):
         if e.get("kind") == "lift_off":
             ax[1].plot([e["t"]], [ell - e["s0"]], "rx", ms=8, label=f"the run's lift-off event, t = {e['t']:.4f} s")
