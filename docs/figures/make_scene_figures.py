@@ -5,7 +5,9 @@ Usage: /usr/bin/python3 docs/figures/make_scene_figures.py RESULTS_DIR
 where RESULTS_DIR/<scene>/ holds the outputs of
     build/chainsim run cases/scenes/<scene>.toml --out RESULTS_DIR/<scene>
 for shaken_chain, travelling_loop, whip_crack, pendulum_release, folded_chain_ends_apart, swinging_u,
-pendulum_whip and thrown_chain (string scenes; the last three with slack = "allow"), chain_off_table_edge and chain_over_peg (edges), atwood_pulley and atwood_rough_pulley (cylinders), chain_landing_at_angle (a surface) and
+pendulum_whip and thrown_chain (string scenes; the last three with slack = "allow"), chain_off_table_edge and
+chain_over_peg (edges), atwood_pulley and atwood_rough_pulley (cylinders), chain_landing_at_angle (a surface),
+chain_off_real_table (a table bounded by its edge), chain_into_heap_on_table (a heap on a contact surface) and
 falling_chain, folded_chain, sliding_chain, swinging_sliding_chain, tilted_falling_chain and
 curved_falling_chain (scenes with fronts), and RESULTS_DIR/<scene>_reduced/ the same canonical scenes run with
 model = "reduced". docs/figures/run_scene_figures.sh RESULTS_DIR does all of it (and `chainsim plot` on each
@@ -180,15 +182,32 @@ def folded_chain_ends_apart(run, ax):
     decorate(ax[1], "t (s)", "free end height (m)", "it follows the energy-conserving fold (f = 0)")
 
 
-def chain_off_table_edge(run, ax):
-    snapshots(ax[0], run, [0, 0.1, 0.22, 0.32, 0.42, 0.525], "chain sliding off a smooth table over its edge, f = 0")
+def edge_slide(run, ax, title, subtitle):
+    """The chain of 1 m sliding off a smooth table over its edge at the origin, 20 cm hanging at release, f = 0:
+    the hanging length against x0 cosh(sqrt(g/l) t) and the lift-off length x*."""
+    snapshots(ax[0], run, [0, 0.1, 0.22, 0.32, 0.42, 0.525], title)
     g, ell, x0 = 9.81, 1.0, 0.2
     ts = np.asarray(run.series["t"])
     ax[1].plot(ts, ell - np.asarray(run.fronts[0].s0), lw=2, alpha=0.7, label="hanging length 1 - s0 (string solver)")
     ax[1].plot(ts, x0 * np.cosh(math.sqrt(g / ell) * ts), "k:", lw=2, label="x0 cosh(sqrt(g/l) t), exact for f = 0")
     x_star = (ell + math.sqrt(ell * ell + 8 * x0 * x0)) / 4
-    ax[1].axhline(x_star, color="r", lw=0.8, ls="--", label=f"lift-off length x* = {x_star:.4f} m")
-    decorate(ax[1], "t (s)", "m", "the edge pushes while the table part's tension exceeds its momentum flux")
+    t_star = math.acosh(x_star / x0) / math.sqrt(g / ell)
+    ax[1].axhline(x_star, color="r", lw=0.8, ls="--",
+                  label=f"lift-off length x* = {x_star:.4f} m (t* = {t_star:.4f} s)")
+    for e in run.summary.get("events", []):
+        if e.get("kind") == "lift_off":
+            ax[1].plot([e["t"]], [ell - e["s0"]], "rx", ms=8, label=f"the run's lift-off event, t = {e['t']:.4f} s")
+    decorate(ax[1], "t (s)", "m", subtitle)
+
+
+def chain_off_table_edge(run, ax):
+    edge_slide(run, ax, "chain sliding off a smooth table over its edge, f = 0",
+               "the edge pushes while the table part's tension exceeds its momentum flux")
+
+
+def chain_off_real_table(run, ax):
+    edge_slide(run, ax, "the same chain on a real table: a surface bounded by its edge, f = 0",
+               "the table's contact forces hold its part: the same x(t) and lift-off")
 
 
 def chain_over_peg(run, ax):
@@ -261,20 +280,44 @@ def atwood_rough_pulley(run, ax):
     decorate(ax[1], "t (s)", "m", "beyond the capstan bound (x1 = 0.45 m > 0.4161 m) it slides")
 
 
-def chain_landing_at_angle(run, ax):
-    snapshots(ax[0], run, [0, 0.1, 0.15, 0.2, 0.25, 0.3], 'chain landing at 20 deg on a smooth table, slack = "allow"')
-    g = 9.81
-    frames = run.nodes
+def free_fall_landing_loss(frames, ts, nodes=slice(None), g=9.81):
+    """-sum of m g y0 over the chosen nodes (lumped masses: 1 kg/m over 1 m, half a link's mass at each end)
+    that have landed on the table y = 0 by each time in ts, each falling freely from rest at its height y0:
+    a node lands at sqrt(2 y0/g) and loses its normal kinetic energy m g y0."""
     y0 = frames.positions(0)[:, 1]
     n = len(y0)
-    mass = np.full(n, 1.0 / (n - 1))  # lumped: 1 kg/m over 1 m, half a link's mass at each end
+    mass = np.full(n, 1.0 / (n - 1))
     mass[[0, -1]] /= 2
+    y0, mass = y0[nodes], mass[nodes]
+    return np.array([-np.sum(mass * g * y0 * (np.sqrt(2 * y0 / g) <= t)) for t in ts])
+
+
+def chain_landing_at_angle(run, ax):
+    snapshots(ax[0], run, [0, 0.1, 0.15, 0.2, 0.25, 0.3], 'chain landing at 20 deg on a smooth table, slack = "allow"')
+    frames = run.nodes
     # Every node falls freely (no tension) and lands at sqrt(2 y0/g), losing its normal kinetic energy m g y0.
     ts = np.linspace(0, frames.times[-1], 400)
-    lost = [-np.sum(mass * g * y0 * (np.sqrt(2 * y0 / g) <= t)) for t in ts]
     ax[1].plot(run.energy["t"], run.energy["W_impacts"], lw=2, alpha=0.7, label="W_impacts (string solver)")
-    ax[1].plot(ts, lost, "k:", lw=1.5, label="- sum of m g y0 over the nodes landed by t (free fall)")
+    ax[1].plot(ts, free_fall_landing_loss(frames, ts), "k:", lw=1.5,
+               label="- sum of m g y0 over the nodes landed by t (free fall)")
     decorate(ax[1], "t (s)", "J", "each landing takes the node's normal kinetic energy")
+
+
+def chain_into_heap_on_table(run, ax):
+    snapshots(ax[0], run, [0, 0.1, 0.15, 0.2, 0.247], "a V of chain falling into its heap on a table, f = 1")
+    g = 9.81
+    frames = run.nodes
+    ts = np.linspace(0, run.series["t"][-1], 400)
+    # f = 1: no tension, every node falls freely. The heap takes the vertical arm at g t^2/2 a second (lambda =
+    # 1 kg/m); the tilted arm (s < 0.5 m, nodes 0 ... 39 of 81) lands on the table node by node.
+    ax[1].plot(run.series["t"], run.series["heap_mass"], lw=2, alpha=0.7, label="heap mass (kg, string solver)")
+    ax[1].plot(ts, g * ts ** 2 / 2, "k:", lw=1.5, label="lambda g t^2/2 (free fall into the heap)")
+    ax[1].plot(run.series["t"], -np.asarray(run.series["W_impacts"]), lw=2, alpha=0.7,
+               label="-W_impacts (J, string solver): the tilted arm's landings")
+    arm = slice(0, int(round(0.5 * (len(frames.positions(0)) - 1))))
+    ax[1].plot(ts, -free_fall_landing_loss(frames, ts, arm), "--", color="0.3", lw=1.2,
+               label="sum of m g y0 over the tilted arm's nodes landed by t")
+    decorate(ax[1], "t (s)", "kg, J", "free fall: the heap's mass and the landings' loss")
 
 
 def slack_panel(ax, run, title):
@@ -304,7 +347,7 @@ def thrown_chain(run, ax):
 SCENES = [shaken_chain, travelling_loop, whip_crack, pendulum_release, falling_chain, folded_chain, sliding_chain,
           swinging_sliding_chain, tilted_falling_chain, curved_falling_chain, folded_chain_ends_apart,
           chain_off_table_edge, swinging_u, pendulum_whip, thrown_chain, chain_over_peg, atwood_pulley,
-          atwood_rough_pulley, chain_landing_at_angle]
+          atwood_rough_pulley, chain_landing_at_angle, chain_off_real_table, chain_into_heap_on_table]
 
 
 def main():

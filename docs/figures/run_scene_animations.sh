@@ -1,6 +1,8 @@
 #!/usr/bin/env bash
-# The animations of docs/scenes.md (slack and snap-taut, the chain off the table's edge, the pulley, a landing): runs
-# cases/scenes/{swinging_u,pendulum_whip,thrown_chain,chain_off_table_edge,atwood_pulley,chain_landing_at_angle}.toml into RESULTS_DIR and animates
+# The animations of docs/scenes.md (slack and snap-taut, the chain off the table's edge and off a real table, the
+# pulleys, landings, a heap on a table): runs
+# cases/scenes/{swinging_u,pendulum_whip,thrown_chain,chain_off_table_edge,chain_off_real_table,atwood_pulley,
+# atwood_rough_pulley,chain_landing_at_angle,chain_into_heap_on_table}.toml into RESULTS_DIR and animates
 # each with `chainsim plot RUN --animate --format gif --fps 15 --speed 0.25` (a quarter of real time, 15 frames
 # per second: 61 frames for a 1 s run), copied from RESULTS_DIR/<scene>/figures/animation.gif to
 # docs/figures/<scene>_animation.gif.
@@ -9,7 +11,8 @@ set -euo pipefail
 cd "$(dirname "$0")/../.."
 out=${1:-results/animations}
 chainsim=${2:-build/chainsim}
-for name in swinging_u pendulum_whip thrown_chain chain_off_table_edge atwood_pulley chain_landing_at_angle; do
+for name in swinging_u pendulum_whip thrown_chain chain_off_table_edge chain_off_real_table atwood_pulley atwood_rough_pulley \
+    chain_landing_at_angle chain_into_heap_on_table; do
   "$chainsim" run "cases/scenes/$name.toml" --out "$out/$name" >/dev/null
   "$chainsim" plot "$out/$name" --animate --format gif --fps 15 --speed 0.25 >/dev/null
   cp "$out/$name/figures/animation.gif" "docs/figures/${name}_animation.gif"

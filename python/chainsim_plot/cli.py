@@ -113,7 +113,8 @@ def draw(run, out_dir=None, times=None):
     if run.kind == "reduced":
         drawn["reduced"] = figures.reduced_figure(run, out_dir)
     if run.kind == "compare":
-        drawn["compare"] = figures.compare_figure(run, out_dir)
+        compare = figures.compare_figure if run.reduced is not None else figures.exact_compare_figure
+        drawn["compare"] = compare(run, out_dir)
     if run.nodes is not None:
         drawn["snapshots"] = figures.snapshots_figure(run, out_dir, times)
     drawn["energy"] = figures.energy_figure(run, out_dir)

@@ -629,3 +629,66 @@ def compare_figure(run, out_dir):
                  " against the reduced ODE", fontsize=10)
     fig.tight_layout()
     return save(fig, out_dir, "compare.png")
+
+
+EXACT_TENSIONS = {  # exact_series.csv's tensions and reactions (docs/cli.md, chainsim compare edge|peg|pulley)
+    "tension_edge": "tension before the edge", "tension_minus": "tension of the rising side at the peg",
+    "tension_plus": "tension after it", "tension_short": "shorter side at the pulley",
+    "tension_long": "longer side at the pulley"}
+
+
+def exact_compare_figure(run, out_dir):
+    """`chainsim compare edge|peg|pulley`: x(t) of the string solver on the exact one (with the lift-off), the
+    exact tensions and the edge's reaction F0 against the string's, and |x - x_exact| at equal times."""
+    s, ex = run.series, run.exact
+    summary = run.summary or {}
+    problem = summary.get("problem", "")
+    fig, axes = plt.subplots(1, 3, figsize=(17, 4.5), dpi=DPI)
+    axes[0].plot(ex["t"], ex["x"], "k-", lw=2.5, alpha=0.4, label="exact solution")
+    x = None
+    if run.fronts and len(s["t"]):  # edge, peg: the edge front at s0 = l - x (l from the first row)
+        x = (ex["x"][0] + run.fronts[0].s0[0]) - run.fronts[0].s0
+        axes[0].plot(s["t"], x, "-", lw=1, label="string solver: l - s0 of the edge front")
+    for key, style, label in (("", "o", "string solver"), ("_exact", "kx", "exact")):
+        t_l, x_l = summary.get("t_lift_off" + key), summary.get("x_lift_off" + key)
+        if t_l is not None and x_l is not None:
+            axes[0].plot([t_l], [x_l], style, mfc="none", ms=9, label=f"lift-off, {label}: t = {t_l:.6g} s")
+    what = {"pulley": "x = x1, the longer side (m)"}.get(problem, "x, the longer or hanging side (m)")
+    decorate(axes[0], "t (s)", what, f"x(t) to the lift-off ({problem})")
+    for name, label in EXACT_TENSIONS.items():
+        if name in ex:
+            axes[1].plot(ex["t"], ex[name], "-", lw=1.5, label=f"{name}: {label} (exact)")
+    for axis in ("x", "y"):
+        if f"reaction_{axis}" in ex and f"R_front0_{axis}" in s:
+            axes[1].plot(ex["t"], ex[f"reaction_{axis}"], "k-", lw=2.5, alpha=0.3, label=f"reaction F0_{axis} (exact)")
+            axes[1].plot(s["t"], s[f"R_front0_{axis}"], "--", lw=1, label=f"R_front0_{axis} (string solver)")
+    title = "tensions and reaction (N)" if "reaction_x" in ex else "tensions (N)"
+    if "max_abs_err_tension" in summary:
+        title += f": max |T error| {summary['max_abs_err_tension']:.2e} N"
+    elif "max_abs_err_tension_short" in summary:
+        title += (f": max |T error| {summary['max_abs_err_tension_short']:.2e} N (short), "
+                  f"{summary.get('max_abs_err_tension_long', float('nan')):.2e} N (long)")
+    decorate(axes[1], "t (s)", "N", title)
+    if x is not None:
+        inside = (s["t"] >= ex["t"][0]) & (s["t"] <= ex["t"][-1])
+        ref = hermite(ex["t"], ex["x"], ex["x_dot"], s["t"][inside]) if "x_dot" in ex else \
+            np.interp(s["t"][inside], ex["t"], ex["x"])
+        worst = semilogy_abs(axes[2], s["t"][inside], x[inside] - ref, lw=1)
+        decorate(axes[2], "t (s)", "m", f"|x_string - x_exact| at equal t: max {worst:.2e} m", legend=False)
+    elif "lift_off_margin" in ex:  # the pulley: the string series has no x, its errors are in the summary
+        axes[2].plot(ex["t"], ex["lift_off_margin"], "k-", lw=1.5, label="(tau2 - lambda xdot^2)/R (exact)")
+        axes[2].axhline(0, color="0.5", lw=0.8)
+        if summary.get("t_lift_off") is not None:
+            axes[2].axvline(summary["t_lift_off"], color="C1", ls="--", lw=1,
+                            label=f"the string's lift-off, t = {summary['t_lift_off']:.6g} s")
+        title = "lift-off margin (N/m), zero at t*"
+        if "max_abs_err_x" in summary:
+            title += f"\nmax |x error| {summary['max_abs_err_x']:.2e} m (summary.json)"
+        decorate(axes[2], "t (s)", "N/m", title)
+    else:
+        axes[2].set_visible(False)
+    nodes = summary.get("nodes")
+    fig.suptitle(f"{run.name}: the {problem} problem, string solver" + (f" ({nodes} nodes)" if nodes else "") +
+                 " against the exact solution", fontsize=10)
+    fig.tight_layout()
+    return save(fig, out_dir, "compare.png")

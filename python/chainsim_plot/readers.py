@@ -6,7 +6,8 @@ A run directory is recognised by the files in it (see `load_run`):
     string      chainsim run (a scene without fronts)            nodes.csv, tension.csv, energy.csv, stats.json
     fronts      chainsim run (a scene with heaps or a fold)      nodes.csv, series.csv, stats.json
     reduced     chainsim reduced, chainsim run (model="reduced")  series.csv, summary.json or stats.json
-    compare     chainsim compare                                 string_series.csv, reduced_series.csv, summary.json
+    compare     chainsim compare falling|folded|sliding          string_series.csv, reduced_series.csv, summary.json
+                chainsim compare edge|peg|pulley                 string_series.csv, exact_series.csv, summary.json
     canonical   chainsim canonical                               summary.csv, figure_data/, falling/ folded/ sliding/
 
 Every table is read by its header and every column is optional: a string run with fronts may carry
@@ -214,7 +215,7 @@ class Run:
     """Everything a run directory holds, read once."""
 
     def __init__(self, path, kind, files, summary=None, nodes=None, energy=None, series=None, tension=None,
-                 reduced=None, fronts=None):
+                 reduced=None, fronts=None, exact=None):
         self.path = path
         self.kind = kind
         self.files = files
@@ -224,6 +225,7 @@ class Run:
         self.series = series
         self.tension = tension
         self.reduced = reduced
+        self.exact = exact  # exact_series.csv of `chainsim compare edge|peg|pulley`: the exact solution
         self.fronts = fronts or []
 
     @property
@@ -313,7 +315,7 @@ def load_run(path):
     files = sorted(os.listdir(path))
     # Every chainsim command clears what the others wrote before writing; a directory holding both
     # `chainsim run`'s summary and another command's was mixed by an older chainsim, or by hand.
-    others = [f for f in ("summary.json", "string_series.csv", "reduced_series.csv") if f in files]
+    others = [f for f in ("summary.json", "string_series.csv", "reduced_series.csv", "exact_series.csv") if f in files]
     if "stats.json" in files and others:
         raise RunError(f"RUN_DIR '{path}' mixes the outputs of two commands: stats.json of `chainsim run` beside "
                        f"{', '.join(others)} of `chainsim compare` or `chainsim reduced`; run the command again "
@@ -321,10 +323,22 @@ def load_run(path):
     summary = read_json(j("stats.json"))
     if summary is None:
         summary = read_json(j("summary.json"))
+    if os.path.exists(j("exact_series.csv")) and not os.path.exists(j("reduced_series.csv")):
+        # chainsim compare edge|peg|pulley: the string solver against the exact solution.
+        string, exact = read_table(j("string_series.csv")), read_table(j("exact_series.csv"))
+        if string is None:
+            raise RunError(f"{path}: a compare run of edge, peg or pulley needs string_series.csv beside "
+                           f"exact_series.csv, and it is missing (run `chainsim compare` again)")
+        if "t" not in exact or "x" not in exact:
+            raise RunError(f"{path}/exact_series.csv: no column t or x (the exact solution's time and x)")
+        return Run(path, "compare", files, summary, series=string, exact=exact, fronts=_fronts(string, None))
     if os.path.exists(j("string_series.csv")) or os.path.exists(j("reduced_series.csv")):
         string, reduced = read_table(j("string_series.csv")), read_table(j("reduced_series.csv"))
         if string is None or reduced is None:
-            raise RunError(f"{path}: a compare run needs both string_series.csv and reduced_series.csv")
+            raise RunError(f"{path}: a compare run needs string_series.csv with either reduced_series.csv "
+                           f"(compare falling|folded|sliding: eta and P against the reduced ODE) or "
+                           f"exact_series.csv (compare edge|peg|pulley: x and the tensions against the exact "
+                           f"solution); it has only {'reduced_series.csv' if string is None else 'string_series.csv'}")
         return Run(path, "compare", files, summary, series=string, reduced=reduced, fronts=_fronts(string, None))
     series = read_table(j("series.csv"))
     if series is not None and "eta" in series and "P" in series:  # the reduced model's series

@@ -105,6 +105,10 @@ def run_dir(kind):
         args = ["reduced", "sliding", "--eta0", "0.25", "--out", out]
     elif kind == "compare":
         args = ["compare", "folded", "--nodes", "21", "--out", out]
+    elif kind in ("compare_edge", "compare_peg"):  # the string solver against the exact solution
+        args = ["compare", kind[len("compare_"):], "--nodes", "21", "--out", out]
+    elif kind == "compare_pulley":  # below about 41 nodes the chain does not start held on the pulley
+        args = ["compare", "pulley", "--nodes", "41", "--out", out]
     elif kind == "canonical":
         args = ["canonical", "--out", out, "--quick"]
     r = chainsim(*args)
@@ -187,6 +191,35 @@ def test_kind_reduced_runs():
 
 def test_kind_compare_run():
     check_plot("compare", ["compare.png", "energy.png", "fronts.png"], here=True)
+
+
+def test_kind_compare_against_the_exact_solution():
+    """chainsim compare edge|peg|pulley writes exact_series.csv, not reduced_series.csv: plot draws x(t) on the
+    exact solution, the tensions and the reactions. Before, it refused them ("needs ... reduced_series.csv").
+    The string's x drawn starts at the release's x0 and ends at the lift-off that summary.json records (the
+    C++ side's measure), and the exact curve is exact_series.csv's x."""
+    from chainsim_plot.cli import draw
+    from chainsim_plot.readers import load_run, read_json
+    import matplotlib.pyplot as plt
+    for problem, x0, fronts in (("edge", 0.2, ["fronts.png"]), ("peg", 0.6, ["fronts.png"]), ("pulley", None, [])):
+        directory = run_dir("compare_" + problem)
+        check_plot(None, ["compare.png", "energy.png"] + fronts, here=True, directory=directory)
+        summary = read_json(os.path.join(directory, "summary.json"))
+        fig = draw(load_run(directory))["compare"]
+        lines = {line.get_label(): line for line in fig.axes[0].lines}
+        exact = lines["exact solution"].get_ydata()
+        with open(os.path.join(directory, "exact_series.csv"), newline="") as fh:
+            assert np.allclose(exact, [float(row["x"]) for row in csv.DictReader(fh)], rtol=0, atol=0)
+        if x0 is not None:  # edge, peg: the edge front's s0 = l - x
+            x = lines["string solver: l - s0 of the edge front"].get_ydata()
+            assert abs(x[0] - x0) < 1e-8 and abs(x[-1] - summary["x_lift_off"]) < 1e-6
+        assert any(label.startswith("lift-off, string solver: t = ") for label in lines)
+        assert any(label.startswith("lift-off, exact: t = ") for label in lines)
+        tensions = [line.get_label() for line in fig.axes[1].lines]
+        assert any(label.startswith("tension_") for label in tensions)
+        if problem != "pulley":
+            assert "R_front0_y (string solver)" in tensions and "reaction F0_y (exact)" in tensions
+        plt.close(fig)
 
 
 def test_kind_canonical_run():
@@ -294,6 +327,19 @@ def test_error_canonical_directory_missing_a_file_exits_2():
     assert not os.path.exists(os.path.join(fake, "figures"))
     code, err = plot_here(fake, "--animate")
     assert code == 2 and "--animate needs node frames" in err
+
+
+def test_error_compare_directory_without_a_reference_exits_2_naming_what_plots():
+    """string_series.csv with neither reduced_series.csv nor exact_series.csv: exit 2, the message naming
+    both references and what each compare draws."""
+    out = os.path.join(ROOT, "compare_no_reference")
+    shutil.copytree(run_dir("compare_edge"), out)
+    os.remove(os.path.join(out, "exact_series.csv"))
+    code, err = plot_here(out)
+    assert code == 2
+    for word in ("reduced_series.csv", "exact_series.csv", "edge|peg|pulley", "falling|folded|sliding",
+                 "it has only string_series.csv"):
+        assert word in err, err
 
 
 def test_error_mixed_directory_exits_2():
