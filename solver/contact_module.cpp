@@ -177,9 +177,10 @@ void Obstacle<dim>::draw(int index, const Points<dim>& nodes, double margin, Obs
     return;
   }
   const Eigen::Vector3d a = dim == 2 ? Eigen::Vector3d(0.0, 0.0, 1.0) : in_3d(axis);
-  const auto [e1, e2] = dim == 2 ? std::make_pair(Eigen::Vector3d(1.0, 0.0, 0.0), Eigen::Vector3d(0.0, 1.0, 0.0))
-                                 : normal_pair(a);
-  auto rim = [&](double phi) { return radius * (std::cos(phi) * e1 + std::sin(phi) * e2); };
+  // The circle's plane (a pair, not a structured binding: C++17 lambdas cannot capture those).
+  const std::pair<Eigen::Vector3d, Eigen::Vector3d> plane =
+      dim == 2 ? std::make_pair(Eigen::Vector3d(1.0, 0.0, 0.0), Eigen::Vector3d(0.0, 1.0, 0.0)) : normal_pair(a);
+  auto rim = [&](double phi) { return radius * (std::cos(phi) * plane.first + std::sin(phi) * plane.second); };
   const double step = 2 * kPi / kCircleSegments;
   if (dim == 2) {
     for (int k = 0; k < kCircleSegments; ++k)
