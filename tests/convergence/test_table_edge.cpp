@@ -363,3 +363,80 @@ t_end = 2.0
                                    "edge's line from");
   }
 }
+
+namespace {
+
+/// The chain off a rough table (docs/model.md §10 "Friction with an edge"): ℓ = 1 m, x0 hanging over a
+/// smooth edge (f = 0), the table part on a level table with Coulomb's μ, at rest at t = 0.
+std::string rough_table_scene(int nodes, double mu, double x0, double t_end) {
+  std::string text = real_table_scene(nodes, "");
+  text.replace(text.find("[[-0.8, 0.0]"), 12, fmt::format("[[{:.17g}, 0.0]", -(1.0 - x0)));
+  text.replace(text.find("[0.0, -0.2]]"), 12, fmt::format("[0.0, {:.17g}]]", -x0));
+  text.replace(text.find("edge = 0\n"), 9, fmt::format("edge = 0\nmu = {:.17g}\n", mu));
+  text.replace(text.find("t_end = 2.0"), 11, fmt::format("t_end = {:.17g}", t_end));
+  return text;
+}
+
+/// The continuum, sliding (ẋ > 0): ℓ ẍ = g x − μ g (ℓ − x); from rest at x0 > x_e = μℓ/(1+μ),
+/// x = x_e + (x0 − x_e) cosh(ω t), ω² = g (1+μ)/ℓ.
+struct RoughEdge {
+  double ell, mu, x0, g = kG;
+  double xe() const { return mu * ell / (1 + mu); }
+  double omega() const { return std::sqrt(g * (1 + mu) / ell); }
+  double x(double t) const { return xe() + (x0 - xe()) * std::cosh(omega() * t); }
+  /// The edge lifts off where the table part's tension T = λ(ℓ − x)(ẍ + μg) reaches λẋ²: with
+  /// y = x − x_e, A = x0 − x_e, L = ℓ/(1+μ) (so μg = ω² x_e, ℓ − x = L − y): 2y² + (x_e − L) y − (L x_e + A²) = 0.
+  double x_star() const {
+    const double L = ell / (1 + mu), A = x0 - xe();
+    return xe() + ((L - xe()) + std::sqrt((L - xe()) * (L - xe()) + 8 * (L * xe() + A * A))) / 4;
+  }
+  double t_star() const { return std::acosh((x_star() - xe()) / (x0 - xe())) / omega(); }
+  /// −μ λ g ∫ (ℓ − x) ẋ dt from x0 to x (λ = 1 kg/m).
+  double w_friction(double x) const {
+    auto F = [&](double y) { return ell * y - y * y / 2; };
+    return -mu * g * (F(x) - F(x0));
+  }
+};
+
+}  // namespace
+
+TEST_CASE("rough table and edge: the chain slides off a rough table as the continuum's cosh, and lifts off the edge "
+          "at its x*", "[contact][edge][friction][convergence]") {
+  const RoughEdge ref{1.0, 0.2, 0.3};
+  // The lift-off point by a bracketed root of T − λẋ² along the closed form (bisection to round-off).
+  {
+    auto gap = [&](double x) {
+      const double w2 = ref.omega() * ref.omega(), y = x - ref.xe(), A = ref.x0 - ref.xe();
+      return (ref.ell - x) * (w2 * y + ref.mu * ref.g) - w2 * (y * y - A * A);
+    };
+    double lo = ref.x0, hi = ref.ell;
+    REQUIRE(gap(lo) > 0);
+    REQUIRE(gap(hi) < 0);
+    for (int k = 0; k < 200; ++k) (gap(0.5 * (lo + hi)) > 0 ? lo : hi) = 0.5 * (lo + hi);
+    CHECK(ref.x_star() == Approx(lo).epsilon(1e-13));
+  }
+  const double t_star = ref.t_star();
+  for (int nodes : {5, 12, 42, 82}) {
+    CAPTURE(nodes);
+    SceneSpec spec = parse_scene_text(rough_table_scene(nodes, ref.mu, ref.x0, 2.0), "rough_table");
+    StringScene<2> scene = build_string_scene<2>(spec);
+    StringSolver<2> solver(*scene.model, scene.solver);
+    solver.run();
+    const RunSummary& run = solver.summary();
+    REQUIRE(run.status == "stopped");
+    CHECK(run.stop_reason.rfind("lifted off the edge at t = ", 0) == 0);
+    REQUIRE(!run.events.empty());
+    CHECK(run.events.back().kind == "lift_off");
+    CHECK(std::abs(run.events.back().t - t_star) < 1e-6);
+    REQUIRE(finite_run(run));
+    double err_x = 0;
+    for (const StepSample& s : run.samples) err_x = std::max(err_x, std::abs((1.0 - s.fronts[0].s0) - ref.x(s.t)));
+    CHECK(err_x < 1e-6);
+    const StepSample& last = run.samples.back();
+    CHECK(last.terms["W_friction"] == Approx(ref.w_friction(1.0 - last.fronts[0].s0)).epsilon(1e-6));
+    CHECK(last.terms["impacts"] == 0);
+    CHECK(last.terms["lift_offs"] == 0);
+    CHECK(run.relative_energy_drift() < 1e-10);
+    CHECK(run.relative_momentum_residual() < 1e-10);
+  }
+}
