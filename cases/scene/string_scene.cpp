@@ -24,9 +24,10 @@ void refuse_friction_with_slack(const SceneSpec& spec) {
                                                   "unilateral links (their complementarity problem needs the "
                                                   "symmetric tension matrix of smooth obstacles): allowed mu = 0, or "
                                                   "solver.slack = \"stop\"", key, mu));
-    scene_build::fail_at(spec, key, fmt::format("{} = {:g} in a scene with fronts (heaps, folds, edges): friction "
-                                                "meets fronts only on a table bounded by its edge (edge = k) in a scene whose only "
-                                                "fronts are edges: allowed mu = 0 here",
+    scene_build::fail_at(spec, key, fmt::format("{} = {:g} in a scene with fronts (heaps, folds, edges): with fronts "
+                                                "friction is built (and tested) only on a table bounded by its edge "
+                                                "([[effects.surface]] with edge = k) in a scene whose only fronts "
+                                                "are edges: allowed mu = 0 here",
                                                 key, mu));
   };
   // Tested with fronts (docs/model.md §10, tests/convergence/test_table_edge.cpp): a rough table bounded by

@@ -440,3 +440,53 @@ TEST_CASE("rough table and edge: the chain slides off a rough table as the conti
     CHECK(run.relative_momentum_residual() < 1e-10);
   }
 }
+
+TEST_CASE("rough table and edge: below x_e = μℓ/(1+μ) the chain stays, just above it slides",
+          "[contact][edge][friction]") {
+  const double mu = 0.2, xe = mu / (1 + mu);
+  for (double x0 : {0.9 * xe, 1.1 * xe}) {
+    CAPTURE(x0);
+    const RoughEdge ref{1.0, mu, x0};
+    SceneSpec spec = parse_scene_text(rough_table_scene(41, mu, x0, 0.5), "rough_table_rest");
+    StringScene<2> scene = build_string_scene<2>(spec);
+    StringSolver<2> solver(*scene.model, scene.solver);
+    solver.run();
+    const RunSummary& run = solver.summary();
+    REQUIRE(finite_run(run));
+    const StepSample& last = run.samples.back();
+    const double x_end = 1.0 - last.fronts[0].s0;
+    if (x0 < xe) {
+      REQUIRE(run.status == "completed");
+      CHECK(std::abs(x_end - x0) < 1e-9);
+      CHECK(last.terms["slips"] == 0);
+      CHECK(std::abs(last.terms["W_friction"]) < 1e-9);
+    } else {
+      CHECK(x_end == Approx(ref.x(last.t)).epsilon(1e-6));
+      CHECK(last.terms["W_friction"] == Approx(ref.w_friction(x_end)).epsilon(1e-6));
+    }
+    CHECK(run.relative_energy_drift() < 1e-10);
+    // At rest the run's largest momentum is round-off, so the residual is measured against M √(gℓ).
+    CHECK(run.max_momentum_residual < 1e-10 * std::sqrt(kG * 1.0));
+    if (x0 > xe) CHECK(run.relative_momentum_residual() < 1e-10);
+  }
+}
+
+TEST_CASE("rough table and edge: friction with fronts other than a table bounded by its edge is refused before the "
+          "run", "[contact][edge][friction]") {
+  const std::string allowed = "with fronts friction is built (and tested) only on a table bounded by its edge";
+  // A rough table that does not end at the edge (no edge = k).
+  std::string unbounded = rough_table_scene(21, 0.2, 0.3, 1.0);
+  unbounded.replace(unbounded.find("edge = 0\n"), 9, "");
+  CHECK_THROWS_WITH(build_string_scene<2>(parse_scene_text(unbounded, "unbounded")),
+                    Catch::Contains("effects.surface[0].mu = 0.2 in a scene with fronts") && Catch::Contains(allowed));
+  // A rough cylinder beside the bounded table.
+  std::string cylinder = rough_table_scene(21, 0.2, 0.3, 1.0);
+  cylinder.replace(cylinder.find("[solver]"), 0, "[[effects.cylinder]]\ncenter = [-0.5, 1.0]\nradius = 0.1\nmu = 0.3\n");
+  CHECK_THROWS_WITH(build_string_scene<2>(parse_scene_text(cylinder, "cylinder")),
+                    Catch::Contains("effects.cylinder[0].mu = 0.3 in a scene with fronts") && Catch::Contains(allowed));
+  // The bounded rough table with slack = "allow" (unilateral links: refused with or without fronts).
+  std::string slack = rough_table_scene(21, 0.2, 0.3, 1.0);
+  slack.replace(slack.find("[solver]\n"), 9, "[solver]\nslack = \"allow\"\n");
+  CHECK_THROWS_WITH(build_string_scene<2>(parse_scene_text(slack, "slack")),
+                    Catch::Contains("with solver.slack = \"allow\": friction does not meet unilateral links"));
+}
