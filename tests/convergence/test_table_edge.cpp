@@ -12,6 +12,9 @@
 //    with f = 1 (no tension: every node falls freely) into the heap at one end while its other arm lands
 //    on the table node by node: the heap's mass λ g t²/2, each landed node where it fell, W_impacts the
 //    landed nodes' potential energy, the ledgers closed (with slack = "allow": slack, contact, fronts).
+//  - the chain off a rough table (mu > 0 on the bounded table, f = 0): x(t) = x_e + (x0 − x_e) cosh ωt, the
+//    lift-off of the edge at x* and W_friction against their closed forms on four meshes, the ledgers closed;
+//    at rest below x_e = μℓ/(1+μ) it stays, just above it it slides; the combinations not tested are refused.
 #include <cmath>
 #include <string>
 
