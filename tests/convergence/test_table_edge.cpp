@@ -493,6 +493,23 @@ TEST_CASE("rough table and edge: friction with fronts other than a table bounded
   cylinder.replace(cylinder.find("[solver]"), 0, "[[effects.cylinder]]\ncenter = [-0.5, 1.0]\nradius = 0.1\nmu = 0.3\n");
   CHECK_THROWS_WITH(build_string_scene<2>(parse_scene_text(cylinder, "cylinder")),
                     Catch::Contains("effects.cylinder[0].mu = 0.3 in a scene with fronts") && Catch::Contains(allowed));
+  // The bounded rough table in 3D (the locked tensions are not chosen inside the cones there).
+  std::string three_d = rough_table_scene(21, 0.2, 0.3, 1.0);
+  auto sub = [&](const std::string& from, const std::string& to) {
+    const std::size_t at = three_d.find(from);
+    REQUIRE(at != std::string::npos);
+    three_d.replace(at, from.size(), to);
+  };
+  sub("density = 1.0\n", "density = 1.0\ndimension = 3\n");
+  const std::size_t points = three_d.find("points = ");
+  three_d.replace(points, three_d.find('\n', points) - points,
+                  "points = [[-0.7, 0.0, 0.0], [0.0, 0.0, 0.0], [0.0, -0.3, 0.0]]");
+  sub("g = [0.0, -9.81]", "g = [0.0, -9.81, 0.0]");
+  sub("[[effects.edge]]\npoint = [0.0, 0.0]", "[[effects.edge]]\npoint = [0.0, 0.0, 0.0]\ndirection = [0.0, 0.0, 1.0]");
+  sub("[[effects.surface]]\npoint = [0.0, 0.0]\nnormal = [0.0, 1.0]",
+      "[[effects.surface]]\npoint = [0.0, 0.0, 0.0]\nnormal = [0.0, 1.0, 0.0]");
+  CHECK_THROWS_WITH(build_string_scene<3>(parse_scene_text(three_d, "three_d")),
+                    Catch::Contains("effects.surface[0].mu = 0.2 on a table bounded by its edge in 3D"));
   // The bounded rough table with slack = "allow" (unilateral links: refused with or without fronts).
   std::string slack = rough_table_scene(21, 0.2, 0.3, 1.0);
   slack.replace(slack.find("[solver]\n"), 9, "[solver]\nslack = \"allow\"\n");
