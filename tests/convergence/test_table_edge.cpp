@@ -14,7 +14,9 @@
 //    landed nodes' potential energy, the ledgers closed (with slack = "allow": slack, contact, fronts).
 //  - the chain off a rough table (mu > 0 on the bounded table, f = 0): x(t) = x_e + (x0 − x_e) cosh ωt, the
 //    lift-off of the edge at x* and W_friction against their closed forms on four meshes, the ledgers closed;
-//    at rest below x_e = μℓ/(1+μ) it stays, just above it it slides; the combinations not tested are refused.
+//    at rest below x_e = μℓ/(1+μ) it stays, just above it it slides; with f > 0 against an RK4 integration of
+//    ℓẍ = gx − μg(ℓ − x) − fẋ²; the combinations not tested are refused.
+#include <array>
 #include <cmath>
 #include <string>
 
@@ -515,4 +517,62 @@ TEST_CASE("rough table and edge: friction with fronts other than a table bounded
   slack.replace(slack.find("[solver]\n"), 9, "[solver]\nslack = \"allow\"\n");
   CHECK_THROWS_WITH(build_string_scene<2>(parse_scene_text(slack, "slack")),
                     Catch::Contains("with solver.slack = \"allow\": friction does not meet unilateral links"));
+}
+
+TEST_CASE("rough table and edge: with a dissipative edge (f > 0) the chain meets an independent Runge-Kutta "
+          "integration of l x'' = g x - mu g (l - x) - f x'^2", "[contact][edge][friction][convergence]") {
+  const double ell = 1.0, mu = 0.2, f = 0.5, x0 = 0.3;
+  // The reference: classical RK4 on (x, ẋ) to round-off; the lift-off where the table part's tension
+  // λ(ℓ − x)(ẍ + μg) reaches λẋ² (the edge lets go on the table side first, §8), by linear interpolation
+  // of that gap between steps; W_friction = −μ λ g ∫(ℓ − x)ẋ dt and the kink's −f λ ∫ẋ³ dt by RK4 too.
+  auto rhs = [&](const std::array<double, 4>& y) {
+    const double acc = (kG * y[0] - mu * kG * (ell - y[0]) - f * y[1] * y[1]) / ell;
+    return std::array<double, 4>{y[1], acc, -mu * kG * (ell - y[0]) * y[1], -f * y[1] * y[1] * y[1]};
+  };
+  auto gap = [&](const std::array<double, 4>& y) { return (ell - y[0]) * (rhs(y)[1] + mu * kG) - y[1] * y[1]; };
+  std::array<double, 4> y{x0, 0.0, 0.0, 0.0};
+  const double dt = 2e-5;
+  double t = 0, t_star = 0;
+  std::array<double, 4> at_star{};
+  while (true) {
+    auto step = [&](const std::array<double, 4>& a, const std::array<double, 4>& k, double c) {
+      std::array<double, 4> r{};
+      for (int i = 0; i < 4; ++i) r[static_cast<std::size_t>(i)] = a[static_cast<std::size_t>(i)] + c * k[static_cast<std::size_t>(i)];
+      return r;
+    };
+    const auto k1 = rhs(y), k2 = rhs(step(y, k1, dt / 2)), k3 = rhs(step(y, k2, dt / 2)), k4 = rhs(step(y, k3, dt));
+    std::array<double, 4> next{};
+    for (std::size_t i = 0; i < 4; ++i) next[i] = y[i] + dt / 6 * (k1[i] + 2 * k2[i] + 2 * k3[i] + k4[i]);
+    if (gap(next) < 0) {
+      const double s = gap(y) / (gap(y) - gap(next));
+      t_star = t + s * dt;
+      for (std::size_t i = 0; i < 4; ++i) at_star[i] = y[i] + s * (next[i] - y[i]);
+      break;
+    }
+    y = next;
+    t += dt;
+    if (t > 2.0) FAIL("the reference did not lift off by 2 s");
+  }
+  CAPTURE(t_star, at_star[0], at_star[2], at_star[3]);
+  for (int nodes : {12, 42}) {
+    CAPTURE(nodes);
+    std::string text = rough_table_scene(nodes, mu, x0, 2.0);
+    text.replace(text.find("[[effects.edge]]\npoint = [0.0, 0.0]\n"), 35, "[[effects.edge]]\npoint = [0.0, 0.0]\nf = 0.5\n");
+    SceneSpec spec = parse_scene_text(text, "rough_table_f");
+    StringScene<2> scene = build_string_scene<2>(spec);
+    StringSolver<2> solver(*scene.model, scene.solver);
+    solver.run();
+    const RunSummary& run = solver.summary();
+    REQUIRE(run.status == "stopped");
+    REQUIRE(!run.events.empty());
+    CHECK(run.events.back().kind == "lift_off");
+    CHECK(std::abs(run.events.back().t - t_star) < 1e-7);
+    const StepSample& last = run.samples.back();
+    CHECK(std::abs((1.0 - last.fronts[0].s0) - at_star[0]) < 1e-7);
+    CHECK(last.terms["W_friction"] == Approx(at_star[2]).epsilon(1e-7));
+    CHECK(last.terms["W_shocks"] == Approx(at_star[3]).epsilon(1e-7));
+    CHECK(last.terms["lift_offs"] == 0);
+    CHECK(run.relative_energy_drift() < 1e-10);
+    CHECK(run.relative_momentum_residual() < 1e-10);
+  }
 }
