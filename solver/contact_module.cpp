@@ -526,14 +526,17 @@ class ContactModule final : public WrappingModule<dim> {
       if (chain.closed()) return false;
       std::vector<int> contact_of(static_cast<std::size_t>(chain.num_nodes()), -1);
       for (std::size_t k = 0; k < model.contacts().size(); ++k) contact_of[static_cast<std::size_t>(model.contacts()[k].node)] = static_cast<int>(k);
-      auto e = [&](int j) -> Vec<dim> {
+      // Link j's direction at its start node (at_end false) or its end node: a link bent over an edge
+      // pulls along e⁻ and e⁺ there, not along its chord.
+      auto e = [&](int j, bool at_end) -> Vec<dim> {
         if (j < 0 || j >= L) return Vec<dim>::Zero();
+        if (model.link_bent(j)) return model.bent_direction(j, at_end);
         return (model.x().col(chain.link_end(j)) - model.x().col(chain.link_start(j))).normalized();
       };
       auto boundary = [&](int j) { return j < 0 || j >= L ? 0.0 : model.link_tension(j); };
       auto node_cone = [&](int i) {
         const int k = contact_of[static_cast<std::size_t>(i)];
-        return k >= 0 && model.contacts()[static_cast<std::size_t>(k)].stuck ? cone(model, static_cast<std::size_t>(k), e(i - 1), e(i))
+        return k >= 0 && model.contacts()[static_cast<std::size_t>(k)].stuck ? cone(model, static_cast<std::size_t>(k), e(i - 1, true), e(i, false))
                                                                              : std::vector<HalfPlane>{};
       };
       const double scale = std::max(model.physical_scales().tension, 1e-300);

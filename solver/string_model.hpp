@@ -286,6 +286,9 @@ class StringModel final : public OdeSystem {
   void clear_bends() { bends_.clear(); }
   /// Link `link` is bent over a point (bend_link).
   bool link_bent(int link) const { return !bends_.empty() && bend_of(link) != nullptr; }
+  /// A bent link's unit vectors after an evaluation: e⁻ at its start node (`at_end` false), e⁺ at its end
+  /// node: the directions its tension pulls along there (T e⁻ on the start node, −T e⁺ on the end node).
+  Vec<dim> bent_direction(int link, bool at_end) const { return at_end ? bend_of(link)->e_plus : Vec<dim>(e_.col(link)); }
   /// Link j's rate of lengthening after an evaluation (m/s): e_j·Δv_j, a bent link's d(l⁻ + l⁺)/dt.
   double link_rate(int j) const;
   /// The force the points of the bent links exert on the string after an evaluation (N): Σ T (e⁻ − e⁺).

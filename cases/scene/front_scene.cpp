@@ -392,8 +392,10 @@ std::unique_ptr<StringModel<dim>> build_front_model(const SceneSpec& spec, scene
       std::vector<Obstacle<dim>> obstacles = contact_obstacles<dim>(spec);
       for (const TableSide<dim>& table : tables) {
         Obstacle<dim>& o = obstacles[table.surface];
+        const double mu = o.mu;  // the table's friction (edge_table builds the geometry only)
         o = edge_table<dim>(*edge_fronts[table.edge], o.normal, table.inward, table.before, edges[table.edge].axis,
                             o.name);
+        o.mu = mu;
       }
       return std::make_unique<StringModel<dim>>(
           std::move(parts.chain), std::move(parts.forces), std::move(parts.prescribed), mo,

@@ -24,12 +24,26 @@ void refuse_friction_with_slack(const SceneSpec& spec) {
                                                   "unilateral links (their complementarity problem needs the "
                                                   "symmetric tension matrix of smooth obstacles): allowed mu = 0, or "
                                                   "solver.slack = \"stop\"", key, mu));
-    scene_build::fail_at(spec, key, fmt::format("{} = {:g} in a scene with fronts (heaps, folds, edges): friction "
-                                                "does not meet fronts yet: allowed mu = 0 with fronts",
+    scene_build::fail_at(spec, key, fmt::format("{} = {:g} in a scene with fronts (heaps, folds, edges): with fronts "
+                                                "friction is built (and tested) only on a table bounded by its edge "
+                                                "([[effects.surface]] with edge = k) in a scene whose only fronts "
+                                                "are edges: allowed mu = 0 here",
                                                 key, mu));
   };
-  for (std::size_t k = 0; k < fx.surfaces.size(); ++k)
-    if (fx.surfaces[k].mu > 0) refuse(fmt::format("effects.surface[{}].mu", k), fx.surfaces[k].mu);
+  // Tested with fronts (docs/model.md §10, tests/convergence/test_table_edge.cpp): a rough table bounded by
+  // its edge in a 2D scene whose only fronts are edges, with the bilateral links (slack = "stop"/"warn").
+  const bool edges_only = fx.heaps.empty() && !fx.fold.has_value();
+  for (std::size_t k = 0; k < fx.surfaces.size(); ++k) {
+    if (!(fx.surfaces[k].mu > 0)) continue;
+    const std::string key = fmt::format("effects.surface[{}].mu", k);
+    if (slack || !edges_only || !fx.surfaces[k].edge) refuse(key, fx.surfaces[k].mu);
+    if (spec.dimension == 3)
+      scene_build::fail_at(spec, key, fmt::format("{} = {:g} on a table bounded by its edge in 3D: the stuck table "
+                                                  "part's locked tensions are not chosen inside the friction cones in "
+                                                  "3D (a chain at rest over the edge below mu l/(1+mu) stops with "
+                                                  "\"stuck on\" at t = 0): allowed mu = 0, or string.dimension = 2",
+                                                  key, fx.surfaces[k].mu));
+  }
   for (std::size_t k = 0; k < fx.cylinders.size(); ++k)
     if (fx.cylinders[k].mu > 0) refuse(fmt::format("effects.cylinder[{}].mu", k), fx.cylinders[k].mu);
 }

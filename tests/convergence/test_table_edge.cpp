@@ -12,6 +12,11 @@
 //    with f = 1 (no tension: every node falls freely) into the heap at one end while its other arm lands
 //    on the table node by node: the heap's mass λ g t²/2, each landed node where it fell, W_impacts the
 //    landed nodes' potential energy, the ledgers closed (with slack = "allow": slack, contact, fronts).
+//  - the chain off a rough table (mu > 0 on the bounded table, f = 0): x(t) = x_e + (x0 − x_e) cosh ωt, the
+//    lift-off of the edge at x* and W_friction against their closed forms on four meshes, the ledgers closed;
+//    at rest below x_e = μℓ/(1+μ) it stays, just above it it slides; with f > 0 against an RK4 integration of
+//    ℓẍ = gx − μg(ℓ − x) − fẋ²; the combinations not tested are refused.
+#include <array>
 #include <cmath>
 #include <string>
 
@@ -361,5 +366,213 @@ t_end = 2.0
     CHECK(std::string(e.what()) == "t3d.toml:17:8: effects.surface[0].edge = 0: the string on the table runs along the "
                                    "line of effects.edge[0] (tangent [0, 0, 1]): allowed a table the string crosses the "
                                    "edge's line from");
+  }
+}
+
+namespace {
+
+/// The chain off a rough table (docs/model.md §10 "Friction with an edge"): ℓ = 1 m, x0 hanging over a
+/// smooth edge (f = 0), the table part on a level table with Coulomb's μ, at rest at t = 0.
+std::string rough_table_scene(int nodes, double mu, double x0, double t_end) {
+  std::string text = real_table_scene(nodes, "");
+  text.replace(text.find("[[-0.8, 0.0]"), 12, fmt::format("[[{:.17g}, 0.0]", -(1.0 - x0)));
+  text.replace(text.find("[0.0, -0.2]]"), 12, fmt::format("[0.0, {:.17g}]]", -x0));
+  text.replace(text.find("edge = 0\n"), 9, fmt::format("edge = 0\nmu = {:.17g}\n", mu));
+  text.replace(text.find("t_end = 2.0"), 11, fmt::format("t_end = {:.17g}", t_end));
+  return text;
+}
+
+/// The continuum, sliding (ẋ > 0): ℓ ẍ = g x − μ g (ℓ − x); from rest at x0 > x_e = μℓ/(1+μ),
+/// x = x_e + (x0 − x_e) cosh(ω t), ω² = g (1+μ)/ℓ.
+struct RoughEdge {
+  double ell, mu, x0, g = kG;
+  double xe() const { return mu * ell / (1 + mu); }
+  double omega() const { return std::sqrt(g * (1 + mu) / ell); }
+  double x(double t) const { return xe() + (x0 - xe()) * std::cosh(omega() * t); }
+  /// The edge lifts off where the table part's tension T = λ(ℓ − x)(ẍ + μg) reaches λẋ²: with
+  /// y = x − x_e, A = x0 − x_e, L = ℓ/(1+μ) (so μg = ω² x_e, ℓ − x = L − y): 2y² + (x_e − L) y − (L x_e + A²) = 0.
+  double x_star() const {
+    const double L = ell / (1 + mu), A = x0 - xe();
+    return xe() + ((L - xe()) + std::sqrt((L - xe()) * (L - xe()) + 8 * (L * xe() + A * A))) / 4;
+  }
+  double t_star() const { return std::acosh((x_star() - xe()) / (x0 - xe())) / omega(); }
+  /// −μ λ g ∫ (ℓ − x) ẋ dt from x0 to x (λ = 1 kg/m).
+  double w_friction(double x) const {
+    auto F = [&](double y) { return ell * y - y * y / 2; };
+    return -mu * g * (F(x) - F(x0));
+  }
+};
+
+}  // namespace
+
+TEST_CASE("rough table and edge: the chain slides off a rough table as the continuum's cosh, and lifts off the edge "
+          "at its x*", "[contact][edge][friction][convergence]") {
+  const RoughEdge ref{1.0, 0.2, 0.3};
+  // The lift-off point by a bracketed root of T − λẋ² along the closed form (bisection to round-off).
+  {
+    auto gap = [&](double x) {
+      const double w2 = ref.omega() * ref.omega(), y = x - ref.xe(), A = ref.x0 - ref.xe();
+      return (ref.ell - x) * (w2 * y + ref.mu * ref.g) - w2 * (y * y - A * A);
+    };
+    double lo = ref.x0, hi = ref.ell;
+    REQUIRE(gap(lo) > 0);
+    REQUIRE(gap(hi) < 0);
+    for (int k = 0; k < 200; ++k) (gap(0.5 * (lo + hi)) > 0 ? lo : hi) = 0.5 * (lo + hi);
+    CHECK(ref.x_star() == Approx(lo).epsilon(1e-13));
+  }
+  const double t_star = ref.t_star();
+  for (int nodes : {5, 12, 42, 82}) {
+    CAPTURE(nodes);
+    SceneSpec spec = parse_scene_text(rough_table_scene(nodes, ref.mu, ref.x0, 2.0), "rough_table");
+    StringScene<2> scene = build_string_scene<2>(spec);
+    StringSolver<2> solver(*scene.model, scene.solver);
+    solver.run();
+    const RunSummary& run = solver.summary();
+    REQUIRE(run.status == "stopped");
+    CHECK(run.stop_reason.rfind("lifted off the edge at t = ", 0) == 0);
+    REQUIRE(!run.events.empty());
+    CHECK(run.events.back().kind == "lift_off");
+    CHECK(std::abs(run.events.back().t - t_star) < 1e-7);
+    // The table part's tension at the edge, T = λ(ℓ − x)(ẍ + μg), at x*.
+    const double x_star = ref.x_star(), w2 = ref.omega() * ref.omega();
+    for (const auto& [name, value] : run.events.back().values)
+      if (name == "tension_minus")
+        CHECK(std::abs(value - (1.0 - x_star) * (w2 * (x_star - ref.xe()) + ref.mu * kG)) < 1e-6);
+    REQUIRE(finite_run(run));
+    double err_x = 0;
+    for (const StepSample& s : run.samples) err_x = std::max(err_x, std::abs((1.0 - s.fronts[0].s0) - ref.x(s.t)));
+    CHECK(err_x < 1e-7);
+    const StepSample& last = run.samples.back();
+    CHECK(last.terms["W_friction"] == Approx(ref.w_friction(1.0 - last.fronts[0].s0)).epsilon(1e-7));
+    CHECK(ref.w_friction(x_star) == Approx(-0.366672082228).epsilon(1e-11));
+    CHECK(last.terms["impacts"] == 0);
+    CHECK(last.terms["lift_offs"] == 0);
+    CHECK(run.relative_energy_drift() < 1e-10);
+    CHECK(run.relative_momentum_residual() < 1e-10);
+  }
+}
+
+TEST_CASE("rough table and edge: below x_e = μℓ/(1+μ) the chain stays, just above it slides",
+          "[contact][edge][friction]") {
+  const double mu = 0.2, xe = mu / (1 + mu);
+  for (double x0 : {0.9 * xe, 1.1 * xe}) {
+    CAPTURE(x0);
+    const RoughEdge ref{1.0, mu, x0};
+    SceneSpec spec = parse_scene_text(rough_table_scene(41, mu, x0, 0.5), "rough_table_rest");
+    StringScene<2> scene = build_string_scene<2>(spec);
+    StringSolver<2> solver(*scene.model, scene.solver);
+    solver.run();
+    const RunSummary& run = solver.summary();
+    REQUIRE(finite_run(run));
+    const StepSample& last = run.samples.back();
+    const double x_end = 1.0 - last.fronts[0].s0;
+    if (x0 < xe) {
+      REQUIRE(run.status == "completed");
+      CHECK(std::abs(x_end - x0) < 1e-9);
+      CHECK(last.terms["slips"] == 0);
+      CHECK(std::abs(last.terms["W_friction"]) < 1e-9);
+    } else {
+      CHECK(x_end == Approx(ref.x(last.t)).epsilon(1e-6));
+      CHECK(last.terms["W_friction"] == Approx(ref.w_friction(x_end)).epsilon(1e-6));
+    }
+    CHECK(run.relative_energy_drift() < 1e-10);
+    // At rest the run's largest momentum is round-off, so the residual is measured against M √(gℓ).
+    CHECK(run.max_momentum_residual < 1e-10 * std::sqrt(kG * 1.0));
+    if (x0 > xe) CHECK(run.relative_momentum_residual() < 1e-10);
+  }
+}
+
+TEST_CASE("rough table and edge: friction with fronts other than a table bounded by its edge is refused before the "
+          "run", "[contact][edge][friction]") {
+  const std::string allowed = "with fronts friction is built (and tested) only on a table bounded by its edge";
+  // A rough table that does not end at the edge (no edge = k).
+  std::string unbounded = rough_table_scene(21, 0.2, 0.3, 1.0);
+  unbounded.replace(unbounded.find("edge = 0\n"), 9, "");
+  CHECK_THROWS_WITH(build_string_scene<2>(parse_scene_text(unbounded, "unbounded")),
+                    Catch::Contains("effects.surface[0].mu = 0.2 in a scene with fronts") && Catch::Contains(allowed));
+  // A rough cylinder beside the bounded table.
+  std::string cylinder = rough_table_scene(21, 0.2, 0.3, 1.0);
+  cylinder.replace(cylinder.find("[solver]"), 0, "[[effects.cylinder]]\ncenter = [-0.5, 1.0]\nradius = 0.1\nmu = 0.3\n");
+  CHECK_THROWS_WITH(build_string_scene<2>(parse_scene_text(cylinder, "cylinder")),
+                    Catch::Contains("effects.cylinder[0].mu = 0.3 in a scene with fronts") && Catch::Contains(allowed));
+  // The bounded rough table in 3D (the locked tensions are not chosen inside the cones there).
+  std::string three_d = rough_table_scene(21, 0.2, 0.3, 1.0);
+  auto sub = [&](const std::string& from, const std::string& to) {
+    const std::size_t at = three_d.find(from);
+    REQUIRE(at != std::string::npos);
+    three_d.replace(at, from.size(), to);
+  };
+  sub("density = 1.0\n", "density = 1.0\ndimension = 3\n");
+  const std::size_t points = three_d.find("points = ");
+  three_d.replace(points, three_d.find('\n', points) - points,
+                  "points = [[-0.7, 0.0, 0.0], [0.0, 0.0, 0.0], [0.0, -0.3, 0.0]]");
+  sub("g = [0.0, -9.81]", "g = [0.0, -9.81, 0.0]");
+  sub("[[effects.edge]]\npoint = [0.0, 0.0]", "[[effects.edge]]\npoint = [0.0, 0.0, 0.0]\ndirection = [0.0, 0.0, 1.0]");
+  sub("[[effects.surface]]\npoint = [0.0, 0.0]\nnormal = [0.0, 1.0]",
+      "[[effects.surface]]\npoint = [0.0, 0.0, 0.0]\nnormal = [0.0, 1.0, 0.0]");
+  CHECK_THROWS_WITH(build_string_scene<3>(parse_scene_text(three_d, "three_d")),
+                    Catch::Contains("effects.surface[0].mu = 0.2 on a table bounded by its edge in 3D"));
+  // The bounded rough table with slack = "allow" (unilateral links: refused with or without fronts).
+  std::string slack = rough_table_scene(21, 0.2, 0.3, 1.0);
+  slack.replace(slack.find("[solver]\n"), 9, "[solver]\nslack = \"allow\"\n");
+  CHECK_THROWS_WITH(build_string_scene<2>(parse_scene_text(slack, "slack")),
+                    Catch::Contains("with solver.slack = \"allow\": friction does not meet unilateral links"));
+}
+
+TEST_CASE("rough table and edge: with a dissipative edge (f > 0) the chain meets an independent Runge-Kutta "
+          "integration of l x'' = g x - mu g (l - x) - f x'^2", "[contact][edge][friction][convergence]") {
+  const double ell = 1.0, mu = 0.2, f = 0.5, x0 = 0.3;
+  // The reference: classical RK4 on (x, ẋ) to round-off; the lift-off where the table part's tension
+  // λ(ℓ − x)(ẍ + μg) reaches λẋ² (the edge lets go on the table side first, §8), by linear interpolation
+  // of that gap between steps; W_friction = −μ λ g ∫(ℓ − x)ẋ dt and the kink's −f λ ∫ẋ³ dt by RK4 too.
+  auto rhs = [&](const std::array<double, 4>& y) {
+    const double acc = (kG * y[0] - mu * kG * (ell - y[0]) - f * y[1] * y[1]) / ell;
+    return std::array<double, 4>{y[1], acc, -mu * kG * (ell - y[0]) * y[1], -f * y[1] * y[1] * y[1]};
+  };
+  auto gap = [&](const std::array<double, 4>& y) { return (ell - y[0]) * (rhs(y)[1] + mu * kG) - y[1] * y[1]; };
+  std::array<double, 4> y{x0, 0.0, 0.0, 0.0};
+  const double dt = 2e-5;
+  double t = 0, t_star = 0;
+  std::array<double, 4> at_star{};
+  while (true) {
+    auto step = [&](const std::array<double, 4>& a, const std::array<double, 4>& k, double c) {
+      std::array<double, 4> r{};
+      for (int i = 0; i < 4; ++i) r[static_cast<std::size_t>(i)] = a[static_cast<std::size_t>(i)] + c * k[static_cast<std::size_t>(i)];
+      return r;
+    };
+    const auto k1 = rhs(y), k2 = rhs(step(y, k1, dt / 2)), k3 = rhs(step(y, k2, dt / 2)), k4 = rhs(step(y, k3, dt));
+    std::array<double, 4> next{};
+    for (std::size_t i = 0; i < 4; ++i) next[i] = y[i] + dt / 6 * (k1[i] + 2 * k2[i] + 2 * k3[i] + k4[i]);
+    if (gap(next) < 0) {
+      const double s = gap(y) / (gap(y) - gap(next));
+      t_star = t + s * dt;
+      for (std::size_t i = 0; i < 4; ++i) at_star[i] = y[i] + s * (next[i] - y[i]);
+      break;
+    }
+    y = next;
+    t += dt;
+    if (t > 2.0) FAIL("the reference did not lift off by 2 s");
+  }
+  CAPTURE(t_star, at_star[0], at_star[2], at_star[3]);
+  for (int nodes : {12, 42}) {
+    CAPTURE(nodes);
+    std::string text = rough_table_scene(nodes, mu, x0, 2.0);
+    text.replace(text.find("[[effects.edge]]\npoint = [0.0, 0.0]\n"), 35, "[[effects.edge]]\npoint = [0.0, 0.0]\nf = 0.5\n");
+    SceneSpec spec = parse_scene_text(text, "rough_table_f");
+    StringScene<2> scene = build_string_scene<2>(spec);
+    StringSolver<2> solver(*scene.model, scene.solver);
+    solver.run();
+    const RunSummary& run = solver.summary();
+    REQUIRE(run.status == "stopped");
+    REQUIRE(!run.events.empty());
+    CHECK(run.events.back().kind == "lift_off");
+    CHECK(std::abs(run.events.back().t - t_star) < 1e-7);
+    const StepSample& last = run.samples.back();
+    CHECK(std::abs((1.0 - last.fronts[0].s0) - at_star[0]) < 1e-7);
+    CHECK(last.terms["W_friction"] == Approx(at_star[2]).epsilon(1e-7));
+    CHECK(last.terms["W_shocks"] == Approx(at_star[3]).epsilon(1e-7));
+    CHECK(last.terms["lift_offs"] == 0);
+    CHECK(run.relative_energy_drift() < 1e-10);
+    CHECK(run.relative_momentum_residual() < 1e-10);
   }
 }
