@@ -57,4 +57,25 @@ inline Vec<2> pulley_path_tangent(double R, double x2, double s) {
   return Vec<2>(0.0, -1.0);
 }
 
+/// The chain of density λ and length ℓ on that path, `links` links, moving along itself at v0.
+inline Chain<2> pulley_chain(double lambda, double ell, double R, double x2, double v0, int links) {
+  Chain<2> chain = Chain<2>::uniform(lambda, ell, links, false);
+  for (int i = 0; i <= links; ++i) {
+    chain.positions().col(i) = pulley_path_point(R, x2, i * ell / links);
+    chain.velocities().col(i) = v0 * pulley_path_tangent(R, x2, i * ell / links);
+  }
+  return chain;
+}
+
+/// The pulley of that path: a cylinder of radius R about the origin, Coulomb's mu (0: smooth).
+inline Obstacle<2> pulley(double R, double mu = 0) {
+  Obstacle<2> o;
+  o.kind = Obstacle<2>::Kind::kCylinder;
+  o.point = Vec<2>::Zero();
+  o.radius = R;
+  o.mu = mu;
+  o.name = "pulley";
+  return o;
+}
+
 }  // namespace chainsim::test

@@ -183,19 +183,10 @@ struct AtwoodRun {
 
 AtwoodRun atwood_run(const Atwood& a, int links, double t_end) {
   const double lambda = 1.0;
-  Chain<2> chain = Chain<2>::uniform(lambda, a.ell, links, false);
-  for (int i = 0; i <= links; ++i) {
-    chain.positions().col(i) = a.at(i * a.ell / links);
-    chain.velocities().col(i) = a.v0 * a.tangent(i * a.ell / links);
-  }
+  Chain<2> chain = test::pulley_chain(lambda, a.ell, a.R, a.x2, a.v0, links);
   std::vector<std::unique_ptr<Force<2>>> forces;
   forces.push_back(std::make_unique<Gravity<2>>(Vec<2>(0.0, -kG)));
-  Obstacle<2> pulley;
-  pulley.kind = Obstacle<2>::Kind::kCylinder;
-  pulley.point = Vec<2>(0.0, 0.0);
-  pulley.radius = a.R;
-  pulley.name = "pulley";
-  StringModel<2> model(std::move(chain), std::move(forces), {}, contact_options(), make_contact_module<2>({pulley}));
+  StringModel<2> model(std::move(chain), std::move(forces), {}, contact_options(), make_contact_module<2>({test::pulley(a.R)}));
   StringSolver<2> solver(model, contact_run(t_end, t_end / 4, 1e-11));
   AtwoodRun r;
   // At every accepted step: (1) the tension where the shorter side meets the pulley (y = 0),

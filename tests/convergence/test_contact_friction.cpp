@@ -289,20 +289,11 @@ struct RoughAtwoodRun {
 };
 
 RoughAtwoodRun rough_atwood_run(const RoughAtwood& a, int links, double t_end) {
-  Chain<2> chain = Chain<2>::uniform(1.0, a.ell, links, false);
-  for (int i = 0; i <= links; ++i) {
-    chain.positions().col(i) = a.at(i * a.ell / links);
-    chain.velocities().col(i) = a.v0 * a.tangent(i * a.ell / links);
-  }
+  Chain<2> chain = test::pulley_chain(1.0, a.ell, a.R, a.x2, a.v0, links);
   std::vector<std::unique_ptr<Force<2>>> forces;
   forces.push_back(std::make_unique<Gravity<2>>(Vec<2>(0.0, -kG)));
-  Obstacle<2> pulley;
-  pulley.kind = Obstacle<2>::Kind::kCylinder;
-  pulley.point = Vec<2>::Zero();
-  pulley.radius = a.R;
-  pulley.mu = a.mu;
-  pulley.name = "pulley";
-  StringModel<2> model(std::move(chain), std::move(forces), {}, test::contact_options(), make_contact_module<2>({pulley}));
+  StringModel<2> model(std::move(chain), std::move(forces), {}, test::contact_options(),
+                       make_contact_module<2>({test::pulley(a.R, a.mu)}));
   StringSolver<2> solver(model, test::contact_run(t_end, t_end / 4, 1e-11));
   const RunSummary& s = solver.run();
   REQUIRE(s.status == "completed");
