@@ -344,7 +344,10 @@ TEST_CASE("contact: compare pulley, the heavy Atwood chain released at rest, aga
   // on the shorter side shakes the chain): their means over the steps fall at about first order, their
   // maxima more slowly. The lift-off (the zero of the string's τ2 − λẋ², averaged over one link's
   // passage) is within 2.05e-3, 5.3e-4, 1.8e-4, 1.55e-4 s of t* on 51 to 401 nodes: second order down to
-  // the floor of about 1.5e-4 s (0.03% of t*) that the tension's oscillation leaves (docs/model.md §10).
+  // the floor of about 1.5e-4 s (0.03% of t*, early) of the tensions' first-order error: each node lands
+  // across a bend of the chain, and the landings' impulses carry a first-order share of the pull on the
+  // shorter side that the tensions of the steps lack (docs/model.md §10, "Where the first-order error
+  // enters"; contact on the links would remove it: not built).
   std::vector<nlohmann::json> runs;
   for (int nodes : {51, 101, 201, 401}) {
     setup.nodes = nodes;
