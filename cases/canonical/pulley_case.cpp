@@ -90,7 +90,7 @@ PulleyComparison compare_pulley_with_exact(const PulleyCaseSetup& setup) {
     return Exact{u, exact::pulley_u_dot(t, u0, ell, g), lambda * (0.5 * free - u) * (g + xdd),
                  lambda * (0.5 * free + u) * (g - xdd)};
   };
-  double err_x = 0, err_short = 0, err_long = 0, sum_short = 0, sum_long = 0;
+  double err_x = 0, err_short = 0, err_long = 0, sum_short = 0, sum_long = 0, signed_short = 0, signed_long = 0;
   long tension_steps = 0;
   // The lift-off: the first zero of the string's margin τ2 − λ ẋ² (its tension where the shorter side
   // meets the pulley, its speed) averaged over one landing period, interpolated linearly between the steps
@@ -114,6 +114,8 @@ PulleyComparison compare_pulley_with_exact(const PulleyCaseSetup& setup) {
     err_long = std::max(err_long, std::abs(T1 - tau1));
     sum_short += std::abs(T2 - tau2);
     sum_long += std::abs(T1 - tau1);
+    signed_short += T2 - tau2;
+    signed_long += T1 - tau1;
     ++tension_steps;
     const double speed = 0.5 * (v(1, 0) - v(1, links)), raw = T2 - lambda * speed * speed;
     // Each node that lands on the shorter side shakes the tension (docs/model.md §10): the margin is
@@ -162,6 +164,8 @@ PulleyComparison compare_pulley_with_exact(const PulleyCaseSetup& setup) {
   const double steps = static_cast<double>(std::max(1L, tension_steps));
   c.summary["mean_abs_err_tension_short"] = sum_short / steps;
   c.summary["mean_abs_err_tension_long"] = sum_long / steps;
+  c.summary["mean_err_tension_short"] = signed_short / steps;
+  c.summary["mean_err_tension_long"] = signed_long / steps;
   c.summary["max_rel_err_tension"] = std::max(err_short, err_long) / setup.chain.P0();
   c.summary["tension_steps"] = tension_steps;
   return c;

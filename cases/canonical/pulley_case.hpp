@@ -38,6 +38,8 @@ struct PulleyCaseSetup {
 ///                               held node; x, ẍ exact,
 ///   max_abs_err_tension_long    the same for τ1 = λ x1 (g − ẍ) where the longer side leaves it (N),
 ///   mean_abs_err_tension_short, mean_abs_err_tension_long   their means over the steps (N),
+///   mean_err_tension_short, mean_err_tension_long   the means of the signed errors (N; negative: the
+///                               landings' impulses carry a share of the pull, docs/model.md §10),
 ///   max_rel_err_tension         the larger maximum over λ g ℓ,
 ///   tension_steps               the steps at which both were measured (each side needs two hanging links
 ///                               below the pulley).

@@ -453,7 +453,8 @@ TEST_CASE("chainsim compare pulley --json: the heavy Atwood chain over a pulley 
   CAPTURE(r.output);
   for (const char* key : {"t_lift_off", "t_lift_off_exact", "abs_err_t_lift_off", "x_lift_off", "x_lift_off_exact",
                           "abs_err_x_lift_off", "max_abs_err_x", "max_abs_err_tension_short", "max_abs_err_tension_long",
-                          "mean_abs_err_tension_short", "mean_abs_err_tension_long", "max_rel_err_tension",
+                          "mean_abs_err_tension_short", "mean_abs_err_tension_long", "mean_err_tension_short",
+                          "mean_err_tension_long", "max_rel_err_tension",
                           "tension_steps", "u_lift_off_exact", "energy_residual", "momentum_residual", "nodes", "u0",
                           "R"})
     CHECK(j.contains(key));
