@@ -189,3 +189,66 @@ TEST_CASE("a kink placed where the string does not turn is refused", "[kink][sho
           std::string::npos);
   }
 }
+
+TEST_CASE("a kink's forces carry the momentum of the material it moves and do no work, at any velocities",
+          "[kink][shocks][unit]") {
+  // Hand-built states: a corner of `turn` degrees inside link (8, 9) of 20 links, random node velocities
+  // (incompatible with a kink: v_b − v_a not along t_A − t_B). The kink's masses change at λ l̇⁻ (l̇⁻ from
+  // central differences of its own l⁻ along the motion), so momentum is exact when F_a + F_b = λ l̇⁻ u, and
+  // the lumped kinetic energy gains F_a·v_a + F_b·v_b + ½ λ l̇⁻ (|v_a|² − |v_b|²), which must vanish
+  // (docs/model.md §2.5). With compatible velocities ṡ0 is the one built in.
+  std::srand(7);
+  auto random = [] { return 2.0 * std::rand() / RAND_MAX - 1.0; };
+  for (const double turn : {20.0, 90.0, 160.0}) {
+    const double lambda = 0.3, s0 = 0.43, angle = turn * kPi / 180;
+    const Vec<2> tA(1.0, 0.0), tB(std::cos(angle), std::sin(angle));
+    Points<2> vertices(2, 3);
+    vertices.col(0) = -s0 * tA;
+    vertices.col(1).setZero();
+    vertices.col(2) = (1 - s0) * tB;
+    Chain<2> chain = discretize<2>(*polyline_curve<2>(vertices), 1.0, lambda, 20, false);
+    std::vector<std::unique_ptr<FrontKind<2>>> kinds;
+    kinds.push_back(std::make_unique<KinkFront<2>>(KinkSpec{s0}));
+    KinkFront<2>* kink = static_cast<KinkFront<2>*>(kinds.back().get());  // held by the model's tracker
+    StringModel<2> model = make_front_model<2>(std::move(chain), {}, {}, std::move(kinds), FrontOptions{});
+    const int n = model.chain().num_nodes(), a = 8, b = 9;
+    for (int trial = 0; trial < 4; ++trial) {
+      for (int i = 0; i < n; ++i) model.v().col(i) = Vec<2>(random(), random());
+      const bool compatible = trial == 0;
+      const double sd_built = 0.7;
+      if (compatible) model.v().col(b) = model.v().col(a) + sd_built * (tA - tB);
+      Eigen::VectorXd mass = Eigen::VectorXd::Zero(n);
+      Points<2> force = Points<2>::Zero(2, n);
+      FrontState<2> s;
+      kink->evaluate(model, s, mass, force);
+      // l̇⁻ by fourth-order central differences of the kink's own l⁻ along x + ε v.
+      const Points<2> x0 = model.x();
+      const double eps = 1e-5;  // the tangents turn at |v|/h: 1e-4 leaves a truncation error of 1e-6
+      auto l_at = [&](double step) {
+        model.x() = x0 + step * model.v();
+        FrontState<2> moved;
+        Eigen::VectorXd m2 = Eigen::VectorXd::Zero(n);
+        Points<2> f2 = Points<2>::Zero(2, n);
+        kink->evaluate(model, moved, m2, f2);
+        return moved.l_minus;
+      };
+      const double l_rate = (8 * (l_at(eps) - l_at(-eps)) - (l_at(2 * eps) - l_at(-2 * eps))) / (12 * eps);
+      model.x() = x0;
+      const Vec<2> va = model.v().col(a), vb = model.v().col(b), u = vb - va;
+      const double scale = lambda * u.norm() * (u.norm() + std::abs(l_rate));
+      CAPTURE(turn, trial, l_rate, s.s0_dot);
+      CHECK(mass[a] == Approx(lambda * s.l_minus).epsilon(1e-14));
+      CHECK(mass[b] == Approx(lambda * s.l_plus).epsilon(1e-14));
+      CHECK(s.l_minus + s.l_plus == Approx(model.chain().link_length(0)).epsilon(1e-14));
+      CHECK((force.col(a) + force.col(b) - lambda * l_rate * u).norm() < 1e-8 * scale);
+      const double power = force.col(a).dot(va) + force.col(b).dot(vb) + 0.5 * lambda * l_rate * (va.squaredNorm() - vb.squaredNorm());
+      CHECK(std::abs(power) < 1e-8 * scale * u.norm());
+      CHECK(s.tension_minus == s.tension_plus);
+      CHECK(s.tension_minus == Approx(lambda * s.s0_dot * s.s0_dot).epsilon(1e-14));
+      CHECK(s.power_shock == 0);
+      if (compatible) CHECK(s.s0_dot == Approx(sd_built).epsilon(1e-12));
+      for (int i = 0; i < n; ++i)
+        if (i != a && i != b) CHECK(force.col(i).norm() == 0);
+    }
+  }
+}
