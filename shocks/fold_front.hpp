@@ -1,8 +1,9 @@
 #pragma once
 /// @file fold_front.hpp
 /// A fold front (front_kind.hpp): an internal shock at the bight of a folded string, between the arc
-/// before and the arc after it (front_tracker.hpp has the physics, docs/shocks.md the numerics).
-#include "shocks/front_kind.hpp"
+/// before and the arc after it (front_tracker.hpp has the physics, docs/shocks.md the numerics); the
+/// split link's bookkeeping is SplitLinkFront's (split_link_front.hpp).
+#include "shocks/split_link_front.hpp"
 
 namespace chainsim {
 
@@ -13,7 +14,7 @@ struct FoldSpec {
 };
 
 template <int dim>
-class FoldFront final : public FrontKind<dim> {
+class FoldFront final : public SplitLinkFront<dim> {
  public:
   explicit FoldFront(const FoldSpec& spec);
 
@@ -31,18 +32,9 @@ class FoldFront final : public FrontKind<dim> {
   const char* name() const override { return "fold"; }
   const char* placed() const override { return "fold"; }
 
-  void cut(FrontLayout& layout) override;
   void check_initial(const FrontState<dim>& state) const override;
   void evaluate(const StringModel<dim>& model, FrontState<dim>& state, Eigen::VectorXd& mass,
                 Points<dim>& force) override;
-  std::vector<int> stencil(const StringModel<dim>& model) const override;
-  bool has_load_derivatives() const override { return true; }
-  std::optional<double> tension_at(const StringModel<dim>& model, const FrontState<dim>& state,
-                                   int node) const override;
-  double potential_moment(const StringModel<dim>& model, const FrontState<dim>& state, const Vec<dim>& g) const override;
-  void crossings(const StringModel<dim>& model, const FrontState<dim>& state, double* g) const override;
-  int second_direction() const override { return -1; }
-  EventAction cross(StringModel<dim>& model, const FrontState<dim>& state, int e0) override;
   /// One: positive while the arms are within kMaxOpeningDeg of antiparallel and the folded link's
   /// material spans its chord.
   int num_checks() const override { return 1; }

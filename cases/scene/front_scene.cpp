@@ -62,11 +62,13 @@ std::string name_fronts(const std::string& reason, const std::vector<std::string
   return fmt::format("the {} front{}", names[k], reason.substr(end));
 }
 
-/// The key a layout refusal of the tracker is located at: the first heap, else the fold, else the first edge.
+/// The key a layout refusal of the tracker is located at: the first heap, else the fold, else the first
+/// edge, else the first kink.
 template <int dim>
 std::string fit_key_of(const SceneSpec& spec, const std::optional<FoldSpec>& fold, const std::vector<HeapSpec<dim>>& heaps) {
   if (!heaps.empty()) return "effects.heap[0]";
   if (fold) return "effects.fold.s0";
+  if (spec.effects.edges.empty() && !spec.effects.kinks.empty()) return "effects.kink[0].s0";
   return spec.effects.edges.empty() ? "effects.fold" : "effects.edge[0]";
 }
 
@@ -323,6 +325,37 @@ std::unique_ptr<StringModel<dim>> build_front_model(const SceneSpec& spec, scene
     edges.push_back(edge);
   }
 
+  // 4b'. Kinks: inside the moving part, a full link from its ends, where the initial shape turns.
+  std::vector<KinkSpec> kinks;
+  for (std::size_t k = 0; k < fx.kinks.size(); ++k) {
+    const double s0 = fx.kinks[k].s0, h = chain.link_length(0);
+    const std::string key = fmt::format("effects.kink[{}].s0", k);
+    if (!(s0 > s_lo + h && s0 < s_hi - h))
+      fail_at(spec, key,
+              fmt::format("{} = {}: allowed inside the moving part of the string with a full link on either side, "
+                          "{:g} < s0 < {:g} m",
+                          key, text_of(spec, key), s_lo + h, s_hi - h));
+    const double d = std::min(kTangentStep * ell, 0.25 * h);
+    const Vec<dim> before = parts.curve->point(s0) - parts.curve->point(s0 - d);
+    const Vec<dim> after = parts.curve->point(s0 + d) - parts.curve->point(s0);
+    const double turn = std::acos(std::clamp(before.dot(after) / (before.norm() * after.norm()), -1.0, 1.0));
+    if (!(turn >= KinkFront<dim>::kMinTurnDeg * kPi / 180))
+      fail_at(spec, key,
+              fmt::format("{} = {}: the shape has no corner there (it turns by {:.3g} deg at s = {:g} m; a kink's arms "
+                          "turn by at least {:g} deg)",
+                          key, text_of(spec, key), turn * 180 / kPi, s0, KinkFront<dim>::kMinTurnDeg));
+    for (const EdgeSpec<dim>& edge : edges)
+      if (std::abs(edge.s0 - s0) < 2 * h)
+        fail_at(spec, key, fmt::format("{} = {} is less than two links from an edge at s = {:g} m", key,
+                                       text_of(spec, key), edge.s0));
+    if (fx.fold && std::abs(fx.fold->s0 - s0) < 2 * h)
+      fail_at(spec, key, fmt::format("{} = {} is less than two links from the fold", key, text_of(spec, key)));
+    for (std::size_t j = 0; j < k; ++j)
+      if (std::abs(fx.kinks[j].s0 - s0) < 2 * h)
+        fail_at(spec, key, fmt::format("{} = {} is less than two links from effects.kink[{}]", key, text_of(spec, key), j));
+    kinks.push_back(KinkSpec{s0});
+  }
+
   // 4c. Tables that end at an edge.
   std::vector<TableSide<dim>> tables;
   for (std::size_t k = 0; k < fx.surfaces.size(); ++k)
@@ -340,10 +373,11 @@ std::unique_ptr<StringModel<dim>> build_front_model(const SceneSpec& spec, scene
       fail_at(spec, key,
               fmt::format("{} = {} is outside the string: allowed 0 <= s0 <= {} m", key, text_of(spec, key), ell));
     const std::string& name = names[static_cast<std::size_t>(stop_fronts[k])];
-    const double s_start = name == "fold"         ? fx.fold->s0
-                           : name == "heap_start" ? s_lo
-                           : name == "heap_end"   ? s_hi
-                                                  : edges[std::stoul(name.substr(4))].s0;
+    const double s_start = name == "fold"               ? fx.fold->s0
+                           : name == "heap_start"       ? s_lo
+                           : name == "heap_end"         ? s_hi
+                           : name.rfind("kink", 0) == 0 ? kinks[std::stoul(name.substr(4))].s0
+                                                        : edges[std::stoul(name.substr(4))].s0;
     if (std::abs(s - s_start) <= kPlaceTolerance * ell)
       fail_at(spec, key,
               fmt::format("{} = {} is where the {} front starts: a stop event needs a front that gets there", key,
@@ -373,6 +407,7 @@ std::unique_ptr<StringModel<dim>> build_front_model(const SceneSpec& spec, scene
         edge_fronts.push_back(edge.get());
         all.emplace_back(std::move(edge), names[n++]);
       }
+      for (const KinkSpec& kink : kinks) all.emplace_back(std::make_unique<KinkFront<dim>>(kink), names[n++]);
       std::stable_sort(all.begin(), all.end(),
                        [](const auto& p, const auto& q) { return p.first->expected_s0 < q.first->expected_s0; });
       for (auto& [kind, name] : all) {
@@ -428,6 +463,8 @@ std::unique_ptr<StringModel<dim>> build_front_model(const SceneSpec& spec, scene
       if constexpr (dim == 3) f["direction"] = to_array<dim>(edges[e].axis);
     } else if (name == "fold") {
       f["s0"] = fold->s0;
+    } else if (name.rfind("kink", 0) == 0) {
+      f["s0"] = kinks[std::stoul(name.substr(4))].s0;
     } else {
       const bool start = name == "heap_start";
       const auto& heap = *std::find_if(fx.heaps.begin(), fx.heaps.end(),

@@ -26,6 +26,7 @@
 
 #include "cases/scene/scene.hpp"
 #include "shocks/edge_front.hpp"
+#include "shocks/kink_front.hpp"
 #include "shocks/front_tracker.hpp"
 #include "solver/contact_module.hpp"
 #include "solver/string_solver.hpp"

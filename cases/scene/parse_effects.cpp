@@ -49,6 +49,16 @@ void parse_edges(const Section& effects, Context& ctx) {
   }
 }
 
+/// [[effects.kink]]: conservative kinks (their place on the string: front_scene.cpp).
+void parse_kinks(const Section& effects, Context& ctx) {
+  const auto tables = table_array(effects, "kink", "kink");
+  for (std::size_t k = 0; k < tables.size(); ++k) {
+    Section e(*tables[k], fmt::format("effects.kink[{}]", k), ctx, {"s0"});
+    if (!e.has("s0")) e.missing("s0", "m, the material coordinate of the kink at t = 0, at a corner of the shape");
+    ctx.spec.effects.kinks.push_back(KinkEntry{*e.number("s0")});
+  }
+}
+
 /// An obstacle's `mu`: Coulomb's coefficient of friction, finite and ≥ 0 (0, the default: smooth).
 double friction_coefficient(const Section& e) { return e.number_in("mu", 0.0, 0.0, INFINITY); }
 
@@ -109,6 +119,7 @@ void parse_effects(const Section& top, Context& ctx) {
   }
   parse_heaps(s, ctx);
   parse_edges(s, ctx);
+  parse_kinks(s, ctx);
   parse_obstacles(s, ctx);
   if (s.has("fold")) {
     Section f(subtable(s, "fold"), "effects.fold", ctx, {"s0", "f"});

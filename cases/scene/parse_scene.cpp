@@ -57,7 +57,7 @@ SceneSpec parse_table(const toml::table& root, const SourceText& text) {
 const std::vector<EffectTable>& effect_tables() {
   static const std::vector<EffectTable> tables = {
       {"gravity", false}, {"drag", false}, {"heap", true}, {"fold", false}, {"plane", false}, {"edge", true},
-      {"surface", true}, {"cylinder", true}};
+      {"surface", true}, {"cylinder", true}, {"kink", true}};
   return tables;
 }
 

@@ -61,6 +61,7 @@ ReducedSetup match(const SceneSpec& spec) {
     refuse("has no obstacle: remove [[effects.surface]] and [[effects.cylinder]] (the string solver runs them: model = "
            "\"string\")");
   if (!fx.edges.empty()) refuse("has no edge: remove [[effects.edge]] (the string solver runs it: model = \"string\")");
+  if (!fx.kinks.empty()) refuse("has no kink: remove [[effects.kink]] (the string solver runs it: model = \"string\")");
   const FrontScene<dim> scene = build_front_scene<dim>(spec);
   const std::vector<std::string> names = scene_build::front_names(spec);
   if (names.size() > 1)

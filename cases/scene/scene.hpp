@@ -23,6 +23,7 @@
 ///     [effects.gravity] g (m/s²)          [effects.drag] coefficient (1/s)
 ///     [[effects.heap]] side = start | end, s0 (m), f, point (m), on_plane, pot
 ///     [effects.fold]   s0 (m), f          [effects.plane] point (m), normal (the table of a heap)
+///     [[effects.kink]] s0 (m)             (a conservative corner, docs/model.md §2.5)
 ///     [solver]   method, rtol, atol, max_step, initial_step, max_steps, stabilization_time, backend,
 ///                linear_solver = auto | banded | klu,
 ///                slack = stop | warn | ignore | allow (check_slack = true | false: its older form),
@@ -77,6 +78,11 @@ struct HeapEntry {
 struct FoldEntry {
   double s0 = 0;           ///< material coordinate of the fold at t = 0 (m)
   double dissipation = 0;  ///< f, in [0, 1]
+};
+
+/// A conservative kink (a corner of the string, f = 0): [[effects.kink]].
+struct KinkEntry {
+  double s0 = 0;  ///< material coordinate of the kink at t = 0 (m), where the initial shape has a corner
 };
 
 /// An edge or a peg the string runs over: [[effects.edge]].
@@ -174,6 +180,7 @@ struct SceneSpec {
     std::optional<FoldEntry> fold;               ///< [effects.fold]
     std::optional<PlaneEntry> plane;             ///< [effects.plane]
     std::vector<EdgeEntry> edges;                ///< [[effects.edge]]
+    std::vector<KinkEntry> kinks;                ///< [[effects.kink]]
     std::vector<SurfaceEntry> surfaces;          ///< [[effects.surface]]
     std::vector<CylinderEntry> cylinders;        ///< [[effects.cylinder]]
   } effects;
@@ -181,8 +188,10 @@ struct SceneSpec {
   bool has_obstacles() const {
     return !effects.surfaces.empty() || !effects.cylinders.empty() || (effects.plane && effects.plane->surface);
   }
-  /// The scene has a heap, a fold or an edge: the string runs with front tracking.
-  bool has_fronts() const { return !effects.heaps.empty() || effects.fold.has_value() || !effects.edges.empty(); }
+  /// The scene has a heap, a fold, an edge or a kink: the string runs with front tracking.
+  bool has_fronts() const {
+    return !effects.heaps.empty() || effects.fold.has_value() || !effects.edges.empty() || !effects.kinks.empty();
+  }
   // [solver]
   struct Solver {
     std::string method = defaults::kScene.method;

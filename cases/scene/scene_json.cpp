@@ -93,6 +93,10 @@ json effects_json(const SceneSpec::Effects& fx) {
       if (e.direction) j["edge"].back()["direction"] = *e.direction;
     }
   }
+  if (!fx.kinks.empty()) {
+    j["kink"] = json::array();
+    for (const KinkEntry& e : fx.kinks) j["kink"].push_back({{"s0", e.s0}});
+  }
   if (!fx.surfaces.empty()) {
     j["surface"] = json::array();
     for (const SurfaceEntry& e : fx.surfaces) {

@@ -310,6 +310,7 @@ std::vector<std::string> front_names(const SceneSpec& spec) {
   if (spec.effects.fold) names.push_back("fold");
   if (has_heap("end")) names.push_back("heap_end");
   for (std::size_t k = 0; k < spec.effects.edges.size(); ++k) names.push_back(fmt::format("edge{}", k));
+  for (std::size_t k = 0; k < spec.effects.kinks.size(); ++k) names.push_back(fmt::format("kink{}", k));
   return names;
 }
 

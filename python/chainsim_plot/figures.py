@@ -150,10 +150,10 @@ class Layout:
         pieces = np.split(x, breaks)
         if run.closed and len(pieces) == 1:
             pieces = [np.vstack([x, x[:1]])]
-        if s is not None:  # a fold is a corner of the string at s0, between two nodes
+        if s is not None:  # a fold or a kink is a corner of the string at s0, between two nodes
             for f in run.fronts:
                 p = f.position_at(t)
-                if f.kind != "fold" or p is None:
+                if f.kind not in ("fold", "kink") or p is None:
                     continue
                 corner = [p]
                 if f is self.fold and self.aside:  # the arms drawn apart: a short bar across at the fold

@@ -37,6 +37,7 @@ TEST_CASE("every effect table of the scene format is written back to scene_effec
       {"edge", "[[effects.edge]]\npoint = [0.0, -0.5]\nf = 0.5\n"},
       {"surface", "[[effects.surface]]\npoint = [0.0, -2.0]\nnormal = [0.0, 1.0]\n"},
       {"cylinder", "[[effects.cylinder]]\ncenter = [0.5, -0.5]\nradius = 0.1\n"},
+      {"kink", "[[effects.kink]]\ns0 = 0.5\n"},
   };
   REQUIRE(!effect_tables().empty());
   for (const EffectTable& table : effect_tables()) {

@@ -85,7 +85,7 @@ TEST_CASE("overrides (--set) are checked as the file is, and located at the argu
       {&H, {"strin.nodes=21"},
        "--set strin.nodes=21: unknown section [strin]; valid sections: string, shape, velocity, ends, effects, solver, output, stop; valid top-level keys: model (did you mean [string]?)"},
       {&H, {"effects.gravty.g=[0.0, -1.0]"},
-       "--set effects.gravty.g=[0.0, -1.0]: unknown effect [effects.gravty]; valid effects: gravity, drag, heap, fold, plane, edge, surface, cylinder (did you mean [effects.gravity]?)"},
+       "--set effects.gravty.g=[0.0, -1.0]: unknown effect [effects.gravty]; valid effects: gravity, drag, heap, fold, plane, edge, surface, cylinder, kink (did you mean [effects.gravity]?)"},
       {&H, {"string.nodes=1"}, "--set string.nodes=1: string.nodes = 1 is out of range: allowed 2 <= nodes <= 10000000"},
       {&H, {"string.nodes=11.5"}, "--set string.nodes=11.5: string.nodes = 11.5 must be an integer"},
       {&H, {"string.density=heavy"}, "--set string.density=heavy: string.density = \"heavy\" must be a number"},

@@ -1,0 +1,47 @@
+#pragma once
+/// @file kink_front.hpp
+/// A kink front (front_kind.hpp): a conservative internal shock (f = 0) at a corner of the string between
+/// the arc before and the arc after it, its arms at any angle (docs/model.md §2.5, docs/shocks.md). The
+/// split link's bookkeeping (layout, crossings, mass parcels) is SplitLinkFront's.
+#include "shocks/split_link_front.hpp"
+
+namespace chainsim {
+
+/// A kink between the arc before and the arc after s0.
+struct KinkSpec {
+  double s0 = 0;  ///< initial material coordinate of the kink (m), in (0, ℓ)
+};
+
+template <int dim>
+class KinkFront final : public SplitLinkFront<dim> {
+ public:
+  explicit KinkFront(const KinkSpec& spec);
+
+  /// The kink's arms turn by at least this angle: its geometry divides by |t⁻ − t⁺|², and a kink that
+  /// straightens out has no place (the run stops when it turns less; a kink that starts straighter is
+  /// refused).
+  static constexpr double kMinTurnDeg = 1;
+  /// The kinked link's chord |x_b − x_a| is at most h for arms that meet at x0; the run stops when it
+  /// passes this (in units of h): the link's material no longer reaches across.
+  static constexpr double kMaxChord = 1.02;
+
+  const char* name() const override { return "kink"; }
+  const char* placed() const override { return "kink"; }
+
+  void check_initial(const FrontState<dim>& state) const override;
+  void evaluate(const StringModel<dim>& model, FrontState<dim>& state, Eigen::VectorXd& mass,
+                Points<dim>& force) override;
+  /// Stops where an arc would be left without a full link (its direction t∓ is that link's).
+  EventAction cross(StringModel<dim>& model, const FrontState<dim>& state, int e0) override;
+  /// One: positive while the arms turn by more than kMinTurnDeg and the chord is within kMaxChord h.
+  int num_checks() const override { return 1; }
+  void checks(const StringModel<dim>& model, const FrontState<dim>& state, double* g) const override;
+  std::string check_failed(const StringModel<dim>& model, const FrontState<dim>& state, double t) const override;
+
+ private:
+  double turn_margin(const FrontState<dim>& state) const;
+
+  double chord_ = 0;  ///< |x_b − x_a| / h of the kinked link
+};
+
+}  // namespace chainsim

@@ -1,0 +1,130 @@
+// What a fold and a kink share: see split_link_front.hpp.
+#include "split_link_front.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include <fmt/format.h>
+
+#include "mesh/errors.hpp"
+
+namespace chainsim {
+
+template <int dim>
+void SplitLinkFront<dim>::cut(FrontLayout& layout) {
+  const double h = this->m_.h;
+  const int a = std::clamp(static_cast<int>(std::floor(this->expected_s0 / h + 1e-9)), 0, this->m_.n - 1);
+  if (a < layout.first || a + 1 > layout.last)
+    throw InputError(fmt::format("the {} must lie inside the moving part of the string", this->name()));
+  layout.splits.push_back(a);
+  this->arc_minus = layout.arc;
+  this->arc_plus = ++layout.arc;
+}
+
+template <int dim>
+Vec<dim> SplitLinkFront<dim>::link_tangent(const StringModel<dim>& model, int i, int j, const char* what,
+                                           Vec<dim>& rate) {
+  const Points<dim>& x = model.x();
+  const Points<dim>& v = model.v();
+  const Vec<dim> link = x.col(j) - x.col(i), link_rate = v.col(j) - v.col(i);
+  const Vec<dim> t = unit_vector<dim>(link, what);
+  rate = (link_rate - t * t.dot(link_rate)) / link.norm();
+  return t;
+}
+
+template <int dim>
+std::vector<int> SplitLinkFront<dim>::stencil(const StringModel<dim>& model) const {
+  // evaluate() reads arc A's end link and arc B's first link.
+  const ArcRange& A = model.arcs()[static_cast<std::size_t>(this->arc_minus)];
+  const ArcRange& B = model.arcs()[static_cast<std::size_t>(this->arc_plus)];
+  std::vector<int> nodes;
+  for (int i : {A.last - 1, A.last, B.first, B.first + 1})
+    if ((i >= A.first && i <= A.last) || (i >= B.first && i <= B.last))
+      if (!model.is_prescribed(i)) nodes.push_back(i);
+  return nodes;
+}
+
+template <int dim>
+std::optional<double> SplitLinkFront<dim>::tension_at(const StringModel<dim>& model, const FrontState<dim>& s,
+                                                      int node) const {
+  if (node_a(model) == node) return s.tension_minus;
+  if (node_b(model) == node) return s.tension_plus;
+  return std::nullopt;
+}
+
+template <int dim>
+double SplitLinkFront<dim>::potential_moment(const StringModel<dim>& model, const FrontState<dim>& f,
+                                             const Vec<dim>& g) const {
+  const double lambda = this->m_.lambda;
+  const int a = node_a(model), b = node_b(model);
+  return lambda * f.l_minus * g.dot(0.5 * (f.position - model.x().col(a))) +
+         lambda * f.l_plus * g.dot(0.5 * (f.position - model.x().col(b)));
+}
+
+template <int dim>
+void SplitLinkFront<dim>::crossings(const StringModel<dim>& /*model*/, const FrontState<dim>& s, double* g) const {
+  g[0] = s.l_plus;   // the front reaches arc B's first node
+  g[1] = s.l_minus;  // the front reaches arc A's last node
+}
+
+template <int dim>
+EventAction SplitLinkFront<dim>::cross(StringModel<dim>& model, const FrontState<dim>& state, int e0) {
+  Points<dim>& v = model.v();
+  const double h = this->m_.h, lambda = this->m_.lambda;
+  ArcRange& A = model.arcs()[static_cast<std::size_t>(this->arc_minus)];
+  ArcRange& B = model.arcs()[static_cast<std::size_t>(this->arc_plus)];
+  // e0: the front reached B's first node (it joins A); e1: it reached A's last node (it joins B).
+  const bool to_A = e0 != 0;
+  if (to_A && B.num_links() == 0)
+    return {EventAction::Kind::kStop, fmt::format("the {} has reached the end of the string", this->name())};
+  if (!to_A && (A.num_links() == 0 || model.is_prescribed(A.last)))
+    return {EventAction::Kind::kStop, fmt::format("the {} has reached the start of the string", this->name())};
+  // Mass parcels: each link's mass is split between its two nodes (½–½ for a full link, l⁻–l⁺ for
+  // the split one). Moving the front changes the split of two links; the mass that changes node
+  // carries its velocity, so momentum is conserved exactly. `state` is the tracker's, so that after
+  // the refresh below it holds the new split.
+  const int a = A.last, b = B.first;
+  const int lo = to_A ? a : a - 1;  // the two links whose split changes: (lo, lo+1), (lo+1, lo+2)
+  auto shares = [&](int j) -> std::pair<double, double> {
+    // split of link (j, j+1) between its start and end node under the current arcs
+    if (model.arc_of(j) == model.arc_of(j + 1)) return {0.5 * lambda * h, 0.5 * lambda * h};
+    return {lambda * state.l_minus, lambda * state.l_plus};
+  };
+  const auto old0 = shares(lo), old1 = shares(lo + 1);
+  Eigen::Vector3d mass;
+  Points<dim> mom(dim, 3);
+  for (int q = 0; q < 3; ++q) {
+    mass[q] = model.masses()[lo + q];
+    mom.col(q) = model.masses()[lo + q] * v.col(lo + q);
+  }
+  if (to_A) {
+    A.last = b;
+    B.first = b + 1;
+  } else {
+    A.last = a - 1;
+    B.first = a;
+  }
+  model.rebuild();
+  model.refresh();
+  const auto new0 = shares(lo), new1 = shares(lo + 1);
+  const Points<dim> v_old = v;
+  auto move = [&](int j, std::pair<double, double> before_split, std::pair<double, double> after_split) {
+    const double delta = after_split.first - before_split.first;  // change of the start node's share
+    const int q = j - lo;
+    const int giver = delta < 0 ? j : j + 1;  // the node whose material moves, with its velocity
+    mass[q] += delta;
+    mom.col(q) += delta * v_old.col(giver);
+    mass[q + 1] -= delta;
+    mom.col(q + 1) -= delta * v_old.col(giver);
+  };
+  move(lo, old0, new0);
+  move(lo + 1, old1, new1);
+  for (int q = 0; q < 3; ++q)
+    if (!model.is_prescribed(lo + q) && model.in_arc(lo + q)) v.col(lo + q) = mom.col(q) / mass[q];
+  return {EventAction::Kind::kTransfer, {}};
+}
+
+template class SplitLinkFront<2>;
+template class SplitLinkFront<3>;
+
+}  // namespace chainsim

@@ -1,0 +1,39 @@
+#pragma once
+/// @file split_link_front.hpp
+/// What a fold and a kink share (front_kind.hpp): a front at a free point x0 inside one link, the
+/// *split link* (a, b) between arc A (s < s0, its last node a) and arc B (s > s0, its first node b),
+/// whose material it splits into partial links l⁻ (on node a) and l⁺ = h − l⁻ (on node b). The layout,
+/// the stencil, the end tensions at a and b, the partial links' potential, the crossings (the front
+/// reaches a or b) and what a crossing does (the node moves to the other arc, the material of the two
+/// links whose split changes moving with its momentum: mass parcels) are here; the geometry of the
+/// split link and the jump conditions are the kind's (FoldFront, KinkFront: its `evaluate`).
+#include "shocks/front_kind.hpp"
+
+namespace chainsim {
+
+template <int dim>
+class SplitLinkFront : public FrontKind<dim> {
+ public:
+  void cut(FrontLayout& layout) override;
+  std::vector<int> stencil(const StringModel<dim>& model) const override;
+  bool has_load_derivatives() const override { return true; }
+  std::optional<double> tension_at(const StringModel<dim>& model, const FrontState<dim>& state,
+                                   int node) const override;
+  /// The partial links as straight segments from their nodes to x0 (state.position).
+  double potential_moment(const StringModel<dim>& model, const FrontState<dim>& state, const Vec<dim>& g) const override;
+  /// g[0] = l⁺ (the front reaches arc B's first node), g[1] = l⁻ (arc A's last node).
+  void crossings(const StringModel<dim>& model, const FrontState<dim>& state, double* g) const override;
+  int second_direction() const override { return -1; }
+  /// The node the front reaches moves to the other arc; the mass of the two links whose split changes
+  /// moves with its velocity (momentum exact). Stops at an end of the string.
+  EventAction cross(StringModel<dim>& model, const FrontState<dim>& state, int e0) override;
+
+ protected:
+  /// The unit tangent of the link i → j and its rate (the part of (v_j − v_i) across it over its length).
+  static Vec<dim> link_tangent(const StringModel<dim>& model, int i, int j, const char* what, Vec<dim>& rate);
+  /// The split link's nodes: arc A's last and arc B's first.
+  int node_a(const StringModel<dim>& model) const { return model.arcs()[static_cast<std::size_t>(this->arc_minus)].last; }
+  int node_b(const StringModel<dim>& model) const { return model.arcs()[static_cast<std::size_t>(this->arc_plus)].first; }
+};
+
+}  // namespace chainsim

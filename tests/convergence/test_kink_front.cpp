@@ -1,0 +1,256 @@
+// A kink front (shocks/kink_front.hpp, docs/model.md §2.5): a conservative corner between two arcs,
+// against the exact solutions of a straight-sided string streaming through a corner (docs/model.md §7.2:
+// uniform speed v along its own shape under uniform tension λ v² keeps its shape), in the frame where the
+// corner is fixed and in the frame where the string ahead of the corner is at rest (the corner then runs
+// into it at the transverse wave speed √(T/λ), d'Alembert's travelling kink on a taut string).
+#include <catch2/catch.hpp>
+
+#include <cmath>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "mesh/discretize.hpp"
+#include "mesh/errors.hpp"
+#include "shocks/front_tracker.hpp"
+#include "shocks/kink_front.hpp"
+#include "solver/string_solver.hpp"
+
+using namespace chainsim;
+
+namespace {
+
+/// A string of length 1 m, λ = 0.5 kg/m, of `links` links, whose arm A (s < s0) arrives at the origin
+/// along t_A and whose arm B leaves it along t_B (turned by `turn_deg` in the plane of the first two
+/// axes; in 3D the plane is tilted about the first axis); the material streams through the corner at
+/// speed v, and the whole string moves with the uniform velocity `frame` on top. End loads −λ v² t_A at
+/// node 0 and λ v² t_B at the last node hold the tension at λ v².
+struct Streaming {
+  double length = 1.0, lambda = 0.5, v = 2.0, s0 = 0.63;
+  double turn_deg = 90;
+  bool resting_ahead = false;  ///< frame = −v t_B: the arm B (ahead of the corner) at rest
+};
+
+template <int dim>
+struct Exact {
+  Vec<dim> tA, tB, frame;
+  double s0 = 0, v = 0;
+  double front(double t) const { return s0 - v * t; }  // ṡ0 = −v: material runs from A into B
+  Vec<dim> corner(double t) const { return frame * t; }
+  Vec<dim> x(double s, double t) const {
+    const double f = front(t);
+    return corner(t) + (s - f) * (s < f ? tA : tB);
+  }
+  Vec<dim> velocity(double s, double t) const { return frame + v * (s < front(t) ? tA : tB); }
+};
+
+template <int dim>
+Exact<dim> exact_of(const Streaming& c) {
+  Exact<dim> e;
+  const double turn = c.turn_deg * kPi / 180;
+  e.tA = Vec<dim>::Zero();
+  e.tB = Vec<dim>::Zero();
+  e.tA[0] = 1;
+  e.tB[0] = std::cos(turn);
+  e.tB[1] = std::sin(turn);
+  if constexpr (dim == 3) {  // the plane of the corner tilted by 30° about the first axis
+    const double c30 = std::cos(kPi / 6), s30 = std::sin(kPi / 6);
+    const double y = e.tB[1];
+    e.tB[1] = c30 * y;
+    e.tB[2] = s30 * y;
+  }
+  // Arm B at rest: the frame moves with the string ahead of the corner, so the corner runs into it at v.
+  e.frame = c.resting_ahead ? Vec<dim>(-c.v * e.tB) : Vec<dim>(Vec<dim>::Zero());
+  e.s0 = c.s0;
+  e.v = c.v;
+  return e;
+}
+
+struct KinkRun {
+  RunSummary run;
+  double x_error = 0;        ///< max over frames and nodes of |x − exact| (m)
+  double v_error = 0;        ///< the same for the velocities (m/s)
+  double front_error = 0;    ///< max over the steps of |s0 − exact|, |x0 − exact| (m)
+  double speed_error = 0;    ///< max over the steps of |ṡ0 + v| (m/s)
+  double tension_error = 0;  ///< max over frames and links of |T − λ v²| (N)
+  double w_shocks = 0;       ///< W_shocks at the end (J)
+};
+
+template <int dim>
+KinkRun stream(const Streaming& c, int links, double t_end) {
+  const Exact<dim> e = exact_of<dim>(c);
+  Points<dim> vertices(dim, 3);
+  vertices.col(0) = -c.s0 * e.tA;
+  vertices.col(1).setZero();
+  vertices.col(2) = (c.length - c.s0) * e.tB;
+  Chain<dim> chain = discretize<dim>(*polyline_curve<dim>(vertices), c.length, c.lambda, links, false);
+  for (int i = 0; i < chain.num_nodes(); ++i) chain.velocities().col(i) = e.velocity(chain.node_coordinate(i), 0.0);
+  const double T = c.lambda * c.v * c.v;
+  std::vector<std::unique_ptr<Force<dim>>> forces;
+  forces.push_back(std::make_unique<EndLoad<dim>>(0, Vec<dim>(-T * e.tA)));
+  forces.push_back(std::make_unique<EndLoad<dim>>(links, Vec<dim>(T * e.tB)));
+  std::vector<std::unique_ptr<FrontKind<dim>>> kinds;
+  kinds.push_back(std::make_unique<KinkFront<dim>>(KinkSpec{c.s0}));
+  StringModel<dim> model =
+      make_front_model<dim>(std::move(chain), std::move(forces), {}, std::move(kinds), FrontOptions{});
+  StringSolverOptions so;
+  so.integrator.method = "erk5";
+  so.integrator.rtol = 1e-10;
+  so.integrator.atol = 1e-12;
+  so.t_end = t_end;
+  so.output_interval = t_end / 10;
+  so.record_steps = true;
+  StringSolver<dim> solver(model, so);
+  KinkRun out;
+  out.run = solver.run();
+  for (const Frame<dim>& f : solver.frames()) {
+    for (int i = 0; i < f.x.cols(); ++i) {
+      const double s = model.chain().node_coordinate(i);
+      out.x_error = std::max(out.x_error, (f.x.col(i) - e.x(s, f.t)).norm());
+      // A node at the corner (to round-off) has the velocity of either arm: the crossing's time is a root.
+      double dv = (f.v.col(i) - e.velocity(s, f.t)).norm();
+      if (std::abs(s - e.front(f.t)) < 1e-9) dv = std::min(dv, (f.v.col(i) - e.velocity(s - 2e-9, f.t)).norm());
+      out.v_error = std::max(out.v_error, dv);
+    }
+    for (int j = 0; j < f.tension.size(); ++j)
+      if (!std::isnan(f.tension[j])) out.tension_error = std::max(out.tension_error, std::abs(f.tension[j] - T));
+  }
+  for (const StepSample& s : out.run.samples) {
+    REQUIRE(s.fronts.size() == 1);
+    out.front_error = std::max(out.front_error, std::abs(s.fronts[0].s0 - e.front(s.t)));
+    out.front_error = std::max(out.front_error, (s.fronts[0].position.template head<dim>() - e.corner(s.t)).norm());
+    out.speed_error = std::max(out.speed_error, std::abs(s.fronts[0].s0_dot + c.v));
+  }
+  out.w_shocks = out.run.samples.back().terms["W_shocks"];
+  return out;
+}
+
+template <int dim>
+void check_exact(const Streaming& c, int links) {
+  const double h = c.length / links, t_end = 0.2;  // the kink runs 0.4 m of material: 0.4/h crossings
+  const KinkRun k = stream<dim>(c, links, t_end);
+  CAPTURE(dim, c.turn_deg, c.resting_ahead, links, k.run.stop_reason, k.run.error);
+  REQUIRE(k.run.status == "completed");
+  CHECK(k.run.transfers == static_cast<long>(std::floor(c.s0 / h + 1e-9) - std::floor((c.s0 - c.v * t_end) / h + 1e-9)));
+  // Exact but for round-off (measured on these meshes: x 6e-15 m, v 1.5e-13 m/s, s0 and x0 4e-15 m, ṡ0
+  // 2.3e-13 m/s, tensions 1.2e-13 of λ v², ledgers 1.5e-15 of their scales).
+  CHECK(k.x_error < 1e-13);
+  CHECK(k.v_error < 1e-11);
+  CHECK(k.front_error < 1e-13);
+  CHECK(k.speed_error < 1e-11);
+  CHECK(k.tension_error < 1e-11 * c.lambda * c.v * c.v);
+  // A conservative kink: nothing dissipated, and the ledgers close (W_applied: the end loads' work on
+  // the material set moving as it turns the corner, zero in the corner's frame).
+  CHECK(k.w_shocks == 0.0);
+  CHECK(k.run.samples.back().terms["W_remesh"] == Approx(0).margin(1e-12));
+  CHECK(std::abs(k.run.relative_energy_residual()) < 1e-13);
+  CHECK(k.run.relative_momentum_residual() < 1e-13);
+}
+
+}  // namespace
+
+TEST_CASE("a kink: a string streaming through a fixed corner follows the exact solution on any mesh",
+          "[kink][shocks][convergence]") {
+  for (const double turn : {90.0, 150.0, 30.0})
+    for (const int links : {7, 20, 61}) {
+      Streaming c;
+      c.turn_deg = turn;
+      check_exact<2>(c, links);
+    }
+  Streaming c;
+  c.turn_deg = 120;
+  check_exact<3>(c, 20);
+}
+
+TEST_CASE("a kink: a corner running into a taut string at rest at the wave speed sqrt(T/lambda) is exact",
+          "[kink][shocks][convergence]") {
+  for (const double turn : {90.0, 45.0})
+    for (const int links : {10, 40}) {
+      Streaming c;
+      c.turn_deg = turn;
+      c.resting_ahead = true;
+      check_exact<2>(c, links);
+    }
+  Streaming c;
+  c.resting_ahead = true;
+  check_exact<3>(c, 25);
+}
+
+TEST_CASE("a kink placed where the string does not turn is refused", "[kink][shocks]") {
+  const double turn = 0.5 * kPi / 180;  // half a degree
+  Points<2> vertices(2, 3);
+  vertices << 0.0, 0.43, 0.43 + 0.57 * std::cos(turn), 0.0, 0.0, 0.57 * std::sin(turn);
+  Chain<2> chain = discretize<2>(*polyline_curve<2>(vertices), 1.0, 1.0, 10, false);
+  std::vector<std::unique_ptr<FrontKind<2>>> kinds;
+  kinds.push_back(std::make_unique<KinkFront<2>>(KinkSpec{0.43}));
+  try {
+    make_front_model<2>(std::move(chain), {}, {}, std::move(kinds), FrontOptions{});
+    FAIL("a straight kink was accepted");
+  } catch (const InputError& e) {
+    CHECK(std::string(e.what()).find("the kink at s0 = 0.43 m turns by 0.5 degrees: a kink's arms turn by at least 1") !=
+          std::string::npos);
+  }
+}
+
+TEST_CASE("a kink's forces carry the momentum of the material it moves and do no work, at any velocities",
+          "[kink][shocks][unit]") {
+  // Hand-built states: a corner of `turn` degrees inside link (8, 9) of 20 links, random node velocities
+  // (incompatible with a kink: v_b − v_a not along t_A − t_B). The kink's masses change at λ l̇⁻ (l̇⁻ from
+  // central differences of its own l⁻ along the motion), so momentum is exact when F_a + F_b = λ l̇⁻ u, and
+  // the lumped kinetic energy gains F_a·v_a + F_b·v_b + ½ λ l̇⁻ (|v_a|² − |v_b|²), which must vanish
+  // (docs/model.md §2.5). With compatible velocities ṡ0 is the one built in.
+  std::srand(7);
+  auto random = [] { return 2.0 * std::rand() / RAND_MAX - 1.0; };
+  for (const double turn : {20.0, 90.0, 160.0}) {
+    const double lambda = 0.3, s0 = 0.43, angle = turn * kPi / 180;
+    const Vec<2> tA(1.0, 0.0), tB(std::cos(angle), std::sin(angle));
+    Points<2> vertices(2, 3);
+    vertices.col(0) = -s0 * tA;
+    vertices.col(1).setZero();
+    vertices.col(2) = (1 - s0) * tB;
+    Chain<2> chain = discretize<2>(*polyline_curve<2>(vertices), 1.0, lambda, 20, false);
+    std::vector<std::unique_ptr<FrontKind<2>>> kinds;
+    kinds.push_back(std::make_unique<KinkFront<2>>(KinkSpec{s0}));
+    KinkFront<2>* kink = static_cast<KinkFront<2>*>(kinds.back().get());  // held by the model's tracker
+    StringModel<2> model = make_front_model<2>(std::move(chain), {}, {}, std::move(kinds), FrontOptions{});
+    const int n = model.chain().num_nodes(), a = 8, b = 9;
+    for (int trial = 0; trial < 4; ++trial) {
+      for (int i = 0; i < n; ++i) model.v().col(i) = Vec<2>(random(), random());
+      const bool compatible = trial == 0;
+      const double sd_built = 0.7;
+      if (compatible) model.v().col(b) = model.v().col(a) + sd_built * (tA - tB);
+      Eigen::VectorXd mass = Eigen::VectorXd::Zero(n);
+      Points<2> force = Points<2>::Zero(2, n);
+      FrontState<2> s;
+      kink->evaluate(model, s, mass, force);
+      // l̇⁻ by fourth-order central differences of the kink's own l⁻ along x + ε v.
+      const Points<2> x0 = model.x();
+      const double eps = 1e-5;  // the tangents turn at |v|/h: 1e-4 leaves a truncation error of 1e-6
+      auto l_at = [&](double step) {
+        model.x() = x0 + step * model.v();
+        FrontState<2> moved;
+        Eigen::VectorXd m2 = Eigen::VectorXd::Zero(n);
+        Points<2> f2 = Points<2>::Zero(2, n);
+        kink->evaluate(model, moved, m2, f2);
+        return moved.l_minus;
+      };
+      const double l_rate = (8 * (l_at(eps) - l_at(-eps)) - (l_at(2 * eps) - l_at(-2 * eps))) / (12 * eps);
+      model.x() = x0;
+      const Vec<2> va = model.v().col(a), vb = model.v().col(b), u = vb - va;
+      const double scale = lambda * u.norm() * (u.norm() + std::abs(l_rate));
+      CAPTURE(turn, trial, l_rate, s.s0_dot);
+      CHECK(mass[a] == Approx(lambda * s.l_minus).epsilon(1e-14));
+      CHECK(mass[b] == Approx(lambda * s.l_plus).epsilon(1e-14));
+      CHECK(s.l_minus + s.l_plus == Approx(model.chain().link_length(0)).epsilon(1e-14));
+      CHECK((force.col(a) + force.col(b) - lambda * l_rate * u).norm() < 1e-8 * scale);
+      const double power = force.col(a).dot(va) + force.col(b).dot(vb) + 0.5 * lambda * l_rate * (va.squaredNorm() - vb.squaredNorm());
+      CHECK(std::abs(power) < 1e-8 * scale * u.norm());
+      CHECK(s.tension_minus == s.tension_plus);
+      CHECK(s.tension_minus == Approx(lambda * s.s0_dot * s.s0_dot).epsilon(1e-14));
+      CHECK(s.power_shock == 0);
+      if (compatible) CHECK(s.s0_dot == Approx(sd_built).epsilon(1e-12));
+      for (int i = 0; i < n; ++i)
+        if (i != a && i != b) CHECK(force.col(i).norm() == 0);
+    }
+  }
+}
