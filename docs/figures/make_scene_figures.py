@@ -7,7 +7,7 @@ where RESULTS_DIR/<scene>/ holds the outputs of
 for shaken_chain, travelling_loop, whip_crack, pendulum_release, folded_chain_ends_apart, swinging_u,
 pendulum_whip and thrown_chain (string scenes; the last three with slack = "allow"), chain_off_table_edge and
 chain_over_peg (edges), atwood_pulley and atwood_rough_pulley (cylinders), chain_landing_at_angle (a surface),
-chain_off_real_table (a table bounded by its edge), chain_into_heap_on_table (a heap on a contact surface) and
+chain_off_real_table (a table bounded by its edge), chain_into_heap_on_table (a heap on a contact surface), streaming_corner (a kink) and
 falling_chain, folded_chain, sliding_chain, swinging_sliding_chain, tilted_falling_chain and
 curved_falling_chain (scenes with fronts), and RESULTS_DIR/<scene>_reduced/ the same canonical scenes run with
 model = "reduced". docs/figures/run_scene_figures.sh RESULTS_DIR does all of it (and `chainsim plot` on each
@@ -234,6 +234,19 @@ def chain_over_peg(run, ax):
     decorate(ax[1], "t (s)", "m", "the peg pushes until its reaction falls to zero")
 
 
+def streaming_corner(run, ax):
+    snapshots(ax[0], run, [0, 0.1, 0.2, 0.28], "string streaming at 2 m/s through a fixed corner (a conservative kink);\ndots: its start, running to the corner; the shape does not change")
+    ts = np.asarray(run.series["t"])
+    s0 = np.asarray(run.fronts[0].s0)
+    # The exact solution (docs/model.md §7.2, §2.5): the corner stays at the origin and runs through the material
+    # at ds0/dt = -v = -2 m/s from s0 = 0.63 m.
+    ax[1].plot(ts, s0, lw=2, alpha=0.7, label="kink s0 (string solver)")
+    ax[1].plot(ts, 0.63 - 2.0 * ts, "k:", lw=2, label="exact s0 = 0.63 m - 2 m/s t")
+    corner = np.hypot(np.asarray(run.series["front_0_x"]), np.asarray(run.series["front_0_y"]))
+    ax[1].plot(ts, corner, label="|x0|: the kink's distance from the fixed corner (m)")
+    decorate(ax[1], "t (s)", "m", "the kink runs through the material at -v and stays put in space")
+
+
 def atwood_pulley(run, ax):
     snapshots(ax[0], run, [0, 0.2, 0.3, 0.4, 0.5], "heavy Atwood chain over a smooth pulley, R = 0.1 m")
     g, ell, u0 = 9.81, 1.0, 0.05
@@ -347,7 +360,7 @@ def thrown_chain(run, ax):
 SCENES = [shaken_chain, travelling_loop, whip_crack, pendulum_release, falling_chain, folded_chain, sliding_chain,
           swinging_sliding_chain, tilted_falling_chain, curved_falling_chain, folded_chain_ends_apart,
           chain_off_table_edge, swinging_u, pendulum_whip, thrown_chain, chain_over_peg, atwood_pulley,
-          atwood_rough_pulley, chain_landing_at_angle, chain_off_real_table, chain_into_heap_on_table]
+          atwood_rough_pulley, streaming_corner, chain_landing_at_angle, chain_off_real_table, chain_into_heap_on_table]
 
 
 def main():
