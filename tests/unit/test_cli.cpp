@@ -495,6 +495,24 @@ TEST_CASE("chainsim compare pulley --json: the heavy Atwood chain over a pulley 
   }
 }
 
+TEST_CASE("chainsim compare edge, peg, pulley: an implicit --method is refused at the option, as scenes refuse it",
+          "[unit][cli][edge][pulley]") {
+  // Scenes refuse implicit methods with an edge or an obstacle (their Newton systems know neither); the
+  // comparisons build the same string over an edge or a pulley, so they refuse them too, before the run
+  // (compare pulley used to run dirk4 with the contact module, and compare edge failed inside its first step).
+  const std::string bad = " --out " + temp_dir("cli_compare_implicit");
+  for (const char* problem : {"edge", "peg", "pulley"})
+    for (const char* method : {"dirk4", "dirk2", "ARKODE_ARK324L2SA_DIRK_4_2_3"}) {
+      const std::string args = std::string("compare ") + problem + " --method " + method;
+      CAPTURE(args);
+      const Result r = run(args + bad);
+      CHECK(r.status == 2);
+      CHECK_THAT(r.output, Catch::Matchers::StartsWith(std::string("chainsim: error: --method = ") + method +
+                                                       " is implicit, and implicit methods do not meet") &&
+                               Catch::Matchers::Contains("allowed an explicit method"));
+    }
+}
+
 TEST_CASE("chainsim compare edge --json: the chain off a table's edge against exact::edge_*, and bad input",
           "[unit][cli][edge]") {
   // The bounds of test_edge_front.cpp ("a chain sliding off a table matches exact::edge_*"), here with the
