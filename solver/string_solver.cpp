@@ -528,6 +528,12 @@ const RunSummary& StringSolver<dim>::run() {
         before_event.emplace_back(output_time(j), integrator->interpolate(output_time(j)));
     };
     const bool interpolating_method = integrator->stats().order <= kMaxDenseOrder;  // fixed for the run
+    // Events that come back at one time without end (a node that lands and is let go at once, over
+    // and over) would spin here: each is handled, the integrator restarts and finds it again at the
+    // same t. Every event at a new time resets the count; so many at one time end the run, located.
+    const long max_events_at_one_time = std::max(1000L, 4L * model_.chain().num_nodes());
+    long events_at_one_time = 0;
+    double last_event_t = -INFINITY;
     while (k <= n_out) {
       const bool dense = interpolating_method && step > kStepOfFrames * options_.output_interval;
       before_event.clear();
@@ -541,6 +547,19 @@ const RunSummary& StringSolver<dim>::run() {
           ++k;
         }
         Eigen::VectorXd state = integrator->state();
+        events_at_one_time = t == last_event_t ? events_at_one_time + 1 : 0;
+        last_event_t = t;
+        if (events_at_one_time >= max_events_at_one_time) {
+          std::string found;
+          for (std::size_t e = 0; e < integrator->events_found().size(); ++e)
+            if (integrator->events_found()[e] != 0) found += fmt::format("{}{}", found.empty() ? "" : ", ", e);
+          throw NumericalError(
+              fmt::format("events stalled at t = {:.12g} s: {} events in a row at this same time (root function {} of "
+                          "{}), each handled and found again at once, the time not advancing (a Zeno point of the "
+                          "model's contact or fronts: e.g. a node that lands and is let go at the same instant)",
+                          t, events_at_one_time, found, integrator->events_found().size()),
+              t);
+        }
         const EventAction action = model_.handle_events(t, state, integrator->events_found());
         if (action.kind == EventAction::Kind::kStop) {
           if (options_.record_steps) record_sample(t, state);
@@ -554,6 +573,12 @@ const RunSummary& StringSolver<dim>::run() {
         else
           integrator->resize(t, state);
         if (options_.record_steps) record_sample(t, state);
+        if (interrupt_requested()) {  // Ctrl-C between events too: a run whose events keep coming stops
+          record_frame(t, state);
+          finish("interrupted");
+          summary_.stop_reason = fmt::format("interrupted by {} at t = {:.9g} s", interrupt_cause(), t);
+          return summary_;
+        }
         continue;
       }
       step = integrator->last_step();
