@@ -313,12 +313,17 @@ void StringSolver<dim>::book(double t, const typename StringModel<dim>::Snapshot
   if (snap.has_momentum_ledger) {
     summary_.max_momentum_residual =
         std::max(summary_.max_momentum_residual, (snap.momentum - p0_ - snap.impulse).norm());
-    summary_.momentum_scale = std::max(summary_.momentum_scale, snap.momentum.norm() + snap.impulse.norm());
+    // As the energy's, the scale is physical, never the round-off of zero: the momentum the run carries
+    // and books, and the momentum sqrt(2 M E) that the string's mass M has at the energy scale E (a
+    // string at rest on its supports, whose net momentum and impulse both stay zero, is judged against
+    // it, not against the round-off of zero).
+    const double mass = model_.chain().density() * model_.chain().length();
+    summary_.momentum_scale = std::max({summary_.momentum_scale, snap.momentum.norm() + snap.impulse.norm(),
+                                        std::sqrt(2 * mass * snap.energy_scale)});
     // slack = allow: a string whose net momentum stays zero (a loop running along itself) is judged
     // against the momentum its mass carries, sqrt(2 M K), not against the round-off of zero.
     if (model_.allows_slack())
-      summary_.momentum_scale = std::max(
-          summary_.momentum_scale, std::sqrt(2 * model_.chain().density() * model_.chain().length() * snap.kinetic));
+      summary_.momentum_scale = std::max(summary_.momentum_scale, std::sqrt(2 * mass * snap.kinetic));
   }
 }
 
