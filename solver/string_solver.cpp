@@ -164,8 +164,9 @@ nlohmann::json to_json(const RunSummary& s) {
   if (s.impulsive_start)
     impulsive["message"] = fmt::format(
         "the initial velocities are not compatible with the inextensible string (a driven end moving at t = 0 "
-        "while the string is at rest): they jumped at t = 0 by up to {:.6g} m/s, giving the string {:.6g} J of "
-        "kinetic energy, booked as the drivers' work at t = 0 (W_applied)",
+        "while the string is at rest, or [velocity] values that would stretch or shorten links, e.g. a tangential "
+        "speed through a corner of the shape): they jumped at t = 0 by up to {:.6g} m/s, giving the string {:.6g} J "
+        "of kinetic energy, booked at t = 0 in W_applied",
         s.impulsive_speed_change, s.impulsive_energy);
   j["impulsive_start"] = impulsive;
   if (!s.error.empty()) j["error"] = s.error;

@@ -418,6 +418,18 @@ TEST_CASE("the printed summary says so when the run starts impulsively", "[unit]
   const Result quiet = run("run " + hanging + " --t-end 0.01 --quiet --out " + (dir / "e").string());
   REQUIRE(quiet.status == 0);
   CHECK_THAT(quiet.output, !Catch::Matchers::Contains("start      "));
+  // Without a driver: a closed square launched along itself at 1 m/s, whose corners turn the velocity; the
+  // message named a driven end and the drivers' work, which this scene has not.
+  const std::filesystem::path square = dir / "square.toml";
+  std::ofstream(square) << "[string]\nclosed = true\nnodes = 40\n[shape]\nkind = \"polyline\"\npoints = [[0.0, 0.0], "
+                           "[0.25, 0.0], [0.25, 0.25], [0.0, 0.25]]\n[velocity]\nkind = \"tangential\"\nspeed = 1.0\n"
+                           "[stop]\nt_end = 0.01\n";
+  const Result corner = run("run " + square.string() + " --quiet --out " + (dir / "f").string());
+  REQUIRE(corner.status == 0);
+  CHECK_THAT(corner.output, Catch::Matchers::Contains("start      the initial velocities are not compatible") &&
+                                Catch::Matchers::Contains("[velocity] values that would stretch or shorten links") &&
+                                Catch::Matchers::Contains("booked at t = 0 in W_applied") &&
+                                !Catch::Matchers::Contains("drivers' work"));
 }
 
 TEST_CASE("paths and --set keys that are not UTF-8 give JSON with U+FFFD and the run's own exit code",
