@@ -39,14 +39,22 @@ constexpr double kTangentStep = 1e-4;
 /// edge's reaction and its lift-off margin vanish identically.
 constexpr double kEdgeTurnTolerance = 1e-6;
 
-/// The angle (rad) by which the shape turns at s0: between its chords over kTangentStep ℓ before and
-/// after s0; nothing where s0 is closer than that to an end of the string.
+/// The shape's unit tangents just before and just after s0: its chords over kTangentStep ℓ on each side;
+/// nothing where s0 is closer than that to an end of the string.
 template <int dim>
-std::optional<double> shape_turn(const Curve<dim>& curve, double s0, double ell) {
+std::optional<std::pair<Vec<dim>, Vec<dim>>> shape_tangents(const Curve<dim>& curve, double s0, double ell) {
   const double d = kTangentStep * ell;
   if (!(s0 - d > 0 && s0 + d < ell)) return std::nullopt;
-  const Vec<dim> before = curve.point(s0) - curve.point(s0 - d), after = curve.point(s0 + d) - curve.point(s0);
-  return std::acos(std::clamp(before.dot(after) / (before.norm() * after.norm()), -1.0, 1.0));
+  return std::pair<Vec<dim>, Vec<dim>>((curve.point(s0) - curve.point(s0 - d)).normalized(),
+                                       (curve.point(s0 + d) - curve.point(s0)).normalized());
+}
+
+/// The angle (rad) by which the shape turns at s0 (between shape_tangents); nothing near an end.
+template <int dim>
+std::optional<double> shape_turn(const Curve<dim>& curve, double s0, double ell) {
+  const auto t = shape_tangents<dim>(curve, s0, ell);
+  if (!t) return std::nullopt;
+  return std::acos(std::clamp(t->first.dot(t->second), -1.0, 1.0));
 }
 
 template <int dim>
@@ -367,6 +375,22 @@ std::unique_ptr<StringModel<dim>> build_front_model(const SceneSpec& spec, scene
   for (std::size_t k = 0; k < fx.surfaces.size(); ++k)
     if (fx.surfaces[k].edge)
       tables.push_back(table_side<dim>(spec, k, edges[static_cast<std::size_t>(*fx.surfaces[k].edge)], *parts.curve, ell));
+  // After a table's own checks (which name its surface): a 3D edge's lift-off cone lies normal to its
+  // line, so a side of the string along that line has no direction in it (the margin stays zero): the
+  // string must cross the line on both sides.
+  if constexpr (dim == 3)
+    for (std::size_t k = 0; k < edges.size(); ++k) {
+      const EdgeSpec<dim>& edge = edges[k];
+      const std::string key = fmt::format("effects.edge[{}]", k);
+      if (const auto t = shape_tangents<dim>(*parts.curve, edge.s0, ell))
+        for (const auto& [side, tangent] : {std::pair("before", t->first), std::pair("after", t->second)})
+          if (!((tangent - tangent.dot(edge.axis) * edge.axis).norm() > kEdgeTurnTolerance))
+            fail_at(spec, key + ".direction",
+                    fmt::format("{}.direction = {}: the string {} the edge runs along its line (tangent {}), and the "
+                                "edge's lift-off cone lies normal to the line; allowed a direction the string crosses "
+                                "on both sides",
+                                key, text_of(spec, key + ".direction"), side, show<dim>(tangent)));
+    }
 
   // 5. Stop events: a front reaching a material coordinate inside the string.
   const std::vector<std::string> names = scene_build::front_names(spec);

@@ -346,6 +346,11 @@ t_end = 1.0
              Contains("effects.edge[0].direction = [0.0, 0.0, 0.0] is not a direction") &&
                  Contains("allowed a finite nonzero vector"));
   CHECK(error(edit(scene3, "f = 0.0", "f = 0.0\ndirection = [0.0, 0.0, 1.0]")).empty());
+  // A 3D edge whose line runs along the string on one side: the lift-off margin stays zero there (a peg
+  // with its line along the hanging side ran to "a node of link 24 has passed the edge" at 0.37 s).
+  CHECK_THAT(error(edit(scene3, "f = 0.0", "f = 0.0\ndirection = [0.0, 1.0, 0.0]")),
+             Contains("effects.edge[0].direction = [0.0, 1.0, 0.0]: the string after the edge runs along its line") &&
+                 Contains("allowed a direction the string crosses on both sides"));
 
   // What a user combines next, each refused at its key before the run (each used to run: a table at a peg
   // gave NaN tensions at t = 0 (its face normal 0/0), an edge where the shape runs straight stalled or
