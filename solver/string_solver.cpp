@@ -164,8 +164,9 @@ nlohmann::json to_json(const RunSummary& s) {
   if (s.impulsive_start)
     impulsive["message"] = fmt::format(
         "the initial velocities are not compatible with the inextensible string (a driven end moving at t = 0 "
-        "while the string is at rest): they jumped at t = 0 by up to {:.6g} m/s, giving the string {:.6g} J of "
-        "kinetic energy, booked as the drivers' work at t = 0 (W_applied)",
+        "while the string is at rest, or [velocity] values that would stretch or shorten links, e.g. a tangential "
+        "speed through a corner of the shape): they jumped at t = 0 by up to {:.6g} m/s, giving the string {:.6g} J "
+        "of kinetic energy, booked at t = 0 in W_applied",
         s.impulsive_speed_change, s.impulsive_energy);
   j["impulsive_start"] = impulsive;
   if (!s.error.empty()) j["error"] = s.error;
@@ -313,12 +314,17 @@ void StringSolver<dim>::book(double t, const typename StringModel<dim>::Snapshot
   if (snap.has_momentum_ledger) {
     summary_.max_momentum_residual =
         std::max(summary_.max_momentum_residual, (snap.momentum - p0_ - snap.impulse).norm());
-    summary_.momentum_scale = std::max(summary_.momentum_scale, snap.momentum.norm() + snap.impulse.norm());
+    // As the energy's, the scale is physical, never the round-off of zero: the momentum the run carries
+    // and books, and the momentum sqrt(2 M E) that the string's mass M has at the energy scale E (a
+    // string at rest on its supports, whose net momentum and impulse both stay zero, is judged against
+    // it, not against the round-off of zero).
+    const double mass = model_.chain().density() * model_.chain().length();
+    summary_.momentum_scale = std::max({summary_.momentum_scale, snap.momentum.norm() + snap.impulse.norm(),
+                                        std::sqrt(2 * mass * snap.energy_scale)});
     // slack = allow: a string whose net momentum stays zero (a loop running along itself) is judged
     // against the momentum its mass carries, sqrt(2 M K), not against the round-off of zero.
     if (model_.allows_slack())
-      summary_.momentum_scale = std::max(
-          summary_.momentum_scale, std::sqrt(2 * model_.chain().density() * model_.chain().length() * snap.kinetic));
+      summary_.momentum_scale = std::max(summary_.momentum_scale, std::sqrt(2 * mass * snap.kinetic));
   }
 }
 
@@ -528,6 +534,12 @@ const RunSummary& StringSolver<dim>::run() {
         before_event.emplace_back(output_time(j), integrator->interpolate(output_time(j)));
     };
     const bool interpolating_method = integrator->stats().order <= kMaxDenseOrder;  // fixed for the run
+    // Events that come back at one time without end (a node that lands and is let go at once, over
+    // and over) would spin here: each is handled, the integrator restarts and finds it again at the
+    // same t. Every event at a new time resets the count; so many at one time end the run, located.
+    const long max_events_at_one_time = std::max(1000L, 4L * model_.chain().num_nodes());
+    long events_at_one_time = 0;
+    double last_event_t = -INFINITY;
     while (k <= n_out) {
       const bool dense = interpolating_method && step > kStepOfFrames * options_.output_interval;
       before_event.clear();
@@ -541,6 +553,19 @@ const RunSummary& StringSolver<dim>::run() {
           ++k;
         }
         Eigen::VectorXd state = integrator->state();
+        events_at_one_time = t == last_event_t ? events_at_one_time + 1 : 0;
+        last_event_t = t;
+        if (events_at_one_time >= max_events_at_one_time) {
+          std::string found;
+          for (std::size_t e = 0; e < integrator->events_found().size(); ++e)
+            if (integrator->events_found()[e] != 0) found += fmt::format("{}{}", found.empty() ? "" : ", ", e);
+          throw NumericalError(
+              fmt::format("events stalled at t = {:.12g} s: {} events in a row at this same time (root function {} of "
+                          "{}), each handled and found again at once, the time not advancing (a Zeno point of the "
+                          "model's contact or fronts: e.g. a node that lands and is let go at the same instant)",
+                          t, events_at_one_time, found, integrator->events_found().size()),
+              t);
+        }
         const EventAction action = model_.handle_events(t, state, integrator->events_found());
         if (action.kind == EventAction::Kind::kStop) {
           if (options_.record_steps) record_sample(t, state);
@@ -554,6 +579,12 @@ const RunSummary& StringSolver<dim>::run() {
         else
           integrator->resize(t, state);
         if (options_.record_steps) record_sample(t, state);
+        if (interrupt_requested()) {  // Ctrl-C between events too: a run whose events keep coming stops
+          record_frame(t, state);
+          finish("interrupted");
+          summary_.stop_reason = fmt::format("interrupted by {} at t = {:.9g} s", interrupt_cause(), t);
+          return summary_;
+        }
         continue;
       }
       step = integrator->last_step();

@@ -25,6 +25,17 @@ void refuse_pulley_options(const CompareCommandOptions& options) {
     throw InputError(fmt::format("--R = {}: only compare pulley takes --R (compare {})", *options.radius, options.problem));
 }
 
+/// compare edge, peg and pulley run the string over an edge or a pulley, which implicit methods do not
+/// meet (as in a scene: the Newton systems know neither a link bent over a point nor contact).
+void refuse_implicit_method(const StringCaseSetup& s, const std::string& name) {
+  if (s.integrator.implicit_method())
+    throw InputError(fmt::format("--method = {} is implicit, and implicit methods do not meet {} (their Newton systems "
+                                 "know no {}): allowed an explicit method (auto, erk3, erk4, erk5, erk6, erk8, or an "
+                                 "ARKODE_* explicit table)",
+                                 s.integrator.method, name == "pulley" ? "the pulley" : "an edge",
+                                 name == "pulley" ? "contact" : "link bent over a point"));
+}
+
 /// `compare edge`'s and `compare peg`'s setup from the command's options; the options they have no use
 /// for are refused.
 EdgeCaseSetup edge_setup(const CompareCommandOptions& options, PointContactProblem problem) {
@@ -39,6 +50,7 @@ EdgeCaseSetup edge_setup(const CompareCommandOptions& options, PointContactProbl
   if (s.eps != StringCaseSetup{}.eps)
     throw InputError(fmt::format("--eps = {}: compare {} stops at the lift-off and has no cutoff", s.eps, name));
   refuse_pulley_options(options);
+  refuse_implicit_method(s, name);
   EdgeCaseSetup e;
   e.problem = problem;
   e.chain = s.chain;
@@ -62,6 +74,7 @@ PulleyCaseSetup pulley_setup(const CompareCommandOptions& options) {
   if (s.chain.dissipation != StringCaseSetup{}.chain.dissipation)
     throw InputError(fmt::format("--f = {}: compare pulley has no f (a smooth pulley; its touchdowns are perfectly "
                                  "inelastic node impacts, docs/model.md section 10)", s.chain.dissipation));
+  refuse_implicit_method(s, "pulley");
   PulleyCaseSetup p;
   p.chain = s.chain;
   p.nodes = s.nodes;

@@ -33,8 +33,29 @@ namespace {
 constexpr double kPlaceTolerance = 1e-6;
 /// A fold's arms must be antiparallel to this angle (rad).
 constexpr double kFoldAngleTolerance = 1e-6;
-/// Step (relative to ℓ) on each side of a fold for the shape's tangents there.
+/// Step (relative to ℓ) on each side of a fold or an edge for the shape's tangents there.
 constexpr double kTangentStep = 1e-4;
+/// The shape must turn by more than this (rad) at an edge's point: where it runs straight through, the
+/// edge's reaction and its lift-off margin vanish identically.
+constexpr double kEdgeTurnTolerance = 1e-6;
+
+/// The shape's unit tangents just before and just after s0: its chords over kTangentStep ℓ on each side;
+/// nothing where s0 is closer than that to an end of the string.
+template <int dim>
+std::optional<std::pair<Vec<dim>, Vec<dim>>> shape_tangents(const Curve<dim>& curve, double s0, double ell) {
+  const double d = kTangentStep * ell;
+  if (!(s0 - d > 0 && s0 + d < ell)) return std::nullopt;
+  return std::pair<Vec<dim>, Vec<dim>>((curve.point(s0) - curve.point(s0 - d)).normalized(),
+                                       (curve.point(s0 + d) - curve.point(s0)).normalized());
+}
+
+/// The angle (rad) by which the shape turns at s0 (between shape_tangents); nothing near an end.
+template <int dim>
+std::optional<double> shape_turn(const Curve<dim>& curve, double s0, double ell) {
+  const auto t = shape_tangents<dim>(curve, s0, ell);
+  if (!t) return std::nullopt;
+  return std::acos(std::clamp(t->first.dot(t->second), -1.0, 1.0));
+}
 
 template <int dim>
 std::string show(const Vec<dim>& v) {
@@ -249,23 +270,33 @@ std::unique_ptr<StringModel<dim>> build_front_model(const SceneSpec& spec, scene
     std::optional<double> start_heap, end_heap;
     for (const HeapEntry& e : fx.heaps) (e.side == "start" ? start_heap : end_heap) = e.s0;
     check_fold_s0(s0, ell, start_heap, end_heap, keys);
-    const double d = kTangentStep * ell;
-    if (s0 - d > 0 && s0 + d < ell) {
-      const Vec<dim> before = parts.curve->point(s0) - parts.curve->point(s0 - d);
-      const Vec<dim> after = parts.curve->point(s0 + d) - parts.curve->point(s0);
-      const double c = std::clamp(before.dot(after) / (before.norm() * after.norm()), -1.0, 1.0);
-      const double turn = std::acos(c);
-      if (kPi - turn > kFoldAngleTolerance)
-        fail_at(spec, key,
-                fmt::format("effects.fold.s0 = {}: the shape does not fold back there (it turns by {:.3g} deg at s = "
-                            "{:g} m; a fold turns by 180 deg, its two arms side by side)",
-                            text_of(spec, key), turn * 180 / kPi, s0));
-    }
+    if (const std::optional<double> turn = shape_turn<dim>(*parts.curve, s0, ell); turn && kPi - *turn > kFoldAngleTolerance)
+      fail_at(spec, key,
+              fmt::format("effects.fold.s0 = {}: the shape does not fold back there (it turns by {:.3g} deg at s = "
+                          "{:g} m; a fold turns by 180 deg, its two arms side by side)",
+                          text_of(spec, key), *turn * 180 / kPi, s0));
     fold = FoldSpec{fx.fold->dissipation, s0};
   }
 
   // 4b. Edges: where the initial shape passes through each edge's point (its material coordinate s0).
   std::vector<EdgeSpec<dim>> edges;
+  if (!fx.edges.empty()) {
+    IntegratorOptions method;
+    method.method = spec.solver.method;
+    if (method.implicit_method())
+      fail_at(spec, "solver.method",
+              fmt::format("solver.method = \"{}\" is implicit, and implicit methods do not meet an edge (the "
+                          "linearisation of a link bent over its point is not written): allowed an explicit method "
+                          "(\"auto\", \"erk5\", \"erk8\", ...)",
+                          spec.solver.method));
+  }
+  if (fx.edges.size() > 1)
+    fail_at(spec, "effects.edge[1]",
+            fmt::format("effects.edge[1]: the scene has {} edges, and a string runs over one edge at most (the edge "
+                        "front moves the material on each side of its point along its own two lines, which a second "
+                        "edge on the same string breaks: a chain over two pegs would not close its energy and "
+                        "momentum ledgers); allowed one [[effects.edge]]",
+                        fx.edges.size()));
   for (std::size_t k = 0; k < fx.edges.size(); ++k) {
     const EdgeEntry& entry = fx.edges[k];
     const std::string key = fmt::format("effects.edge[{}]", k);
@@ -322,6 +353,22 @@ std::unique_ptr<StringModel<dim>> build_front_model(const SceneSpec& spec, scene
               fmt::format("{}.point = {} is at s = {:.6g} m of the string: allowed inside its moving part, {:g} < s < "
                           "{:g} m, and two links from a fold",
                           key, text_of(spec, key + ".point"), edge.s0, s_lo, s_hi));
+    // The string must bend over the edge (the jump conditions' [t] ≠ 0), and a table needs a face beside
+    // the string on its side: none where the string turns back on itself (a peg).
+    if (const std::optional<double> turn = shape_turn<dim>(*parts.curve, edge.s0, ell)) {
+      if (!(*turn > kEdgeTurnTolerance))
+        fail_at(spec, key + ".point",
+                fmt::format("{}.point = {}: the shape runs straight through it (it turns by {:.3g} deg at s = {:.6g} "
+                            "m), and an edge acts only where the string bends over it; allowed a point where the shape "
+                            "turns, e.g. a corner of the polyline",
+                            key, text_of(spec, key + ".point"), *turn * 180 / kPi, edge.s0));
+      if (edge.table != EdgeSpec<dim>::Table::kNone && kPi - *turn <= kFoldAngleTolerance)
+        fail_at(spec, key + ".table",
+                fmt::format("{}.table = \"{}\": the shape turns back on itself at the edge (by {:.6g} deg: a peg), "
+                            "so no table face lies beside the string there; allowed table = \"none\" where the shape "
+                            "turns by 180 deg",
+                            key, entry.table, *turn * 180 / kPi));
+    }
     edges.push_back(edge);
   }
 
@@ -361,6 +408,22 @@ std::unique_ptr<StringModel<dim>> build_front_model(const SceneSpec& spec, scene
   for (std::size_t k = 0; k < fx.surfaces.size(); ++k)
     if (fx.surfaces[k].edge)
       tables.push_back(table_side<dim>(spec, k, edges[static_cast<std::size_t>(*fx.surfaces[k].edge)], *parts.curve, ell));
+  // After a table's own checks (which name its surface): a 3D edge's lift-off cone lies normal to its
+  // line, so a side of the string along that line has no direction in it (the margin stays zero): the
+  // string must cross the line on both sides.
+  if constexpr (dim == 3)
+    for (std::size_t k = 0; k < edges.size(); ++k) {
+      const EdgeSpec<dim>& edge = edges[k];
+      const std::string key = fmt::format("effects.edge[{}]", k);
+      if (const auto t = shape_tangents<dim>(*parts.curve, edge.s0, ell))
+        for (const auto& [side, tangent] : {std::pair("before", t->first), std::pair("after", t->second)})
+          if (!((tangent - tangent.dot(edge.axis) * edge.axis).norm() > kEdgeTurnTolerance))
+            fail_at(spec, key + ".direction",
+                    fmt::format("{}.direction = {}: the string {} the edge runs along its line (tangent {}), and the "
+                                "edge's lift-off cone lies normal to the line; allowed a direction the string crosses "
+                                "on both sides",
+                                key, text_of(spec, key + ".direction"), side, show<dim>(tangent)));
+    }
 
   // 5. Stop events: a front reaching a material coordinate inside the string.
   const std::vector<std::string> names = scene_build::front_names(spec);

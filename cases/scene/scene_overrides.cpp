@@ -3,6 +3,8 @@
 
 #include <cctype>
 #include <memory>
+#include <string>
+#include <vector>
 
 #include <fmt/format.h>
 
@@ -65,6 +67,7 @@ class Override {
       text_.mark_changed(table);
       const bool last = i + 1 == steps_.size();
       if (last && step.indices.empty()) {
+        drop_file_alternatives(*table, at);
         take_value([&](auto&& value) { table->insert_or_assign(toml::key(step.name, region()), std::move(value)); });
         return;
       }
@@ -111,6 +114,29 @@ class Override {
  private:
   [[noreturn]] void fail(const std::string& message) const {
     throw InputError(fmt::format("{}: {}", origin_, message));
+  }
+
+  /// The scene keys that set what `key` sets under another name, which the parser refuses together
+  /// ("give one of them"): the slack policy and its older form, the resolution as nodes or as a link length.
+  static std::vector<std::string> alternatives(const std::string& key) {
+    if (key == "solver.slack") return {"check_slack"};
+    if (key == "solver.check_slack") return {"slack"};
+    if (key == "string.nodes") return {"link_length"};
+    if (key == "string.link_length") return {"nodes"};
+    return {};
+  }
+
+  /// The command line is later than the file: setting `key` (in `table`) removes what the file says of the
+  /// same thing under another name (--set solver.slack=allow on a scene with check_slack = true, --set
+  /// string.link_length on one with nodes). Two overrides that do so still meet the parser's refusal.
+  void drop_file_alternatives(toml::table& table, const std::string& key) const {
+    for (const std::string& other : alternatives(key)) {
+      const toml::node* node = table.get(other);
+      if (node == nullptr) continue;
+      const auto& path = node->source().path;
+      if (path && path->rfind("--set ", 0) == 0) continue;  // set by an override: the parser says both
+      table.erase(other);
+    }
   }
 
   /// The parts of the key; throws if it is no dotted key.

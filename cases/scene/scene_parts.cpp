@@ -163,7 +163,7 @@ SceneParts<dim> build_scene_parts(const SceneSpec& spec) {
   if (spec.elements == "quadratic") {  // what quadratic elements hold (solver/quadratic_string.hpp)
     std::string why;
     if (spec.has_fronts())
-      why = "the scene has a front (a heap or a fold), which quadratic elements do not meet";
+      why = "the scene has a front (a heap, a fold or an edge), which quadratic elements do not meet";
     else if (closed)
       why = "the string is closed; quadratic elements hold open strings only";
     else if (chain.num_nodes() % 2 == 0)

@@ -23,12 +23,13 @@ namespace {
 
 /// `f` -> the dotted key of the scene's only front's dissipation.
 std::string front_f_key(const SceneSpec& spec) {
-  const std::size_t fronts = spec.effects.heaps.size() + (spec.effects.fold ? 1 : 0);
+  const auto& fx = spec.effects;
+  const std::size_t fronts = fx.heaps.size() + (fx.fold ? 1 : 0) + fx.edges.size();
   if (fronts != 1)
     throw InputError(fmt::format("{}: the sweep key f names the dissipation of the scene's only front, but the "
-                                 "scene has {} fronts: write effects.heap[K].f or effects.fold.f",
+                                 "scene has {} fronts: write effects.heap[K].f, effects.fold.f or effects.edge[K].f",
                                  spec.source, fronts));
-  return spec.effects.fold ? "effects.fold.f" : "effects.heap[0].f";
+  return fx.fold ? "effects.fold.f" : !fx.edges.empty() ? "effects.edge[0].f" : "effects.heap[0].f";
 }
 
 /// The key of an override "KEY=VALUE".

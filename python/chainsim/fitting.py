@@ -240,11 +240,13 @@ def _scene_key(scene, key):
     if key != "f":
         return key
     effects = scene.effective.get("effects", {})
-    fronts = len(effects.get("heap", [])) + (1 if "fold" in effects else 0)
+    fronts = len(effects.get("heap", [])) + (1 if "fold" in effects else 0) + len(effects.get("edge", []))
     if fronts != 1:
         raise _error(f"{scene.source}: the fit parameter f names the dissipation of the scene's only front, but the "
-                     f"scene has {fronts} fronts: write effects.heap[K].f or effects.fold.f")
-    return "effects.fold.f" if "fold" in effects else "effects.heap[0].f"
+                     f"scene has {fronts} fronts: write effects.heap[K].f, effects.fold.f or effects.edge[K].f")
+    if "fold" in effects:
+        return "effects.fold.f"
+    return "effects.edge[0].f" if effects.get("edge") else "effects.heap[0].f"
 
 
 def _allowed_range(target, name):

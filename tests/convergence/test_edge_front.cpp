@@ -346,6 +346,39 @@ t_end = 1.0
              Contains("effects.edge[0].direction = [0.0, 0.0, 0.0] is not a direction") &&
                  Contains("allowed a finite nonzero vector"));
   CHECK(error(edit(scene3, "f = 0.0", "f = 0.0\ndirection = [0.0, 0.0, 1.0]")).empty());
+  // A 3D edge whose line runs along the string on one side: the lift-off margin stays zero there (a peg
+  // with its line along the hanging side ran to "a node of link 24 has passed the edge" at 0.37 s).
+  CHECK_THAT(error(edit(scene3, "f = 0.0", "f = 0.0\ndirection = [0.0, 1.0, 0.0]")),
+             Contains("effects.edge[0].direction = [0.0, 1.0, 0.0]: the string after the edge runs along its line") &&
+                 Contains("allowed a direction the string crosses on both sides"));
+
+  // What a user combines next, each refused at its key before the run (each used to run: a table at a peg
+  // gave NaN tensions at t = 0 (its face normal 0/0), an edge where the shape runs straight stalled or
+  // closed its momentum ledger to 0.98 only, two pegs lost 0.1 J of their energy ledger, and an implicit
+  // method failed inside its first step with a message naming no key).
+  const std::string peg = edit(edit(scene, "[[-0.8, 0.0], [0.0, 0.0], [0.0, -0.2]]", "[[0.0, -0.4], [0.0, 0.0], [0.0, -0.6]]"),
+                               "table = \"before\"", "table = \"none\"");
+  CHECK(error(peg).empty());
+  for (const char* side : {"before", "after"})
+    CHECK_THAT(error(edit(peg, "table = \"none\"", std::string("table = \"") + side + "\"")),
+               Contains(std::string("s.toml:15:9: effects.edge[0].table = \"") + side +
+                        "\": the shape turns back on itself at the edge") &&
+                   Contains("allowed table = \"none\""));
+  const std::string straight = edit(edit(peg, "[[0.0, -0.4], [0.0, 0.0], [0.0, -0.6]]", "[[0.0, 0.4], [0.0, -0.6]]"),
+                                    "point = [0.0, 0.0]", "point = [0.0, 0.0123]");
+  CHECK_THAT(error(straight), Contains("s.toml:13:9: effects.edge[0].point = [0.0, 0.0123]: the shape runs straight "
+                                       "through it (it turns by 0 deg at s = 0.3877 m)") &&
+                                  Contains("allowed a point where the shape turns"));
+  CHECK(error(edit(straight, "[[0.0, 0.4], [0.0, -0.6]]", "[[0.0, 0.4], [0.0, 0.0123], [0.001, -0.6]]")).empty());
+  const std::string two_pegs =
+      edit(edit(peg, "[[0.0, -0.4], [0.0, 0.0], [0.0, -0.6]]", "[[0.0, -0.3], [0.0, 0.0], [0.2, 0.0], [0.2, -0.5]]"),
+           "[stop]", "[[effects.edge]]\npoint = [0.2, 0.0]\n\n[stop]");
+  CHECK_THAT(error(two_pegs), Contains("s.toml:17:1: effects.edge[1]: the scene has 2 edges, and a string runs over one "
+                                       "edge at most") &&
+                                  Contains("allowed one [[effects.edge]]"));
+  CHECK_THAT(error(edit(peg, "[stop]", "[solver]\nmethod = \"dirk4\"\n\n[stop]")),
+             Contains("s.toml:18:10: solver.method = \"dirk4\" is implicit, and implicit methods do not meet an edge") &&
+                 Contains("allowed an explicit method"));
 }
 
 namespace {

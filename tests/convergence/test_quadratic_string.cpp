@@ -149,4 +149,12 @@ TEST_CASE("quadratic elements: refused where they do not apply, at the key", "[u
   const std::string heap = message(std::regex_replace(falling.str(), std::regex("\\[string\\]\n"),
                                                       "[string]\nelements = \"quadratic\"\n"));
   CHECK_THAT(heap, Contains("q.toml:") && Contains("string.elements") && Contains("front") && Contains("\"links\""));
+  // An edge is a front too, and the message says so (it spoke of "a heap or a fold" only).
+  std::ifstream peg_file(std::string(CHAINSIM_SOURCE_DIR) + "/cases/scenes/chain_over_peg.toml");
+  std::stringstream peg;
+  peg << peg_file.rdbuf();
+  const std::string edge = message(std::regex_replace(peg.str(), std::regex("\\[string\\]\n"),
+                                                      "[string]\nelements = \"quadratic\"\n"));
+  CHECK_THAT(edge, Contains("q.toml:") && Contains("string.elements = \"quadratic\" is not allowed here") &&
+                       Contains("a front (a heap, a fold or an edge)"));
 }

@@ -355,3 +355,12 @@ def test_chainsim_fit_help_describes_every_option():
     for option in ("--observable", "--column", "--time-column", "--sigma", "--free", "--per-run", "--set", "--profile",
                    "--absolute-sigma", "--jobs", "--max-nfev", "--out", "--no-figures", "--json"):
         assert option in r.stdout, option
+
+
+def test_f_names_an_edge_when_the_edge_is_the_only_front():
+    """`--free f` on a scene whose only front is an edge (the peg) names effects.edge[0].f, as `chainsim sweep`'s
+    `f` does; it said "the scene has 0 fronts" (an edge was not counted)."""
+    from chainsim.fitting import _scene_key
+    scene = chainsim.Scene.from_file(os.path.join(SCENES, "chain_over_peg.toml"))
+    assert _scene_key(scene, "f") == "effects.edge[0].f"
+    assert _scene_key(chainsim.Scene.from_file(os.path.join(SCENES, "falling_chain.toml")), "f") == "effects.heap[0].f"

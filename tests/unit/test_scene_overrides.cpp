@@ -172,6 +172,24 @@ TEST_CASE("an override (--set) replaces values, array elements and whole arrays,
     CHECK(spec.output.select.energy);
     CHECK_FALSE(spec.output.select.vtk);
   }
+  SECTION("an override replaces what the file says of the same thing under another name") {
+    // The example scenes write check_slack = true (slack's older form) and nodes; --set solver.slack=allow
+    // and --set string.link_length=... were refused as "both say what a slack link does" and "both set
+    // the resolution", the file's key against the command line's. The command line is the later one.
+    const std::string file = edit(test::kSceneBase, "[stop]", "[solver]\ncheck_slack = true\n\n[stop]");
+    const SceneSpec slack = parse_scene_text(file, "s.toml", {"solver.slack=allow"});
+    CHECK(slack.solver.slack == "allow");
+    CHECK(parse_scene_text(file, "s.toml", {"solver.check_slack=false"}).solver.slack == "ignore");
+    const SceneSpec spacing = parse_scene_text(file, "s.toml", {"string.link_length=0.05"});
+    CHECK_FALSE(spacing.nodes);
+    CHECK(build_string_scene<2>(spacing).model->chain().num_links() == 20);
+    // Two overrides that set one thing twice are still refused, at the later one.
+    CHECK_THAT(error_of(file, {"solver.slack=allow", "solver.check_slack=true"}),
+               Contains("--set solver.check_slack=true: solver.check_slack = true and solver.slack = \"allow\" both say"));
+    CHECK_THAT(error_of(file, {"string.nodes=21", "string.link_length=0.05"}),
+               Contains("--set string.link_length=0.05: string.link_length = 0.05 and string.nodes = 21 both set the "
+                        "resolution"));
+  }
   SECTION("a section the scene lacks is created: --set effects.drag.coefficient declares drag") {
     const SceneSpec plain = parse_scene_text(test::kSceneBase, "s.toml");
     REQUIRE_FALSE(plain.effects.drag);

@@ -4,8 +4,10 @@
 #include <cmath>
 
 #include <catch2/catch.hpp>
+#include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
+#include "cases/reduced/exact_solutions.hpp"
 #include "cases/reduced/reduced_models.hpp"
 #include "cases/scene/scene.hpp"
 #include "cases/scene/scene_json.hpp"
@@ -70,6 +72,23 @@ TEST_CASE("a sweep point that fails numerically is a row with its error", "[unit
   const nlohmann::json bad = run_sweep_point(hanging, {"f=0.5"});  // no front: f names nothing
   CHECK(bad["status"] == "error");
   CHECK_THAT(bad["error"].get<std::string>(), Catch::Contains("has 0 fronts"));
+}
+
+TEST_CASE("the sweep key f names an edge's dissipation when the edge is the scene's only front", "[unit][sweep][edge]") {
+  // chainsim sweep chain_over_peg.toml --grid f=0,0.5 said "the scene has 0 fronts": an edge was not counted.
+  // The peg lifts off where the exact solution says (compare peg), at each f.
+  const std::string peg = "[string]\nlength = 1.0\nnodes = 21\n[shape]\nkind = \"polyline\"\npoints = [[0.0, -0.4], "
+                          "[0.0, 0.0], [0.0, -0.6]]\n[effects.gravity]\ng = [0.0, -9.81]\n[[effects.edge]]\n"
+                          "point = [0.0, 0.0]\n[solver]\nmethod = \"erk5\"\nrtol = 1e-10\natol = 1e-12\n[stop]\n"
+                          "t_end = 2.0\n";
+  const SweepScene scene{peg, "peg.toml", {}, 2.0};
+  for (const double f : {0.0, 0.5}) {
+    CAPTURE(f);
+    const nlohmann::json row = run_sweep_point(scene, {fmt::format("f={}", f)});
+    REQUIRE(row["status"] == "stopped");
+    CHECK(row["t_stop"].get<double>() ==
+          Approx(exact::peg_time(f, exact::peg_lift_off_x(f, 0.6, 1.0, 9.81), 0.6, 1.0, 9.81)).epsilon(1e-6));
+  }
 }
 
 TEST_CASE("a scene given as JSON is the scene of the same TOML", "[unit][sweep]") {
