@@ -862,6 +862,18 @@ void StringModel<dim>::project_positions(double t) {
     exclude_slack_links();
     correct_constraints(t, target, x_);
     project_link_lengths(t);  // the links again (their violation is second order in the step)
+    // A slack link the correction carried past its length is taut again (its tension solve may release
+    // it): the projection holds it at its length, as it holds the taut ones.
+    if (num_slack_ > 0) {
+      links();
+      bool caught = false;
+      for (int j = 0; j < chain_.num_links(); ++j)
+        if (link_unknown_[static_cast<std::size_t>(j)] >= 0 && link_slack(j) && l_[j] > chain_.link_length(j)) {
+          set_slack(j, false);
+          caught = true;
+        }
+      if (caught) project_link_lengths(t);
+    }
   }
 }
 
