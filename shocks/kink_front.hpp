@@ -36,6 +36,9 @@ class KinkFront final : public SplitLinkFront<dim> {
   /// C is quadratic in the positions): one constraint in 2D, its two components normal to d in 3D.
   void constraints(const StringModel<dim>& model, const FrontState<dim>& state,
                    std::vector<NodeConstraint<dim>>& out) const override;
+  /// The string's linearisation does not include the constraint: implicit methods solve their Newton
+  /// systems with GMRES, whose products J v (difference quotients of the right-hand side) honour it.
+  bool has_load_derivatives() const override { return false; }
   /// Stops where an arc would be left without a full link (its direction t∓ is that link's).
   EventAction cross(StringModel<dim>& model, const FrontState<dim>& state, int e0) override;
   /// One: positive while the arms turn by more than kMinTurnDeg and the chord is within kMaxChord h.
