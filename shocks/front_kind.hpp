@@ -139,6 +139,10 @@ class FrontKind {
   virtual int second_direction() const = 0;
   /// Acts on a crossing (e0: g[0] was found, else g[1]): moves material between the arcs or the front.
   virtual EventAction cross(StringModel<dim>& model, const FrontState<dim>& state, int e0) = 0;
+  /// Constraints of the front that couple nodes beyond the links (NodeConstraint, a kink's
+  /// compatibility), at the string's current state, after `evaluate`.
+  virtual void constraints(const StringModel<dim>& /*model*/, const FrontState<dim>& /*state*/,
+                           std::vector<NodeConstraint<dim>>& /*out*/) const {}
   /// Root functions of the front's own that stop the run (positive while it may go on).
   virtual int num_checks() const { return 0; }
   virtual void checks(const StringModel<dim>& /*model*/, const FrontState<dim>& /*state*/, double* /*g*/) const {}

@@ -139,6 +139,11 @@ std::optional<double> FrontTracker<dim>::front_tension_at(const StringModel<dim>
 }
 
 template <int dim>
+void FrontTracker<dim>::node_constraints(const StringModel<dim>& model, std::vector<NodeConstraint<dim>>& out) const {
+  for (std::size_t k = 0; k < fronts_.size(); ++k) fronts_[k]->constraints(model, fs_[k], out);
+}
+
+template <int dim>
 bool FrontTracker<dim>::has_load_derivatives() const {
   return std::all_of(fronts_.begin(), fronts_.end(), [](const auto& front) { return front->has_load_derivatives(); });
 }

@@ -139,6 +139,7 @@ class FrontTracker final : public StringModule<dim> {
   /// the jump conditions (τ at a heap, τ∓ at a fold), which its partial link carries to the node.
   std::optional<double> front_tension_at(const StringModel<dim>& model, int node) const override;
   bool events_need_tensions() const override;
+  void node_constraints(const StringModel<dim>& model, std::vector<NodeConstraint<dim>>& out) const override;
   bool has_load_derivatives() const override;
   void load_derivatives(StringModel<dim>& model, std::vector<LoadDerivative<dim>>& out) override;
   std::vector<RunEvent> run_events() const override { return events_; }

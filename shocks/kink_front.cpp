@@ -4,6 +4,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include <Eigen/Geometry>
+
 #include <fmt/format.h>
 
 #include "mesh/errors.hpp"
@@ -82,6 +84,56 @@ void KinkFront<dim>::evaluate(const StringModel<dim>& model, FrontState<dim>& s,
   const Vec<dim> G = 0.5 * s.tension_minus * sum - 0.5 * lambda * sd * (sum.dot(u) / dd) * d;
   force.col(a) += 0.5 * lambda * lA_rate * u + G;
   force.col(b) += 0.5 * lambda * lA_rate * u - G;
+}
+
+template <int dim>
+void KinkFront<dim>::constraints(const StringModel<dim>& model, const FrontState<dim>& /*state*/,
+                                 std::vector<NodeConstraint<dim>>& out) const {
+  const Points<dim>& x = model.x();
+  const Points<dim>& v = model.v();
+  const double h = this->m_.h;
+  const int a = this->node_a(model), b = this->node_b(model);
+  // With the arms' links as chords (t_A = (x_a − x_{a−1})/h, t_B = (x_{b+1} − x_b)/h, unit while the
+  // links hold their length): w = x_b − x_a − h t_B = 2x_b − x_a − x_{b+1} =: p and h d = x_a + x_b −
+  // x_{a−1} − x_{b+1} =: q, so C = (p × q)/h is bilinear in the positions. ∂C/∂x_i = (c_i q − k_i p)
+  // × e / h (2D: its normal), with c the coefficients of p and k those of q at node i, and its second
+  // derivative at zero accelerations 2 (ṗ × q̇)/h.
+  const int nodes[4] = {a - 1, a, b, b + 1};
+  const double cp[4] = {0, -1, 2, -1}, cq[4] = {-1, 1, 1, -1};
+  Vec<dim> p = Vec<dim>::Zero(), q = Vec<dim>::Zero(), pd = Vec<dim>::Zero(), qd = Vec<dim>::Zero();
+  for (int k = 0; k < 4; ++k) {
+    p += cp[k] * x.col(nodes[k]);
+    q += cq[k] * x.col(nodes[k]);
+    pd += cp[k] * v.col(nodes[k]);
+    qd += cq[k] * v.col(nodes[k]);
+  }
+  auto constraint = [&]() {
+    NodeConstraint<dim> c;
+    c.nodes.assign(nodes, nodes + 4);
+    c.gradient = Points<dim>::Zero(dim, 4);
+    return c;
+  };
+  if constexpr (dim == 2) {
+    auto cross = [](const Vec<2>& l, const Vec<2>& r) { return l[0] * r[1] - l[1] * r[0]; };
+    NodeConstraint<dim> c = constraint();
+    for (int k = 0; k < 4; ++k) {
+      const Vec<2> g = cp[k] * q - cq[k] * p;
+      c.gradient.col(k) = Vec<2>(g[1], -g[0]) / h;
+    }
+    c.value = cross(p, q) / h;
+    c.curvature = 2 * cross(pd, qd) / h;
+    out.push_back(std::move(c));
+  } else {
+    // The two components of p × q normal to d (its component along d is zero: p × q ⊥ q).
+    const Vec<3> dn = q.normalized(), e1 = dn.unitOrthogonal(), e2 = dn.cross(e1);
+    for (const Vec<3>& e : {e1, e2}) {
+      NodeConstraint<dim> c = constraint();
+      for (int k = 0; k < 4; ++k) c.gradient.col(k) = (cp[k] * q - cq[k] * p).cross(e) / h;
+      c.value = e.dot(p.cross(q)) / h;
+      c.curvature = 2 * e.dot(pd.cross(qd)) / h;
+      out.push_back(std::move(c));
+    }
+  }
 }
 
 template <int dim>

@@ -31,6 +31,14 @@ class KinkFront final : public SplitLinkFront<dim> {
   void check_initial(const FrontState<dim>& state) const override;
   void evaluate(const StringModel<dim>& model, FrontState<dim>& state, Eigen::VectorXd& mass,
                 Points<dim>& force) override;
+  /// The rest of the compatibility [v] = −ṡ0 [t] (docs/model.md §2.5): the arms meet at x0,
+  /// w × d = 0 with w = x_b − x_a − h t_B and h d = h (t_A − t_B) (the arms' links as chords, so that
+  /// C is quadratic in the positions): one constraint in 2D, its two components normal to d in 3D.
+  void constraints(const StringModel<dim>& model, const FrontState<dim>& state,
+                   std::vector<NodeConstraint<dim>>& out) const override;
+  /// The string's linearisation does not include the constraint: implicit methods solve their Newton
+  /// systems with GMRES, whose products J v (difference quotients of the right-hand side) honour it.
+  bool has_load_derivatives() const override { return false; }
   /// Stops where an arc would be left without a full link (its direction t∓ is that link's).
   EventAction cross(StringModel<dim>& model, const FrontState<dim>& state, int e0) override;
   /// One: positive while the arms turn by more than kMinTurnDeg and the chord is within kMaxChord h.

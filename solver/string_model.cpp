@@ -5,6 +5,8 @@
 #include <cmath>
 #include <limits>
 
+#include <Eigen/LU>
+
 #include <fmt/format.h>
 
 #include "mesh/errors.hpp"
@@ -586,6 +588,8 @@ void StringModel<dim>::refresh() {
     if (slot_[i] >= 0) w_[i] = 1.0 / m_[i];
   contacts_.clear();
   module_->node_contacts(*this, contacts_);
+  constraints_.clear();
+  module_->node_constraints(*this, constraints_);
   contact_friction_on_ = contact_stuck_ = false;
   for (const NodeContact<dim>& c : contacts_) {
     if (c.mu > 0) contact_friction_on_ = true;
@@ -698,6 +702,7 @@ double StringModel<dim>::evaluate_current(double t) {
     }
     if (contact_stuck_) locked_rhs();
     const Eigen::VectorXd& T = solve_tensions(t);
+    if (!constraints_.empty()) impose_constraints(t);  // T: the sum with the constraints' share
     if (contact_friction_on_) {
       last_tension_.resize(static_cast<std::size_t>(chain_.num_links()), 0.0);
       for_each_link([&](int j, int u, int) { last_tension_[static_cast<std::size_t>(j)] = T[u]; });
@@ -827,6 +832,53 @@ void StringModel<dim>::project_positions(double t) {
     v_.col(p.node) = p.path->velocity(t);
   }
   if (quadratic_) return quadratic_->project(t, x_, v_);
+  project_link_lengths(t);
+  if (module_) {  // the module's constraints at these positions (refresh() may not have run yet)
+    constraints_.clear();
+    module_->node_constraints(*this, constraints_);
+  }
+  if (constraints_.empty()) return;
+  // The module's constraints (a kink's compatibility): Newton steps along their gradients projected
+  // onto the links' rates, each followed by the links' projection, until C is at its round-off
+  // (|C| ~ ε |x|) or no longer halves.
+  double c_previous = INFINITY;
+  for (int iteration = 0;; ++iteration) {
+    refresh();
+    const double c_violation = constraint_violation();
+    if (c_violation <= kRoundoffUlps * std::numeric_limits<double>::epsilon() * x_max_ ||
+        (c_violation < 1e3 * constraint_tolerance() * h_min_ && c_violation > 0.5 * c_previous))
+      break;
+    if (iteration == kProjectionIterations || !std::isfinite(c_violation))
+      throw NumericalError(fmt::format("at t = {:.9g} s the kink's arms cannot be brought to meet: after {} projection "
+                                       "steps they are still {:.3g} m apart",
+                                       t, iteration, c_violation),
+                           t);
+    c_previous = c_violation;
+    Eigen::VectorXd target(static_cast<Eigen::Index>(constraints_.size()));
+    for (std::size_t k = 0; k < constraints_.size(); ++k) target[static_cast<Eigen::Index>(k)] = constraints_[k].value;
+    links();
+    system_->zero();
+    assemble_matrix();
+    exclude_slack_links();
+    correct_constraints(t, target, x_);
+    project_link_lengths(t);  // the links again (their violation is second order in the step)
+    // A slack link the correction carried past its length is taut again (its tension solve may release
+    // it): the projection holds it at its length, as it holds the taut ones.
+    if (num_slack_ > 0) {
+      links();
+      bool caught = false;
+      for (int j = 0; j < chain_.num_links(); ++j)
+        if (link_unknown_[static_cast<std::size_t>(j)] >= 0 && link_slack(j) && l_[j] > chain_.link_length(j)) {
+          set_slack(j, false);
+          caught = true;
+        }
+      if (caught) project_link_lengths(t);
+    }
+  }
+}
+
+template <int dim>
+void StringModel<dim>::project_link_lengths(double t) {
   // Newton's method for g_j(x) = |Δx_j| − h_j = 0 along δx = W Gᵀ ν: the matrix is the tension
   // matrix A = −G W Gᵀ, so A ν = g gives the smallest mass-weighted correction.
   auto correct = [&](Points<dim>& target, const Eigen::VectorXd& nu) { add_link_responses(target, nu); };
@@ -865,6 +917,141 @@ void StringModel<dim>::project_positions(double t) {
 }
 
 template <int dim>
+double StringModel<dim>::constraint_violation() const {
+  double c = 0;
+  for (const NodeConstraint<dim>& k : constraints_) c = std::max(c, std::abs(k.value));
+  return c;
+}
+
+template <int dim>
+void StringModel<dim>::project_onto_links(double t, Points<dim>& z) {
+  for_each_link([&](int j, int u, int) {
+    system_->rhs(u) = e_.col(j).dot(z.col(chain_.link_end(j)) - z.col(chain_.link_start(j)));
+  });
+  for (const Bend& bend : bends_) {
+    const int u = link_unknown_[static_cast<std::size_t>(bend.link)];
+    if (u >= 0)
+      system_->rhs(u) = bend.e_plus.dot(z.col(chain_.link_end(bend.link))) -
+                        e_.col(bend.link).dot(z.col(chain_.link_start(bend.link)));
+  }
+  exclude_slack_links();
+  add_link_responses(z, system_->solve(t));
+}
+
+template <int dim>
+void StringModel<dim>::correct_constraints(double t, const Eigen::VectorXd& target, Points<dim>& field) {
+  const int K = static_cast<int>(constraints_.size()), n = chain_.num_nodes();
+  std::vector<Points<dim>> z(static_cast<std::size_t>(K));
+  Eigen::MatrixXd M(K, K);
+  for (int k = 0; k < K; ++k) {
+    const NodeConstraint<dim>& c = constraints_[static_cast<std::size_t>(k)];
+    Points<dim>& zk = z[static_cast<std::size_t>(k)];
+    zk = Points<dim>::Zero(dim, n);
+    for (std::size_t q = 0; q < c.nodes.size(); ++q) {
+      const int i = c.nodes[q];
+      if (arc_of_[i] >= 0 && path_of_[i] < 0) zk.col(i) += w_[i] * c.gradient.col(static_cast<Eigen::Index>(q));
+    }
+    project_onto_links(t, zk);
+  }
+  for (int l = 0; l < K; ++l) {
+    const NodeConstraint<dim>& c = constraints_[static_cast<std::size_t>(l)];
+    for (int k = 0; k < K; ++k) {
+      double m = 0;
+      for (std::size_t q = 0; q < c.nodes.size(); ++q)
+        m += c.gradient.col(static_cast<Eigen::Index>(q)).dot(z[static_cast<std::size_t>(k)].col(c.nodes[q]));
+      M(l, k) = m;
+    }
+  }
+  const Eigen::VectorXd mu = M.fullPivLu().solve(-target);
+  if (!mu.allFinite())
+    throw NumericalError(fmt::format("at t = {:.9g} s the kink's constraint cannot be met: its nodes cannot move", t), t);
+  for (int k = 0; k < K; ++k) field += mu[k] * z[static_cast<std::size_t>(k)];
+}
+
+template <int dim>
+void StringModel<dim>::impose_constraints(double t) {
+  // The constraints' rows bordering the tension system: T = T0 + Σ μ_k Y_k, Y_k the tensions that a
+  // unit multiplier's forces ∂C_k/∂x_i ask of the links, and μ from C̈_l + 2α Ċ_l + β² C_l = 0 with
+  // the accelerations they give (docs/model.md §2.5, "The arms meet").
+  const int K = static_cast<int>(constraints_.size()), N = system_->size();
+  const Eigen::VectorXd rhs0 = system_->rhs_vector(), T0 = system_->solution();
+  auto is_free = [&](int i) { return arc_of_[i] >= 0 && path_of_[i] < 0; };
+  auto unknown = [&](int j) { return j >= 0 ? link_unknown_[static_cast<std::size_t>(j)] : -1; };
+  auto end_direction = [&](int j) -> Vec<dim> {
+    const Bend* bend = bends_.empty() ? nullptr : bend_of(j);
+    return bend ? bend->e_plus : Vec<dim>(e_.col(j));
+  };
+  // The links' force on node i for tensions T.
+  auto tension_on = [&](int i, const Eigen::VectorXd& T) {
+    Vec<dim> f = Vec<dim>::Zero();
+    const auto [jm, jp] = node_links(i);
+    if (unknown(jp) >= 0) f += T[unknown(jp)] * e_.col(jp);
+    if (unknown(jm) >= 0) f -= T[unknown(jm)] * end_direction(jm);
+    return f;
+  };
+  // Constraint k's unit force on node i (zero where it has none).
+  auto unit_force = [&](int k, int i) {
+    const NodeConstraint<dim>& c = constraints_[static_cast<std::size_t>(k)];
+    Vec<dim> f = Vec<dim>::Zero();
+    for (std::size_t q = 0; q < c.nodes.size(); ++q)
+      if (c.nodes[q] == i) f += c.gradient.col(static_cast<Eigen::Index>(q));
+    return f;
+  };
+  std::vector<Eigen::VectorXd> drhs(static_cast<std::size_t>(K), Eigen::VectorXd::Zero(N)), Y(static_cast<std::size_t>(K));
+  for (int k = 0; k < K; ++k) {
+    Eigen::VectorXd& r = drhs[static_cast<std::size_t>(k)];
+    for (const int i : constraints_[static_cast<std::size_t>(k)].nodes) {
+      if (!is_free(i)) continue;
+      const Vec<dim> db = w_[i] * unit_force(k, i);
+      const auto [jm, jp] = node_links(i);
+      // row j: ... = −e_end·b_end + e_j·b_start
+      if (unknown(jp) >= 0) r[unknown(jp)] += e_.col(jp).dot(db);
+      if (unknown(jm) >= 0) r[unknown(jm)] -= end_direction(jm).dot(db);
+    }
+    for (int u = 0; u < N; ++u) {
+      if (system_->excluded(u)) r[u] = 0;
+      system_->rhs(u) = r[u];
+    }
+    Y[static_cast<std::size_t>(k)] = system_->solve(t);
+  }
+  // μ from the constraints' rows.
+  Eigen::MatrixXd M(K, K);
+  Eigen::VectorXd residual(K);
+  for (int l = 0; l < K; ++l) {
+    const NodeConstraint<dim>& c = constraints_[static_cast<std::size_t>(l)];
+    double rate = 0, row = 0;
+    for (std::size_t q = 0; q < c.nodes.size(); ++q) {
+      const int i = c.nodes[q];
+      const Vec<dim> g = c.gradient.col(static_cast<Eigen::Index>(q));
+      rate += g.dot(v_.col(i));
+      row += g.dot(is_free(i) ? Vec<dim>(b_.col(i) + w_[i] * tension_on(i, T0)) : Vec<dim>(b_.col(i)));
+      for (int k = 0; k < K; ++k)
+        M(l, k) = (q == 0 ? 0.0 : M(l, k)) +
+                  (is_free(i) ? g.dot(w_[i] * (unit_force(k, i) + tension_on(i, Y[static_cast<std::size_t>(k)]))) : 0.0);
+    }
+    residual[l] = row + c.curvature + 2 * alpha_ * rate + beta2_ * c.value;
+  }
+  constraint_multipliers_ = M.fullPivLu().solve(-residual);
+  if (!constraint_multipliers_.allFinite())
+    throw RecoverableError(fmt::format("at t = {:.9g} s the kink's constraint has no multiplier", t));
+  Eigen::VectorXd rhs = rhs0;
+  for (int k = 0; k < K; ++k) rhs += constraint_multipliers_[k] * drhs[static_cast<std::size_t>(k)];
+  for (int u = 0; u < N; ++u) system_->rhs(u) = rhs[u];
+  system_->solve(t);
+  // The multipliers' forces on the nodes: in the module's forces (a support's reaction takes the
+  // share on a prescribed node) and in the free nodes' accelerations.
+  for (int k = 0; k < K; ++k) {
+    const NodeConstraint<dim>& c = constraints_[static_cast<std::size_t>(k)];
+    for (std::size_t q = 0; q < c.nodes.size(); ++q) {
+      const int i = c.nodes[q];
+      const Vec<dim> f = constraint_multipliers_[k] * c.gradient.col(static_cast<Eigen::Index>(q));
+      module_force_.col(i) += f;
+      if (is_free(i)) b_.col(i) += w_[i] * f;
+    }
+  }
+}
+
+template <int dim>
 void StringModel<dim>::project_velocities(double t) {
   auto correct = [&](Points<dim>& target, const Eigen::VectorXd& nu) { add_link_responses(target, nu); };
   // Velocities: one linear projection onto e_j·Δv_j = 0 (held nodes: onto n·v = 0 first, then with
@@ -880,6 +1067,26 @@ void StringModel<dim>::project_velocities(double t) {
   }
   exclude_slack_links();
   correct(v_, system_->solve(t));
+  if (module_) {
+    constraints_.clear();
+    module_->node_constraints(*this, constraints_);
+  }
+  if (constraints_.empty()) return;
+  // The module's constraints: Ċ_k = Σ ∂C_k/∂x_i · v_i = 0 as well (the mass-weighted projection onto
+  // both: the links' projection of the constraints' gradients, combined).
+  // As for the positions, a rate at its round-off (ε Σ |∂C/∂x_i| |v_i|) is left as it is.
+  Eigen::VectorXd rate = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(constraints_.size()));
+  bool off = false;
+  for (std::size_t k = 0; k < constraints_.size(); ++k) {
+    double scale = 0;
+    for (std::size_t q = 0; q < constraints_[k].nodes.size(); ++q) {
+      const Vec<dim> g = constraints_[k].gradient.col(static_cast<Eigen::Index>(q)), vi = v_.col(constraints_[k].nodes[q]);
+      rate[static_cast<Eigen::Index>(k)] += g.dot(vi);
+      scale += g.norm() * vi.norm();
+    }
+    off = off || std::abs(rate[static_cast<Eigen::Index>(k)]) > kRoundoffUlps * std::numeric_limits<double>::epsilon() * scale;
+  }
+  if (off) correct_constraints(t, rate, v_);
 }
 
 template <int dim>

@@ -296,6 +296,10 @@ class StringModel final : public OdeSystem {
   /// The tension of link `link` after an evaluation (N): its multiplier; NaN for a link in no arc.
   double link_tension(int link) const;
   const Points<dim>& accelerations() const { return a_; }
+  /// The constraints beyond the links (StringModule::node_constraints, a kink's compatibility) at the
+  /// last refresh(), and after an evaluation their multipliers μ_k (forces μ_k ∂C_k/∂x_i).
+  const std::vector<NodeConstraint<dim>>& node_constraints() const { return constraints_; }
+  const Eigen::VectorXd& constraint_multipliers() const { return constraint_multipliers_; }
   // --- nodes held on obstacles (a contact module; docs/model.md §10) ---------------------------
   /// The nodes the module holds on obstacles (StringModule::node_contacts), at the last refresh().
   const std::vector<NodeContact<dim>>& contacts() const { return contacts_; }
@@ -402,6 +406,23 @@ class StringModel final : public OdeSystem {
   /// the velocities onto e_j·Δv_j = 0 and n_i·v_i = 0 (mass-weighted, linear).
   void project_positions(double t);
   void project_velocities(double t);
+  /// project_positions' Newton iteration onto the links' lengths and the held nodes' surfaces.
+  void project_link_lengths(double t);
+  /// The module's constraints beyond the links (NodeConstraint): evaluate_current, after the tension
+  /// solve, finds their multipliers by a bordered solve (the tension system once more per constraint
+  /// and once for the sum: its matrix is unchanged, so every backend keeps its band) and puts their
+  /// forces on the nodes; the projections correct along their mass-weighted gradients.
+  std::vector<NodeConstraint<dim>> constraints_;
+  Eigen::VectorXd constraint_multipliers_;
+  void impose_constraints(double t);
+  /// z + W Gᵀ ν with G (z + W Gᵀ ν) = 0: a field's mass-weighted projection onto the links' rates
+  /// (the system assembled at the current positions).
+  void project_onto_links(double t, Points<dim>& z);
+  /// Adds to `field` the combination Σ μ_k P(W ∂C_k) (P: project_onto_links) with ∂C_l · (the
+  /// correction) = −target_l for every constraint l: the projections' share of the constraints.
+  void correct_constraints(double t, const Eigen::VectorXd& target, Points<dim>& field);
+  /// The largest |C_k| (m) at the last refresh().
+  double constraint_violation() const;
   /// The impulsive tensions P ≥ 0 of the taut links for restitution e (the snap's complementarity
   /// problem on the tension matrix, contact-reduced at held nodes): the velocities jump, links that
   /// separate go slack (faster than kSeparation of the larger of their approach speed and u_floor);

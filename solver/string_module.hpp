@@ -157,6 +157,20 @@ struct NodeContact {
   bool stuck = false;
 };
 
+/// A kinematic constraint C(x) = 0 on a few nodes that no link expresses (a kink's compatibility,
+/// docs/model.md §2.5): its gradient ∂C/∂x_i at each of `nodes`, its value and its second derivative
+/// at zero accelerations. Its multiplier μ acts on the nodes as the forces μ ∂C/∂x_i, which do no work
+/// while the constraint holds (their power is μ Ċ); StringModel finds it with the link tensions (a
+/// bordered solve of the tension system: the matrix stays the arcs' tridiagonal one), and its
+/// projections keep C = 0 and Ċ = 0 (StringModel::project).
+template <int dim>
+struct NodeConstraint {
+  std::vector<int> nodes;
+  Points<dim> gradient;   ///< ∂C/∂x_i (a column per node of `nodes`)
+  double value = 0;       ///< C
+  double curvature = 0;   ///< C̈ − Σ ∂C/∂x_i · a_i: C̈ at zero accelerations
+};
+
 /// What an event means.
 struct EventAction {
   enum class Kind { kNone, kTransfer, kStop } kind = Kind::kNone;
@@ -226,6 +240,9 @@ class StringModule {
   /// The nodes held on obstacles at the current positions and velocities (called by refresh(), after
   /// add_mass_and_forces); none without a contact module.
   virtual void node_contacts(const StringModel<dim>&, std::vector<NodeContact<dim>>&) const {}
+  /// The constraints that couple nodes beyond the links (NodeConstraint) at the current positions and
+  /// velocities (called by refresh(), after node_contacts); none but at a kink front.
+  virtual void node_constraints(const StringModel<dim>&, std::vector<NodeConstraint<dim>>&) const {}
   /// After an impulse the module did not make (a snap of the slack module around it): lets go of the
   /// held nodes whose contact force would now pull; returns whether one was let go.
   virtual bool release_contacts(StringModel<dim>&, double) { return false; }

@@ -27,6 +27,9 @@ class WrappingModule : public StringModule<dim> {
   void add_mass_and_forces(const StringModel<dim>& model, Eigen::VectorXd& mass, Points<dim>& force) override {
     if (inner_) inner_->add_mass_and_forces(model, mass, force);
   }
+  void node_constraints(const StringModel<dim>& model, std::vector<NodeConstraint<dim>>& out) const override {
+    if (inner_) inner_->node_constraints(model, out);
+  }
   std::vector<FrontField> front_fields() const override {
     return inner_ ? inner_->front_fields() : std::vector<FrontField>{};
   }

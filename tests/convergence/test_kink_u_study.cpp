@@ -1,10 +1,12 @@
 // Study (hidden, [.kink_u]; docs/model.md §9 "Inserting a kink front into the U"): the swinging U
 // (cases/scenes/swinging_u.toml, slack = "allow") run to t_ins, its state restarted with a kink front
 // (shocks/kink_front.hpp) in the link whose neighbours turn most, and run on to t_end; prints where it
-// stops. KU_NODES (101), KU_TINS (0.40 s), KU_TEND (1 s) set the mesh and the times.
+// stops. KU_NODES (101), KU_TINS (0.40 s), KU_TEND (1 s) set the mesh and the times; KU_OUT names a file for
+// the frames (t, s, x, y rows).
 #include <catch2/catch.hpp>
 
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <memory>
 #include <string>
@@ -75,6 +77,16 @@ TEST_CASE("study: the swinging U with a kink front inserted at t_ins", "[.kink_u
     second.run();
   } catch (const Error& e) {
     fmt::print("  failed: {}\n", e.what());
+  }
+  // KU_OUT: the frames (every 0.05 s from t_ins) as t, s, x, y rows, for a self-convergence study.
+  if (const char* out = std::getenv("KU_OUT")) {
+    std::FILE* f = std::fopen(out, "w");
+    REQUIRE(f != nullptr);
+    for (const Frame<2>& frame : second.frames())
+      for (int i = 0; i < frame.x.cols(); ++i)
+        std::fprintf(f, "%.6f,%.17g,%.17g,%.17g\n", t_ins + frame.t, model.chain().node_coordinate(i), frame.x(0, i),
+                     frame.x(1, i));
+    std::fclose(f);
   }
   const RunSummary& r = second.summary();
   fmt::print("  {} at t = {:.4f} s ({}): {} transfers, W_snap {:.3g} J, W_shocks {:.3g}, energy residual {:.2e}\n",
