@@ -135,6 +135,8 @@ class FrontTracker final : public StringModule<dim> {
                             const std::vector<int>& found) override;
   long transfers() const override { return transfers_; }
   int num_fronts() const override { return static_cast<int>(fronts_.size()); }
+  /// Each front's two crossings come first in events().
+  int num_crossing_events() const override { return 2 * static_cast<int>(fronts_.size()); }
   /// The tension at an arc's end node on its front's side, after an evaluation: the end tension of
   /// the jump conditions (τ at a heap, τ∓ at a fold), which its partial link carries to the node.
   std::optional<double> front_tension_at(const StringModel<dim>& model, int node) const override;
