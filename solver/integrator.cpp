@@ -633,8 +633,12 @@ Integrator::Outcome Integrator::advance(double t_target, bool one_step, const Ro
     const Eigen::VectorXd y_step_start = y_;
     int predicted = -1;
     const double t_stop = predict_recurring_event(t_target, predicted);
+    const long refused_before = impl_->recoverable_failures;
+    long fails_before = 0, fails_after = 0;
+    ARKStepGetNumErrTestFails(impl_->mem, &fails_before);
     const int flag = evolve(t_stop, /*one_step=*/true);
     if (predicted >= 0) set_root_directions();
+    ARKStepGetNumErrTestFails(impl_->mem, &fails_after);
     if (flag == ARK_UNREC_RHSFUNC_ERR) {
       if (h_retry == 0) h_retry = last_step();
       h_retry *= 0.25;
@@ -666,10 +670,28 @@ Integrator::Outcome Integrator::advance(double t_target, bool one_step, const Ro
       polish_event(t_step_start, y_step_start, /*from_here=*/false);
       return Outcome::kEvent;
     }
-    if (predicted >= 0 && flag == ARK_TSTOP_RETURN && t_ < t_target) {
-      if (predicted_event(predicted, t_step_start, y_step_start, before_polish)) return Outcome::kEvent;
-      if (one_step) return Outcome::kStep;
-      continue;
+    if (predicted >= 0) {
+      // The step may end at the stop time with either flag. Past the zero: the event. Short of it at
+      // the stop time: no prediction for that function until the next event. Short of it because the
+      // model refused trial states on the way or the error test failed (a front that may not be passed,
+      // or whose far side the step cannot resolve: the steps would shrink towards the stop time): no
+      // prediction for it any more. A step that covered less than 0.6 of the way: none until the next
+      // event (the steps would shrink towards the stop time: chain_fountain.toml took 17,358 steps, not 3,311).
+      if (passed_zero(predicted)) {
+        predicted_event(predicted, t_step_start, y_step_start, before_polish);
+        return Outcome::kEvent;
+      }
+      char& off = impl_->prediction_off[static_cast<std::size_t>(predicted)];
+      // (ARKODE ends a step at the stop time up to a few units of round-off short of it, either flag.)
+      const bool at_stop = flag == ARK_TSTOP_RETURN || t_stop - t_ <= 1e-6 * (t_stop - t_step_start);
+      if (impl_->recoverable_failures > refused_before || (fails_after > fails_before && !at_stop))
+        off = Impl::kPredictionRefused;
+      else if (at_stop || t_ - t_step_start < 0.6 * (t_stop - t_step_start))
+        off = Impl::kPredictionMissed;
+      if (t_ < t_target) {
+        if (one_step) return Outcome::kStep;
+        continue;
+      }
     }
     if (flag == ARK_TSTOP_RETURN || t_ >= t_target) {
       t_ = t_target;
@@ -829,7 +851,10 @@ double Integrator::predict_recurring_event(double t_target, int& which) {
   const std::vector<int> dirs = d.system.event_directions();
   const bool two = d.root_rate_before.size() == nev && d.root_time > d.root_time_before;
   double best = t_target;
-  for (int j = 0; j < n; ++j) {
+  // Only the first of each front's two crossings (a node into a heap, the fold reaching a node): past a
+  // node that comes out of a heap or a pot the steps shrank towards the stop time without reaching it
+  // (hole_release_at_rest: 299 -> 1,503 steps), a case not understood yet.
+  for (int j = 0; j < n; j += 2) {
     const int dir = dirs.empty() ? 0 : dirs[static_cast<std::size_t>(j)];
     if (dir == 0 || d.prediction_off[static_cast<std::size_t>(j)] || !(g[j] * dir < 0)) continue;
     const double curvature = two ? (d.root_rate[j] - d.root_rate_before[j]) / (d.root_time - d.root_time_before) : 0.0;
@@ -857,22 +882,16 @@ bool Integrator::passed_zero(int which) {
   return g[which] * impl_->system.event_directions()[static_cast<std::size_t>(which)] >= 0;
 }
 
-// After a step that ended at a predicted stop time: if the function predicted has passed its zero in
-// its direction, the event is polished from the step's end back to the zero and true is returned;
-// else the prediction is dropped until the next event (ARKODE's rootfinding finds the zero).
-bool Integrator::predicted_event(int which, double t_step_start, const Eigen::VectorXd& y_step_start,
+// After a predicted step in which the function predicted passed its zero (ARKODE's rootfinding did not
+// report it): the event, polished from the step's end back to the zero.
+void Integrator::predicted_event(int which, double t_step_start, const Eigen::VectorXd& y_step_start,
                                  const RootStepHook& before_polish) {
   Impl& d = *impl_;
   const int nev = d.system.num_events();
-  if (!passed_zero(which)) {
-    d.prediction_off[static_cast<std::size_t>(which)] = Impl::kPredictionMissed;
-    return false;
-  }
   events_found_.assign(static_cast<std::size_t>(nev), 0);
   events_found_[static_cast<std::size_t>(which)] = d.system.event_directions()[static_cast<std::size_t>(which)];
   if (before_polish) before_polish(t_step_start, t_);
   polish_event(t_step_start, y_step_start, /*from_here=*/true);
-  return true;
 }
 
 Eigen::VectorXd Integrator::interpolate(double t, int k) const {

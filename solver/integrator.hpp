@@ -233,7 +233,7 @@ class Integrator {
   void set_root_directions(int ignored = -1);
   double predict_recurring_event(double t_target, int& which);
   bool passed_zero(int which);
-  bool predicted_event(int which, double t_step_start, const Eigen::VectorXd& y_step_start,
+  void predicted_event(int which, double t_step_start, const Eigen::VectorXd& y_step_start,
                        const RootStepHook& before_polish);
 
   struct Impl;
