@@ -177,6 +177,12 @@ struct Integrator::Impl {
   double root_time = 0, root_time_before = 0;
   static constexpr char kPredictionMissed = 1, kPredictionRefused = 2;
   std::vector<char> prediction_off;
+  // The last step that no stop time cut short: a predicted event resumes with it (ARKODE's next step
+  // after a step cut at the stop time is that cut step).
+  double h_free = 0;
+  // The step the run resumed with after the last event: a predicted step far shorter than it is one of
+  // steps shrinking towards the stop time.
+  double h_event = 0;
   int short_steps = 0;         // accepted steps in a row below the step-size floor
   std::chrono::steady_clock::time_point wall_start = std::chrono::steady_clock::now();
 
@@ -671,12 +677,11 @@ Integrator::Outcome Integrator::advance(double t_target, bool one_step, const Ro
       return Outcome::kEvent;
     }
     if (predicted >= 0) {
-      // The step may end at the stop time with either flag. Past the zero: the event. Short of it at
-      // the stop time: no prediction for that function until the next event. Short of it because the
-      // model refused trial states on the way or the error test failed (a front that may not be passed,
-      // or whose far side the step cannot resolve: the steps would shrink towards the stop time): no
-      // prediction for it any more. A step that covered less than 0.6 of the way: none until the next
-      // event (the steps would shrink towards the stop time: chain_fountain.toml took 17,358 steps, not 3,311).
+      // The step may end at the stop time with either flag. Past the zero: the event. Short of it, at
+      // the stop time, or after refused trial states or a failed error test on the way, or having
+      // shorter than a quarter of the step the run resumed with after the last event: no prediction for
+      // that function until the next event (otherwise the steps could shrink towards the stop time
+      // without reaching it, as past a node coming out of a heap).
       if (passed_zero(predicted)) {
         predicted_event(predicted, t_step_start, y_step_start, before_polish);
         return Outcome::kEvent;
@@ -684,15 +689,16 @@ Integrator::Outcome Integrator::advance(double t_target, bool one_step, const Ro
       char& off = impl_->prediction_off[static_cast<std::size_t>(predicted)];
       // (ARKODE ends a step at the stop time up to a few units of round-off short of it, either flag.)
       const bool at_stop = flag == ARK_TSTOP_RETURN || t_stop - t_ <= 1e-6 * (t_stop - t_step_start);
-      if (impl_->recoverable_failures > refused_before || (fails_after > fails_before && !at_stop))
-        off = Impl::kPredictionRefused;
-      else if (at_stop || t_ - t_step_start < 0.6 * (t_stop - t_step_start))
+      if (at_stop || impl_->recoverable_failures > refused_before || fails_after > fails_before ||
+          last_step() < 0.25 * impl_->h_event)
         off = Impl::kPredictionMissed;
+      if (!at_stop) impl_->h_free = last_step();
       if (t_ < t_target) {
         if (one_step) return Outcome::kStep;
         continue;
       }
     }
+    if (flag == ARK_SUCCESS) impl_->h_free = last_step();
     if (flag == ARK_TSTOP_RETURN || t_ >= t_target) {
       t_ = t_target;
       return Outcome::kReachedTarget;
@@ -789,6 +795,7 @@ void Integrator::polish_event(double t_step_start, const Eigen::VectorXd& y_step
     t_event = t_next;
   }
   d.h_resume = std::abs(h_next);
+  d.h_event = d.h_resume;
   // Every function's rate at the event, for the prediction of the next zero of a recurring one.
   std::swap(d.root_rate, d.root_rate_before);
   d.root_time_before = d.root_time;
@@ -892,6 +899,8 @@ void Integrator::predicted_event(int which, double t_step_start, const Eigen::Ve
   events_found_[static_cast<std::size_t>(which)] = d.system.event_directions()[static_cast<std::size_t>(which)];
   if (before_polish) before_polish(t_step_start, t_);
   polish_event(t_step_start, y_step_start, /*from_here=*/true);
+  d.h_resume = std::max(d.h_resume, d.h_free);
+  d.h_event = d.h_resume;
 }
 
 Eigen::VectorXd Integrator::interpolate(double t, int k) const {
