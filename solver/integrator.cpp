@@ -177,6 +177,9 @@ struct Integrator::Impl {
   Eigen::VectorXd root_rate, root_rate_before;
   double root_time = 0, root_time_before = 0;
   static constexpr char kPredictionMissed = 1, kPredictionRefused = 2;
+  // The event functions at the last state a prediction was made from since the last event (empty: none).
+  Eigen::VectorXd g_last;
+  double g_last_time = 0;
   std::vector<char> prediction_off;
   // The step the run resumed with after the last event: a predicted step far shorter than it is one of
   // steps shrinking towards the stop time.
@@ -798,6 +801,7 @@ void Integrator::polish_event(double t_step_start, const Eigen::VectorXd& y_step
   d.root_time_before = d.root_time;
   d.root_rate = (g_ahead - g) / last_probe;
   d.root_time = t_;
+  d.g_last.resize(0);
   d.prediction_off.resize(static_cast<std::size_t>(nev), 0);
   for (char& off : d.prediction_off)
     if (off == Impl::kPredictionMissed) off = 0;
@@ -854,6 +858,7 @@ double Integrator::predict_recurring_event(double t_target, int& which) {
   }
   const std::vector<int> dirs = d.system.event_directions();
   const bool two = d.root_rate_before.size() == nev && d.root_time > d.root_time_before;
+  const bool secant = d.g_last.size() == nev && t_ > d.g_last_time;
   double best = t_target;
   // Only the first of each front's two crossings (a node into a heap, the fold reaching a node): past a
   // node that comes out of a heap or a pot the steps shrank towards the stop time without reaching it
@@ -862,7 +867,10 @@ double Integrator::predict_recurring_event(double t_target, int& which) {
     const int dir = dirs.empty() ? 0 : dirs[static_cast<std::size_t>(j)];
     if (dir == 0 || d.prediction_off[static_cast<std::size_t>(j)] || !(g[j] * dir < 0)) continue;
     const double curvature = two ? (d.root_rate[j] - d.root_rate_before[j]) / (d.root_time - d.root_time_before) : 0.0;
-    const double rate = d.root_rate[j] + curvature * (t_ - d.root_time);
+    // The rate now: from the last event's, or, after a step since, from the secant over that step
+    // (the function's rate may change at the crossing itself, where the front is re-drawn).
+    const double rate = secant ? (g[j] - d.g_last[j]) / (t_ - d.g_last_time) + 0.5 * curvature * (t_ - d.g_last_time)
+                               : d.root_rate[j] + curvature * (t_ - d.root_time);
     if (!(rate * dir > 0)) continue;
     double tau = -g[j] / rate;
     for (int iteration = 0; iteration < 3 && std::isfinite(tau); ++iteration) {
@@ -875,6 +883,8 @@ double Integrator::predict_recurring_event(double t_target, int& which) {
       which = j;
     }
   }
+  d.g_last = g;
+  d.g_last_time = t_;
   if (which >= 0) set_root_directions(which);
   return best;
 }
@@ -894,25 +904,27 @@ void Integrator::predicted_event(int which, double t_step_start, const Eigen::Ve
   const int nev = d.system.num_events();
   events_found_.assign(static_cast<std::size_t>(nev), 0);
   events_found_[static_cast<std::size_t>(which)] = d.system.event_directions()[static_cast<std::size_t>(which)];
-  // The step the run resumes with: ARKODE's next step after a step cut at a stop time is that cut step
-  // (two steps per crossing where one would do), so the step the error of the predicted step allows,
-  // 0.7 h err^(-1/(p+1)) with at most 10 times h (the elementary controller of the method's error
-  // estimate, of order p), if larger. (With 0.9 the falling chain on 41 nodes with eps = 1e-4 erred by
-  // 1.1e-7 in η near its singular end, against 7.8e-8 before the prediction and 2.4e-8 with 0.7.)
-  double h_allowed = 0;
-  {
-    N_Vector e = N_VClone(d.y);
-    const int flag = ARKStepGetEstLocalErrors(d.mem, e);
-    const Eigen::Map<const Eigen::VectorXd> error(N_VGetArrayPointer(e), N_VGetLength(e));
-    const double err = flag == ARK_SUCCESS ? std::sqrt((error.array() * error_weights().array()).square().mean()) : 0.0;
-    N_VDestroy(e);
-    const double h = std::abs(last_step());
-    if (err > 0 && std::isfinite(err)) h_allowed = h * std::min(10.0, 0.7 * std::pow(err, -1.0 / (d.embedding_order + 1)));
-  }
+  const double h_allowed = allowed_step();
   if (before_polish) before_polish(t_step_start, t_);
   polish_event(t_step_start, y_step_start, /*from_here=*/true);
   d.h_resume = std::max(d.h_resume, h_allowed);
   d.h_event = d.h_resume;
+}
+
+// The step the run resumes with after a predicted crossing: ARKODE's next step after a step cut at a
+// stop time is that cut step (two steps per crossing where one would do). So the step the error of the
+// last step allows, 0.7 h err^(-1/(p+1)) with at most 10 times h (the elementary controller of the method's error
+// estimate, of order p), if larger. (With 0.9 the falling chain on 41 nodes with eps = 1e-4 erred by
+// 1.1e-7 in η near its singular end, against 7.8e-8 before the prediction and 2.4e-8 with 0.7.)
+double Integrator::allowed_step() const {
+  const Impl& d = *impl_;
+  N_Vector e = N_VClone(d.y);
+  const int flag = ARKStepGetEstLocalErrors(d.mem, e);
+  const Eigen::Map<const Eigen::VectorXd> error(N_VGetArrayPointer(e), N_VGetLength(e));
+  const double err = flag == ARK_SUCCESS ? std::sqrt((error.array() * error_weights().array()).square().mean()) : 0.0;
+  N_VDestroy(e);
+  const double h = std::abs(last_step());
+  return err > 0 && std::isfinite(err) ? h * std::min(10.0, 0.7 * std::pow(err, -1.0 / (d.embedding_order + 1))) : 0.0;
 }
 
 Eigen::VectorXd Integrator::interpolate(double t, int k) const {

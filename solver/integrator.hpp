@@ -230,6 +230,7 @@ class Integrator {
   std::string diagnosis() const;
   void polish_event(double t_step_start, const Eigen::VectorXd& y_step_start, bool from_here);
   Eigen::VectorXd error_weights() const;
+  double allowed_step() const;
   void set_root_directions(int ignored = -1);
   double predict_recurring_event(double t_target, int& which);
   bool passed_zero(int which);
