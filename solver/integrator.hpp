@@ -207,7 +207,9 @@ class Integrator {
   /// the step holding the root is recomputed up to ARKODE's root in one step of the method, and the
   /// root's time corrected by Newton iteration on g (small corrections by a Heun step along the flow,
   /// larger ones by recomputing the step). The next restart() or resize() resumes with the step size
-  /// ARKODE had reached before the event rather than a fresh estimate.
+  /// ARKODE had reached before the event rather than a fresh estimate (after a predicted zero of a
+  /// recurring function, OdeSystem::num_recurring_events, the step the error of the last step allows,
+  /// if larger: the step before it was cut at the stop time).
   const std::vector<int>& events_found() const { return events_found_; }
 
   /// Interpolated state (k = 0) or its k-th derivative at time t inside the last step (dense output).
