@@ -679,11 +679,10 @@ Integrator::Outcome Integrator::advance(double t_target, bool one_step, const Ro
       return Outcome::kEvent;
     }
     if (predicted >= 0) {
-      // The step may end at the stop time with either flag. Past the zero: the event. Short of it, at
-      // the stop time, or after refused trial states or a failed error test on the way, or having
-      // shorter than a quarter of the step the run resumed with after the last event: no prediction for
-      // that function until the next event (otherwise the steps could shrink towards the stop time
-      // without reaching it, as past a node coming out of a heap).
+      // The step may end at the stop time with either flag. Past the zero: the event. Short of it, and at
+      // the stop time, or after refused trial states or a failed error test on the way, or shorter than a
+      // quarter of the step the run resumed with after the last event: no prediction for that function
+      // until the next event (otherwise the steps could shrink towards a stop time they never reach).
       if (passed_zero(predicted)) {
         predicted_event(predicted, t_step_start, y_step_start, before_polish);
         return Outcome::kEvent;
@@ -835,7 +834,8 @@ void Integrator::set_root_directions(int ignored) {
 // interpolant (a right-hand side per evaluation of the degree-4 interpolant of erk5, about ten per
 // root), and the step recomputed by the polish: 30 - 50 right-hand sides per crossing on the
 // canonical compares. The next zero of each recurring function is predicted here from its value now
-// and its rate at the last two events (a quadratic in t), and the step is ended at kAimPast of the
+// and its rate (the last event's or the secant over the last step, with the change of rate between the
+// last two events: a quadratic in t), and the step is ended at kAimPast of the
 // way beyond it, the function's own direction turned off in ARKODE's rootfinding for that step, so
 // that the step holds the root and the polish corrects from the step's end back to it
 // (predicted_event): about one step and a few right-hand sides per crossing. Returns the stop time of
@@ -860,9 +860,12 @@ double Integrator::predict_recurring_event(double t_target, int& which) {
   const bool two = d.root_rate_before.size() == nev && d.root_time > d.root_time_before;
   const bool secant = d.g_last.size() == nev && t_ > d.g_last_time;
   double best = t_target;
-  // Only the first of each front's two crossings (a node into a heap, the fold reaching a node): past a
-  // node that comes out of a heap or a pot the steps shrank towards the stop time without reaching it
-  // (hole_release_at_rest: 299 -> 1,503 steps), a case not understood yet.
+  // Only the first of each front's two crossings (a node into a heap, the fold reaching a node). The
+  // second (a node out of a heap) predicted too, the sliding compare took 8,096 right-hand sides instead
+  // of 22,925 at 800 nodes, but chains leaving a heap while they swing took 1.5 - 1.7 times the steps
+  // (hole_release_at_rest.toml 299 -> 494, swinging_sliding_chain.toml 325 -> 487): predictions early by
+  // about 1 %, each leaving a short remainder after which ARKODE's steps grew back slowly. Not understood
+  // yet (docs/shocks.md, "On fine meshes").
   for (int j = 0; j < n; j += 2) {
     const int dir = dirs.empty() ? 0 : dirs[static_cast<std::size_t>(j)];
     if (dir == 0 || d.prediction_off[static_cast<std::size_t>(j)] || !(g[j] * dir < 0)) continue;
@@ -913,8 +916,8 @@ void Integrator::predicted_event(int which, double t_step_start, const Eigen::Ve
 
 // The step the run resumes with after a predicted crossing: ARKODE's next step after a step cut at a
 // stop time is that cut step (two steps per crossing where one would do). So the step the error of the
-// last step allows, 0.7 h err^(-1/(p+1)) with at most 10 times h (the elementary controller of the method's error
-// estimate, of order p), if larger. (With 0.9 the falling chain on 41 nodes with eps = 1e-4 erred by
+// last step allows, 0.7 h err^(-1/(p+1)) with at most 10 times h (the elementary controller of the
+// method's error estimate, of order p), if larger. (With 0.9 the falling chain on 41 nodes with eps = 1e-4 erred by
 // 1.1e-7 in η near its singular end, against 7.8e-8 before the prediction and 2.4e-8 with 0.7.)
 double Integrator::allowed_step() const {
   const Impl& d = *impl_;
