@@ -37,6 +37,12 @@ class OdeSystem {
                       Eigen::Ref<Eigen::VectorXd> /*g*/) {}
   /// Direction of the zero crossings to report per event: +1 increasing, -1 decreasing, 0 both.
   virtual std::vector<int> event_directions() const { return {}; }
+  /// The first num_recurring_events() event functions vanish again and again at a steady pace (a
+  /// front crossing one node after another, each zero followed by a jump of the function back up).
+  /// After a zero of one, the integrator predicts the next from the rates of the last two and ends a
+  /// step just before it, so that the root is reached by a short correction instead of being
+  /// overstepped, located on the interpolant and the step recomputed (docs/shocks.md, "On fine meshes").
+  virtual int num_recurring_events() const { return 0; }
   /// Natural magnitude of each state component (e.g. the length for a position, a reference
   /// speed for a velocity). The absolute tolerance of component i is atol * scale[i], so atol is
   /// dimensionless and results do not depend on the choice of units. Empty = all ones.
@@ -201,7 +207,9 @@ class Integrator {
   /// the step holding the root is recomputed up to ARKODE's root in one step of the method, and the
   /// root's time corrected by Newton iteration on g (small corrections by a Heun step along the flow,
   /// larger ones by recomputing the step). The next restart() or resize() resumes with the step size
-  /// ARKODE had reached before the event rather than a fresh estimate.
+  /// ARKODE had reached before the event rather than a fresh estimate (after a predicted zero of a
+  /// recurring function, OdeSystem::num_recurring_events, the step the error of the last step allows,
+  /// if larger: the step before it was cut at the stop time).
   const std::vector<int>& events_found() const { return events_found_; }
 
   /// Interpolated state (k = 0) or its k-th derivative at time t inside the last step (dense output).
@@ -222,7 +230,14 @@ class Integrator {
   int evolve(double t_target, bool one_step);
   void watchdog(double t_before, int flag);
   std::string diagnosis() const;
-  void polish_event(double t_step_start, const Eigen::VectorXd& y_step_start);
+  void polish_event(double t_step_start, const Eigen::VectorXd& y_step_start, bool from_here);
+  Eigen::VectorXd error_weights() const;
+  double allowed_step() const;
+  void set_root_directions(int ignored = -1);
+  double predict_recurring_event(double t_target, int& which);
+  bool passed_zero(int which);
+  void predicted_event(int which, double t_step_start, const Eigen::VectorXd& y_step_start,
+                       const RootStepHook& before_polish);
 
   struct Impl;
   std::unique_ptr<Impl> impl_;

@@ -109,6 +109,7 @@ class StringModel final : public OdeSystem {
   std::vector<int> event_directions() const override {
     return module_ ? module_->event_directions() : std::vector<int>{};
   }
+  int num_recurring_events() const override { return module_ ? module_->num_crossing_events() : 0; }
   /// With a module: positions scale with ℓ, velocities with a reference speed, ledgers with the
   /// matching energies; without one, plain absolute tolerances (empty).
   Eigen::VectorXd state_scale() const override;

@@ -223,6 +223,9 @@ class StringModule {
   virtual long transfers() const = 0;
   /// Number of fronts (entries of ModuleLedger::fronts).
   virtual int num_fronts() const = 0;
+  /// The first num_crossing_events() root functions are node crossings of fronts, which recur one
+  /// link after another (OdeSystem::num_recurring_events: the integrator ends a step at the next).
+  virtual int num_crossing_events() const { return 0; }
   /// The tension (N) the module's partial link carries at `node`, an arc's end node next to a front,
   /// after an evaluation; nothing if no front is next to it. A prescribed node whose arc has no full
   /// link (a front at the fixed end) reports this tension: the one-sided limit at the node.

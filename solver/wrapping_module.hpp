@@ -35,6 +35,7 @@ class WrappingModule : public StringModule<dim> {
   }
   long transfers() const override { return inner_ ? inner_->transfers() : 0; }
   int num_fronts() const override { return inner_ ? inner_->num_fronts() : 0; }
+  int num_crossing_events() const override { return inner_ ? inner_->num_crossing_events() : 0; }
   std::optional<double> front_tension_at(const StringModel<dim>& model, int node) const override {
     return inner_ ? inner_->front_tension_at(model, node) : std::nullopt;
   }
