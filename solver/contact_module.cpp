@@ -96,15 +96,15 @@ Vec<dim> from_edge(const Obstacle<dim>& o, const Vec<dim>& x) {
 }  // namespace
 
 template <int dim>
-double Obstacle<dim>::gap(const Vec<dim>& x) const {
-  if (beyond_edge(*this, x)) return from_edge(*this, x).norm();
+double Obstacle<dim>::gap(const Vec<dim>& x, bool held) const {
+  if (!held && beyond_edge(*this, x)) return from_edge(*this, x).norm();
   if (kind == Kind::kPlane) return normal.dot(x - point);
   return radial(*this, x).norm() - radius;
 }
 
 template <int dim>
-Vec<dim> Obstacle<dim>::outward(const Vec<dim>& x) const {
-  if (beyond_edge(*this, x)) {
+Vec<dim> Obstacle<dim>::outward(const Vec<dim>& x, bool held) const {
+  if (!held && beyond_edge(*this, x)) {
     const Vec<dim> r = from_edge(*this, x);
     return r.norm() > 0 ? Vec<dim>(r.normalized()) : normal;
   }
@@ -128,7 +128,7 @@ double Obstacle<dim>::curvature(const Vec<dim>& x, const Vec<dim>& v) const {
 
 template <int dim>
 Eigen::Matrix<double, dim, dim - 1> Obstacle<dim>::tangents(const Vec<dim>& x) const {
-  const Vec<dim> n = outward(x);
+  const Vec<dim> n = outward(x, true);
   Eigen::Matrix<double, dim, dim - 1> basis;
   if constexpr (dim == 2) {
     basis.col(0) = Vec<2>(-n[1], n[0]);
@@ -278,7 +278,7 @@ class ContactModule final : public WrappingModule<dim> {
       if (!holds(model, static_cast<int>(i))) continue;
       const Obstacle<dim>& o = obstacles_[static_cast<std::size_t>(held_[i])];
       const Vec<dim> x = model.x().col(static_cast<Eigen::Index>(i)), v = model.v().col(static_cast<Eigen::Index>(i));
-      out.push_back({static_cast<int>(i), o.outward(x), o.gap(x), o.curvature(x, v)});
+      out.push_back({static_cast<int>(i), o.outward(x, true), o.gap(x, true), o.curvature(x, v)});
       if (o.mu > 0) {
         out.back().mu = o.mu;
         out.back().stuck = stuck_[i] != 0;
@@ -404,7 +404,7 @@ class ContactModule final : public WrappingModule<dim> {
     return held_[i] >= 0 && obstacle_of(i).mu > 0 && !stuck_[i] && dir_.col(static_cast<Eigen::Index>(i)).squaredNorm() > 0;
   }
   static Vec<dim> tangential(const Obstacle<dim>& o, const Vec<dim>& x, const Vec<dim>& v) {
-    const Vec<dim> n = o.outward(x);
+    const Vec<dim> n = o.outward(x, true);
     return v - n.dot(v) * n;
   }
   /// The direction node i slides in: the stored one carried with the surface (in 2D, always: the
@@ -644,7 +644,7 @@ class ContactModule final : public WrappingModule<dim> {
   Vec<dim> chain_direction(const StringModel<dim>& model, int i, const Vec<dim>& fallback) const {
     const int n = static_cast<int>(held_.size());
     const Obstacle<dim>& o = obstacle_of(static_cast<std::size_t>(i));
-    const Vec<dim> normal = o.outward(model.x().col(i));
+    const Vec<dim> normal = o.outward(model.x().col(i), true);
     for (const Vec<dim>& c : {Vec<dim>(model.x().col(std::min(i + 1, n - 1)) - model.x().col(std::max(i - 1, 0))), fallback}) {
       const Vec<dim> t = c - normal.dot(c) * normal;
       if (t.norm() > 1e-12 * c.norm()) return t.normalized();
@@ -765,7 +765,7 @@ class ContactModule final : public WrappingModule<dim> {
       for (const auto& [i, k] : landing) {
         const Obstacle<dim>& o = obstacles_[static_cast<std::size_t>(k)];
         const Vec<dim> x = model.x().col(i);
-        normal_impulse.push_back(o.mu > 0 ? std::max(0.0, -o.outward(x).dot(model.v().col(i))) * model.masses()[i] : 0.0);
+        normal_impulse.push_back(o.mu > 0 ? std::max(0.0, -o.outward(x, true).dot(model.v().col(i))) * model.masses()[i] : 0.0);
       }
     const double K_before = model.kinetic_energy();
     const Vec<dim> p_before = model.momentum();
