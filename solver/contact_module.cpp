@@ -21,6 +21,12 @@ constexpr double kCatchWindow = 1e-5;
 /// A node let go starts its landing root function at +kReleaseGap (ARKODE deactivates a root function
 /// that is zero at a restart).
 constexpr double kReleaseGap = 2e-7;
+/// A node let go, then landing at that same instant and let go again (its contact force after the impact
+/// pulls) has not landed: it passes, its velocity projected, and its landing root function restarts at
+/// +kPassGap, above the error of the interpolant on which ARKODE looks for roots (at +kReleaseGap that
+/// error found its landing again in the next step, the recomputed step put it back at the same instant,
+/// and it landed and was let go there over and over).
+constexpr double kPassGap = kCatchWindow;
 /// A held node's normal force counts as pulling below −kPull of its weight scale m a (a the physical
 /// acceleration scale): round-off is not a lift-off.
 constexpr double kPull = 1e-9;
@@ -224,6 +230,7 @@ class ContactModule final : public WrappingModule<dim> {
     drawn_nodes_ = model.x();
     held_.assign(static_cast<std::size_t>(n), -1);
     offset_.assign(static_cast<std::size_t>(n), 0.0);
+    let_go_at_.assign(static_cast<std::size_t>(n), -INFINITY);
     stuck_.assign(static_cast<std::size_t>(n), 0);
     dir_.setZero(dim - 1, n);
     length_ = chain.length();
@@ -388,6 +395,7 @@ class ContactModule final : public WrappingModule<dim> {
   std::vector<Obstacle<dim>> obstacles_;
   std::vector<int> held_;        // per node: the obstacle it is held on, or −1
   std::vector<double> offset_;   // per node: its landing root function's offset (of h)
+  std::vector<double> let_go_at_;  // per node: when settle() last let it go (s; −∞: never)
   double h_ = 1;
   long impacts_ = 0, lift_offs_ = 0;
   // Friction: whether an obstacle has μ > 0; per node, whether it sticks, and the direction it slides
@@ -775,6 +783,8 @@ class ContactModule final : public WrappingModule<dim> {
     ledger[1] += model.kinetic_energy() - K_before;
     ledger.template segment<dim>(2) += model.momentum() - p_before;
     ++impacts_;
+    std::vector<double> let_go_before;
+    for (const auto& [i, k] : landing) let_go_before.push_back(let_go_at_[static_cast<std::size_t>(i)]);
     settle(model, t, false);
     if (friction_) {
       Eigen::VectorXd book = ledger;
@@ -782,6 +792,10 @@ class ContactModule final : public WrappingModule<dim> {
       classify(model, t, &book);
       ledger = book;
       settle(model, t, false);
+    }
+    for (std::size_t q = 0; q < landing.size(); ++q) {  // let go, caught and let go again at t: it passes
+      const auto i = static_cast<std::size_t>(landing[q].first);
+      if (held_[i] < 0 && let_go_before[q] == t) offset_[i] = kPassGap;
     }
     return true;
   }
@@ -864,6 +878,7 @@ class ContactModule final : public WrappingModule<dim> {
       if (worst < 0) break;
       held_[static_cast<std::size_t>(worst)] = -1;
       offset_[static_cast<std::size_t>(worst)] = kReleaseGap;
+      let_go_at_[static_cast<std::size_t>(worst)] = t;
       if (friction_) {
         stuck_[static_cast<std::size_t>(worst)] = 0;
         dir_.col(worst).setZero();
