@@ -615,3 +615,56 @@ TEST_CASE("table and edge: the real table's chain slides off as x0 cosh ωt at e
       CHECK(run.transfers >= 30);  // x* − x0 = 0.337 m: 33 crossings of links of 1 cm
     }
 }
+
+TEST_CASE("table and edge: a start heap feeding a table edge runs empty at s0 = 0, its ledger closed",
+          "[contact][edge][heap]") {
+  // A start heap at (−0.3, 0) (s0 = 0.5 m, f = 0.5) feeds the table (table = "before") and its edge at the
+  // origin, 0.2 m hanging. The heap's s0 and the edge's stay a fixed chord of 0.3 m apart on the straight
+  // table, so the heap empties at the instant the edge passes the node at s = 0.3 m: the edge's crossing,
+  // found first, moved the material 3·10⁻¹⁰ m ahead of time and carried the heap's content past its root
+  // (from +10⁻¹⁴ m): the heap's s0 ran on to −0.29 m, the partial link at the heap became the 0.3 m chord,
+  // and the run stopped at "node 1 has reached the edge" with the energy ledger off by 0.21 J.
+  const std::string text = R"(model = "string"
+[string]
+length = 1.0
+density = 1.0
+nodes = 101
+[shape]
+kind = "polyline"
+points = [[-0.8, 0.0], [-0.3, 0.0], [0.0, 0.0], [0.0, -0.2]]
+[effects.gravity]
+g = [0.0, -9.81]
+[[effects.heap]]
+side = "start"
+s0 = 0.5
+f = 0.5
+point = [-0.3, 0.0]
+[[effects.edge]]
+point = [0.0, 0.0]
+table = "before"
+[solver]
+method = "erk5"
+rtol = 1e-9
+atol = 1e-11
+[output]
+interval = 0.05
+[stop]
+t_end = 2.0
+)";
+  StringScene<2> scene = build_string_scene<2>(parse_scene_text(text, "heap_feeding_edge"));
+  StringSolver<2> solver(*scene.model, scene.solver);
+  const RunSummary& run = solver.run();
+  REQUIRE(run.status == "stopped");
+  CHECK(run.stop_reason == "the heap has run empty");
+  CHECK(finite_run(run));
+  for (const StepSample& s : run.samples) {
+    CAPTURE(s.t);
+    CHECK(s.fronts[0].s0 > -1e-12);                               // the heap never holds less than nothing
+    CHECK(s.fronts[1].s0 - s.fronts[0].s0 == Approx(0.3).margin(1e-9));  // the chord on the table
+  }
+  const StepSample& last = run.samples.back();
+  CHECK(last.fronts[0].s0 < 1e-8);  // empty
+  CHECK(last.terms["heap_mass"] < 1e-8);
+  CHECK(run.relative_energy_drift() < 1e-10);
+  CHECK(run.relative_momentum_residual() < 1e-10);
+}
