@@ -21,6 +21,12 @@ constexpr double kCatchWindow = 1e-5;
 /// A node let go starts its landing root function at +kReleaseGap (ARKODE deactivates a root function
 /// that is zero at a restart).
 constexpr double kReleaseGap = 2e-7;
+/// A node let go, then landing at that same instant and let go again (its contact force after the impact
+/// pulls) has not landed: it passes, its velocity projected, and its landing root function restarts at
+/// +kPassGap, above the error of the interpolant on which ARKODE looks for roots (at +kReleaseGap that
+/// error found its landing again in the next step, the recomputed step put it back at the same instant,
+/// and it landed and was let go there over and over).
+constexpr double kPassGap = kCatchWindow;
 /// A held node's normal force counts as pulling below −kPull of its weight scale m a (a the physical
 /// acceleration scale): round-off is not a lift-off.
 constexpr double kPull = 1e-9;
@@ -96,15 +102,15 @@ Vec<dim> from_edge(const Obstacle<dim>& o, const Vec<dim>& x) {
 }  // namespace
 
 template <int dim>
-double Obstacle<dim>::gap(const Vec<dim>& x) const {
-  if (beyond_edge(*this, x)) return from_edge(*this, x).norm();
+double Obstacle<dim>::gap(const Vec<dim>& x, bool held) const {
+  if (!held && beyond_edge(*this, x)) return from_edge(*this, x).norm();
   if (kind == Kind::kPlane) return normal.dot(x - point);
   return radial(*this, x).norm() - radius;
 }
 
 template <int dim>
-Vec<dim> Obstacle<dim>::outward(const Vec<dim>& x) const {
-  if (beyond_edge(*this, x)) {
+Vec<dim> Obstacle<dim>::outward(const Vec<dim>& x, bool held) const {
+  if (!held && beyond_edge(*this, x)) {
     const Vec<dim> r = from_edge(*this, x);
     return r.norm() > 0 ? Vec<dim>(r.normalized()) : normal;
   }
@@ -128,7 +134,7 @@ double Obstacle<dim>::curvature(const Vec<dim>& x, const Vec<dim>& v) const {
 
 template <int dim>
 Eigen::Matrix<double, dim, dim - 1> Obstacle<dim>::tangents(const Vec<dim>& x) const {
-  const Vec<dim> n = outward(x);
+  const Vec<dim> n = outward(x, true);
   Eigen::Matrix<double, dim, dim - 1> basis;
   if constexpr (dim == 2) {
     basis.col(0) = Vec<2>(-n[1], n[0]);
@@ -224,6 +230,7 @@ class ContactModule final : public WrappingModule<dim> {
     drawn_nodes_ = model.x();
     held_.assign(static_cast<std::size_t>(n), -1);
     offset_.assign(static_cast<std::size_t>(n), 0.0);
+    let_go_at_.assign(static_cast<std::size_t>(n), -INFINITY);
     stuck_.assign(static_cast<std::size_t>(n), 0);
     dir_.setZero(dim - 1, n);
     length_ = chain.length();
@@ -278,7 +285,7 @@ class ContactModule final : public WrappingModule<dim> {
       if (!holds(model, static_cast<int>(i))) continue;
       const Obstacle<dim>& o = obstacles_[static_cast<std::size_t>(held_[i])];
       const Vec<dim> x = model.x().col(static_cast<Eigen::Index>(i)), v = model.v().col(static_cast<Eigen::Index>(i));
-      out.push_back({static_cast<int>(i), o.outward(x), o.gap(x), o.curvature(x, v)});
+      out.push_back({static_cast<int>(i), o.outward(x, true), o.gap(x, true), o.curvature(x, v)});
       if (o.mu > 0) {
         out.back().mu = o.mu;
         out.back().stuck = stuck_[i] != 0;
@@ -388,6 +395,7 @@ class ContactModule final : public WrappingModule<dim> {
   std::vector<Obstacle<dim>> obstacles_;
   std::vector<int> held_;        // per node: the obstacle it is held on, or −1
   std::vector<double> offset_;   // per node: its landing root function's offset (of h)
+  std::vector<double> let_go_at_;  // per node: when settle() last let it go (s; −∞: never)
   double h_ = 1;
   long impacts_ = 0, lift_offs_ = 0;
   // Friction: whether an obstacle has μ > 0; per node, whether it sticks, and the direction it slides
@@ -404,7 +412,7 @@ class ContactModule final : public WrappingModule<dim> {
     return held_[i] >= 0 && obstacle_of(i).mu > 0 && !stuck_[i] && dir_.col(static_cast<Eigen::Index>(i)).squaredNorm() > 0;
   }
   static Vec<dim> tangential(const Obstacle<dim>& o, const Vec<dim>& x, const Vec<dim>& v) {
-    const Vec<dim> n = o.outward(x);
+    const Vec<dim> n = o.outward(x, true);
     return v - n.dot(v) * n;
   }
   /// The direction node i slides in: the stored one carried with the surface (in 2D, always: the
@@ -644,7 +652,7 @@ class ContactModule final : public WrappingModule<dim> {
   Vec<dim> chain_direction(const StringModel<dim>& model, int i, const Vec<dim>& fallback) const {
     const int n = static_cast<int>(held_.size());
     const Obstacle<dim>& o = obstacle_of(static_cast<std::size_t>(i));
-    const Vec<dim> normal = o.outward(model.x().col(i));
+    const Vec<dim> normal = o.outward(model.x().col(i), true);
     for (const Vec<dim>& c : {Vec<dim>(model.x().col(std::min(i + 1, n - 1)) - model.x().col(std::max(i - 1, 0))), fallback}) {
       const Vec<dim> t = c - normal.dot(c) * normal;
       if (t.norm() > 1e-12 * c.norm()) return t.normalized();
@@ -765,7 +773,7 @@ class ContactModule final : public WrappingModule<dim> {
       for (const auto& [i, k] : landing) {
         const Obstacle<dim>& o = obstacles_[static_cast<std::size_t>(k)];
         const Vec<dim> x = model.x().col(i);
-        normal_impulse.push_back(o.mu > 0 ? std::max(0.0, -o.outward(x).dot(model.v().col(i))) * model.masses()[i] : 0.0);
+        normal_impulse.push_back(o.mu > 0 ? std::max(0.0, -o.outward(x, true).dot(model.v().col(i))) * model.masses()[i] : 0.0);
       }
     const double K_before = model.kinetic_energy();
     const Vec<dim> p_before = model.momentum();
@@ -775,6 +783,8 @@ class ContactModule final : public WrappingModule<dim> {
     ledger[1] += model.kinetic_energy() - K_before;
     ledger.template segment<dim>(2) += model.momentum() - p_before;
     ++impacts_;
+    std::vector<double> let_go_before;
+    for (const auto& [i, k] : landing) let_go_before.push_back(let_go_at_[static_cast<std::size_t>(i)]);
     settle(model, t, false);
     if (friction_) {
       Eigen::VectorXd book = ledger;
@@ -782,6 +792,10 @@ class ContactModule final : public WrappingModule<dim> {
       classify(model, t, &book);
       ledger = book;
       settle(model, t, false);
+    }
+    for (std::size_t q = 0; q < landing.size(); ++q) {  // let go, caught and let go again at t: it passes
+      const auto i = static_cast<std::size_t>(landing[q].first);
+      if (held_[i] < 0 && let_go_before[q] == t) offset_[i] = kPassGap;
     }
     return true;
   }
@@ -864,6 +878,7 @@ class ContactModule final : public WrappingModule<dim> {
       if (worst < 0) break;
       held_[static_cast<std::size_t>(worst)] = -1;
       offset_[static_cast<std::size_t>(worst)] = kReleaseGap;
+      let_go_at_[static_cast<std::size_t>(worst)] = t;
       if (friction_) {
         stuck_[static_cast<std::size_t>(worst)] = 0;
         dir_.col(worst).setZero();

@@ -59,9 +59,14 @@ struct Obstacle {
   std::function<bool(int node)> carries;
   bool may_hold(int node) const { return !carries || carries(node); }
   /// The signed distance of x from the surface (m), > 0 outside, its outward unit normal there, and
-  /// the gap's second derivative at zero acceleration for a velocity v (m/s²).
-  double gap(const Vec<dim>& x) const;
-  Vec<dim> outward(const Vec<dim>& x) const;
+  /// the gap's second derivative at zero acceleration for a velocity v (m/s²). `held`: of a node held
+  /// on the surface, for which a bounded plane goes on past its edge: the edge front takes the node off
+  /// the table at its crossing root, and until then (a trial stage of the step that holds that root
+  /// may carry the node a little past the edge) its constraint stays the plane's; the distance from
+  /// the edge's line there (a free node's gap) would turn its normal and its normal force at once, a
+  /// root of the lift-off function that comes before the crossing's.
+  double gap(const Vec<dim>& x, bool held = false) const;
+  Vec<dim> outward(const Vec<dim>& x, bool held = false) const;
   double curvature(const Vec<dim>& x, const Vec<dim>& v) const;
   /// An orthonormal basis of the surface's tangent space at x, carried along with the surface (2D:
   /// the outward normal turned by +90°; 3D plane: a fixed basis; 3D cylinder: the axis and axis × n),

@@ -285,6 +285,8 @@ class StringModel final : public OdeSystem {
   }
   /// Straightens every bent link.
   void clear_bends() { bends_.clear(); }
+  /// Whether a link is bent over a point (an edge front's).
+  bool has_bends() const { return !bends_.empty(); }
   /// Link `link` is bent over a point (bend_link).
   bool link_bent(int link) const { return !bends_.empty() && bend_of(link) != nullptr; }
   /// A bent link's unit vectors after an evaluation: e⁻ at its start node (`at_end` false), e⁺ at its end

@@ -24,7 +24,7 @@ namespace {
 struct HardRun {
   std::string status, error;
   double seconds = 0, t_last = 0, drift = 0, momentum = 0, impacts = 0, lift_offs = 0, snaps = 0;
-  double highest = 0, lowest = 0, px0 = 0, px = 0;
+  double highest = 0, lowest = 0, px0 = 0, px = 0, w_impacts = 0;
   bool finite = true;
 };
 
@@ -51,7 +51,9 @@ HardRun run_spec(const SceneSpec& spec) {
   r.t_last = last.t;
   r.impacts = last.terms["impacts"];
   r.lift_offs = last.terms["lift_offs"];
-  r.snaps = last.terms["snaps"];
+  for (const LedgerTerm& term : *last.terms.names)  // slack = "allow" only
+    if (term.name == "snaps") r.snaps = last.terms["snaps"];
+  r.w_impacts = last.terms["W_impacts"];
   r.highest = last.x.row(1).maxCoeff();
   r.lowest = last.x.row(1).minCoeff();
   const Eigen::VectorXd& m = scene.model->masses();
@@ -158,7 +160,16 @@ TEST_CASE("hard contact: a closed loop running round over a pulley ends in secon
   // with "stop" the same happens at 0.4606 s). Near t = 0.3453 s a node of it landed and was let go at the
   // same instant over and over: events at one time until the step budget, a minute of wall time for 0.5 s,
   // deaf to SIGTERM between the events. The run now ends in a second: completed, or stopped at that time
-  // with the events named.
+  // with the events named. That node had not landed: ARKODE's interpolant put its landing root function
+  // (started at +2e-7 when it was let go) below zero within the next step, the recomputed step put the
+  // root back at the same instant, the node was caught there, and its contact force after the impact
+  // pulled, so it was let go again. A node whose force pulls after its impact now passes (its velocity
+  // projected, the impact booked in W_impacts) and its landing root restarts above the interpolant's
+  // error: with slack = "stop" (1000 events at 0.460590 s) the loop runs round the pulley to t_end, its
+  // energy ledger closed to 10⁻⁸. With "allow" it stops, located, at 0.1697 s: a snap not located (the
+  // slack module's, not this).
+  for (const char* slack : {"allow", "stop"}) {
+  CAPTURE(slack);
   std::string points;
   for (int i = 0; i <= 60; ++i) {
     const double a = 3.141592653589793 * i / 60, r = 0.1 * 1.0003;
@@ -168,10 +179,18 @@ TEST_CASE("hard contact: a closed loop running round over a pulley ends in secon
   const std::string text = fmt::format(
       "[string]\nclosed = true\nnodes = 80\n[shape]\nkind = \"points\"\npoints = [{}]\n[velocity]\n"
       "kind = \"tangential\"\nspeed = 3.0\n[effects.gravity]\ng = [0.0, -9.81]\n[[effects.cylinder]]\n"
-      "center = [0.0, 0.0]\nradius = 0.1\n[solver]\nslack = \"allow\"\n[stop]\nt_end = 0.5\n",
-      points);
+      "center = [0.0, 0.0]\nradius = 0.1\n[solver]\nslack = \"{}\"\n[stop]\nt_end = 0.5\n",
+      points, slack);
   const HardRun r = run_text(text);
   print("closed loop round a pulley", r);
   CHECK(r.seconds < 10);
   finished_or_located(r);
+  if (std::string(slack) == "stop") {
+    CHECK(r.status == "completed");
+    CHECK(r.t_last == Approx(0.5));
+    CHECK(r.impacts > 0);
+    CHECK(r.w_impacts < 0);  // the landings' Carnot losses, booked
+    CHECK(r.drift < 1e-7);
+  }
+  }
 }
