@@ -674,8 +674,13 @@ Integrator::Outcome Integrator::advance(double t_target, bool one_step, const Ro
     }
     if (flag == ARK_ROOT_RETURN) {
       impl_->check(ARKStepGetRootInfo(impl_->mem, events_found_.data()), "ARKStepGetRootInfo");
-      if (before_polish) before_polish(t_step_start, t_);
-      polish_event(t_step_start, y_step_start, /*from_here=*/false);
+      // The step ARKODE took ends after its root; the polished event lies in that step, not always
+      // before ARKODE's root, so the frames up to the step's end are taken before the polish.
+      sunrealtype t_step_end = t_;
+      impl_->check(ARKStepGetCurrentTime(impl_->mem, &t_step_end), "ARKStepGetCurrentTime");
+      t_step_end = std::max<double>(t_step_end, t_);
+      if (before_polish) before_polish(t_step_start, t_step_end);
+      polish_event(t_step_start, y_step_start, t_step_end, /*from_here=*/false);
       return Outcome::kEvent;
     }
     if (predicted >= 0) {
@@ -718,10 +723,13 @@ Integrator::Outcome Integrator::advance(double t_target, bool one_step, const Ro
 // whose second-order term is checked to be below kHeunShare of the error tolerance (its error,
 // O(dt³), is smaller still by dt over the time scale of the motion); a larger correction integrates
 // again from the step's start.
-void Integrator::polish_event(double t_step_start, const Eigen::VectorXd& y_step_start, bool from_here) {
+void Integrator::polish_event(double t_step_start, const Eigen::VectorXd& y_step_start, double t_step_end,
+                              bool from_here) {
   // The largest share of the error tolerance (weighted RMS norm) the second-order term of a Heun
   // correction may have.
   constexpr double kHeunShare = 1e-3;
+  // How many times a refused step towards the event is taken again, four times smaller (as advance()).
+  constexpr int kMaxPolishRetries = 30;
   Impl& d = *impl_;
   int k = 0;
   while (k < static_cast<int>(events_found_.size()) && events_found_[k] == 0) ++k;
@@ -754,7 +762,7 @@ void Integrator::polish_event(double t_step_start, const Eigen::VectorXd& y_step
     weights = error_weights();
     const double dt_probe = probe(t_, y_, f_base);
     const double slope = (g_ahead[k] - g[k]) / dt_probe;
-    if (slope != 0.0 && std::isfinite(slope)) t_event = std::max(t_ - g[k] / slope, t_step_start);
+    if (slope != 0.0 && std::isfinite(slope)) t_event = std::clamp(t_ - g[k] / slope, t_step_start, t_step_end);
   }
   for (int iteration = 0; iteration < 4; ++iteration) {
     bool corrected = false;
@@ -770,9 +778,24 @@ void Integrator::polish_event(double t_step_start, const Eigen::VectorXd& y_step
       }
     }
     if (!corrected) {
-      restart(t_step_start, y_step_start);
-      if (t_event > t_step_start) d.check(ARKStepSetInitStep(d.mem, t_event - t_step_start), "ARKStepSetInitStep");
-      while (t_ < t_event) evolve(t_event, /*one_step=*/false);
+      // As in advance(): when the model refuses a trial state, ARKODE stops without moving (evolve
+      // returns ARK_UNREC_RHSFUNC_ERR), so the step is taken again from its start, four times
+      // smaller each time; calling evolve() again as it was would spin here for ever.
+      double h_try = t_event - t_step_start;
+      for (int retries = 0;; ++retries) {
+        restart(t_step_start, y_step_start);
+        if (h_try > 0) d.check(ARKStepSetInitStep(d.mem, h_try), "ARKStepSetInitStep");
+        int flag = 0;
+        while (t_ < t_event && flag != ARK_UNREC_RHSFUNC_ERR) flag = evolve(t_event, /*one_step=*/false);
+        if (flag != ARK_UNREC_RHSFUNC_ERR) break;
+        h_try *= 0.25;
+        if (retries >= kMaxPolishRetries || !(h_try > 0))
+          throw NumericalError(fmt::format("locating an event at t = {:.12g} s (root function {}): the model refused "
+                                           "every trial state from the step's start at t = {:.12g} s down to a step "
+                                           "of {:.3g} s ({})",
+                                           t_event, k, t_step_start, h_try, d.last_recoverable),
+                               t_step_start);
+      }
     }
     d.system.events(t_, y_, g);
     d.system.rhs(t_, y_, ydot);
@@ -786,7 +809,9 @@ void Integrator::polish_event(double t_step_start, const Eigen::VectorXd& y_step
     last_probe = dt_probe;
     const double slope = (g_ahead[k] - g[k]) / dt_probe;
     if (!(slope != 0.0) || !std::isfinite(slope)) break;
-    const double t_next = std::max(t_event - g[k] / slope, t_step_start);
+    // The event lies in the step that holds the root: a secant that points outside it (far from the
+    // root, a nearly flat function) is held to the step, never extrapolated beyond it.
+    const double t_next = std::clamp(t_event - g[k] / slope, t_step_start, t_step_end);
     // Converged to a few units of round-off of t (relative: an absolute floor in seconds would
     // stop early on a short time scale, e.g. a 1 mm chain under 1000 m/s²).
     const double t_unit = std::max({std::abs(t_event), std::abs(t_step_start), d.system.time_scale()});
@@ -909,7 +934,7 @@ void Integrator::predicted_event(int which, double t_step_start, const Eigen::Ve
   events_found_[static_cast<std::size_t>(which)] = d.system.event_directions()[static_cast<std::size_t>(which)];
   const double h_allowed = allowed_step();
   if (before_polish) before_polish(t_step_start, t_);
-  polish_event(t_step_start, y_step_start, /*from_here=*/true);
+  polish_event(t_step_start, y_step_start, t_, /*from_here=*/true);
   d.h_resume = std::max(d.h_resume, h_allowed);
   d.h_event = d.h_resume;
 }

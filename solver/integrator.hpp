@@ -185,9 +185,10 @@ class Integrator {
   };
 
   /// Called by advance() at a root return before the event is polished, with the step that holds
-  /// the root: its start and the root ARKODE located on it. interpolate() covers [t_start, t_root]
-  /// during the call (it no longer does once the polish has recomputed the step).
-  using RootStepHook = std::function<void(double t_start, double t_root)>;
+  /// the root: its start and its end (the polished event lies in between, not always before the
+  /// root ARKODE located). interpolate() covers [t_start, t_end] during the call (it no longer does
+  /// once the polish has recomputed the step).
+  using RootStepHook = std::function<void(double t_start, double t_end)>;
 
   /// Advance towards t_target (never past it). In one_step mode return after each internal step,
   /// which lets a caller record the adaptive steps. Throws NumericalError when ARKODE fails (the
@@ -230,7 +231,7 @@ class Integrator {
   int evolve(double t_target, bool one_step);
   void watchdog(double t_before, int flag);
   std::string diagnosis() const;
-  void polish_event(double t_step_start, const Eigen::VectorXd& y_step_start, bool from_here);
+  void polish_event(double t_step_start, const Eigen::VectorXd& y_step_start, double t_step_end, bool from_here);
   Eigen::VectorXd error_weights() const;
   double allowed_step() const;
   void set_root_directions(int ignored = -1);

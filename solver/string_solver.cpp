@@ -515,8 +515,9 @@ const RunSummary& StringSolver<dim>::run() {
     // per frame), and so are all frames of methods of order above kMaxDenseOrder, whose steps are far
     // more accurate than ARKODE's Hermite interpolant (degree <= 5). With root functions, the frames
     // inside the step that holds a root are interpolated before the event's polish recomputes that
-    // step (the interpolant no longer covers them afterwards) and kept if they lie before the
-    // polished event; those at or after it are taken after the event, on the steps that follow.
+    // step (the interpolant no longer covers them afterwards), all of them up to the step's end (the
+    // polish may move the event past ARKODE's root), and kept if they lie before the polished event;
+    // those at or after it are taken after the event, on the steps that follow.
     // `step` is the last step that ended without an event: the polish's step ends at the event and
     // says nothing about the step size of the run.
     // An interpolated frame is also a row of the step record (series.csv), as a frame at a stop time
@@ -529,8 +530,8 @@ const RunSummary& StringSolver<dim>::run() {
     double step = 0;
     std::vector<std::pair<double, Eigen::VectorXd>> before_event;
     long k = 1;
-    const Integrator::RootStepHook interpolate_before_event = [&](double, double t_root) {
-      for (long j = k; j <= n_out && output_time(j) < t_root; ++j)
+    const Integrator::RootStepHook interpolate_before_event = [&](double, double t_step_end) {
+      for (long j = k; j <= n_out && output_time(j) < t_step_end; ++j)
         before_event.emplace_back(output_time(j), integrator->interpolate(output_time(j)));
     };
     const bool interpolating_method = integrator->stats().order <= kMaxDenseOrder;  // fixed for the run
