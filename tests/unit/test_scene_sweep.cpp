@@ -91,6 +91,26 @@ TEST_CASE("the sweep key f names an edge's dissipation when the edge is the scen
   }
 }
 
+TEST_CASE("a sweep row holds the run's events and fronts: a peg's lift-off time at each f", "[unit][sweep][edge]") {
+  // The summary's events (lists of objects) were left out of the rows, so chainsim sweep chain_over_peg.toml
+  // --grid f=... gave the lift-off time only inside the text of stop_reason.
+  const std::string peg = "[string]\nlength = 1.0\nnodes = 21\n[shape]\nkind = \"polyline\"\npoints = [[0.0, -0.4], "
+                          "[0.0, 0.0], [0.0, -0.6]]\n[effects.gravity]\ng = [0.0, -9.81]\n[[effects.edge]]\n"
+                          "point = [0.0, 0.0]\n[solver]\nmethod = \"erk5\"\nrtol = 1e-10\natol = 1e-12\n[stop]\n"
+                          "t_end = 2.0\n";
+  const SweepScene scene{peg, "peg.toml", {}, 2.0};
+  const nlohmann::json row = run_sweep_point(scene, {"f=0.5"});
+  REQUIRE(row["status"] == "stopped");
+  CHECK(row["events[0].kind"] == "lift_off");
+  CHECK(row["events[0].front"] == "edge0");
+  CHECK(row["events[0].t"].get<double>() ==
+        Approx(exact::peg_time(0.5, exact::peg_lift_off_x(0.5, 0.6, 1.0, 9.81), 0.6, 1.0, 9.81)).epsilon(1e-6));
+  CHECK(row["events[0].position[1]"] == 0.0);
+  CHECK(row["fronts[0].kind"] == "edge");
+  CHECK(row["fronts[0].f"] == 0.5);
+  CHECK_FALSE(row.contains("effects[0]"));  // lists of names stay out
+}
+
 TEST_CASE("a scene given as JSON is the scene of the same TOML", "[unit][sweep]") {
   const nlohmann::json scene = {
       {"string", {{"length", 1.0}, {"density", 0.1}, {"nodes", 11}}},
