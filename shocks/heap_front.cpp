@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <string>
 
 #include <fmt/format.h>
 
@@ -42,6 +43,16 @@ constexpr double kEmptyLinks = 1e-7;
 /// A string meeting a plane at less than this cosine between its tangent and the plane's normal
 /// runs along the plane: the contact point is then ill-defined and the run stops.
 constexpr double kGrazing = 1e-3;
+
+/// Why the string's tangent t at the heap (n·t, n the plane's normal) does not run into the plane: at a grazing
+/// angle (|n·t| <= kGrazing), or away from it (the string turns back up within the links the heap's curve spans).
+std::string not_meeting_plane(double n_t, int node) {
+  if (n_t > kGrazing)
+    return fmt::format("the string leaves the heap's plane instead of running into it (n·t = {:.3g} > 0 at node {}: "
+                       "it turns back within two links of the heap)",
+                       n_t, node);
+  return fmt::format("the string meets the heap's plane at a grazing angle (n·t = {:.3g} at node {})", n_t, node);
+}
 
 /// The string near a heap front: the interpolant in the material coordinate (quadratic through
 /// three points, linear through two) of the positions and velocities of the arc's last nodes and, at
@@ -150,9 +161,7 @@ HeapGeometry<dim> heap_geometry(const Points<dim>& x, const Points<dim>& v, bool
   }
   const Vec<dim>& n = normal;
   const Vec<dim> e_last = unit_vector<dim>(Vec<dim>(sigma * c.slope(0)), "the link next to the heap");
-  if (!(n.dot(e_last) < -kGrazing))
-    throw RecoverableError(
-        fmt::format("the string meets the heap's plane at a grazing angle (n·t = {:.3g} at node {})", n.dot(e_last), node));
+  if (!(n.dot(e_last) < -kGrazing)) throw RecoverableError(not_meeting_plane(n.dot(e_last), node));
   double t = sigma * n.dot(point - x.col(node)) / n.dot(e_last);  // the last link's crossing
   // Converged when the step is below 1e-14 h, or at the round-off of the curve: Newton no longer
   // halves a step already below 1e-9 h. The curve is extrapolated past the end node when an accepted
@@ -173,9 +182,7 @@ HeapGeometry<dim> heap_geometry(const Points<dim>& x, const Points<dim>& v, bool
   if (!(g.l > 1e-9 * h) || !std::isfinite(g.l)) throw RecoverableError(fmt::format("node {} has gone through the heap's plane", node));
   const Vec<dim> slope = c.slope(t);
   g.e = sigma * unit_vector<dim>(slope, "the string's tangent at the heap");
-  if (!(n.dot(g.e) < -kGrazing))
-    throw RecoverableError(
-        fmt::format("the string meets the heap's plane at a grazing angle (n·t = {:.3g} at node {})", n.dot(g.e), node));
+  if (!(n.dot(g.e) < -kGrazing)) throw RecoverableError(not_meeting_plane(n.dot(g.e), node));
   g.w = -sigma * n.dot(c.velocity(t)) / n.dot(slope);  // l = σ (s0 − s_k), ṡ0 = −n·ẋ(s0) / n·x'(s0)
   g.position = c.position(t);
   return g;

@@ -128,18 +128,27 @@ void parse_shape(const Section& top, Context& ctx) {
 
 void parse_velocity(const Section& top, Context& ctx) {
   auto& v = ctx.spec.velocity;
-  Section s(subtable(top, "velocity"), "velocity", ctx, {"kind", "value", "speed", "values"});
-  v.kind = s.choice("kind", {"rest", "uniform", "tangential", "nodes"}, "rest");
+  Section s(subtable(top, "velocity"), "velocity", ctx, {"kind", "value", "speed", "values", "omega", "center"});
+  v.kind = s.choice("kind", {"rest", "uniform", "tangential", "nodes", "rotation"}, "rest");
   v.value = s.vector("value");
   v.speed = s.number("speed").value_or(0.0);
   v.values = s.matrix("values");
+  if (const toml::node* omega = s.node("omega"))  // a number in 2D, a vector in 3D
+    v.omega = omega->is_array() ? s.vector("omega") : std::vector<double>{*s.number("omega")};
+  v.center = s.vector("center");
   const std::string context = fmt::format("kind = \"{}\"", v.kind);
   if (v.kind == "uniform" && !s.has("value")) s.missing("value", "m/s, the velocity of every node, for kind = \"uniform\"");
   if (v.kind == "tangential" && !s.has("speed")) s.missing("speed", "m/s, along the string, for kind = \"tangential\"");
   if (v.kind == "nodes" && !s.has("values")) s.missing("values", "m/s, one vector per node, for kind = \"nodes\"");
+  if (v.kind == "rotation" && !s.has("omega"))
+    s.missing("omega", "rad/s, the angular velocity: a number in 2D, [wx, wy, wz] in 3D, for kind = \"rotation\"");
+  if (v.kind == "rotation" && !s.has("center"))
+    s.missing("center", "m, the point the string turns about, for kind = \"rotation\"");
   s.forbid("value", v.kind == "uniform", context);
   s.forbid("speed", v.kind == "tangential", context);
   s.forbid("values", v.kind == "nodes", context);
+  s.forbid("omega", v.kind == "rotation", context);
+  s.forbid("center", v.kind == "rotation", context);
 }
 
 void parse_ends(const Section& top, Context& ctx) {

@@ -18,7 +18,7 @@
 ///     [string]   length (m), density (kg/m), nodes | link_length (m), closed, dimension (2 | 3),
 ///                elements (links | quadratic)
 ///     [shape]    kind = polyline | points | arc | circle | catenary, and that kind's keys
-///     [velocity] kind = rest | uniform | tangential | nodes
+///     [velocity] kind = rest | uniform | tangential | nodes | rotation
 ///     [ends]     start, end = "free" | "fixed" | { kind = "loaded", … } | { kind = "driven", … }
 ///     [effects.gravity] g (m/s²)          [effects.drag] coefficient (1/s)
 ///     [[effects.heap]] side = start | end, s0 (m), f, point (m), on_plane, pot
@@ -169,6 +169,8 @@ struct SceneSpec {
     std::vector<double> value;
     double speed = 0;
     std::vector<std::vector<double>> values;
+    std::vector<double> omega;   ///< rotation: rad/s, one component in 2D (about the out-of-plane axis), three in 3D
+    std::vector<double> center;  ///< rotation: m, the point the string turns about
   } velocity;
   // [ends]
   EndSpec start, end;

@@ -46,6 +46,10 @@ json velocity_json(const SceneSpec::Velocity& v) {
   if (v.kind == "uniform") j["value"] = v.value;
   if (v.kind == "tangential") j["speed"] = v.speed;
   if (v.kind == "nodes") j["values"] = v.values;
+  if (v.kind == "rotation") {
+    j["omega"] = v.omega.size() == 1 ? json(v.omega[0]) : json(v.omega);
+    j["center"] = v.center;
+  }
   return j;
 }
 

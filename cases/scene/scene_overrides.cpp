@@ -3,6 +3,7 @@
 
 #include <cctype>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -126,11 +127,24 @@ class Override {
     return {};
   }
 
+  /// The scene keys that the value being set leaves nothing to apply to: a slack policy other than "allow"
+  /// (check_slack is never "allow") and the restitution of the snaps that only "allow" makes.
+  std::vector<std::string> mooted(const std::string& key) const {
+    const toml::node* value = value_.get("v");
+    const bool allow = value && value->value<std::string>() == std::optional<std::string>("allow");
+    if ((key == "solver.slack" && !allow) || key == "solver.check_slack") return {"snap_restitution"};
+    return {};
+  }
+
   /// The command line is later than the file: setting `key` (in `table`) removes what the file says of the
   /// same thing under another name (--set solver.slack=allow on a scene with check_slack = true, --set
-  /// string.link_length on one with nodes). Two overrides that do so still meet the parser's refusal.
+  /// string.link_length on one with nodes), and what the new value leaves nothing to apply to (--set
+  /// solver.slack=stop on a scene with slack = "allow" and snap_restitution). Two overrides that do so still
+  /// meet the parser's refusal.
   void drop_file_alternatives(toml::table& table, const std::string& key) const {
-    for (const std::string& other : alternatives(key)) {
+    std::vector<std::string> others = alternatives(key);
+    for (std::string& other : mooted(key)) others.push_back(std::move(other));
+    for (const std::string& other : others) {
       const toml::node* node = table.get(other);
       if (node == nullptr) continue;
       const auto& path = node->source().path;

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include <Eigen/Geometry>
 #include <fmt/format.h>
 
 #include "cases/scene/scene_build.hpp"
@@ -182,6 +183,25 @@ SceneParts<dim> build_scene_parts(const SceneSpec& spec) {
     const Points<dim> values = as_points<dim>(spec, vel.values, "velocity.values");
     at_key(spec, "velocity.values", [&] { set_node_velocities(chain, values); });
   }
+  if (vel.kind == "rotation") {  // a rigid rotation: v_i = ω × (x_i − c)
+    const Vec<dim> center = as_vec<dim>(spec, vel.center, "velocity.center");
+    const std::size_t components = dim == 2 ? 1 : 3;
+    if (vel.omega.size() != components)
+      fail_at(spec, "velocity.omega",
+              fmt::format("velocity.omega = {} has {} component{} but string.dimension = {}: allowed {}",
+                          text_of(spec, "velocity.omega"), vel.omega.size(), vel.omega.size() == 1 ? "" : "s",
+                          spec.dimension, dim == 2 ? "a number (rad/s about the out-of-plane axis)" : "[wx, wy, wz]"));
+    Points<dim> values(dim, chain.num_nodes());
+    for (int i = 0; i < chain.num_nodes(); ++i) {
+      const Vec<dim> r = chain.positions().col(i) - center;
+      if constexpr (dim == 2) {
+        values.col(i) = vel.omega[0] * Vec<dim>(-r[1], r[0]);
+      } else {
+        values.col(i) = Eigen::Vector3d(vel.omega[0], vel.omega[1], vel.omega[2]).cross(Eigen::Vector3d(r));
+      }
+    }
+    at_key(spec, "velocity.omega", [&] { set_node_velocities(chain, values); });
+  }
 
   // 3. Effects and ends: exactly those the scene declares.
   std::vector<std::unique_ptr<Force<dim>>> forces;
@@ -244,6 +264,7 @@ SceneParts<dim> build_scene_parts(const SceneSpec& spec) {
     const std::string velocity_key = vel.kind == "uniform"      ? "velocity.value"
                                      : vel.kind == "tangential" ? "velocity.speed"
                                      : vel.kind == "nodes"      ? "velocity.values"
+                                     : vel.kind == "rotation"   ? "velocity.omega"
                                                                 : "ends";
     const double t_end = spec.stop.t_end, gn = g.stableNorm();
     const double tension = spec.density * (gn * length + v_max * v_max) + force;

@@ -95,10 +95,15 @@ void flatten_into(nlohmann::json& row, const std::string& prefix, const nlohmann
   if (value.is_object()) {
     for (const auto& [key, item] : value.items()) flatten_into(row, prefix.empty() ? key : prefix + "." + key, item);
   } else if (value.is_array()) {
-    bool numbers = true;
-    for (const auto& item : value) numbers = numbers && item.is_number();
-    if (!numbers) return;
-    for (std::size_t k = 0; k < value.size(); ++k) row[fmt::format("{}[{}]", prefix, k)] = value[k];
+    // Numbers as name[k]; objects (the events, the fronts, the obstacles) as name[k].key, so that a row holds
+    // an edge's lift-off time (events[0].t); other lists (of names) are left out.
+    bool numbers = true, objects = true;
+    for (const auto& item : value) {
+      numbers = numbers && item.is_number();
+      objects = objects && item.is_object();
+    }
+    if (!numbers && !objects) return;
+    for (std::size_t k = 0; k < value.size(); ++k) flatten_into(row, fmt::format("{}[{}]", prefix, k), value[k]);
   } else if (!value.is_null()) {
     row[prefix] = value;
   }

@@ -4,11 +4,14 @@
 // test_hard_tilted_fold.cpp.
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <string>
 
 #include <catch2/catch.hpp>
 
 #include "cases/canonical/canonical_string.hpp"
+#include "cases/scene/scene.hpp"
+#include "solver/string_solver.hpp"
 #include "../convergence/canonical_test_support.hpp"
 
 using namespace chainsim;
@@ -118,4 +121,21 @@ TEST_CASE("a sliding chain stopped by the safety time agrees with the reduced OD
   // A safety stop before the string's start is refused, naming it.
   setup.t_max_over_t0 = 0.1;
   CHECK_THROWS_WITH(compare_with_reduced(setup), Contains("--t-max = 0.1 ends before the string starts"));
+}
+
+TEST_CASE("a heap whose curve spans a corner of a coarse V stops saying the string leaves the plane, not grazing",
+          "[hard][shocks]") {
+  // cases/scenes/chain_into_heap_on_table.toml (a V falling into its heap on a table) on 7 and 11 nodes: the
+  // heap's curve through the last two links spans the V's corner, its tangent at the table points up, and
+  // the run stopped with "the string meets the heap's plane at a grazing angle (n·t = 0.8 at node 3)",
+  // an angle of 37° from the table, not a grazing one.
+  const auto file = std::filesystem::path(CHAINSIM_SOURCE_DIR) / "cases" / "scenes" / "chain_into_heap_on_table.toml";
+  for (const int nodes : {7, 11}) {
+    CAPTURE(nodes);
+    StringScene<2> scene = build_string_scene<2>(parse_scene(file, {"string.nodes=" + std::to_string(nodes)}));
+    StringSolver<2> solver(*scene.model, scene.solver);
+    CHECK_THROWS_WITH(solver.run(), Contains("the string degenerated at t = 0.") &&
+                                        Contains("the string leaves the heap's plane instead of running into it (n·t = "
+                                                 "0.8 > 0 at node"));
+  }
 }

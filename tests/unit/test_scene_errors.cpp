@@ -151,7 +151,7 @@ TEST_CASE("bad scenes are refused with the location, the key, the value and what
        "points of an open polyline are rounded"},
       {"an unknown velocity kind",
        kBase + std::string("[velocity]\nkind = \"spin\"\n"),
-       "s.toml:19:8: velocity.kind = \"spin\" is not allowed; valid values: rest, uniform, tangential, nodes"},
+       "s.toml:19:8: velocity.kind = \"spin\" is not allowed; valid values: rest, uniform, tangential, nodes, rotation"},
       {"a tangential velocity without speed",
        kBase + std::string("[velocity]\nkind = \"tangential\"\n"),
        "s.toml:18:1: [velocity] needs speed (m/s, along the string, for kind = \"tangential\")"},

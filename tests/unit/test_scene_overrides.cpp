@@ -190,6 +190,26 @@ TEST_CASE("an override (--set) replaces values, array elements and whole arrays,
                Contains("--set string.link_length=0.05: string.link_length = 0.05 and string.nodes = 21 both set the "
                         "resolution"));
   }
+  SECTION("a slack policy other than allow set on the command line drops the file's snap_restitution") {
+    // cases/scenes/swinging_u.toml writes slack = "allow" and snap_restitution = 0.0: --set solver.slack=stop (to
+    // see where the taut model ends) was refused at the file's restitution, "applies only with slack = allow",
+    // and so was every point but allow of chainsim sweep --grid solver.slack=stop,warn,allow.
+    const std::string file =
+        edit(test::kSceneBase, "[stop]", "[solver]\nslack = \"allow\"\nsnap_restitution = 0.5\n\n[stop]");
+    CHECK(parse_scene_text(file, "s.toml").solver.snap_restitution == 0.5);
+    for (const char* policy : {"stop", "warn", "ignore"}) {
+      const SceneSpec spec = parse_scene_text(file, "s.toml", {std::string("solver.slack=") + policy});
+      CHECK(spec.solver.slack == policy);
+      CHECK(spec.solver.snap_restitution == 0.0);
+    }
+    CHECK(parse_scene_text(file, "s.toml", {"solver.check_slack=true"}).solver.slack == "stop");
+    // allow keeps the file's restitution; a restitution given on the command line with another policy is
+    // still refused, as in the file.
+    CHECK(parse_scene_text(file, "s.toml", {"solver.slack=allow"}).solver.snap_restitution == 0.5);
+    CHECK_THAT(error_of(file, {"solver.slack=stop", "solver.snap_restitution=0.5"}),
+               Contains("--set solver.snap_restitution=0.5: solver.snap_restitution = 0.5 applies only with "
+                        "solver.slack = \"allow\""));
+  }
   SECTION("a section the scene lacks is created: --set effects.drag.coefficient declares drag") {
     const SceneSpec plain = parse_scene_text(test::kSceneBase, "s.toml");
     REQUIRE_FALSE(plain.effects.drag);

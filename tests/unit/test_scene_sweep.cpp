@@ -19,6 +19,14 @@ using namespace chainsim;
 using chainsim::test::kFallingBase;
 using chainsim::test::kSceneBase;
 
+namespace {
+/// 1 m of chain over a sharp peg, 0.6 m and 0.4 m, released at rest (cases/scenes/chain_over_peg.toml on 21 nodes).
+const std::string kPeg = "[string]\nlength = 1.0\nnodes = 21\n[shape]\nkind = \"polyline\"\npoints = [[0.0, -0.4], "
+                         "[0.0, 0.0], [0.0, -0.6]]\n[effects.gravity]\ng = [0.0, -9.81]\n[[effects.edge]]\n"
+                         "point = [0.0, 0.0]\n[solver]\nmethod = \"erk5\"\nrtol = 1e-10\natol = 1e-12\n[stop]\n"
+                         "t_end = 2.0\n";
+}  // namespace
+
 TEST_CASE("sweep grids: axes, points in order, refused grids", "[unit][sweep]") {
   const SweepAxis a = parse_grid_axis("shape.points=[[0,0],[0,-1]],[[0,0],[1,0]]");
   CHECK(a.key == "shape.points");
@@ -77,11 +85,7 @@ TEST_CASE("a sweep point that fails numerically is a row with its error", "[unit
 TEST_CASE("the sweep key f names an edge's dissipation when the edge is the scene's only front", "[unit][sweep][edge]") {
   // chainsim sweep chain_over_peg.toml --grid f=0,0.5 said "the scene has 0 fronts": an edge was not counted.
   // The peg lifts off where the exact solution says (compare peg), at each f.
-  const std::string peg = "[string]\nlength = 1.0\nnodes = 21\n[shape]\nkind = \"polyline\"\npoints = [[0.0, -0.4], "
-                          "[0.0, 0.0], [0.0, -0.6]]\n[effects.gravity]\ng = [0.0, -9.81]\n[[effects.edge]]\n"
-                          "point = [0.0, 0.0]\n[solver]\nmethod = \"erk5\"\nrtol = 1e-10\natol = 1e-12\n[stop]\n"
-                          "t_end = 2.0\n";
-  const SweepScene scene{peg, "peg.toml", {}, 2.0};
+  const SweepScene scene{kPeg, "peg.toml", {}, 2.0};
   for (const double f : {0.0, 0.5}) {
     CAPTURE(f);
     const nlohmann::json row = run_sweep_point(scene, {fmt::format("f={}", f)});
@@ -89,6 +93,22 @@ TEST_CASE("the sweep key f names an edge's dissipation when the edge is the scen
     CHECK(row["t_stop"].get<double>() ==
           Approx(exact::peg_time(f, exact::peg_lift_off_x(f, 0.6, 1.0, 9.81), 0.6, 1.0, 9.81)).epsilon(1e-6));
   }
+}
+
+TEST_CASE("a sweep row holds the run's events and fronts: a peg's lift-off time at each f", "[unit][sweep][edge]") {
+  // The summary's events (lists of objects) were left out of the rows, so chainsim sweep chain_over_peg.toml
+  // --grid f=... gave the lift-off time only inside the text of stop_reason.
+  const SweepScene scene{kPeg, "peg.toml", {}, 2.0};
+  const nlohmann::json row = run_sweep_point(scene, {"f=0.5"});
+  REQUIRE(row["status"] == "stopped");
+  CHECK(row["events[0].kind"] == "lift_off");
+  CHECK(row["events[0].front"] == "edge0");
+  CHECK(row["events[0].t"].get<double>() ==
+        Approx(exact::peg_time(0.5, exact::peg_lift_off_x(0.5, 0.6, 1.0, 9.81), 0.6, 1.0, 9.81)).epsilon(1e-6));
+  CHECK(row["events[0].position[1]"] == 0.0);
+  CHECK(row["fronts[0].kind"] == "edge");
+  CHECK(row["fronts[0].f"] == 0.5);
+  CHECK_FALSE(row.contains("effects[0]"));  // lists of names stay out
 }
 
 TEST_CASE("a scene given as JSON is the scene of the same TOML", "[unit][sweep]") {
