@@ -190,6 +190,10 @@ std::unique_ptr<StringModel<dim>> build_front_model(const SceneSpec& spec, scene
 
   // 2. What a string with fronts cannot have.
   const SceneFrontKeys keys(spec);
+  if (chain.closed() && spec.solver.kinks == "insert" && !spec.has_fronts_declared())
+    fail_at(spec, "solver.kinks",
+            "solver.kinks = \"insert\" on a closed string: kink fronts are tracked on open strings only (string.closed = "
+            "true); allowed: \"off\"");
   check_open_string(chain.closed(), !fx.heaps.empty(), keys);
   if (chain.num_links() < 2) {
     const std::string key = spec.link_length ? "string.link_length" : "string.nodes";

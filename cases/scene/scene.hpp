@@ -189,9 +189,10 @@ struct SceneSpec {
     return !effects.surfaces.empty() || !effects.cylinders.empty() || (effects.plane && effects.plane->surface);
   }
   /// The scene has a heap, a fold, an edge or a kink: the string runs with front tracking.
-  bool has_fronts() const {
-    return !effects.heaps.empty() || effects.fold.has_value() || !effects.edges.empty() || !effects.kinks.empty() ||
-           solver.kinks == "insert";
+  bool has_fronts() const { return has_fronts_declared() || solver.kinks == "insert"; }
+  /// A front declared among the effects (not only a kink that may form).
+  bool has_fronts_declared() const {
+    return !effects.heaps.empty() || effects.fold.has_value() || !effects.edges.empty() || !effects.kinks.empty();
   }
   // [solver]
   struct Solver {

@@ -441,3 +441,16 @@ TEST_CASE("a kink front inserted where the swinging U's kink forms: the formatio
   CHECK(std::abs(absorbed[1] - absorbed[0]) < 1e-2);
   CHECK(residual[1] < residual[0]);
 }
+
+TEST_CASE("kinks = insert is refused on a closed string, located at the key", "[kink][shocks][scene]") {
+  const std::filesystem::path file =
+      std::filesystem::path(CHAINSIM_SOURCE_DIR) / "cases" / "scenes" / "travelling_loop.toml";
+  const SceneSpec spec = parse_scene(file, {"solver.kinks=\"insert\""});
+  try {
+    build_string_scene<2>(spec);
+    FAIL("a closed string with kinks = insert was accepted");
+  } catch (const InputError& e) {
+    CHECK_THAT(e.what(), Catch::Contains("solver.kinks = \"insert\" on a closed string") &&
+                             Catch::Contains("allowed: \"off\""));
+  }
+}
