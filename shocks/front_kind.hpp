@@ -70,6 +70,10 @@ class FrontKind {
   double dissipation = 0;  ///< f of the front's internal shock, in [0, 1]
   double expected_s0 = 0;  ///< where the front is meant to start (m)
   int arc_minus = -1, arc_plus = -1;  ///< arcs on either side (−1: the side of a reservoir, e.g. a heap)
+  /// False once the front has left the string (a kink absorbed at a held end, docs/model.md §2.5): the
+  /// tracker then skips it (no masses, loads, constraints or ledger rates; root functions held positive),
+  /// and its record keeps the state it had when it left.
+  bool active = true;
 
   /// "heap", "fold": the kind's name in messages and in the scene description.
   virtual const char* name() const = 0;
@@ -139,6 +143,23 @@ class FrontKind {
   virtual int second_direction() const = 0;
   /// Acts on a crossing (e0: g[0] was found, else g[1]): moves material between the arcs or the front.
   virtual EventAction cross(StringModel<dim>& model, const FrontState<dim>& state, int e0) = 0;
+  /// Whether the crossing e0 takes the front out of the string (a kink that reaches a held end, docs/model.md
+  /// §2.5): the tracker then calls remove() instead of cross(), and the velocities jump by an impact.
+  virtual bool absorbed(const StringModel<dim>& /*model*/, const FrontState<dim>& /*state*/, int /*e0*/) const {
+    return false;
+  }
+  /// Takes the front out of the string: its two arcs become one (model.arcs(), then model.rebuild()), the
+  /// material it split between them lumped as the string lumps a full link, moving with its momentum.
+  virtual void remove(StringModel<dim>& /*model*/, const FrontState<dim>& /*state*/) {
+    throw Error(fmt::format("a {} front cannot be removed", name()));
+  }
+  /// A front that is not in the string yet (active false) and may be inserted where its kind forms (a kink
+  /// where the string's tangent turns sharply): its formation root function, positive until then (it takes
+  /// the slot of the front's first check). 1 for a kind that never forms.
+  virtual double formation_margin(const StringModel<dim>& /*model*/) const { return 1; }
+  /// Puts the front into the string where it formed: splits an arc (model.arcs(), then model.rebuild()) and
+  /// sets arc_minus, arc_plus; returns false if no place fits (the run then stops).
+  virtual bool insert(StringModel<dim>& /*model*/) { return false; }
   /// Constraints of the front that couple nodes beyond the links (NodeConstraint, a kink's
   /// compatibility), at the string's current state, after `evaluate`.
   virtual void constraints(const StringModel<dim>& /*model*/, const FrontState<dim>& /*state*/,

@@ -112,19 +112,22 @@ void FrontTracker<dim>::initialize(StringModel<dim>& model) {
   // A front is where the links put it: a partial link is straight, so on a curved shape the front
   // lies off s0 by O(κ h²). That is accepted up to a tenth of a link; the masses follow the geometry.
   for (std::size_t k = 0; k < fronts_.size(); ++k)
-    if (std::abs(fs_[k].s0 - fronts_[k]->expected_s0) > std::max(1e-6 * material_.ell, 0.1 * material_.h))
+    if (fronts_[k]->active &&
+        std::abs(fs_[k].s0 - fronts_[k]->expected_s0) > std::max(1e-6 * material_.ell, 0.1 * material_.h))
       throw InputError(fmt::format(
           "the {} front is meant to be at s0 = {:.9g} m but the initial shape puts it at s0 = {:.9g} m: "
           "place the {} at the string's material point s0",
           fronts_[k]->name(), fronts_[k]->expected_s0, fs_[k].s0, fronts_[k]->placed()));
-  for (std::size_t k = 0; k < fronts_.size(); ++k) fronts_[k]->check_initial(fs_[k]);
+  for (std::size_t k = 0; k < fronts_.size(); ++k)
+    if (fronts_[k]->active) fronts_[k]->check_initial(fs_[k]);
   heap_moment0_.setZero();
   for (std::size_t k = 0; k < fronts_.size(); ++k) fronts_[k]->add_held_moment(fs_[k], 0.0, heap_moment0_);
 }
 
 template <int dim>
 void FrontTracker<dim>::add_mass_and_forces(const StringModel<dim>& model, Eigen::VectorXd& mass, Points<dim>& force) {
-  for (std::size_t k = 0; k < fronts_.size(); ++k) fronts_[k]->evaluate(model, fs_[k], mass, force);
+  for (std::size_t k = 0; k < fronts_.size(); ++k)
+    if (fronts_[k]->active) fronts_[k]->evaluate(model, fs_[k], mass, force);
   const double lambda = material_.lambda, h = material_.h;
   for (int i = 0; i < material_.n; ++i)
     if (model.in_arc(i) && !model.is_prescribed(i) && !(mass[i] > 1e-12 * lambda * h))
@@ -134,13 +137,16 @@ void FrontTracker<dim>::add_mass_and_forces(const StringModel<dim>& model, Eigen
 template <int dim>
 std::optional<double> FrontTracker<dim>::front_tension_at(const StringModel<dim>& model, int node) const {
   for (std::size_t k = 0; k < fronts_.size(); ++k)
-    if (const std::optional<double> tension = fronts_[k]->tension_at(model, fs_[k], node)) return tension;
+    if (!fronts_[k]->active) continue;
+    else if (const std::optional<double> tension = fronts_[k]->tension_at(model, fs_[k], node))
+      return tension;
   return std::nullopt;
 }
 
 template <int dim>
 void FrontTracker<dim>::node_constraints(const StringModel<dim>& model, std::vector<NodeConstraint<dim>>& out) const {
-  for (std::size_t k = 0; k < fronts_.size(); ++k) fronts_[k]->constraints(model, fs_[k], out);
+  for (std::size_t k = 0; k < fronts_.size(); ++k)
+    if (fronts_[k]->active) fronts_[k]->constraints(model, fs_[k], out);
 }
 
 template <int dim>
@@ -150,7 +156,8 @@ bool FrontTracker<dim>::has_load_derivatives() const {
 
 template <int dim>
 void FrontTracker<dim>::load_derivatives(StringModel<dim>& model, std::vector<LoadDerivative<dim>>& out) {
-  for (std::size_t k = 0; k < fronts_.size(); ++k) fronts_[k]->add_load_derivatives(model, fs_[k], out);
+  for (std::size_t k = 0; k < fronts_.size(); ++k)
+    if (fronts_[k]->active) fronts_[k]->add_load_derivatives(model, fs_[k], out);
 }
 
 template <int dim>
@@ -165,6 +172,7 @@ void FrontTracker<dim>::ledger_rates(const StringModel<dim>& model, Eigen::Ref<E
   double w_shocks = 0, w_heaps = 0;
   Vec<dim> external = model.external_force(), heap_moment_rate = Vec<dim>::Zero();
   for (std::size_t k = 0; k < fs_.size(); ++k) {
+    if (!fronts_[k]->active) continue;
     const FrontState<dim>& s = fs_[k];
     w_shocks += s.power_shock;
     w_heaps += s.power_heap;
@@ -194,7 +202,8 @@ double FrontTracker<dim>::potential_correction(const StringModel<dim>& model,
   // uniform field the forces declare (initialize() refuses any other conservative force).
   const Vec<dim> g = model.uniform_field();
   double first_moment = g.dot(heap_moment0_ + ledger.template segment<dim>(2 + dim));
-  for (std::size_t k = 0; k < fronts_.size(); ++k) first_moment += fronts_[k]->potential_moment(model, fs_[k], g);
+  for (std::size_t k = 0; k < fronts_.size(); ++k)
+    if (fronts_[k]->active) first_moment += fronts_[k]->potential_moment(model, fs_[k], g);
   return -first_moment;
 }
 
@@ -250,7 +259,12 @@ void FrontTracker<dim>::fill(const StringModel<dim>& model, const Eigen::Ref<con
 
 template <int dim>
 void FrontTracker<dim>::events(const StringModel<dim>& model, Eigen::Ref<Eigen::VectorXd> g) const {
-  for (std::size_t k = 0; k < fronts_.size(); ++k) fronts_[k]->crossings(model, fs_[k], g.data() + 2 * k);
+  // A front that has left the string (FrontKind::active) keeps its root functions, held positive.
+  for (std::size_t k = 0; k < fronts_.size(); ++k)
+    if (fronts_[k]->active)
+      fronts_[k]->crossings(model, fs_[k], g.data() + 2 * k);
+    else
+      g[2 * static_cast<Eigen::Index>(k)] = g[2 * static_cast<Eigen::Index>(k) + 1] = 1;
   for (std::size_t k = 0; k < options_.stop_at.size(); ++k) {
     const auto& stop = options_.stop_at[k];
     g[2 * static_cast<int>(fronts_.size()) + static_cast<int>(k)] = fs_[static_cast<std::size_t>(stop.front)].s0 - stop.s;
@@ -258,7 +272,12 @@ void FrontTracker<dim>::events(const StringModel<dim>& model, Eigen::Ref<Eigen::
   // Then each front's own checks, positive while the run may go on.
   int q = 2 * static_cast<int>(fronts_.size()) + static_cast<int>(options_.stop_at.size());
   for (std::size_t k = 0; k < fronts_.size(); ++k) {
-    fronts_[k]->checks(model, fs_[k], g.data() + q);
+    if (fronts_[k]->active) {
+      fronts_[k]->checks(model, fs_[k], g.data() + q);
+    } else if (fronts_[k]->num_checks() > 0) {  // its formation takes its first check's slot
+      g.segment(q, fronts_[k]->num_checks()).setOnes();
+      g[q] = fronts_[k]->formation_margin(model);
+    }
     q += fronts_[k]->num_checks();
   }
 }
@@ -283,9 +302,14 @@ EventAction FrontTracker<dim>::handle_events(StringModel<dim>& model, double t, 
     if (found[static_cast<std::size_t>(2 * nf) + k] != 0)
       return {EventAction::Kind::kStop,
               fmt::format("front {} reached s0 = {:.9g} m", options_.stop_at[k].front, options_.stop_at[k].s)};
+  std::optional<std::size_t> forming;  // a front not yet in the string whose formation was found
   for (std::size_t k = 0, q = static_cast<std::size_t>(2 * nf) + options_.stop_at.size(); k < fronts_.size(); ++k)
     for (int c = 0; c < fronts_[k]->num_checks(); ++c)
       if (found[q++] != 0) {
+        if (!fronts_[k]->active) {
+          forming = k;
+          continue;
+        }
         if (std::optional<RunEvent> event = fronts_[k]->check_event(model, fs_[k], t)) {
           event->front = static_cast<int>(k);
           events_.push_back(std::move(*event));
@@ -297,22 +321,40 @@ EventAction FrontTracker<dim>::handle_events(StringModel<dim>& model, double t, 
   const Vec<dim> p_before = model.momentum();
   std::vector<double> held_before(fronts_.size());
   for (std::size_t k = 0; k < fronts_.size(); ++k) held_before[k] = fronts_[k]->held_mass(fs_[k]);
-  for (int f = 0; f < nf; ++f) {
+  bool absorbed = false;
+  if (forming && !insert_front(model, *forming, t))
+    return {EventAction::Kind::kStop,
+            fmt::format("a {} formed at t = {:.9g} s where no link fits it (its arms need a full link on either side)",
+                        fronts_[*forming]->name(), t)};
+  for (int f = 0; f < nf && !forming; ++f) {
     const int e0 = found[static_cast<std::size_t>(2 * f)], e1 = found[static_cast<std::size_t>(2 * f + 1)];
     if (e0 == 0 && e1 == 0) continue;
     const auto k = static_cast<std::size_t>(f);
+    if (!fronts_[k]->active) continue;
+    if (fronts_[k]->absorbed(model, fs_[k], e0)) {
+      remove_front(model, k, t);
+      absorbed = true;
+      break;
+    }
     const EventAction action = fronts_[k]->cross(model, fs_[k], e0);
     if (action.kind == EventAction::Kind::kStop) return action;
     ++transfers_;
     break;  // one crossing per event; a simultaneous one is found again right after
   }
   // The new links are brought back to their lengths (a fold's arms are never exactly antiparallel
-  // in the discrete state); the kinetic energy the crossing changes is booked.
+  // in the discrete state); the kinetic energy the crossing changes is booked. A front absorbed at a held
+  // end leaves velocities that the string's constraints no longer allow (the merged link lengthens, the
+  // end is held): they jump by an impact, the snap's law with the scene's restitution where slack is
+  // allowed (perfectly inelastic otherwise), and the energy it changes is the front's last dissipation,
+  // booked in W_shocks (docs/model.md §2.5, "A kink at a held end").
   model.refresh();
   try {
-    model.project(t);
+    if (absorbed)
+      model.impact(t, model.options().snap_restitution);
+    else
+      model.project(t);
   } catch (const NumericalError& e) {
-    throw NumericalError(fmt::format("after a front crossing: {}", e.what()), t);
+    throw NumericalError(fmt::format("after a front {}: {}", absorbed ? "left the string" : "crossing", e.what()), t);
   }
   model.refresh();
   // The material a crossing moves between an arc and a heap (the front is re-drawn through the new
@@ -326,8 +368,53 @@ EventAction FrontTracker<dim>::handle_events(StringModel<dim>& model, double t, 
     fronts_[k]->add_held_moment(fs_[k], held_before[k], moment);
     ledger.template segment<dim>(2 + dim) = moment;
   }
-  w_remesh_ += model.kinetic_energy() + model.potential_energy(ledger) - E_before;
+  const double changed = model.kinetic_energy() + model.potential_energy(ledger) - E_before;
+  if (absorbed)
+    ledger[0] += changed;
+  else
+    w_remesh_ += changed;
   return {EventAction::Kind::kTransfer, {}};
+}
+
+template <int dim>
+bool FrontTracker<dim>::insert_front(StringModel<dim>& model, std::size_t k, double t) {
+  FrontKind<dim>& front = *fronts_[k];
+  if (!front.insert(model)) return false;
+  const int split = front.arc_minus;  // arc `split` became arcs split, split + 1
+  front.active = true;
+  for (auto& other : fronts_) {
+    if (other.get() == &front) continue;
+    if (other->arc_minus >= split) ++other->arc_minus;
+    if (other->arc_plus > split) ++other->arc_plus;
+  }
+  model.refresh();
+  const FrontState<dim>& s = fs_[k];
+  RunEvent event{fmt::format("{}_inserted", front.name()), t, static_cast<int>(k), {}, {{"s0", s.s0}, {"s0_dot", s.s0_dot}}};
+  for (int d = 0; d < dim; ++d) event.position.push_back(s.position[d]);
+  events_.push_back(std::move(event));
+  return true;
+}
+
+template <int dim>
+void FrontTracker<dim>::remove_front(StringModel<dim>& model, std::size_t k, double t) {
+  FrontKind<dim>& front = *fronts_[k];
+  const int gone = front.arc_plus;  // arcs A and B become one: the arcs after B shift down by one
+  front.active = false;
+  front.remove(model, fs_[k]);
+  for (auto& other : fronts_) {
+    if (other.get() == &front) continue;
+    if (other->arc_minus >= gone) --other->arc_minus;
+    if (other->arc_plus >= gone) --other->arc_plus;
+  }
+  FrontState<dim>& s = fs_[k];
+  RunEvent event{fmt::format("{}_absorbed", front.name()), t, static_cast<int>(k), {}, {{"s0", s.s0}, {"s0_dot", s.s0_dot}}};
+  for (int d = 0; d < dim; ++d) event.position.push_back(s.position[d]);
+  events_.push_back(std::move(event));
+  // Its record from now on: where it left, at rest in the material, carrying nothing.
+  s.s0_dot = 0;
+  s.tension_minus = s.tension_plus = 0;
+  s.power_shock = s.power_heap = 0;
+  s.reaction.setZero();
 }
 
 template <int dim>

@@ -156,6 +156,14 @@ class FrontTracker final : public StringModule<dim> {
 
  private:
   int num_checks() const;
+  /// Takes front k out of the string at t (FrontKind::absorbed: a kink at a held end): its arcs merge
+  /// (FrontKind::remove), the other fronts' arc indices follow, it becomes inactive, and the run's events
+  /// list "<kind>_absorbed".
+  void remove_front(StringModel<dim>& model, std::size_t k, double t);
+  /// Puts front k, not yet in the string, where it formed (FrontKind::insert: a kink where the tangent turns
+  /// sharply), the other fronts' arc indices following; the run's events list "<kind>_inserted". False if no
+  /// place fits.
+  bool insert_front(StringModel<dim>& model, std::size_t k, double t);
 
   FrontOptions options_;
   FrontMaterial material_;

@@ -14,9 +14,70 @@
 namespace chainsim {
 
 template <int dim>
-KinkFront<dim>::KinkFront(const KinkSpec& spec) {
+KinkFront<dim>::KinkFront(const KinkSpec& spec) : spec_(spec) {
   this->dissipation = 0;  // a kink whose arms are not antiparallel dissipates nothing (docs/model.md §2.5)
   this->expected_s0 = spec.s0;
+  this->active = !spec.inserted;
+}
+
+template <int dim>
+void KinkFront<dim>::cut(FrontLayout& layout) {
+  if (this->active) SplitLinkFront<dim>::cut(layout);
+}
+
+template <int dim>
+double KinkFront<dim>::formation_margin(const StringModel<dim>& model) const {
+  // The turn between the links at either end of a window of 2m links (m ≥ 1), centred on link j, inside one arc.
+  const Points<dim>& x = model.x();
+  const int m = std::max(1, static_cast<int>(std::lround(spec_.window / (2 * this->m_.h))));
+  double lowest = 2;
+  sharpest_ = -1;
+  for (const ArcRange& arc : model.arcs())
+    for (int j = arc.first + m; j + m + 1 <= arc.last; ++j) {
+      const Vec<dim> t1 = x.col(j - m + 1) - x.col(j - m), t2 = x.col(j + m + 1) - x.col(j + m);
+      const double n = t1.norm() * t2.norm();
+      if (!(n > 0)) continue;
+      const double c = t1.dot(t2) / n;
+      if (c < lowest) lowest = c, sharpest_ = j;
+    }
+  return lowest - std::cos(spec_.turn_deg * kPi / 180);
+}
+
+template <int dim>
+bool KinkFront<dim>::insert(StringModel<dim>& model) {
+  formation_margin(model);
+  if (sharpest_ < 0) return false;
+  const Points<dim>& x = model.x();
+  const double h = this->m_.h;
+  const int m = std::max(1, static_cast<int>(std::lround(spec_.window / (2 * h))));
+  std::vector<ArcRange>& arcs = model.arcs();
+  const int k = model.arc_of(sharpest_);
+  const ArcRange arc = arcs[static_cast<std::size_t>(k)];
+  // The link (j, j+1) of the window whose neighbours turn most, with the arms' meeting point inside it
+  // (l⁻ in (0.05 h, 0.95 h)) and a full link on either side.
+  int best = -1;
+  double best_cos = 2, best_l = 0;
+  for (int j = std::max(arc.first + 1, sharpest_ - m); j <= std::min(arc.last - 2, sharpest_ + m); ++j) {
+    const Vec<dim> tA = (x.col(j) - x.col(j - 1)).normalized(), tB = (x.col(j + 2) - x.col(j + 1)).normalized();
+    const Vec<dim> d = tA - tB;
+    if (!(d.squaredNorm() > 0)) continue;
+    const double lA = (x.col(j + 1) - x.col(j) - h * tB).dot(d) / d.squaredNorm();
+    const double c = tA.dot(tB);
+    if (c < best_cos && lA > 0.05 * h && lA < 0.95 * h) best = j, best_cos = c, best_l = lA;
+  }
+  if (best < 0) return false;
+  // The arms are full taut links; the kinked link leaves the arcs (StringModel::rebuild).
+  if (model.allows_slack()) {
+    model.set_slack(best - 1, false);
+    model.set_slack(best + 1, false);
+  }
+  arcs[static_cast<std::size_t>(k)].last = best;
+  arcs.insert(arcs.begin() + k + 1, ArcRange{best + 1, arc.last, false});
+  this->arc_minus = k;
+  this->arc_plus = k + 1;
+  this->expected_s0 = model.chain().node_coordinate(best) + best_l;
+  model.rebuild();
+  return true;
 }
 
 template <int dim>
@@ -134,6 +195,15 @@ void KinkFront<dim>::constraints(const StringModel<dim>& model, const FrontState
       out.push_back(std::move(c));
     }
   }
+}
+
+template <int dim>
+bool KinkFront<dim>::absorbed(const StringModel<dim>& model, const FrontState<dim>& /*state*/, int e0) const {
+  const ArcRange& A = model.arcs()[static_cast<std::size_t>(this->arc_minus)];
+  const ArcRange& B = model.arcs()[static_cast<std::size_t>(this->arc_plus)];
+  // e0: the kink reached arc B's first node (towards the end of the string), else arc A's last node.
+  if (e0 != 0) return B.num_links() < 2 && model.is_prescribed(B.last);
+  return A.num_links() < 2 && model.is_prescribed(A.first);
 }
 
 template <int dim>

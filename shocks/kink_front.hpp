@@ -10,6 +10,11 @@ namespace chainsim {
 /// A kink between the arc before and the arc after s0.
 struct KinkSpec {
   double s0 = 0;  ///< initial material coordinate of the kink (m), in (0, ℓ)
+  /// Not in the string at the start: inserted where a kink forms ([solver] kinks = "insert"), the tangent's
+  /// turn over `window` (m of material) first passing `turn_deg`.
+  bool inserted = false;
+  double turn_deg = 90;
+  double window = 0;
 };
 
 template <int dim>
@@ -29,6 +34,14 @@ class KinkFront final : public SplitLinkFront<dim> {
   const char* placed() const override { return "kink"; }
 
   void check_initial(const FrontState<dim>& state) const override;
+  /// A kink to be inserted takes no share of the initial layout.
+  void cut(FrontLayout& layout) override;
+  /// cos(turn_deg) subtracted from the smallest cosine of the turn between the links at either end of a
+  /// window of material (KinkSpec::window) in one arc: negative once a window turns by more than turn_deg.
+  double formation_margin(const StringModel<dim>& model) const override;
+  /// In the link whose neighbours turn most near the sharpest window (its arms' meeting point l⁻ inside it),
+  /// its neighbouring links taken taut.
+  bool insert(StringModel<dim>& model) override;
   void evaluate(const StringModel<dim>& model, FrontState<dim>& state, Eigen::VectorXd& mass,
                 Points<dim>& force) override;
   /// The rest of the compatibility [v] = −ṡ0 [t] (docs/model.md §2.5): the arms meet at x0,
@@ -39,6 +52,10 @@ class KinkFront final : public SplitLinkFront<dim> {
   /// The string's linearisation does not include the constraint: implicit methods solve their Newton
   /// systems with GMRES, whose products J v (difference quotients of the right-hand side) honour it.
   bool has_load_derivatives() const override { return false; }
+  /// A kink that reaches a held end (the arc between it and the end down to one link, the end prescribed) is
+  /// absorbed there (docs/model.md §2.5, "A kink at a held end"): the tracker removes it and the velocities
+  /// jump by the support's impact.
+  bool absorbed(const StringModel<dim>& model, const FrontState<dim>& state, int e0) const override;
   /// Stops where an arc would be left without a full link (its direction t∓ is that link's).
   EventAction cross(StringModel<dim>& model, const FrontState<dim>& state, int e0) override;
   /// One: positive while the arms turn by more than kMinTurnDeg and the chord is within kMaxChord h.
@@ -50,6 +67,9 @@ class KinkFront final : public SplitLinkFront<dim> {
   double turn_margin(const FrontState<dim>& state) const;
 
   double chord_ = 0;  ///< |x_b − x_a| / h of the kinked link
+  KinkSpec spec_;
+  /// The links at either end of the sharpest window at the last formation_margin (−1: none).
+  mutable int sharpest_ = -1;
 };
 
 }  // namespace chainsim

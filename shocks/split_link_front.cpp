@@ -91,7 +91,7 @@ EventAction SplitLinkFront<dim>::cross(StringModel<dim>& model, const FrontState
     return {lambda * state.l_minus, lambda * state.l_plus};
   };
   const auto old0 = shares(lo), old1 = shares(lo + 1);
-  Eigen::Vector3d mass;
+  Eigen::VectorXd mass(3);
   Points<dim> mom(dim, 3);
   for (int q = 0; q < 3; ++q) {
     mass[q] = model.masses()[lo + q];
@@ -107,21 +107,52 @@ EventAction SplitLinkFront<dim>::cross(StringModel<dim>& model, const FrontState
   model.rebuild();
   model.refresh();
   const auto new0 = shares(lo), new1 = shares(lo + 1);
-  const Points<dim> v_old = v;
-  auto move = [&](int j, std::pair<double, double> before_split, std::pair<double, double> after_split) {
-    const double delta = after_split.first - before_split.first;  // change of the start node's share
-    const int q = j - lo;
-    const int giver = delta < 0 ? j : j + 1;  // the node whose material moves, with its velocity
-    mass[q] += delta;
-    mom.col(q) += delta * v_old.col(giver);
-    mass[q + 1] -= delta;
-    mom.col(q + 1) -= delta * v_old.col(giver);
-  };
-  move(lo, old0, new0);
-  move(lo + 1, old1, new1);
-  for (int q = 0; q < 3; ++q)
-    if (!model.is_prescribed(lo + q) && model.in_arc(lo + q)) v.col(lo + q) = mom.col(q) / mass[q];
+  move_parcel(model, lo, lo, new0.first - old0.first, mass, mom);
+  move_parcel(model, lo, lo + 1, new1.first - old1.first, mass, mom);
+  set_velocities(model, lo, mass, mom);
   return {EventAction::Kind::kTransfer, {}};
+}
+
+template <int dim>
+void SplitLinkFront<dim>::move_parcel(const StringModel<dim>& model, int lo, int j, double delta, Eigen::Ref<Eigen::VectorXd> mass,
+                                      Points<dim>& mom) {
+  // delta: the change of link j's share on its start node j; the material that changes node carries the
+  // velocity of the node it leaves.
+  const int q = j - lo;
+  const int giver = delta < 0 ? j : j + 1;
+  mass[q] += delta;
+  mom.col(q) += delta * model.v().col(giver);
+  mass[q + 1] -= delta;
+  mom.col(q + 1) -= delta * model.v().col(giver);
+}
+
+template <int dim>
+void SplitLinkFront<dim>::set_velocities(StringModel<dim>& model, int lo, const Eigen::Ref<const Eigen::VectorXd>& mass,
+                                         const Points<dim>& mom) {
+  Points<dim> v_new = model.v();
+  for (int q = 0; q < mass.size(); ++q)
+    if (!model.is_prescribed(lo + q) && model.in_arc(lo + q)) v_new.col(lo + q) = mom.col(q) / mass[q];
+  model.v() = v_new;
+}
+
+template <int dim>
+void SplitLinkFront<dim>::remove(StringModel<dim>& model, const FrontState<dim>& state) {
+  // The split link (a, b) becomes a full link of one arc: its shares go from λ l⁻ on a and λ l⁺ on b to
+  // ½ λ h on each, the material that changes node moving with its velocity (momentum exact; the kinetic
+  // energy of the lumped masses changes by −½ (λ l⁻ − ½ λ h)(...)², a perfectly inelastic merge of the
+  // parcel, of order λ h |[v]|²: docs/model.md §2.5).
+  const double h = this->m_.h, lambda = this->m_.lambda;
+  std::vector<ArcRange>& arcs = model.arcs();
+  const auto A = static_cast<std::size_t>(this->arc_minus), B = static_cast<std::size_t>(this->arc_plus);
+  const int a = arcs[A].last;
+  Eigen::Vector2d mass(model.masses()[a], model.masses()[a + 1]);
+  Points<dim> mom(dim, 2);
+  for (int q = 0; q < 2; ++q) mom.col(q) = mass[q] * model.v().col(a + q);
+  move_parcel(model, a, a, 0.5 * lambda * h - lambda * state.l_minus, mass, mom);
+  arcs[A].last = arcs[B].last;
+  arcs.erase(arcs.begin() + static_cast<std::ptrdiff_t>(B));
+  model.rebuild();
+  set_velocities(model, a, mass, mom);
 }
 
 template class SplitLinkFront<2>;

@@ -27,10 +27,20 @@ class SplitLinkFront : public FrontKind<dim> {
   /// The node the front reaches moves to the other arc; the mass of the two links whose split changes
   /// moves with its velocity (momentum exact). Stops at an end of the string.
   EventAction cross(StringModel<dim>& model, const FrontState<dim>& state, int e0) override;
+  /// The split link becomes a full link again: arcs A and B merge, its material re-lumped ½–½ with its
+  /// momentum (mass parcels, as at a crossing).
+  void remove(StringModel<dim>& model, const FrontState<dim>& state) override;
 
  protected:
   /// The unit tangent of the link i → j and its rate (the part of (v_j − v_i) across it over its length).
   static Vec<dim> link_tangent(const StringModel<dim>& model, int i, int j, const char* what, Vec<dim>& rate);
+  /// Mass parcels: link j's share on its start node changes by `delta` (kg), the material moving with the
+  /// velocity of the node it leaves; `mass` and `mom` hold the nodes lo, lo + 1, … (momentum exact).
+  static void move_parcel(const StringModel<dim>& model, int lo, int j, double delta, Eigen::Ref<Eigen::VectorXd> mass,
+                          Points<dim>& mom);
+  /// The velocities of the free nodes lo, lo + 1, … in an arc from their parcels' mass and momentum.
+  static void set_velocities(StringModel<dim>& model, int lo, const Eigen::Ref<const Eigen::VectorXd>& mass,
+                             const Points<dim>& mom);
   /// The split link's nodes: arc A's last and arc B's first.
   int node_a(const StringModel<dim>& model) const { return model.arcs()[static_cast<std::size_t>(this->arc_minus)].last; }
   int node_b(const StringModel<dim>& model) const { return model.arcs()[static_cast<std::size_t>(this->arc_plus)].first; }

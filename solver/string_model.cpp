@@ -1456,7 +1456,7 @@ typename StringModel<dim>::SnapResult StringModel<dim>::snap(double t) {
 }
 
 template <int dim>
-void StringModel<dim>::impact(double t) {
+void StringModel<dim>::impact(double t, double e) {
   if (!allows_slack()) {
     project(t);
   } else {
@@ -1471,7 +1471,7 @@ void StringModel<dim>::impact(double t) {
       speed = std::max(speed, v_.col(c.node).norm());
       v_.col(c.node) -= c.normal.dot(v_.col(c.node)) * c.normal;
     }
-    link_impulses(t, 0.0, speed);
+    link_impulses(t, e, speed);
   }
 }
 

@@ -229,7 +229,9 @@ class StringModel final : public OdeSystem {
   /// Bilateral links: the mass-weighted projection (project()). With slack = allow: the held nodes'
   /// normal velocity is taken, and the links' impulses solve the snap's complementarity problem at
   /// e = 0 on the contact-reduced matrix (a link the landing would push goes slack).
-  void impact(double t);
+  /// `e`: Newton's restitution of the links' impulses (slack = allow; a front absorbed at a held end takes the
+  /// scene's snap_restitution, shocks/front_tracker.cpp).
+  void impact(double t, double e = 0);
   /// At an accepted step (t, y): the taut links shorter than (1 − kSlackGap) h_j (released by the
   /// complementarity problem during the step) become slack; a slack link past its length (a snap not
   /// located) throws NumericalError. O(N), no tension solve.

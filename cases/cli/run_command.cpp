@@ -111,6 +111,12 @@ int run_string_scene(const SceneSpec& spec, const std::filesystem::path& dir, bo
       for (const nlohmann::json& f : description["fronts"]) {
         std::string where;
         if (f.contains("on_plane")) where = f["on_plane"].get<bool>() ? ", on a plane" : ", pinned";
+        if (f.contains("inserted")) {  // [solver] kinks = "insert": not in the string until a kink forms
+          names.push_back(fmt::format("{} (f = {:g}, inserted where the tangent turns by {:g} deg over {:g} m)",
+                                      f["name"].get<std::string>(), f["f"].get<double>(), f["turn"].get<double>(),
+                                      f["window"].get<double>()));
+          continue;
+        }
         names.push_back(fmt::format("{} (f = {:g}, s0 = {:g} m{})", f["name"].get<std::string>(),
                                     f["f"].get<double>(), f["s0"].get<double>(), where));
       }

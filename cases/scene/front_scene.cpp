@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <cctype>
 #include <cmath>
+#include <limits>
 #include <optional>
 
 #include <fmt/format.h>
@@ -189,6 +190,10 @@ std::unique_ptr<StringModel<dim>> build_front_model(const SceneSpec& spec, scene
 
   // 2. What a string with fronts cannot have.
   const SceneFrontKeys keys(spec);
+  if (chain.closed() && spec.solver.kinks == "insert" && !spec.has_fronts_declared())
+    fail_at(spec, "solver.kinks",
+            "solver.kinks = \"insert\" on a closed string: kink fronts are tracked on open strings only (string.closed = "
+            "true); allowed: \"off\"");
   check_open_string(chain.closed(), !fx.heaps.empty(), keys);
   if (chain.num_links() < 2) {
     const std::string key = spec.link_length ? "string.link_length" : "string.nodes";
@@ -402,6 +407,15 @@ std::unique_ptr<StringModel<dim>> build_front_model(const SceneSpec& spec, scene
         fail_at(spec, key, fmt::format("{} = {} is less than two links from effects.kink[{}]", key, text_of(spec, key), j));
     kinks.push_back(KinkSpec{s0});
   }
+  // 4b''. A kink inserted where one forms ([solver] kinks = "insert"): last in s until then.
+  if (spec.solver.kinks == "insert") {
+    KinkSpec formed;
+    formed.s0 = ell;
+    formed.inserted = true;
+    formed.turn_deg = spec.solver.kink_turn;
+    formed.window = spec.solver.kink_window.value_or(ell / 50);
+    kinks.push_back(formed);
+  }
 
   // 4c. Tables that end at an edge.
   std::vector<TableSide<dim>> tables;
@@ -439,6 +453,7 @@ std::unique_ptr<StringModel<dim>> build_front_model(const SceneSpec& spec, scene
     const double s_start = name == "fold"               ? fx.fold->s0
                            : name == "heap_start"       ? s_lo
                            : name == "heap_end"         ? s_hi
+                           : name == "kink_formed"      ? std::numeric_limits<double>::quiet_NaN()
                            : name.rfind("kink", 0) == 0 ? kinks[std::stoul(name.substr(4))].s0
                                                         : edges[std::stoul(name.substr(4))].s0;
     if (std::abs(s - s_start) <= kPlaceTolerance * ell)
@@ -526,6 +541,11 @@ std::unique_ptr<StringModel<dim>> build_front_model(const SceneSpec& spec, scene
       if constexpr (dim == 3) f["direction"] = to_array<dim>(edges[e].axis);
     } else if (name == "fold") {
       f["s0"] = fold->s0;
+    } else if (name == "kink_formed") {  // not in the string until a kink forms
+      f["inserted"] = true;
+      f["s0"] = kinks.back().s0;  // ℓ: the list is in order of s until it forms
+      f["turn"] = spec.solver.kink_turn;
+      f["window"] = kinks.back().window;
     } else if (name.rfind("kink", 0) == 0) {
       f["s0"] = kinks[std::stoul(name.substr(4))].s0;
     } else {

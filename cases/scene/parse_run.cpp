@@ -12,7 +12,8 @@ void parse_solver(const Section& top, Context& ctx) {
   auto& so = ctx.spec.solver;
   Section s(subtable(top, "solver"), "solver", ctx,
             {"method", "rtol", "atol", "max_step", "initial_step", "max_steps", "stabilization_time", "backend", "linear_solver",
-             "check_slack", "slack_tolerance", "slack", "snap_restitution", "max_wall_s"},
+             "check_slack", "slack_tolerance", "slack", "snap_restitution", "kinks", "kink_turn", "kink_window",
+             "max_wall_s"},
             {{"t_end", "in [stop]"}, {"output_interval", "as interval in [output]"}, {"vtk", "as formats in [output]"}});
   // Each value is checked by the option struct that owns its range, one field at a time.
   // The method is checked once, here at its key; the other fields by their ranges alone.
@@ -77,6 +78,14 @@ void parse_solver(const Section& top, Context& ctx) {
     s.fail("snap_restitution", fmt::format("solver.snap_restitution = {} applies only with solver.slack = \"allow\"",
                                            s.text("snap_restitution")));
   }
+  // Kinks inserted where they form (docs/model.md §9, "Inserting a kink front where a kink forms").
+  so.kinks = s.choice("kinks", {"off", "insert"}, so.kinks);
+  so.kink_turn = s.number_in("kink_turn", so.kink_turn, 1, 179);
+  so.kink_window = s.positive("kink_window");
+  if (so.kinks != "insert")
+    for (const char* key : {"kink_turn", "kink_window"})
+      if (s.has(key))
+        s.fail(key, fmt::format("solver.{} = {} applies only with solver.kinks = \"insert\"", key, s.text(key)));
   so.max_wall_s = s.positive("max_wall_s");
 }
 

@@ -191,7 +191,9 @@ struct SceneSpec {
     return !effects.surfaces.empty() || !effects.cylinders.empty() || (effects.plane && effects.plane->surface);
   }
   /// The scene has a heap, a fold, an edge or a kink: the string runs with front tracking.
-  bool has_fronts() const {
+  bool has_fronts() const { return has_fronts_declared() || solver.kinks == "insert"; }
+  /// A front declared among the effects (not only a kink that may form).
+  bool has_fronts_declared() const {
     return !effects.heaps.empty() || effects.fold.has_value() || !effects.edges.empty() || !effects.kinks.empty();
   }
   // [solver]
@@ -213,6 +215,12 @@ struct SceneSpec {
     std::string slack = defaults::kSceneSlack;
     /// slack = "allow": Newton's restitution of a link that snaps taut, in [0, 1] (0: perfectly inelastic).
     double snap_restitution = 0;
+    /// "off" (default) or "insert": a kink front (shocks/kink_front.hpp) is inserted where a kink forms, the
+    /// turn of the tangent over kink_window (m of material; default ℓ/50) first passing kink_turn (degrees,
+    /// default 90) (docs/model.md §9, "Inserting a kink front where a kink forms").
+    std::string kinks = "off";
+    double kink_turn = 90;
+    std::optional<double> kink_window;
     std::optional<double> max_wall_s;  ///< s of wall-clock time the run may take (> 0); none: no limit
   } solver;
   // [output]

@@ -174,6 +174,11 @@ json scene_to_json(const SceneSpec& spec) {
   };
   // Only where it applies, so that a scene without slack = "allow" writes what it always wrote.
   if (so.slack == "allow") out["solver"]["snap_restitution"] = so.snap_restitution;
+  if (so.kinks == "insert") {
+    out["solver"]["kinks"] = so.kinks;
+    out["solver"]["kink_turn"] = so.kink_turn;
+    if (so.kink_window) out["solver"]["kink_window"] = *so.kink_window;
+  }
   return out;
 }
 

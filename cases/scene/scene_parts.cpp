@@ -332,6 +332,7 @@ std::vector<std::string> front_names(const SceneSpec& spec) {
   if (has_heap("end")) names.push_back("heap_end");
   for (std::size_t k = 0; k < spec.effects.edges.size(); ++k) names.push_back(fmt::format("edge{}", k));
   for (std::size_t k = 0; k < spec.effects.kinks.size(); ++k) names.push_back(fmt::format("kink{}", k));
+  if (spec.solver.kinks == "insert") names.push_back("kink_formed");  // not in the string until it forms
   return names;
 }
 

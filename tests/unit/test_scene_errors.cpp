@@ -68,7 +68,7 @@ TEST_CASE("bad scenes are refused with the location, the key, the value and what
        "s.toml:13:10: unknown effect [effects.gravty]; valid effects: gravity, drag, heap, fold, plane, edge, surface, cylinder, kink (did you mean [effects.gravity]?)"},
       {"a solver key of the old format",
        kBase + std::string("[solver]\nt_end = 1.0\n"),
-       "s.toml:19:1: unknown key 't_end' in [solver]; valid keys: method, rtol, atol, max_step, initial_step, max_steps, stabilization_time, backend, linear_solver, check_slack, slack_tolerance, slack, snap_restitution, max_wall_s; t_end is now written in [stop]"},
+       "s.toml:19:1: unknown key 't_end' in [solver]; valid keys: method, rtol, atol, max_step, initial_step, max_steps, stabilization_time, backend, linear_solver, check_slack, slack_tolerance, slack, snap_restitution, kinks, kink_turn, kink_window, max_wall_s; t_end is now written in [stop]"},
       {"a top-level key",
        std::string("title = \"x\"\n") + kBase,
        "s.toml:1:1: unknown top-level key 'title'; valid sections: string, shape, velocity, ends, effects, solver, output, stop; valid top-level keys: model"},
@@ -398,6 +398,10 @@ TEST_CASE("solver.slack and solver.max_wall_s are parsed and checked, and check_
   for (const char* value : {"stop", "warn", "ignore", "allow"})
     CHECK(solver(std::string("slack = \"") + value + "\"\n").slack == value);
   CHECK(solver("slack = \"allow\"\nsnap_restitution = 0.5\n").snap_restitution == 0.5);
+  // kinks: off by default; "insert" with its turn and window.
+  CHECK(solver("").kinks == "off");
+  CHECK(solver("kinks = \"insert\"\nkink_turn = 60\nkink_window = 0.03\n").kink_turn == 60.0);
+  CHECK(solver("kinks = \"insert\"\nkink_window = 0.03\n").kink_window == 0.03);
   // check_slack, the older key: true is "stop", false is "ignore".
   CHECK(solver("check_slack = true\n").slack == "stop");
   CHECK(solver("check_slack = false\n").slack == "ignore");
@@ -410,10 +414,18 @@ TEST_CASE("solver.slack and solver.max_wall_s are parsed and checked, and check_
       {"slack and check_slack together", kBase + "\n[solver]\ncheck_slack = true\nslack = \"warn\"\n",
        "s.toml:20:15: solver.check_slack = true and solver.slack = \"warn\" both say what a slack link does: give one of them (check_slack = true is slack = \"stop\", false is slack = \"ignore\")"},
       {"a key misspelt", kBase + "\n[solver]\nslak = \"warn\"\n",
-       "s.toml:20:1: unknown key 'slak' in [solver]; valid keys: method, rtol, atol, max_step, initial_step, max_steps, stabilization_time, backend, linear_solver, check_slack, slack_tolerance, slack, snap_restitution, max_wall_s (did you mean 'slack'?)"},
+       "s.toml:20:1: unknown key 'slak' in [solver]; valid keys: method, rtol, atol, max_step, initial_step, max_steps, stabilization_time, backend, linear_solver, check_slack, slack_tolerance, slack, snap_restitution, kinks, kink_turn, kink_window, max_wall_s (did you mean 'slack'?)"},
       {"snap_restitution above 1", kBase + "\n[solver]\nslack = \"allow\"\nsnap_restitution = 1.5\n", "s.toml:21:20: solver.snap_restitution = 1.5 is out of range: allowed 0 <= snap_restitution <= 1"},
       {"snap_restitution below 0", kBase + "\n[solver]\nslack = \"allow\"\nsnap_restitution = -0.1\n", "s.toml:21:20: solver.snap_restitution = -0.1 is out of range: allowed 0 <= snap_restitution <= 1"},
       {"snap_restitution without slack = allow", kBase + "\n[solver]\nsnap_restitution = 0.5\n", "s.toml:20:20: solver.snap_restitution = 0.5 applies only with solver.slack = \"allow\""},
+      {"kinks misspelt", kBase + "\n[solver]\nkinks = \"inset\"\n",
+       "s.toml:20:9: solver.kinks = \"inset\" is not allowed; valid values: off, insert (did you mean \"insert\"?)"},
+      {"kink_turn above 179", kBase + "\n[solver]\nkinks = \"insert\"\nkink_turn = 180\n",
+       "s.toml:21:13: solver.kink_turn = 180 is out of range: allowed 1 <= kink_turn <= 179"},
+      {"kink_window of 0", kBase + "\n[solver]\nkinks = \"insert\"\nkink_window = 0.0\n",
+       "s.toml:21:15: solver.kink_window = 0 is out of range: allowed kink_window > 0"},
+      {"kink_turn without kinks = insert", kBase + "\n[solver]\nkink_turn = 60\n",
+       "s.toml:20:13: solver.kink_turn = 60 applies only with solver.kinks = \"insert\""},
       {"slack = allow with an implicit method", kBase + "\n[solver]\nmethod = \"dirk3\"\nslack = \"allow\"\n", "s.toml:20:10: solver.method = \"dirk3\" is implicit, and implicit methods do not meet solver.slack = \"allow\" (their Newton systems know no slack link): use an explicit method (\"auto\", \"erk8\", ...)"},
       {"a surface with a zero normal", kBase + "[[effects.surface]]\npoint = [0.0, -2.0]\nnormal = [0.0, 0.0]\n",
        "s.toml:20:10: effects.surface[0].normal = [0.0, 0.0] is not a normal: allowed a finite nonzero vector"},
