@@ -156,9 +156,9 @@ struct Integrator::Impl {
   int order = 0;
   int embedding_order = 0;  // of the method's error estimate
   long recoverable_failures = 0;
-  // An event function ARKODE does not see (a constant 1 in its place; -1: none): one whose root in a step
-  // the polish refuted, while advance() takes that step again.
-  int muted_event = -1;
+  // The event functions ARKODE does not see (a constant 1 in their place; empty: none): those whose roots
+  // in a step the polish refuted, while advance() takes that step again.
+  std::vector<int> muted_events;
   // The system's Newton solver: whether it is set up, and counters.
   bool newton_ready = false;
   long jv_evals = 0;  // right-hand sides of jac_times()
@@ -474,7 +474,7 @@ struct Integrator::Impl {
     Eigen::Map<Eigen::VectorXd> gm(g, self->system.num_events());
     try {
       self->system.events(t, ym, gm);
-      if (self->muted_event >= 0) gm[self->muted_event] = 1;
+      for (const int e : self->muted_events) gm[e] = 1;
       return 0;
     } catch (...) {
       self->pending = std::current_exception();
@@ -640,19 +640,20 @@ Integrator::Outcome Integrator::advance(double t_target, bool one_step, const Ro
   constexpr int kMaxRetries = 30;
   int retries = 0;
   double h_retry = 0;
-  int ignored = -1;  // an event function whose root the polish refuted: its root off for the step taken again
+  // The event functions whose roots in this step the polish refuted: hidden for the step taken again.
+  std::vector<int> ignored;
   for (;;) {
     if (t_ >= t_target) return Outcome::kReachedTarget;
     const double t_step_start = t_;
     const Eigen::VectorXd y_step_start = y_;
     int predicted = -1;
-    const double t_stop = ignored >= 0 ? t_target : predict_recurring_event(t_target, predicted);
-    impl_->muted_event = ignored;
+    const double t_stop = !ignored.empty() ? t_target : predict_recurring_event(t_target, predicted);
+    impl_->muted_events = ignored;
     const long refused_before = impl_->recoverable_failures;
     long fails_before = 0, fails_after = 0;
     ARKStepGetNumErrTestFails(impl_->mem, &fails_before);
     const int flag = evolve(t_stop, /*one_step=*/true);
-    impl_->muted_event = -1;
+    impl_->muted_events.clear();
     if (predicted >= 0) set_root_directions();
     ARKStepGetNumErrTestFails(impl_->mem, &fails_after);
     if (flag == ARK_UNREC_RHSFUNC_ERR) {
@@ -671,14 +672,14 @@ Integrator::Outcome Integrator::advance(double t_target, bool one_step, const Ro
     retries = 0;
     h_retry = 0;
     watchdog(t_step_start, flag);
-    if (ignored >= 0) {
-      const int was_ignored = std::exchange(ignored, -1);
-      if (flag != ARK_ROOT_RETURN && passed_zero(was_ignored)) {
-        // The step taken again ends past that zero after all: the event, polished back from its end.
-        predicted_event(was_ignored, t_step_start, y_step_start, before_polish);
-        return Outcome::kEvent;
-      }
-    }
+    const std::vector<int> were_ignored = std::exchange(ignored, {});
+    if (flag != ARK_ROOT_RETURN)
+      for (const int e : were_ignored)
+        if (passed_zero(e)) {
+          // The step taken again ends past that zero after all: the event, polished back from its end.
+          predicted_event(e, t_step_start, y_step_start, before_polish);
+          return Outcome::kEvent;
+        }
     if (flag == ARK_ROOT_RETURN && predicted >= 0 && passed_zero(predicted)) {
       // Another root after the predicted zero (the step past it went where the front may not go, e.g. a
       // fold's arms apart): that step is taken again without the prediction, which is not made again.
@@ -702,7 +703,8 @@ Integrator::Outcome Integrator::advance(double t_target, bool one_step, const Ro
       // as long as ARKODE's, with that function hidden from ARKODE's rootfinding (its interpolant would
       // find the same root again), and its zero checked at the step's end.
       impl_->check(ARKStepSetInitStep(impl_->mem, t_step_end - t_step_start), "ARKStepSetInitStep");
-      ignored = refuted;
+      ignored = were_ignored;  // (the step taken again may meet another function's false root)
+      ignored.push_back(refuted);
       continue;
     }
     if (predicted >= 0) {

@@ -73,11 +73,12 @@ void print(const char* name, const HardRun& r) {
               r.lift_offs, r.snaps, r.drift, r.momentum, r.lowest);
 }
 
-/// A hard case's verdict: finite outputs, and either completed with closed ledgers or stopped with the time.
-void finished_or_located(const HardRun& r) {
+/// A hard case's verdict: finite outputs, and either completed with closed ledgers (the energy's relative
+/// residual below drift_bound) or stopped with the time.
+void finished_or_located(const HardRun& r, double drift_bound = 1e-6) {
   CHECK(r.finite);
   if (r.status == "completed") {
-    CHECK(r.drift < 1e-6);
+    CHECK(r.drift < drift_bound);
     CHECK(r.momentum < 1e-9);
   } else {
     CHECK_THAT(r.error, Catch::Matchers::Contains("t = "));
@@ -202,14 +203,16 @@ TEST_CASE("hard contact: the Atwood pulley at loose tolerances ends in seconds, 
   // At rtol = atol = 1e-2 the polish moved the event past ARKODE's root, beyond the frames taken before it:
   // an internal error ("the integrator only moves forward in time"). Now the refused step is taken again
   // smaller (as advance() does), the event stays inside the step that holds the root, and the frames are
-  // taken up to that step's end. (Both runs now stop, located: events come back at one time.)
+  // taken up to that step's end. (Both runs then stopped, located: events came back at one time. Now the
+  // run at rtol = atol = 1e-2 completes: its energy ledger closes to the accuracy asked for, a few rtol (1.04e-2
+  // measured: a global error), not 1e-6.)
   const std::filesystem::path file = std::filesystem::path(CHAINSIM_SOURCE_DIR) / "cases" / "scenes" / "atwood_pulley.toml";
   for (const char* rtol : {"1e-4", "1e-2"}) {
     CAPTURE(rtol);
     const HardRun r = run_spec(parse_scene(file, {fmt::format("solver.rtol={}", rtol), "solver.atol=1e-2"}));
     print("Atwood pulley at loose tolerances", r);
     CHECK(r.seconds < 20);
-    finished_or_located(r);
+    finished_or_located(r, std::max(1e-6, 3 * std::stod(rtol)));
   }
 }
 
@@ -239,4 +242,30 @@ TEST_CASE("hard contact: a lift-off root that Newton overshoots or the recompute
     CHECK_THAT(r.error, !Catch::Matchers::Contains("events stalled"));
     CHECK(r.t_last > c.stalled_at + 0.01);
   }
+}
+
+TEST_CASE("hard contact: a node that an impact's projection carries through the pulley lands at that instant",
+          "[hard][contact]") {
+  // The Atwood pulley at rtol = atol = 1e-2: its links are off their lengths by up to a few % of h, and the
+  // projection at a landing moved a free node (let go 0.01 s before) 0.003 h into the pulley. Its landing
+  // function started below zero, where ARKODE never finds a root: it fell through the pulley, and the run
+  // ended in a Zeno of events (main: "events stalled" at 0.2507 s; rtol 1e-4: steps below the floor at
+  // 0.170 s). Now the nodes the projection puts through a surface land at that instant. Reference: the
+  // obstacle, never entered (every node at least R from the axis up to the integration's accuracy).
+  const std::filesystem::path file = std::filesystem::path(CHAINSIM_SOURCE_DIR) / "cases" / "scenes" / "atwood_pulley.toml";
+  const SceneSpec spec = parse_scene(file, {"solver.rtol=1e-2", "solver.atol=1e-2"});
+  StringScene<2> scene = build_string_scene<2>(spec);
+  StringSolver<2> solver(*scene.model, scene.solver);
+  const auto start = std::chrono::steady_clock::now();
+  const RunSummary& s = solver.run();
+  CHECK(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count() < 20);
+  CHECK(s.status == "completed");
+  double closest = INFINITY;
+  for (const auto& f : solver.frames()) {
+    REQUIRE(f.x.allFinite());
+    for (int i = 0; i < f.x.cols(); ++i) closest = std::min(closest, f.x.col(i).norm());
+  }
+  std::printf("\nAtwood pulley at rtol = atol = 1e-2: %s to t = %.4g s, closest node to the axis %.6g m (R = 0.1 m)\n",
+              s.status.c_str(), solver.frames().back().t, closest);
+  CHECK(closest > 0.1 - 1e-3);  // R less 1e-3 m (h = 0.01 m, the links off their lengths by up to ~2 %)
 }
