@@ -642,6 +642,7 @@ Integrator::Outcome Integrator::advance(double t_target, bool one_step, const Ro
   double h_retry = 0;
   // The event functions whose roots in this step the polish refuted: hidden for the step taken again.
   std::vector<int> ignored;
+  bool hidden_checked = false;  // a hidden function's zero before another root: looked at once per step
   for (;;) {
     if (t_ >= t_target) return Outcome::kReachedTarget;
     const double t_step_start = t_;
@@ -673,13 +674,31 @@ Integrator::Outcome Integrator::advance(double t_target, bool one_step, const Ro
     h_retry = 0;
     watchdog(t_step_start, flag);
     const std::vector<int> were_ignored = std::exchange(ignored, {});
-    if (flag != ARK_ROOT_RETURN)
-      for (const int e : were_ignored)
-        if (passed_zero(e)) {
-          // The step taken again ends past that zero after all: the event, polished back from its end.
-          predicted_event(e, t_step_start, y_step_start, before_polish);
-          return Outcome::kEvent;
-        }
+    for (const int e : were_ignored) {
+      if (!passed_zero(e)) continue;
+      if (flag != ARK_ROOT_RETURN) {
+        // The step taken again ends past that zero after all: the event, polished back from its end.
+        predicted_event(e, t_step_start, y_step_start, before_polish);
+        return Outcome::kEvent;
+      }
+      if (hidden_checked) break;
+      // The step taken again stopped at another function's root, and the hidden one has passed its zero
+      // before it: that event comes first, polished in [the step's start, that root] from a recomputed
+      // state (taking the other root instead lost it: a landing of a loop on a table, the node then fell
+      // through). If that polish refutes it too, the step is taken again once more, as before.
+      hidden_checked = true;
+      const double t_root = t_;
+      events_found_.assign(events_found_.size(), 0);
+      events_found_[static_cast<std::size_t>(e)] = impl_->system.event_directions()[static_cast<std::size_t>(e)];
+      if (before_polish) before_polish(t_step_start, t_root);
+      if (polish_event(t_step_start, y_step_start, t_root, /*from_here=*/false) < 0) return Outcome::kEvent;
+      break;
+    }
+    if (hidden_checked && !were_ignored.empty() && t_ == t_step_start) {
+      impl_->muted_events.clear();
+      ignored = were_ignored;
+      continue;
+    }
     if (flag == ARK_ROOT_RETURN && predicted >= 0 && passed_zero(predicted)) {
       // Another root after the predicted zero (the step past it went where the front may not go, e.g. a
       // fold's arms apart): that step is taken again without the prediction, which is not made again.

@@ -292,3 +292,25 @@ TEST_CASE("hard contact: the Atwood pulley with slack allowed and elastic snaps 
   CHECK(r.t_last == Approx(0.285));
   CHECK(r.drift < 1e-6);
 }
+
+TEST_CASE("hard contact: a spinning loop dropped on a table with slack allowed stays on the table",
+          "[hard][contact][slack]") {
+  // A closed loop of 60 nodes (radius 0.1 m, its centre 0.3 m above a table) running along itself at 2 m/s,
+  // dropped (slack = "allow"). main stops at 0.6128 s, located: "the tension system is singular ...
+  // (Sherman-Morrison correction of the closed arc)"; this branch stops at 0.4785 s, located: "link 25 has
+  // collapsed" (the root cause, a real limit or a defect, is not found yet). A step taken again after a
+  // refuted landing root stopped at a snap's root, and the landing the hidden function had passed before it
+  // was lost: a node fell through the table at 0.255 s. Now that landing comes first. References: finite
+  // outputs, a located stop or the end with the ledger closed, and the table never entered.
+  const std::string text =
+      "[string]\ndensity = 1.0\nnodes = 60\nclosed = true\n[shape]\nkind = \"circle\"\ncenter = [0.0, 0.3]\n"
+      "radius = 0.1\n[velocity]\nkind = \"tangential\"\nspeed = 2.0\n[effects.gravity]\ng = [0.0, -9.81]\n"
+      "[[effects.surface]]\npoint = [0.0, 0.0]\nnormal = [0.0, 1.0]\n[solver]\nslack = \"allow\"\n[output]\n"
+      "interval = 0.01\n[stop]\nt_end = 1.0\n";
+  const HardRun r = run_text(text);
+  print("spinning loop dropped on a table", r);
+  CHECK(r.seconds < 20);
+  finished_or_located(r);
+  CHECK(r.t_last > 0.3);
+  CHECK(r.lowest > -1e-9);  // on or above the table
+}
