@@ -758,7 +758,7 @@ class ContactModule final : public WrappingModule<dim> {
   }
   /// Holds the nodes `landing` (node, obstacle) with an impact (booked in the ledgers); false if none.
   bool hold(StringModel<dim>& model, double t, Eigen::Ref<Eigen::VectorXd> ledger,
-            const std::vector<std::pair<int, int>>& landing) {
+            const std::vector<std::pair<int, int>>& landing, int round = 0) {
     int caught = 0;
     for (const auto& [i, k] : landing) {
       held_[static_cast<std::size_t>(i)] = k;
@@ -797,6 +797,17 @@ class ContactModule final : public WrappingModule<dim> {
       const auto i = static_cast<std::size_t>(landing[q].first);
       if (held_[i] < 0 && let_go_before[q] == t) offset_[i] = kPassGap;
     }
+    // The impact's projection onto the links' lengths may carry a free node through a surface (at loose
+    // tolerances the links are off their lengths by up to a few % of h): its landing function would start
+    // below zero, where ARKODE never finds its root, and the node would fall through the obstacle. Such
+    // nodes land too, at this same instant (at most one round per node).
+    std::vector<std::pair<int, int>> through;
+    for (std::size_t i = 0; i < held_.size(); ++i) {
+      if (held_[i] >= 0 || !free_node(model, static_cast<int>(i))) continue;
+      const auto [k, gap] = nearest(static_cast<int>(i), model.x().col(static_cast<Eigen::Index>(i)));
+      if (k >= 0 && gap / h_ + offset_[i] < 0) through.emplace_back(static_cast<int>(i), k);
+    }
+    if (!through.empty() && round < static_cast<int>(held_.size())) hold(model, t, ledger, through, round + 1);
     return true;
   }
   /// Coulomb's impulse at a landing: each landing node still held on a rough obstacle takes the

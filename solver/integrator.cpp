@@ -9,6 +9,7 @@
 #include <exception>
 #include <limits>
 #include <map>
+#include <utility>
 
 #include <arkode/arkode_arkstep.h>
 #include <arkode/arkode_butcher_dirk.h>
@@ -155,6 +156,9 @@ struct Integrator::Impl {
   int order = 0;
   int embedding_order = 0;  // of the method's error estimate
   long recoverable_failures = 0;
+  // The event functions ARKODE does not see (a constant 1 in their place; empty: none): those whose roots
+  // in a step the polish refuted, while advance() takes that step again.
+  std::vector<int> muted_events;
   // The system's Newton solver: whether it is set up, and counters.
   bool newton_ready = false;
   long jv_evals = 0;  // right-hand sides of jac_times()
@@ -470,6 +474,7 @@ struct Integrator::Impl {
     Eigen::Map<Eigen::VectorXd> gm(g, self->system.num_events());
     try {
       self->system.events(t, ym, gm);
+      for (const int e : self->muted_events) gm[e] = 1;
       return 0;
     } catch (...) {
       self->pending = std::current_exception();
@@ -635,16 +640,21 @@ Integrator::Outcome Integrator::advance(double t_target, bool one_step, const Ro
   constexpr int kMaxRetries = 30;
   int retries = 0;
   double h_retry = 0;
+  // The event functions whose roots in this step the polish refuted: hidden for the step taken again.
+  std::vector<int> ignored;
+  bool hidden_checked = false;  // a hidden function's zero before another root: looked at once per step
   for (;;) {
     if (t_ >= t_target) return Outcome::kReachedTarget;
     const double t_step_start = t_;
     const Eigen::VectorXd y_step_start = y_;
     int predicted = -1;
-    const double t_stop = predict_recurring_event(t_target, predicted);
+    const double t_stop = !ignored.empty() ? t_target : predict_recurring_event(t_target, predicted);
+    impl_->muted_events = ignored;
     const long refused_before = impl_->recoverable_failures;
     long fails_before = 0, fails_after = 0;
     ARKStepGetNumErrTestFails(impl_->mem, &fails_before);
     const int flag = evolve(t_stop, /*one_step=*/true);
+    impl_->muted_events.clear();
     if (predicted >= 0) set_root_directions();
     ARKStepGetNumErrTestFails(impl_->mem, &fails_after);
     if (flag == ARK_UNREC_RHSFUNC_ERR) {
@@ -663,6 +673,32 @@ Integrator::Outcome Integrator::advance(double t_target, bool one_step, const Ro
     retries = 0;
     h_retry = 0;
     watchdog(t_step_start, flag);
+    const std::vector<int> were_ignored = std::exchange(ignored, {});
+    for (const int e : were_ignored) {
+      if (!passed_zero(e)) continue;
+      if (flag != ARK_ROOT_RETURN) {
+        // The step taken again ends past that zero after all: the event, polished back from its end.
+        predicted_event(e, t_step_start, y_step_start, before_polish);
+        return Outcome::kEvent;
+      }
+      if (hidden_checked) break;
+      // The step taken again stopped at another function's root, and the hidden one has passed its zero
+      // before it: that event comes first, polished in [the step's start, that root] from a recomputed
+      // state (taking the other root instead lost it: a landing of a loop on a table, the node then fell
+      // through). If that polish refutes it too, the step is taken again once more, as before.
+      hidden_checked = true;
+      const double t_root = t_;
+      events_found_.assign(events_found_.size(), 0);
+      events_found_[static_cast<std::size_t>(e)] = impl_->system.event_directions()[static_cast<std::size_t>(e)];
+      if (before_polish) before_polish(t_step_start, t_root);
+      if (polish_event(t_step_start, y_step_start, t_root, /*from_here=*/false) < 0) return Outcome::kEvent;
+      break;
+    }
+    if (hidden_checked && !were_ignored.empty() && t_ == t_step_start) {
+      impl_->muted_events.clear();
+      ignored = were_ignored;
+      continue;
+    }
     if (flag == ARK_ROOT_RETURN && predicted >= 0 && passed_zero(predicted)) {
       // Another root after the predicted zero (the step past it went where the front may not go, e.g. a
       // fold's arms apart): that step is taken again without the prediction, which is not made again.
@@ -680,8 +716,15 @@ Integrator::Outcome Integrator::advance(double t_target, bool one_step, const Ro
       impl_->check(ARKStepGetCurrentTime(impl_->mem, &t_step_end), "ARKStepGetCurrentTime");
       t_step_end = std::max<double>(t_step_end, t_);
       if (before_polish) before_polish(t_step_start, t_step_end);
-      polish_event(t_step_start, y_step_start, t_step_end, /*from_here=*/false);
-      return Outcome::kEvent;
+      const int refuted = polish_event(t_step_start, y_step_start, t_step_end, /*from_here=*/false);
+      if (refuted < 0) return Outcome::kEvent;
+      // No event (the recomputed step refutes ARKODE's root): the step is taken again from its start,
+      // as long as ARKODE's, with that function hidden from ARKODE's rootfinding (its interpolant would
+      // find the same root again), and its zero checked at the step's end.
+      impl_->check(ARKStepSetInitStep(impl_->mem, t_step_end - t_step_start), "ARKStepSetInitStep");
+      ignored = were_ignored;  // (the step taken again may meet another function's false root)
+      ignored.push_back(refuted);
+      continue;
     }
     if (predicted >= 0) {
       // The step may end at the stop time with either flag. Past the zero: the event. Short of it, and at
@@ -723,13 +766,15 @@ Integrator::Outcome Integrator::advance(double t_target, bool one_step, const Ro
 // whose second-order term is checked to be below kHeunShare of the error tolerance (its error,
 // O(dt³), is smaller still by dt over the time scale of the motion); a larger correction integrates
 // again from the step's start.
-void Integrator::polish_event(double t_step_start, const Eigen::VectorXd& y_step_start, double t_step_end,
-                              bool from_here) {
+int Integrator::polish_event(double t_step_start, const Eigen::VectorXd& y_step_start, double t_step_end,
+                             bool from_here) {
   // The largest share of the error tolerance (weighted RMS norm) the second-order term of a Heun
   // correction may have.
   constexpr double kHeunShare = 1e-3;
   // How many times a refused step towards the event is taken again, four times smaller (as advance()).
   constexpr int kMaxPolishRetries = 30;
+  // How many corrections in all once one has been a bisection of the root's bracket.
+  constexpr int kMaxBracketIterations = 60;
   Impl& d = *impl_;
   int k = 0;
   while (k < static_cast<int>(events_found_.size()) && events_found_[k] == 0) ++k;
@@ -741,6 +786,12 @@ void Integrator::polish_event(double t_step_start, const Eigen::VectorXd& y_step
   d.check(ARKStepRootInit(d.mem, 0, nullptr), "ARKStepRootInit");
 
   Eigen::VectorXd g(nev), g_ahead(nev), ydot(y_.size());
+  // The root's bracket: t_lo, the last time at which the function has not reached its zero (the step's
+  // start), and t_hi, the first at which a state computed by the method has passed it (NaN: none known;
+  // a predicted event's step ends past it).
+  const double sense = events_found_[static_cast<std::size_t>(k)];
+  const auto passed = [&](double gk) { return gk * sense >= 0; };
+  double t_lo = t_step_start, t_hi = from_here ? t_ : std::numeric_limits<double>::quiet_NaN();
   double last_probe = 1;
   // The last integrated state, F there, and the error weights of the tolerance (ARKStepGetErrWeights).
   double t_base = t_step_start;
@@ -764,7 +815,9 @@ void Integrator::polish_event(double t_step_start, const Eigen::VectorXd& y_step
     const double slope = (g_ahead[k] - g[k]) / dt_probe;
     if (slope != 0.0 && std::isfinite(slope)) t_event = std::clamp(t_ - g[k] / slope, t_step_start, t_step_end);
   }
-  for (int iteration = 0; iteration < 4; ++iteration) {
+  int max_iterations = 4;
+  bool converged = false, bisecting = false, refuted = false;
+  for (int iteration = 0; iteration < max_iterations; ++iteration) {
     bool corrected = false;
     if (y_base.size() > 0) {
       const double dt = t_event - t_base;
@@ -807,16 +860,66 @@ void Integrator::polish_event(double t_step_start, const Eigen::VectorXd& y_step
     }
     const double dt_probe = probe(t_, y_, ydot);
     last_probe = dt_probe;
-    const double slope = (g_ahead[k] - g[k]) / dt_probe;
-    if (!(slope != 0.0) || !std::isfinite(slope)) break;
-    // The event lies in the step that holds the root: a secant that points outside it (far from the
-    // root, a nearly flat function) is held to the step, never extrapolated beyond it.
-    const double t_next = std::clamp(t_event - g[k] / slope, t_step_start, t_step_end);
+    if (passed(g[k])) {
+      if (!(t_ >= t_hi)) t_hi = t_;
+    } else if (t_ > t_lo && !(t_ >= t_hi)) {
+      t_lo = t_;
+    }
     // Converged to a few units of round-off of t (relative: an absolute floor in seconds would
     // stop early on a short time scale, e.g. a 1 mm chain under 1000 m/s²).
     const double t_unit = std::max({std::abs(t_event), std::abs(t_step_start), d.system.time_scale()});
-    if (std::abs(t_next - t_event) <= 8 * std::numeric_limits<double>::epsilon() * t_unit) break;
+    const double t_tol = 8 * std::numeric_limits<double>::epsilon() * t_unit;
+    const double slope = (g_ahead[k] - g[k]) / dt_probe;
+    const bool has_slope = slope != 0.0 && std::isfinite(slope);
+    if (!has_slope && !bisecting) break;
+    const double t_newton = has_slope ? t_event - g[k] / slope : NAN;
+    // Newton's step, inside the step that holds the root (held to it if it leaves it by round-off: a root
+    // at the step's start, just after a stop time); once it has left the step, inside the bracket.
+    const double margin = std::max(t_tol, 1e-8 * (t_step_end - t_step_start));
+    const bool inside = bisecting ? t_newton >= t_lo - t_tol && t_newton <= t_hi + t_tol
+                                  : t_newton >= t_step_start - margin && t_newton <= t_step_end + margin;
+    double t_next = 0;
+    if (inside) {
+      t_next = std::clamp(t_newton, t_step_start, t_step_end);
+    } else if (!std::isnan(t_hi)) {
+      // Newton leaves the step (a function whose rate changes fast, or at a kink: the smallest of
+      // several, e.g. the normal forces of the held nodes): the bracket is halved, and the polish
+      // goes on until it has converged.
+      t_next = 0.5 * (t_lo + t_hi);
+      bisecting = true;
+      max_iterations = kMaxBracketIterations;
+    } else {
+      refuted = true;  // no state computed in this step has passed the zero: see below
+      break;
+    }
+    if (std::abs(t_next - t_event) <= t_tol || (bisecting && t_hi - t_lo <= t_tol)) {
+      converged = true;
+      break;
+    }
     t_event = t_next;
+  }
+  if (refuted) {
+    // No state recomputed in the step has passed the zero, and Newton points out of the step: ARKODE's
+    // root was a zero of its interpolant, not of the method's solution (at loose tolerances the
+    // interpolant of a function of the tensions may cross where the solution does not). No event here:
+    // the integrator is back at the step's start, and advance() takes the step again with this
+    // function hidden from ARKODE's rootfinding; if that step ends past the zero, the event is
+    // polished back from its end (predicted_event), with the bracket the step's start and end.
+    restart(t_step_start, y_step_start);
+    d.check(ARKStepRootInit(d.mem, nev, Impl::roots), "ARKStepRootInit");
+    d.check(ARKStepSetNoInactiveRootWarn(d.mem), "ARKStepSetNoInactiveRootWarn");
+    return k;
+  }
+  if (!converged && bisecting && !passed(g[k])) {
+    // (Bisection converges in ~50 halvings of the step: a safeguard.) The event is the first state
+    // known to have passed the zero.
+    restart(t_step_start, y_step_start);
+    d.check(ARKStepSetInitStep(d.mem, t_hi - t_step_start), "ARKStepSetInitStep");
+    int flag = 0;
+    while (t_ < t_hi && flag != ARK_UNREC_RHSFUNC_ERR) flag = evolve(t_hi, /*one_step=*/false);
+    d.system.events(t_, y_, g);
+    d.system.rhs(t_, y_, ydot);
+    last_probe = probe(t_, y_, ydot);
   }
   d.h_resume = std::abs(h_next);
   d.h_event = d.h_resume;
@@ -833,6 +936,7 @@ void Integrator::polish_event(double t_step_start, const Eigen::VectorXd& y_step
   d.check(ARKStepRootInit(d.mem, nev, Impl::roots), "ARKStepRootInit");
   set_root_directions();
   d.check(ARKStepSetNoInactiveRootWarn(d.mem), "ARKStepSetNoInactiveRootWarn");
+  return -1;
 }
 
 // The error weights of the tolerance at the current state (ARKStepGetErrWeights).

@@ -187,7 +187,8 @@ class Integrator {
   /// Called by advance() at a root return before the event is polished, with the step that holds
   /// the root: its start and its end (the polished event lies in between, not always before the
   /// root ARKODE located). interpolate() covers [t_start, t_end] during the call (it no longer does
-  /// once the polish has recomputed the step).
+  /// once the polish has recomputed the step). It may be called again within one advance() (a root the
+  /// polish refutes: the step is taken again): each call supersedes the last.
   using RootStepHook = std::function<void(double t_start, double t_end)>;
 
   /// Advance towards t_target (never past it). In one_step mode return after each internal step,
@@ -231,7 +232,9 @@ class Integrator {
   int evolve(double t_target, bool one_step);
   void watchdog(double t_before, int flag);
   std::string diagnosis() const;
-  void polish_event(double t_step_start, const Eigen::VectorXd& y_step_start, double t_step_end, bool from_here);
+  /// Returns -1 (the event is polished), or the event function whose root the recomputed step refutes
+  /// (no event: the integrator is back at the step's start).
+  int polish_event(double t_step_start, const Eigen::VectorXd& y_step_start, double t_step_end, bool from_here);
   Eigen::VectorXd error_weights() const;
   double allowed_step() const;
   void set_root_directions(int ignored = -1);

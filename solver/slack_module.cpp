@@ -115,7 +115,11 @@ class SlackModule final : public WrappingModule<dim> {
     const EventAction action = this->handle_inner_events(model, t, ledger, found);
     if (action.kind == EventAction::Kind::kStop) return action;
     if (action.kind == EventAction::Kind::kTransfer) model.refresh();
-    if (found[static_cast<std::size_t>(k)] == 0) return action;
+    // A transfer of the inner module (a landing's impact projects the positions) may carry a slack link
+    // past its length: its snap is now, with the root function below zero at the restart, where ARKODE
+    // would never find it (a loop round a pulley: the link then went on stretching unseen).
+    const bool stretched = action.kind == EventAction::Kind::kTransfer && model.slack_gap() <= 0;
+    if (found[static_cast<std::size_t>(k)] == 0 && !stretched) return action;
     const typename StringModel<dim>::SnapResult snap = model.snap(t);
     if (snap.caught == 0) return action;
     ledger[kl] -= snap.dissipated;

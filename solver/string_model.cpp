@@ -1409,7 +1409,9 @@ void StringModel<dim>::accept_step(double t, const Eigen::Ref<const Eigen::Vecto
     const double h = chain_.link_length(j);
     const double gap = (h - current_length(j)) / h;
     if (!link_slack(j)) {
-      if (gap > kSlackGap) set_slack(j, true);
+      // (Released: no tension at the step's last evaluation. A link short only by the drift of the
+      // constraints, which at loose tolerances is far above kSlackGap, keeps its tension: it is taut.)
+      if (gap > kSlackGap && !(link_tension(j) > 0)) set_slack(j, true);
     } else if (gap + slack_offset_[static_cast<std::size_t>(j)] < -kSlackGap) {
       throw NumericalError(fmt::format("at t = {:.9g} s slack link {} (s = {:.6g} m) is {:.3g} of its length past it: "
                                        "its snap taut was not located",

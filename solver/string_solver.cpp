@@ -531,6 +531,7 @@ const RunSummary& StringSolver<dim>::run() {
     std::vector<std::pair<double, Eigen::VectorXd>> before_event;
     long k = 1;
     const Integrator::RootStepHook interpolate_before_event = [&](double, double t_step_end) {
+      before_event.clear();  // (a root the polish refuted: the step is taken again, and may hold another)
       for (long j = k; j <= n_out && output_time(j) < t_step_end; ++j)
         before_event.emplace_back(output_time(j), integrator->interpolate(output_time(j)));
     };

@@ -73,11 +73,12 @@ void print(const char* name, const HardRun& r) {
               r.lift_offs, r.snaps, r.drift, r.momentum, r.lowest);
 }
 
-/// A hard case's verdict: finite outputs, and either completed with closed ledgers or stopped with the time.
-void finished_or_located(const HardRun& r) {
+/// A hard case's verdict: finite outputs, and either completed with closed ledgers (the energy's relative
+/// residual below drift_bound) or stopped with the time.
+void finished_or_located(const HardRun& r, double drift_bound = 1e-6) {
   CHECK(r.finite);
   if (r.status == "completed") {
-    CHECK(r.drift < 1e-6);
+    CHECK(r.drift < drift_bound);
     CHECK(r.momentum < 1e-9);
   } else {
     CHECK_THAT(r.error, Catch::Matchers::Contains("t = "));
@@ -166,8 +167,11 @@ TEST_CASE("hard contact: a closed loop running round over a pulley ends in secon
   // pulled, so it was let go again. A node whose force pulls after its impact now passes (its velocity
   // projected, the impact booked in W_impacts) and its landing root restarts above the interpolant's
   // error: with slack = "stop" (1000 events at 0.460590 s) the loop runs round the pulley to t_end, its
-  // energy ledger closed to 10⁻⁸. With "allow" it stops, located, at 0.1697 s: a snap not located (the
-  // slack module's, not this).
+  // energy ledger closed to 10⁻⁸. With "allow" it stopped, located, at 0.1697 s: "snap taut was not
+  // located". A landing's impact projects the positions, and that carried a slack link 6e-10 past its root
+  // (its snap function below zero at the restart, where ARKODE never finds a root): the link went on
+  // stretching unseen. The slack module now snaps such a link at that instant; the loop runs to t_end with
+  // its snaps and its energy ledger closed (measured 5.1e-8 with W_snap, W_impacts).
   for (const char* slack : {"allow", "stop"}) {
   CAPTURE(slack);
   std::string points;
@@ -191,6 +195,11 @@ TEST_CASE("hard contact: a closed loop running round over a pulley ends in secon
     CHECK(r.impacts > 0);
     CHECK(r.w_impacts < 0);  // the landings' Carnot losses, booked
     CHECK(r.drift < 1e-7);
+  } else {
+    CHECK(r.status == "completed");
+    CHECK(r.t_last == Approx(0.5));
+    CHECK(r.snaps > 0);
+    CHECK(r.drift < 1e-6);
   }
   }
 }
@@ -202,13 +211,106 @@ TEST_CASE("hard contact: the Atwood pulley at loose tolerances ends in seconds, 
   // At rtol = atol = 1e-2 the polish moved the event past ARKODE's root, beyond the frames taken before it:
   // an internal error ("the integrator only moves forward in time"). Now the refused step is taken again
   // smaller (as advance() does), the event stays inside the step that holds the root, and the frames are
-  // taken up to that step's end. (Both runs now stop, located: events come back at one time.)
+  // taken up to that step's end. (Both runs then stopped, located: events came back at one time. Now the
+  // run at rtol = atol = 1e-2 completes: its energy ledger closes to the accuracy asked for, a few rtol (1.04e-2
+  // measured: a global error), not 1e-6.)
   const std::filesystem::path file = std::filesystem::path(CHAINSIM_SOURCE_DIR) / "cases" / "scenes" / "atwood_pulley.toml";
   for (const char* rtol : {"1e-4", "1e-2"}) {
     CAPTURE(rtol);
     const HardRun r = run_spec(parse_scene(file, {fmt::format("solver.rtol={}", rtol), "solver.atol=1e-2"}));
     print("Atwood pulley at loose tolerances", r);
     CHECK(r.seconds < 20);
-    finished_or_located(r);
+    finished_or_located(r, std::max(1e-6, 3 * std::stod(rtol)));
   }
+}
+
+TEST_CASE("hard contact: a lift-off root that Newton overshoots or the recomputed step refutes is no event at "
+          "the step's start", "[hard][contact]") {
+  // The smallest normal force of the held nodes is a minimum over nodes: its rate jumps where another node
+  // becomes the smallest. At loose tolerances the polish's Newton step from the recomputed state at ARKODE's
+  // root (past the zero) pointed before the step's start; it was held there, where the force is 0.609 of the
+  // weight scale (rough pulley, rtol = atol = 1e-2) or 0.544 (smooth pulley, rtol 1e-4, atol 1e-2), and the
+  // event was reported there: nothing to let go, the same root found again, 1000 times, "events stalled" at
+  // 0.04 s and 0.1325 s. Now the polish keeps the root's bracket (the last state before the zero, the first
+  // past it) and halves it where Newton leaves it; a root that neither the accepted step's end nor any
+  // recomputed state has passed is no event (the step is taken again without it). Both runs now go past
+  // those times (their later stops, located, are the contact model's at that accuracy).
+  const std::filesystem::path dir = std::filesystem::path(CHAINSIM_SOURCE_DIR) / "cases" / "scenes";
+  struct Case {
+    const char* file;
+    const char* rtol;
+    double stalled_at;
+  };
+  for (const Case& c : {Case{"atwood_rough_pulley.toml", "1e-2", 0.04}, Case{"atwood_pulley.toml", "1e-4", 0.1325}}) {
+    CAPTURE(c.file, c.rtol);
+    const HardRun r = run_spec(parse_scene(dir / c.file, {fmt::format("solver.rtol={}", c.rtol), "solver.atol=1e-2"}));
+    print("lift-off root at loose tolerances", r);
+    CHECK(r.seconds < 20);
+    finished_or_located(r);
+    CHECK_THAT(r.error, !Catch::Matchers::Contains("events stalled"));
+    CHECK(r.t_last > c.stalled_at + 0.01);
+  }
+}
+
+TEST_CASE("hard contact: a node that an impact's projection carries through the pulley lands at that instant",
+          "[hard][contact]") {
+  // The Atwood pulley at rtol = atol = 1e-2: its links are off their lengths by up to a few % of h, and the
+  // projection at a landing moved a free node (let go 0.01 s before) 0.003 h into the pulley. Its landing
+  // function started below zero, where ARKODE never finds a root: it fell through the pulley, and the run
+  // ended in a Zeno of events (main: "events stalled" at 0.2507 s; rtol 1e-4: steps below the floor at
+  // 0.170 s). Now the nodes the projection puts through a surface land at that instant. Reference: the
+  // obstacle, never entered (every node at least R from the axis up to the integration's accuracy).
+  const std::filesystem::path file = std::filesystem::path(CHAINSIM_SOURCE_DIR) / "cases" / "scenes" / "atwood_pulley.toml";
+  const SceneSpec spec = parse_scene(file, {"solver.rtol=1e-2", "solver.atol=1e-2"});
+  StringScene<2> scene = build_string_scene<2>(spec);
+  StringSolver<2> solver(*scene.model, scene.solver);
+  const auto start = std::chrono::steady_clock::now();
+  const RunSummary& s = solver.run();
+  CHECK(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count() < 20);
+  CHECK(s.status == "completed");
+  double closest = INFINITY;
+  for (const auto& f : solver.frames()) {
+    REQUIRE(f.x.allFinite());
+    for (int i = 0; i < f.x.cols(); ++i) closest = std::min(closest, f.x.col(i).norm());
+  }
+  std::printf("\nAtwood pulley at rtol = atol = 1e-2: %s to t = %.4g s, closest node to the axis %.6g m (R = 0.1 m)\n",
+              s.status.c_str(), solver.frames().back().t, closest);
+  CHECK(closest > 0.1 - 1e-3);  // R less 1e-3 m (h = 0.01 m, the links off their lengths by up to ~2 %)
+}
+
+TEST_CASE("hard contact: the Atwood pulley with slack allowed and elastic snaps runs to its end",
+          "[hard][contact][slack]") {
+  // atwood_pulley.toml with slack = "allow" and snap_restitution = 1 stopped at 0.27994 s (main), "snap taut
+  // was not located": a landing's projection had carried a slack link past its root at the restart. The
+  // short run to 0.285 s passes that time; reference: the energy ledger (elastic snaps: W_snap only from the
+  // supports, the landings' Carnot losses in W_impacts).
+  const std::filesystem::path file = std::filesystem::path(CHAINSIM_SOURCE_DIR) / "cases" / "scenes" / "atwood_pulley.toml";
+  const HardRun r = run_spec(parse_scene(file, {"solver.slack=allow", "solver.snap_restitution=1", "stop.t_end=0.285"}));
+  print("Atwood pulley, slack allowed, elastic snaps", r);
+  CHECK(r.seconds < 30);
+  CHECK(r.status == "completed");
+  CHECK(r.t_last == Approx(0.285));
+  CHECK(r.drift < 1e-6);
+}
+
+TEST_CASE("hard contact: a spinning loop dropped on a table with slack allowed stays on the table",
+          "[hard][contact][slack]") {
+  // A closed loop of 60 nodes (radius 0.1 m, its centre 0.3 m above a table) running along itself at 2 m/s,
+  // dropped (slack = "allow"). main stops at 0.6128 s, located: "the tension system is singular ...
+  // (Sherman-Morrison correction of the closed arc)"; this branch stops at 0.4785 s, located: "link 25 has
+  // collapsed" (the root cause, a real limit or a defect, is not found yet). A step taken again after a
+  // refuted landing root stopped at a snap's root, and the landing the hidden function had passed before it
+  // was lost: a node fell through the table at 0.255 s. Now that landing comes first. References: finite
+  // outputs, a located stop or the end with the ledger closed, and the table never entered.
+  const std::string text =
+      "[string]\ndensity = 1.0\nnodes = 60\nclosed = true\n[shape]\nkind = \"circle\"\ncenter = [0.0, 0.3]\n"
+      "radius = 0.1\n[velocity]\nkind = \"tangential\"\nspeed = 2.0\n[effects.gravity]\ng = [0.0, -9.81]\n"
+      "[[effects.surface]]\npoint = [0.0, 0.0]\nnormal = [0.0, 1.0]\n[solver]\nslack = \"allow\"\n[output]\n"
+      "interval = 0.01\n[stop]\nt_end = 1.0\n";
+  const HardRun r = run_text(text);
+  print("spinning loop dropped on a table", r);
+  CHECK(r.seconds < 20);
+  finished_or_located(r);
+  CHECK(r.t_last > 0.3);
+  CHECK(r.lowest > -1e-9);  // on or above the table
 }
