@@ -235,17 +235,18 @@ def chain_over_peg(run, ax):
 
 
 def chain_over_two_pegs(run, ax):
-    snapshots(ax[0], run, [0, 0.4, 0.7, 1.0], "chain over two sharp pegs, f = 0.5, ends pulled by 2 N and 1.5 N")
+    snapshots(ax[0], run, [0, 0.3, 0.6, 0.754], "chain over two sharp pegs, f = 0.5, ends pulled by 2 N and 0.5 N")
     ts = np.asarray(run.series["t"])
     s0, s1 = np.asarray(run.fronts[0].s0), np.asarray(run.fronts[1].s0)
     # The closed form (docs/model.md §8): l x'' = F1 - F2 - 2 f x'^2, x = x0 + ln cosh(sqrt(AB) t)/B.
     ell, f, x0 = 1.2, 0.5, 0.4
-    A, B = 0.5 / ell, 2 * f / ell
+    A, B = 1.5 / ell, 2 * f / ell
     exact = x0 + np.log(np.cosh(np.sqrt(A * B) * ts)) / B
     ax[1].plot(ts, s0, lw=2, alpha=0.7, label="first peg's s0 = x (string solver)")
     ax[1].plot(ts, s1 - 0.3, "--", lw=1.5, label="second peg's s0 - 0.3 m")
     ax[1].plot(ts, exact, "k:", lw=2, label="x0 + ln cosh(sqrt(AB) t)/B, exact")
     worst = float(np.max(np.abs(s0 - exact)))
+    ax[1].axvline(0.754021410, color="r", lw=0.8, ls="--", label="lift-off off the second peg, t* = 0.75402 s")
     decorate(ax[1], "t (s)", "m", f"the material runs through both pegs (max |x - exact| = {worst:.1e} m)")
 
 
