@@ -3,8 +3,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <stdexcept>
-#include <vector>
 
 #include <Eigen/Geometry>
 #include <fmt/format.h>
@@ -131,7 +129,6 @@ void EdgeFront<dim>::initialize(StringModel<dim>& model) {
 template <int dim>
 void EdgeFront<dim>::evaluate(const StringModel<dim>& model, FrontState<dim>& s, Eigen::VectorXd& mass,
                               Points<dim>& force) {
-  sync_link(model);
   const Points<dim>& x = model.x();
   const Points<dim>& v = model.v();
   const double h = this->m_.h, lambda = this->m_.lambda;
@@ -245,23 +242,6 @@ void EdgeFront<dim>::set_link(StringModel<dim>& model, int a) {
 }
 
 template <int dim>
-void EdgeFront<dim>::sync_link(const StringModel<dim>& model) {
-  const Vec<dim>* own = model.bend_point(link_);
-  if (own != nullptr && *own == point_) return;
-  // Another edge's crossing has carried a node over this edge and moved its bend by a link (cross()).
-  for (const int j : {link_ - 1, link_ + 1}) {
-    const Vec<dim>* p = j >= 0 && j + 1 < this->m_.n ? model.bend_point(j) : nullptr;
-    if (p != nullptr && *p == point_) {
-      link_ = j;
-      bent_minus_ = unit_vector<dim>(point_ - model.x().col(j), "the bent link before the edge");
-      bent_plus_ = unit_vector<dim>(model.x().col(j + 1) - point_, "the bent link after the edge");
-      return;
-    }
-  }
-  throw std::logic_error(fmt::format("the edge at {} has lost its bent link {}", show<dim>(point_), link_));
-}
-
-template <int dim>
 Vec<dim> EdgeFront<dim>::side_direction(const StringModel<dim>& model, int j, bool before) const {
   const Points<dim>& x = model.x();
   const Vec<dim>& p = *model.bend_point(j);
@@ -372,38 +352,7 @@ EventAction EdgeFront<dim>::cross(StringModel<dim>& model, const FrontState<dim>
   // and beyond another edge's bent link (a second edge or peg on the string) along that edge's line on
   // its far side, so that the material flows through every edge by the same length and every link,
   // straight or bent, keeps its length (to first order in the step; the projection does the rest).
-  // Other edges' bent links (a second edge or peg), their directions before the shift.
-  struct Other {
-    int link;
-    Vec<dim> point, e_minus, e_plus;
-  };
-  // Each along its longer part: the part of a node within kCross h of the point has a direction only to
-  // the round-off of the coordinates over kCross h (1e-7 rad at x0 = 0.3 m), which the crossing's turned
-  // velocity would carry off the line; the end link of that side instead (a link away from the point).
-  std::vector<Other> others;
-  for (int j = arc.first; j < arc.last; ++j)
-    if (j != link_)
-      if (const Vec<dim>* p = model.bend_point(j))
-        others.push_back({j, *p, side_direction(model, j, true), side_direction(model, j, false)});
   shift_sides(model, arc.first, node - 1, node + 1, arc.last, sign * (delta + past), t_minus_, t_plus_);
-  // The shift carries the material through the other edges too; where it has carried a node of one of
-  // them to within kCross h of its point or past it (the crossings fall at the same instant, as with a
-  // whole number of links between two pegs), that node crosses that edge here as well, the same way
-  // (that edge's front finds its moved link at its next evaluation, sync_link()).
-  for (const Other& o : others) {
-    const int oa = o.link, ob = o.link + 1;
-    if (o.e_minus.dot(o.point - x.col(oa)) < kCross * h && oa - 1 >= arc.first && model.bend_point(oa - 1) == nullptr) {
-      x.col(oa) = o.point + past * o.e_plus;
-      v.col(oa) = rotate_onto<dim>(v.col(oa), o.e_minus, o.e_plus, Vec<dim>::Zero());
-      model.unbend_link(oa);
-      model.bend_link(oa - 1, o.point);
-    } else if (o.e_plus.dot(x.col(ob) - o.point) < kCross * h && ob + 1 <= arc.last && model.bend_point(ob) == nullptr) {
-      x.col(ob) = o.point - past * o.e_minus;
-      v.col(ob) = rotate_onto<dim>(v.col(ob), o.e_plus, o.e_minus, Vec<dim>::Zero());
-      model.unbend_link(oa);
-      model.bend_link(ob, o.point);
-    }
-  }
   if (e0 != 0) {
     x.col(a) = point_ + past * t_plus_;
     v.col(a) = rotate_onto<dim>(v.col(a), t_minus_, t_plus_, axis_);

@@ -124,8 +124,6 @@ class EdgeFront final : public FrontKind<dim> {
   /// The direction of the string before (`before`) or after another edge's bent link j: along its part
   /// to or from the point if that is longer than half a link, else along the link beyond it.
   Vec<dim> side_direction(const StringModel<dim>& model, int j, bool before) const;
-  /// Takes the link bent over x0 again from the model when another edge's crossing has moved it (cross()).
-  void sync_link(const StringModel<dim>& model);
   /// Bends link `a` over x0 and fixes its directions.
   void set_link(StringModel<dim>& model, int a);
   // Of the last evaluation: the tangents on either side, the tension jump [τ] (N).

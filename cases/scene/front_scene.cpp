@@ -371,6 +371,19 @@ std::unique_ptr<StringModel<dim>> build_front_model(const SceneSpec& spec, scene
                 fmt::format("{}.point = {} is at s = {:.6g} m of the string, less than two links ({:g} m) from "
                             "effects.edge[{}] at s = {:.6g} m: allowed edges at least two links apart along the string",
                             key, text_of(spec, key + ".point"), edge.s0, 2 * chain.link_length(0), j, edges[j].s0));
+    // Nor a whole number of links apart along the string: the material moves through both by the same
+    // length, so a node would reach each at the same instant, which one crossing at a time does not
+    // handle (the second node is carried over its edge by the first crossing: the links cannot be projected).
+    for (std::size_t j = 0; j < edges.size(); ++j) {
+      const double links = std::abs(edges[j].s0 - edge.s0) / chain.link_length(0);
+      if (std::abs(links - std::round(links)) < 1e-6)
+        fail_at(spec, key + ".point",
+                fmt::format("{}.point = {} is at s = {:.9g} m of the string, a whole number of links ({:.0f} h) from "
+                            "effects.edge[{}] at s = {:.9g} m: nodes would reach both at the same instant, which the edge "
+                            "fronts do not handle; move a point along the string by a fraction of a link or change "
+                            "string.nodes",
+                            key, text_of(spec, key + ".point"), edge.s0, std::round(links), j, edges[j].s0));
+    }
     const bool surface_table = std::any_of(fx.surfaces.begin(), fx.surfaces.end(), [](const auto& f) { return f.edge.has_value(); });
     if (fx.edges.size() > 1 && (edge.table != EdgeSpec<dim>::Table::kNone || surface_table))
       fail_at(spec, edge.table != EdgeSpec<dim>::Table::kNone ? key + ".table" : key,
