@@ -94,8 +94,8 @@ void EdgeFront<dim>::initialize(StringModel<dim>& model) {
             show<dim>(point_), c, model.chain().node_coordinate(c), i, nudge));
     const Vec<dim> tm = unit_vector<dim>(point_ - x.col(c - 1), "the string before the edge");
     const Vec<dim> tp = unit_vector<dim>(x.col(c + 1) - point_, "the string after the edge");
-    for (int i = 0; i < this->m_.n; ++i)
-      model.move_initial_node(i, Vec<dim>(x.col(i) - nudge * (i <= c ? tm : tp)));
+    shift_sides(model, 0, c, c + 1, this->m_.n - 1, -nudge, tm, tp);
+    for (int i = 0; i < this->m_.n; ++i) model.move_initial_node(i, Vec<dim>(x.col(i)));
     link_ = c;
   }
   const int a = link_;
@@ -242,11 +242,51 @@ void EdgeFront<dim>::set_link(StringModel<dim>& model, int a) {
 }
 
 template <int dim>
+Vec<dim> EdgeFront<dim>::side_direction(const StringModel<dim>& model, int j, bool before) const {
+  const Points<dim>& x = model.x();
+  const Vec<dim>& p = *model.bend_point(j);
+  const int a = j, b = j + 1;
+  const double h = this->m_.h;
+  const ArcRange& arc = model.arcs()[static_cast<std::size_t>(this->arc_minus)];
+  if (before) {
+    const bool link_before = a > arc.first && model.bend_point(a - 1) == nullptr;
+    return (p - x.col(a)).norm() > 0.5 * h || !link_before
+               ? unit_vector<dim>(p - x.col(a), "the string before an edge")
+               : unit_vector<dim>(x.col(a) - x.col(a - 1), "the string before an edge");
+  }
+  const bool link_after = b < arc.last && model.bend_point(b) == nullptr;
+  return (x.col(b) - p).norm() > 0.5 * h || !link_after ? unit_vector<dim>(x.col(b) - p, "the string after an edge")
+                                                        : unit_vector<dim>(x.col(b + 1) - x.col(b), "the string after an edge");
+}
+
+template <int dim>
+void EdgeFront<dim>::shift_sides(StringModel<dim>& model, int first, int last_minus, int first_plus, int last,
+                                 double step, const Vec<dim>& minus, const Vec<dim>& plus) const {
+  Points<dim>& x = model.x();
+  Vec<dim> along = minus;
+  for (int i = last_minus; i >= first; --i) {
+    if (i != link_ && model.bend_point(i))  // passing another edge's bent link i, from node i + 1 to node i
+      along = side_direction(model, i, true);
+    x.col(i) += step * along;
+  }
+  along = plus;
+  for (int i = first_plus; i <= last; ++i) {
+    if (i - 1 != link_ && model.bend_point(i - 1))  // passing another edge's bent link i − 1, from node i − 1 to node i
+      along = side_direction(model, i - 1, false);
+    x.col(i) += step * along;
+  }
+}
+
+template <int dim>
 double EdgeFront<dim>::g_minus(const StringModel<dim>& model) const {
   const Points<dim>& x = model.x();
   const int a = link_;
   const ArcRange& arc = model.arcs()[static_cast<std::size_t>(this->arc_minus)];
-  const Vec<dim> d = a > arc.first ? Vec<dim>((x.col(a) - x.col(a - 1)).normalized()) : bent_minus_;
+  // The link before a, or its part after the point it is bent over (another edge's).
+  const Vec<dim>* other = a > arc.first ? model.bend_point(a - 1) : nullptr;
+  const Vec<dim> d = other ? Vec<dim>((x.col(a) - *other).normalized())
+                     : a > arc.first ? Vec<dim>((x.col(a) - x.col(a - 1)).normalized())
+                                     : bent_minus_;
   return d.dot(point_ - x.col(a));
 }
 
@@ -255,7 +295,10 @@ double EdgeFront<dim>::g_plus(const StringModel<dim>& model) const {
   const Points<dim>& x = model.x();
   const int b = link_ + 1;
   const ArcRange& arc = model.arcs()[static_cast<std::size_t>(this->arc_minus)];
-  const Vec<dim> d = b < arc.last ? Vec<dim>((x.col(b + 1) - x.col(b)).normalized()) : bent_plus_;
+  const Vec<dim>* other = b < arc.last ? model.bend_point(b) : nullptr;  // the link after b bent over another edge
+  const Vec<dim> d = other ? Vec<dim>((*other - x.col(b)).normalized())
+                     : b < arc.last ? Vec<dim>((x.col(b + 1) - x.col(b)).normalized())
+                                    : bent_plus_;
   return d.dot(x.col(b) - point_);
 }
 
@@ -294,12 +337,22 @@ EventAction EdgeFront<dim>::cross(StringModel<dim>& model, const FrontState<dim>
                         "edge at s0 = {:.9g} m: an edge carries material over it only while the string on both sides "
                         "is free to move along itself",
                         held < node ? "before" : "after", held, node, s.s0)};
+  // The new bent link would be another edge's (two edges within one link of each other): no link is
+  // left between them to carry the material from one to the other.
+  const int new_link = e0 != 0 ? a - 1 : b;
+  if (model.bend_point(new_link) != nullptr)
+    return {EventAction::Kind::kStop,
+            fmt::format("node {} has reached the edge at {} (s0 = {:.9g} m) and the next link over it, link {}, runs "
+                        "over another edge at {}: two edges within one link of each other",
+                        node, show<dim>(point_), s.s0, new_link, show<dim>(*model.bend_point(new_link)))};
   const double h = this->m_.h, past = kMirror * kCross * h;
   const int sign = e0 != 0 ? +1 : -1;
   const double delta = e0 != 0 ? g_minus(model) : g_plus(model);
-  const Vec<dim> shift_minus = sign * (delta + past) * t_minus_, shift_plus = sign * (delta + past) * t_plus_;
-  for (int i = arc.first; i <= arc.last; ++i)
-    if (i != node) x.col(i) += i < node ? shift_minus : shift_plus;
+  // Each side moves on by δ + kMirror kCross h along itself: from this edge along its line on that side,
+  // and beyond another edge's bent link (a second edge or peg on the string) along that edge's line on
+  // its far side, so that the material flows through every edge by the same length and every link,
+  // straight or bent, keeps its length (to first order in the step; the projection does the rest).
+  shift_sides(model, arc.first, node - 1, node + 1, arc.last, sign * (delta + past), t_minus_, t_plus_);
   if (e0 != 0) {
     x.col(a) = point_ + past * t_plus_;
     v.col(a) = rotate_onto<dim>(v.col(a), t_minus_, t_plus_, axis_);
@@ -309,7 +362,7 @@ EventAction EdgeFront<dim>::cross(StringModel<dim>& model, const FrontState<dim>
     v.col(b) = rotate_onto<dim>(v.col(b), t_plus_, t_minus_, axis_);
     link_ = b;
   }
-  model.clear_bends();
+  model.unbend_link(a);  // this edge's bend only: another edge's stays
   set_link(model, link_);
   model.rebuild();
   model.refresh();

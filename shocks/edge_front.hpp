@@ -115,6 +115,15 @@ class EdgeFront final : public FrontKind<dim> {
   Vec<dim> bent_minus_ = Vec<dim>::Zero(), bent_plus_ = Vec<dim>::Zero();
   /// The sides' tangents at the edge at the start (the faces drawn along them).
   Vec<dim> start_minus_ = Vec<dim>::Zero(), start_plus_ = Vec<dim>::Zero();
+  /// Moves the nodes first … last_minus (before the edge) and first_plus … last (after it) by `step` (m)
+  /// along the string: from this edge along `minus` and `plus`, and beyond another edge's bent link (a
+  /// second edge or peg on the string) along that edge's line on its far side, so that the material
+  /// moves through every edge by the same length (a crossing, the nudge off a node at the start).
+  void shift_sides(StringModel<dim>& model, int first, int last_minus, int first_plus, int last, double step,
+                   const Vec<dim>& minus, const Vec<dim>& plus) const;
+  /// The direction of the string before (`before`) or after another edge's bent link j: along its part
+  /// to or from the point if that is longer than half a link, else along the link beyond it.
+  Vec<dim> side_direction(const StringModel<dim>& model, int j, bool before) const;
   /// Bends link `a` over x0 and fixes its directions.
   void set_link(StringModel<dim>& model, int a);
   // Of the last evaluation: the tangents on either side, the tension jump [τ] (N).

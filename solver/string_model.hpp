@@ -287,6 +287,20 @@ class StringModel final : public OdeSystem {
   }
   /// Straightens every bent link.
   void clear_bends() { bends_.clear(); }
+  /// Straightens link `link` if it is bent, the other bends kept (an edge front whose material crosses
+  /// its point moves its bend to the next link; another edge's bend stays).
+  void unbend_link(int link) {
+    for (auto it = bends_.begin(); it != bends_.end(); ++it)
+      if (it->link == link) {
+        bends_.erase(it);
+        return;
+      }
+  }
+  /// The point link `link` is bent over (bend_link), or null if it is straight.
+  const Vec<dim>* bend_point(int link) const {
+    const Bend* bend = bends_.empty() ? nullptr : bend_of(link);
+    return bend ? &bend->point : nullptr;
+  }
   /// Whether a link is bent over a point (an edge front's).
   bool has_bends() const { return !bends_.empty(); }
   /// Link `link` is bent over a point (bend_link).

@@ -295,13 +295,6 @@ std::unique_ptr<StringModel<dim>> build_front_model(const SceneSpec& spec, scene
                           "(\"auto\", \"erk5\", \"erk8\", ...)",
                           spec.solver.method));
   }
-  if (fx.edges.size() > 1)
-    fail_at(spec, "effects.edge[1]",
-            fmt::format("effects.edge[1]: the scene has {} edges, and a string runs over one edge at most (the edge "
-                        "front moves the material on each side of its point along its own two lines, which a second "
-                        "edge on the same string breaks: a chain over two pegs would not close its energy and "
-                        "momentum ledgers); allowed one [[effects.edge]]",
-                        fx.edges.size()));
   for (std::size_t k = 0; k < fx.edges.size(); ++k) {
     const EdgeEntry& entry = fx.edges[k];
     const std::string key = fmt::format("effects.edge[{}]", k);
@@ -373,6 +366,48 @@ std::unique_ptr<StringModel<dim>> build_front_model(const SceneSpec& spec, scene
                             "so no table face lies beside the string there; allowed table = \"none\" where the shape "
                             "turns by 180 deg",
                             key, entry.table, *turn * 180 / kPi));
+    }
+    // Several edges on one string (a chain over two pegs): each at least two links from the others, so
+    // that a link lies between their bent links; no table then (a table's side would hold the string
+    // beyond the other edge as well).
+    for (std::size_t j = 0; j < edges.size(); ++j)
+      if (std::abs(edges[j].s0 - edge.s0) < 2 * chain.link_length(0))
+        fail_at(spec, key + ".point",
+                fmt::format("{}.point = {} is at s = {:.6g} m of the string, less than two links ({:g} m) from "
+                            "effects.edge[{}] at s = {:.6g} m: allowed edges at least two links apart along the string",
+                            key, text_of(spec, key + ".point"), edge.s0, 2 * chain.link_length(0), j, edges[j].s0));
+    // Nor a whole number of links apart along the string: the material moves through both by the same
+    // length, so a node would reach each at the same instant, which one crossing at a time does not
+    // handle (the second node is carried over its edge by the first crossing: the links cannot be projected).
+    for (std::size_t j = 0; j < edges.size(); ++j) {
+      const double links = std::abs(edges[j].s0 - edge.s0) / chain.link_length(0);
+      if (std::abs(links - std::round(links)) < 1e-6)
+        fail_at(spec, key + ".point",
+                fmt::format("{}.point = {} is at s = {:.9g} m of the string, a whole number of links ({:.0f} h) from "
+                            "effects.edge[{}] at s = {:.9g} m: nodes would reach both at the same instant, which the edge "
+                            "fronts do not handle; move a point along the string by a fraction of a link or change "
+                            "string.nodes",
+                            key, text_of(spec, key + ".point"), edge.s0, std::round(links), j, edges[j].s0));
+    }
+    const bool surface_table = std::any_of(fx.surfaces.begin(), fx.surfaces.end(), [](const auto& f) { return f.edge.has_value(); });
+    if (fx.edges.size() > 1 && (edge.table != EdgeSpec<dim>::Table::kNone || surface_table))
+      fail_at(spec, edge.table != EdgeSpec<dim>::Table::kNone ? key + ".table" : key,
+              fmt::format("{}: the scene has {} edges and a table ({}): a table with more than one edge on the "
+                          "string is not supported (its side would hold the string beyond the other edge too); allowed "
+                          "table = \"none\" and no [[effects.surface]] with edge when there are several edges",
+                          key, fx.edges.size(),
+                          edge.table != EdgeSpec<dim>::Table::kNone ? key + ".table = \"" + entry.table + "\""
+                                                                   : std::string("an [[effects.surface]] with edge")));
+    // With several edges, none on a node: the nudge that moves the string off it (EdgeFront::initialize)
+    // moves the string beyond the other edges along the wrong lines, and their links then meet their
+    // points off the line they approach along (a tension spike at every crossing).
+    if (fx.edges.size() > 1) {
+      const double h = chain.link_length(0), off = edge.s0 - h * std::floor(edge.s0 / h);
+      if (std::min(off, h - off) < 2 * EdgeFront<dim>::kCross * h)
+        fail_at(spec, key + ".point",
+                fmt::format("{}.point = {} is on node {} of the string (s = {:.9g} m), and with several edges each "
+                            "point must lie inside a link; move the point along the string or change string.nodes",
+                            key, text_of(spec, key + ".point"), static_cast<int>(std::lround(edge.s0 / h)), edge.s0));
     }
     edges.push_back(edge);
   }

@@ -6,7 +6,7 @@ where RESULTS_DIR/<scene>/ holds the outputs of
     build/chainsim run cases/scenes/<scene>.toml --out RESULTS_DIR/<scene>
 for shaken_chain, travelling_loop, whip_crack, pendulum_release, folded_chain_ends_apart, swinging_u,
 pendulum_whip and thrown_chain (string scenes; the last three with slack = "allow"), chain_off_table_edge and
-chain_over_peg (edges), atwood_pulley and atwood_rough_pulley (cylinders), chain_landing_at_angle (a surface),
+chain_over_peg and chain_over_two_pegs (edges), atwood_pulley and atwood_rough_pulley (cylinders), chain_landing_at_angle (a surface),
 chain_off_real_table (a table bounded by its edge), chain_into_heap_on_table (a heap on a contact surface), streaming_corner (a kink) and
 falling_chain, folded_chain, sliding_chain, swinging_sliding_chain, tilted_falling_chain and
 curved_falling_chain (scenes with fronts), and RESULTS_DIR/<scene>_reduced/ the same canonical scenes run with
@@ -234,6 +234,22 @@ def chain_over_peg(run, ax):
     decorate(ax[1], "t (s)", "m", "the peg pushes until its reaction falls to zero")
 
 
+def chain_over_two_pegs(run, ax):
+    snapshots(ax[0], run, [0, 0.3, 0.6, 0.754], "chain over two sharp pegs, f = 0.5, ends pulled by 2 N and 0.5 N")
+    ts = np.asarray(run.series["t"])
+    s0, s1 = np.asarray(run.fronts[0].s0), np.asarray(run.fronts[1].s0)
+    # The closed form (docs/model.md §8): l x'' = F1 - F2 - 2 f x'^2, x = x0 + ln cosh(sqrt(AB) t)/B.
+    ell, f, x0 = 1.2, 0.5, 0.4
+    A, B = 1.5 / ell, 2 * f / ell
+    exact = x0 + np.log(np.cosh(np.sqrt(A * B) * ts)) / B
+    ax[1].plot(ts, s0, lw=2, alpha=0.7, label="first peg's s0 = x (string solver)")
+    ax[1].plot(ts, s1 - 0.3, "--", lw=1.5, label="second peg's s0 - 0.3 m")
+    ax[1].plot(ts, exact, "k:", lw=2, label="x0 + ln cosh(sqrt(AB) t)/B, exact")
+    worst = float(np.max(np.abs(s0 - exact)))
+    ax[1].axvline(0.754021410, color="r", lw=0.8, ls="--", label="lift-off off the second peg, t* = 0.75402 s")
+    decorate(ax[1], "t (s)", "m", f"the material runs through both pegs (max |x - exact| = {worst:.1e} m)")
+
+
 def streaming_corner(run, ax):
     snapshots(ax[0], run, [0, 0.1, 0.2, 0.28], "string streaming at 2 m/s through a fixed corner (a conservative kink);\ndots: its start, running to the corner; the shape does not change")
     ts = np.asarray(run.series["t"])
@@ -359,8 +375,8 @@ def thrown_chain(run, ax):
 
 SCENES = [shaken_chain, travelling_loop, whip_crack, pendulum_release, falling_chain, folded_chain, sliding_chain,
           swinging_sliding_chain, tilted_falling_chain, curved_falling_chain, folded_chain_ends_apart,
-          chain_off_table_edge, swinging_u, pendulum_whip, thrown_chain, chain_over_peg, atwood_pulley,
-          atwood_rough_pulley, streaming_corner, chain_landing_at_angle, chain_off_real_table, chain_into_heap_on_table]
+          chain_off_table_edge, swinging_u, pendulum_whip, thrown_chain, chain_over_peg, chain_over_two_pegs,
+          atwood_pulley, atwood_rough_pulley, streaming_corner, chain_landing_at_angle, chain_off_real_table, chain_into_heap_on_table]
 
 
 def main():

@@ -371,11 +371,19 @@ t_end = 1.0
                                   Contains("allowed a point where the shape turns"));
   CHECK(error(edit(straight, "[[0.0, 0.4], [0.0, -0.6]]", "[[0.0, 0.4], [0.0, 0.0123], [0.001, -0.6]]")).empty());
   const std::string two_pegs =
-      edit(edit(peg, "[[0.0, -0.4], [0.0, 0.0], [0.0, -0.6]]", "[[0.0, -0.3], [0.0, 0.0], [0.2, 0.0], [0.2, -0.5]]"),
-           "[stop]", "[[effects.edge]]\npoint = [0.2, 0.0]\n\n[stop]");
-  CHECK_THAT(error(two_pegs), Contains("s.toml:17:1: effects.edge[1]: the scene has 2 edges, and a string runs over one "
-                                       "edge at most") &&
-                                  Contains("allowed one [[effects.edge]]"));
+      edit(edit(peg, "[[0.0, -0.4], [0.0, 0.0], [0.0, -0.6]]", "[[0.0, -0.32], [0.0, 0.0], [0.17, 0.0], [0.17, -0.51]]"),
+           "[stop]", "[[effects.edge]]\npoint = [0.17, 0.0]\n\n[stop]");
+  // Two pegs run (tests/convergence/test_two_edges.cpp); closer than two links, or with a table, they are refused.
+  CHECK(error(two_pegs).empty());
+  CHECK_THAT(error(edit(edit(two_pegs, "[[0.0, -0.32], [0.0, 0.0], [0.17, 0.0], [0.17, -0.51]]",
+                             "[[0.0, -0.32], [0.0, 0.0], [0.07, 0.0], [0.07, -0.61]]"),
+                        "point = [0.17, 0.0]", "point = [0.07, 0.0]")),
+             Contains("effects.edge[1].point = [0.07, 0.0] is at s = 0.39 m of the string, less than two links (0.1 m) "
+                      "from effects.edge[0] at s = 0.32 m") &&
+                 Contains("allowed edges at least two links apart"));
+  CHECK_THAT(error(edit(two_pegs, "table = \"none\"", "table = \"after\"")),
+             Contains("s.toml:15:9: effects.edge[0]: the scene has 2 edges and a table (effects.edge[0].table = \"after\")") &&
+                 Contains("allowed table = \"none\""));
   CHECK_THAT(error(edit(peg, "[stop]", "[solver]\nmethod = \"dirk4\"\n\n[stop]")),
              Contains("s.toml:18:10: solver.method = \"dirk4\" is implicit, and implicit methods do not meet an edge") &&
                  Contains("allowed an explicit method"));
