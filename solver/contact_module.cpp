@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <tuple>
 
 #include <Eigen/Geometry>
 #include <fmt/format.h>
@@ -30,6 +31,15 @@ constexpr double kPassGap = kCatchWindow;
 /// A held node's normal force counts as pulling below −kPull of its weight scale m a (a the physical
 /// acceleration scale): round-off is not a lift-off.
 constexpr double kPull = 1e-9;
+/// Links along the arc: a free end lands when its straight part is this share of h (on the tangent line,
+/// its gap is then kWrapLand² h²/2R and its normal speed kWrapLand h/R of its speed: an impulse of second
+/// order in h). Not closer: a free node near its tangent point is a stiff pendulum (frequency² ~ T/(m s)),
+/// whose small swing each landing leaves grows as s shrinks; landing at 10⁻⁵ h or 10⁻² h let it grow from
+/// landing to landing into tension spikes (compare pulley on 101 and 801 nodes), at 0.05 h it does not.
+constexpr double kWrapLand = 0.05;
+/// Links along the arc: a node lands at kWrapLand h from its tangent point, on the circle at that arc behind
+/// it, so the link behind it starts with an arc of about −kWrapLand h: its arc runs out at −kWrapEnter h.
+constexpr double kWrapEnter = 3 * kWrapLand;
 /// A sliding node whose tangential speed is within kStopWindow of the speed scale √(a ℓ) at a located
 /// stop has stopped (the state recomputed to the event is within the integration error of the root).
 constexpr double kStopWindow = 1e-5;
@@ -214,7 +224,10 @@ class ContactModule final : public WrappingModule<dim> {
  public:
   ContactModule(std::vector<Obstacle<dim>> obstacles, std::unique_ptr<StringModule<dim>> inner)
       : WrappingModule<dim>(std::move(inner)), obstacles_(std::move(obstacles)) {
-    for (const Obstacle<dim>& o : obstacles_) friction_ = friction_ || o.mu > 0;
+    for (const Obstacle<dim>& o : obstacles_) {
+      friction_ = friction_ || o.mu > 0;
+      arc_ = arc_ || on_arc(o);
+    }
   }
 
   // Ledgers: [ the inner module's | W_contact | W_impacts | impulse (dim) | W_friction (with friction) ]. Without an inner module
@@ -229,6 +242,9 @@ class ContactModule final : public WrappingModule<dim> {
     for (int j = 0; j < chain.num_links(); ++j) h_ = std::min(h_, chain.link_length(j));
     drawn_nodes_ = model.x();
     held_.assign(static_cast<std::size_t>(n), -1);
+    wrap_.assign(static_cast<std::size_t>(chain.num_links()), -1);
+    no_wrap_land_.assign(static_cast<std::size_t>(n), 0);
+    entering_.assign(static_cast<std::size_t>(chain.num_links()), 0);
     offset_.assign(static_cast<std::size_t>(n), 0.0);
     let_go_at_.assign(static_cast<std::size_t>(n), -INFINITY);
     stuck_.assign(static_cast<std::size_t>(n), 0);
@@ -244,7 +260,33 @@ class ContactModule final : public WrappingModule<dim> {
                                      i, -gap, obstacles_[static_cast<std::size_t>(k)].name, kInitialContact));
       if (gap <= kInitialContact * h_) held_[static_cast<std::size_t>(i)] = k;
     }
-    model.refresh();
+    if (arc_) {
+      // The sense each circle is wrapped in: that of the first two consecutive nodes held on it.
+      sense_.assign(obstacles_.size(), 1.0);
+      for (int j = 0; j < chain.num_links(); ++j) {
+        const int a = chain.link_start(j), b = chain.link_end(j), k = held_[static_cast<std::size_t>(a)];
+        if (k < 0 || held_[static_cast<std::size_t>(b)] != k) continue;
+        const Vec<dim> ra = model.x().col(a) - obstacles_[static_cast<std::size_t>(k)].point;
+        const Vec<dim> rb = model.x().col(b) - obstacles_[static_cast<std::size_t>(k)].point;
+        sense_[static_cast<std::size_t>(k)] = ra[0] * rb[1] - ra[1] * rb[0] >= 0 ? 1.0 : -1.0;
+      }
+      // A node on a straight part within kInitialContact h of the circle (near the tangent point) is not on
+      // the arc: the link from it to the next held node would run round the circle backwards (a negative
+      // arc). Such end nodes of the held runs are not held, until none is.
+      for (bool again = true; again;) {
+        again = false;
+        refresh(model);
+        Points<dim> x = model.x(), v = model.v();
+        model.evaluate(0.0, x, v);
+        for (int j = 0; j < chain.num_links(); ++j) {
+          const auto [k, a_on, b_on] = link_wrap(model, j);
+          if (k < 0 || a_on == b_on || !(model.bend_arc(j) < 0)) continue;
+          held_[static_cast<std::size_t>(a_on ? chain.link_start(j) : chain.link_end(j))] = -1;
+          again = true;
+        }
+      }
+    }
+    refresh(model);
     // On a cylinder the nodes start on the circle an arc apart, so the chords between them are short of
     // their links by h³/24R²: the forces are judged on the state projected onto the links and the
     // gaps, or the drift control's pull towards the links' lengths reads as a pull off the cylinder
@@ -268,7 +310,7 @@ class ContactModule final : public WrappingModule<dim> {
         model.x() = x0;
         model.v() = v0;
       }
-      model.refresh();
+      refresh(model);
     }
     settle(model, 0.0, false);
     if (friction_) {
@@ -337,7 +379,7 @@ class ContactModule final : public WrappingModule<dim> {
                        {ledger[k + kFriction], static_cast<double>(sticks_), static_cast<double>(slips_)});
     out.has_momentum_ledger = true;
   }
-  int num_events() const override { return inner_events() + (friction_ ? 4 : 2); }
+  int num_events() const override { return inner_events() + (friction_ ? 4 : 2) + (arc_ ? 2 : 0); }
   bool events_need_tensions() const override { return true; }
   void events(const StringModel<dim>& model, Eigen::Ref<Eigen::VectorXd> g) const override {
     // The inner module's, then: the smallest gap of a free node (landing); the smallest normal force of
@@ -353,13 +395,15 @@ class ContactModule final : public WrappingModule<dim> {
     g[k + 1] = 1;
     const double a = acceleration_scale(model);
     for (std::size_t c = 0; c < model.contacts().size(); ++c)
-      g[k + 1] = std::min(g[k + 1], model.contact_force(c) / (model.masses()[model.contacts()[c].node] * a));
+      g[k + 1] = std::min(g[k + 1], held_force(model, c, a));
     if (friction_) friction_events(model, g.tail(g.size() - k));
+    if (arc_) wrap_events(model, g.tail(2));
   }
   std::vector<int> event_directions() const override {
     std::vector<int> directions = inner_ ? inner_->event_directions() : std::vector<int>{};
     directions.insert(directions.end(), {-1, -1});
     if (friction_) directions.insert(directions.end(), {-1, -1});
+    if (arc_) directions.insert(directions.end(), {-1, -1});
     return directions;
   }
   EventAction handle_events(StringModel<dim>& model, double t, Eigen::Ref<Eigen::VectorXd> ledger,
@@ -376,8 +420,16 @@ class ContactModule final : public WrappingModule<dim> {
     if (found.size() > land_at && found[land_at] != 0) changed = land(model, t, own) || changed;
     if (found.size() > lift_at && found[lift_at] != 0) changed = settle(model, t, true) || changed;
     const std::size_t stop_at = lift_at + 1, slip_at = lift_at + 2;
-    if (found.size() > stop_at && found[stop_at] != 0) changed = stop(model, t, own) || changed;
-    if (found.size() > slip_at && found[slip_at] != 0) changed = slip(model, t) || changed;
+    if (friction_ && found.size() > stop_at && found[stop_at] != 0) changed = stop(model, t, own) || changed;
+    if (friction_ && found.size() > slip_at && found[slip_at] != 0) changed = slip(model, t) || changed;
+    const std::size_t wrap_at = lift_at + (friction_ ? 3 : 1);
+    // Links along the arc: at every event, every end that has reached its landing and every arc that has
+    // run out (a root of the same function within the step of another one is not located again: its
+    // function restarts below zero); the one located caught within kCatchWindow.
+    if (arc_) {
+      changed = wrap_land(model, t, own, found.size() > wrap_at && found[wrap_at] != 0) || changed;
+      changed = wrap_leave(model, t, found.size() > wrap_at + 1 && found[wrap_at + 1] != 0) || changed;
+    }
     if (!changed) return {};
     return {EventAction::Kind::kTransfer, ""};  // the velocities or the held set changed: the integrator restarts
   }
@@ -480,7 +532,7 @@ class ContactModule final : public WrappingModule<dim> {
         stick_node(model, i, ledger);
       changed = true;
     }
-    model.refresh();
+    refresh(model);
     return unstick(model, t, false) || changed;
   }
   /// A located stop: the sliding nodes whose speed along their direction has reached zero stick (in 3D
@@ -680,7 +732,7 @@ class ContactModule final : public WrappingModule<dim> {
         dir_.col(i) = obstacle_of(static_cast<std::size_t>(i)).tangents(model.x().col(i)).transpose() *
                       (sign * chain_direction(model, i, -ft));
       }
-      model.refresh();
+      refresh(model);
       Points<dim> x = model.x(), v = model.v();
       bool consistent = true;
       try {
@@ -701,7 +753,7 @@ class ContactModule final : public WrappingModule<dim> {
       stuck_[static_cast<std::size_t>(i)] = 1;
       dir_.col(i).setZero();
     }
-    model.refresh();
+    refresh(model);
     throw NumericalError(fmt::format("stuck on {} at t = {:.9g} s, node {}: the friction cone cannot hold it (|F_t| = "
                                      "{:.6g} N beyond mu N), and its block of {} nodes cannot slide either way "
                                      "(Coulomb's law has no consistent motion here)",
@@ -709,6 +761,190 @@ class ContactModule final : public WrappingModule<dim> {
                          t);
   }
   Points<dim> drawn_nodes_;  // the string's initial nodes, which the obstacles' drawing spans
+
+  // Links along the arc (Obstacle::arc_links): whether an obstacle has them, the sense each circle is
+  // wrapped in (+1 counterclockwise along increasing node index), per link the circle a link with both
+  // ends free runs round (−1: none; a link with a held end runs round its end's), and per node whether
+  // its landing along a link is off (a node let go there, until it is held again).
+  bool arc_ = false;
+  std::vector<double> sense_;
+  std::vector<int> wrap_;
+  std::vector<char> no_wrap_land_;
+  std::vector<char> entering_;  // per link: made by a landing at its end (its arc starts at about −kWrapLand h)
+  static bool on_arc(const Obstacle<dim>& o) {
+    return dim == 2 && o.arc_links && o.kind == Obstacle<dim>::Kind::kCylinder && !(o.mu > 0);
+  }
+  /// The circle node i is held on with links along the arc, or −1.
+  int held_on_arc(const StringModel<dim>& model, int i) const {
+    const int k = held_[static_cast<std::size_t>(i)];
+    return k >= 0 && on_arc(obstacles_[static_cast<std::size_t>(k)]) && holds(model, i) ? k : -1;
+  }
+  /// The circle link j runs round (−1: none) and whether its ends are held on it.
+  std::tuple<int, bool, bool> link_wrap(const StringModel<dim>& model, int j) const {
+    const Chain<dim>& chain = model.chain();
+    const int ka = held_on_arc(model, chain.link_start(j)), kb = held_on_arc(model, chain.link_end(j));
+    const int k = ka >= 0 ? ka : kb >= 0 ? kb : wrap_[static_cast<std::size_t>(j)];
+    return {k, k >= 0 && ka == k, k >= 0 && kb == k};
+  }
+  /// The links along the arcs set on the model from the held set, then its refresh.
+  void refresh(StringModel<dim>& model) {
+    if (arc_) {
+      model.clear_circle_bends();
+      for (int j = 0; j < model.chain().num_links(); ++j) {
+        const auto [k, a_on, b_on] = link_wrap(model, j);
+        if (k < 0) continue;
+        const Obstacle<dim>& o = obstacles_[static_cast<std::size_t>(k)];
+        model.bend_link_on_circle(j, o.point, o.radius, sense_[static_cast<std::size_t>(k)], a_on, b_on);
+      }
+    }
+    model.refresh();
+  }
+  /// Held contact k's force per its mass and the acceleration scale a (the lift-off root function). On a
+  /// circle with links along the arc the links press on it too (T (e⁻ − e⁺) on each, the string's
+  /// pressure T/R): its force per length is the node's N over its mass's length plus its share of its
+  /// links' reactions over their arcs' length (half of a link between two held nodes, the whole arc of
+  /// a link from a free end): (T − λ v²)/R − λ g·n in the limit.
+  double held_force(const StringModel<dim>& model, std::size_t c, double a) const {
+    const int i = model.contacts()[c].node;
+    if (!arc_ || held_on_arc(model, i) < 0) return model.contact_force(c) / (model.masses()[i] * a);
+    const Vec<dim> n = model.contacts()[c].normal;
+    const Chain<dim>& chain = model.chain();
+    const int L = chain.num_links();
+    double force = 0, length = 0;
+    for (const int j : {i - 1, i}) {
+      const int jj = chain.closed() ? (j + L) % L : j;
+      if (jj < 0 || jj >= L || !model.link_bent(jj)) continue;
+      const double T = model.link_tension(jj), arc = model.bend_arc(jj);
+      if (!std::isfinite(T) || !(arc > 0)) continue;
+      const int other = jj == i - 1 || (chain.closed() && jj == (i - 1 + L) % L) ? chain.link_start(jj) : chain.link_end(jj);
+      const double share = held_on_arc(model, other) >= 0 ? 0.5 : 1.0;
+      force += share * T * n.dot(model.bent_direction(jj, false) - model.bent_direction(jj, true));
+      length += share * arc;
+    }
+    const double per_mass = model.contact_force(c) / model.masses()[i];
+    return (per_mass + (length > 0 ? force / (model.chain().density() * length) : 0.0)) / a;
+  }
+  /// Links along the arc, two root functions: the smallest straight part of a free end of a link that
+  /// runs round a circle, per h, less kWrapLand (the end lands), and the smallest arc of a link with a
+  /// free end, per h (it runs out: its held end leaves the circle, or a link with two free ends is
+  /// straight again; a link entering from a free start at −kWrapEnter).
+  void wrap_events(const StringModel<dim>& model, Eigen::Ref<Eigen::VectorXd> g) const {
+    g.setOnes();
+    const Chain<dim>& chain = model.chain();
+    for (int j = 0; j < chain.num_links(); ++j) {
+      if (!model.link_bent(j)) continue;
+      const double arc = model.bend_arc(j);
+      if (!std::isfinite(arc)) continue;
+      const auto [k, a_on, b_on] = link_wrap(model, j);
+      if (k < 0) continue;
+      const int a = chain.link_start(j), b = chain.link_end(j);
+      const double h = chain.link_length(j);
+      if (!a_on && !no_wrap_land_[static_cast<std::size_t>(a)] && free_node(model, a))
+        g[0] = std::min(g[0], model.bend_straight(j, false) / h - kWrapLand);
+      if (!b_on && !no_wrap_land_[static_cast<std::size_t>(b)] && free_node(model, b))
+        g[0] = std::min(g[0], model.bend_straight(j, true) / h - kWrapLand);
+      if (a_on && b_on) continue;
+      g[1] = std::min(g[1], arc / h + (entering_[static_cast<std::size_t>(j)] ? kWrapEnter : 0.0));
+    }
+  }
+  /// Node i, held on a circle with links along the arc, is let go: its links with a free far end run
+  /// round the circle from both free ends, except `straight` (a link whose arc has run out).
+  void release_on_arc(const StringModel<dim>& model, int i, int straight) {
+    const int k = held_on_arc(model, i);
+    if (k < 0) return;
+    const Chain<dim>& chain = model.chain();
+    const int L = chain.num_links();
+    for (const int j0 : {i - 1, i}) {
+      const int j = chain.closed() ? (j0 + L) % L : j0;
+      if (j < 0 || j >= L) continue;
+      const int other = chain.link_start(j) == i ? chain.link_end(j) : chain.link_start(j);
+      wrap_[static_cast<std::size_t>(j)] = j != straight && held_on_arc(model, other) < 0 ? k : -1;
+      entering_[static_cast<std::size_t>(j)] = 0;
+    }
+    no_wrap_land_[static_cast<std::size_t>(i)] = 1;
+  }
+  /// A free end lands along its link: held, with the impact of what normal speed it has (of order
+  /// kWrapLand h v/R).
+  bool wrap_land(StringModel<dim>& model, double t, Eigen::Ref<Eigen::VectorXd> ledger, bool located) {
+    const Chain<dim>& chain = model.chain();
+    std::vector<std::pair<int, int>> landing;
+    int closest = -1, closest_k = -1;
+    double closest_g = INFINITY;
+    for (int j = 0; j < chain.num_links(); ++j) {
+      const auto [k, a_on, b_on] = link_wrap(model, j);
+      if (k < 0 || !model.link_bent(j)) continue;
+      const double h = chain.link_length(j);
+      for (const bool at_end : {false, true}) {
+        const int i = at_end ? chain.link_end(j) : chain.link_start(j);
+        if ((at_end ? b_on : a_on) || no_wrap_land_[static_cast<std::size_t>(i)] || !free_node(model, i)) continue;
+        const double g = model.bend_straight(j, at_end) / h - kWrapLand;
+        if (g <= kLandWindow) {
+          if (std::none_of(landing.begin(), landing.end(), [&](const auto& p) { return p.first == i; }))
+            landing.emplace_back(i, k);
+        } else if (g < closest_g) {
+          closest_g = g;
+          closest = i;
+          closest_k = k;
+        }
+      }
+    }
+    if (located && landing.empty() && closest >= 0 && closest_g < kCatchWindow) landing.emplace_back(closest, closest_k);
+    for (const auto& [i, k] : landing)  // the links from it with a free far end now run from a held end
+      for (const int j : {i - 1, i})
+        if (j >= 0 && j < chain.num_links()) {
+          wrap_[static_cast<std::size_t>(j)] = -1;
+          const int other = j == i ? chain.link_end(j) : chain.link_start(j);
+          entering_[static_cast<std::size_t>(j)] = held_on_arc(model, other) < 0 ? 1 : 0;
+        }
+    // The impact places the landing node on the circle (from its gap, kWrapLand² h²/2R) and the links on
+    // their lengths along it: the potential energy that moves is booked with the impact's kinetic energy.
+    const Eigen::VectorXd none = Eigen::VectorXd::Zero(this->num_ledgers());
+    const double V_before = model.potential_energy(none);
+    const bool held = hold(model, t, ledger, landing);
+    if (held) ledger[1] += model.potential_energy(none) - V_before;
+    return held;
+  }
+  /// A link's arc has run out: its held end leaves the circle (no impulse: it moves along the circle's
+  /// tangent, which its link continues), or a link with two free ends is straight again.
+  bool wrap_leave(StringModel<dim>& model, double t, bool located) {
+    const Chain<dim>& chain = model.chain();
+    bool changed = false;
+    int closest = -1;
+    double closest_g = INFINITY;
+    std::vector<int> out;
+    for (int j = 0; j < chain.num_links(); ++j) {
+      if (!model.link_bent(j)) continue;
+      const auto [k, a_on, b_on] = link_wrap(model, j);
+      if (k < 0 || (a_on && b_on)) continue;
+      const double g = model.bend_arc(j) / chain.link_length(j) + (entering_[static_cast<std::size_t>(j)] ? kWrapEnter : 0.0);
+      if (g <= kLandWindow)
+        out.push_back(j);
+      else if (g < closest_g) {
+        closest_g = g;
+        closest = j;
+      }
+    }
+    if (located && out.empty() && closest >= 0 && closest_g < kCatchWindow) out.push_back(closest);
+    for (const int j : out) {
+      const auto [k, a_on, b_on] = link_wrap(model, j);
+      if (k < 0) continue;
+      const int held = a_on ? chain.link_start(j) : b_on ? chain.link_end(j) : -1;
+      if (held >= 0) {
+        release_on_arc(model, held, j);
+        held_[static_cast<std::size_t>(held)] = -1;
+        offset_[static_cast<std::size_t>(held)] = kReleaseGap;
+        let_go_at_[static_cast<std::size_t>(held)] = t;
+        ++lift_offs_;
+      } else {
+        wrap_[static_cast<std::size_t>(j)] = -1;
+      }
+      changed = true;
+    }
+    if (!changed) return false;
+    refresh(model);
+    settle(model, t, false);
+    return true;
+  }
 
   static bool free_node(const StringModel<dim>& model, int i) { return model.in_arc(i) && !model.is_prescribed(i); }
   /// Node i is held now: on an obstacle, free (a front may have taken it into a heap), and on the
@@ -763,6 +999,7 @@ class ContactModule final : public WrappingModule<dim> {
     for (const auto& [i, k] : landing) {
       held_[static_cast<std::size_t>(i)] = k;
       offset_[static_cast<std::size_t>(i)] = 0;
+      if (arc_) no_wrap_land_[static_cast<std::size_t>(i)] = 0;
       ++caught;
     }
     if (caught == 0) return false;
@@ -777,9 +1014,9 @@ class ContactModule final : public WrappingModule<dim> {
       }
     const double K_before = model.kinetic_energy();
     const Vec<dim> p_before = model.momentum();
-    model.refresh();
+    refresh(model);
     model.impact(t);
-    model.refresh();
+    refresh(model);
     ledger[1] += model.kinetic_energy() - K_before;
     ledger.template segment<dim>(2) += model.momentum() - p_before;
     ++impacts_;
@@ -832,9 +1069,9 @@ class ContactModule final : public WrappingModule<dim> {
       applied = true;
     }
     if (!applied) return;
-    model.refresh();
+    refresh(model);
     model.project(t);
-    model.refresh();
+    refresh(model);
     ledger[kFriction] += model.kinetic_energy() - K_before;
     ledger.template segment<dim>(2) += model.momentum() - p_before;
   }
@@ -854,7 +1091,7 @@ class ContactModule final : public WrappingModule<dim> {
       const auto [k, gap] = nearest(static_cast<int>(i), model.x().col(static_cast<Eigen::Index>(i)));
       if (k >= 0 && gap <= kLandWindow * h_) landing.emplace_back(static_cast<int>(i), k);
     }
-    model.refresh();
+    refresh(model);
     if (!hold(model, t, ledger, landing)) settle(model, t, false);
   }
   /// Lets go of the held nodes whose normal force pulls, one at a time, most negative first (each
@@ -870,7 +1107,7 @@ class ContactModule final : public WrappingModule<dim> {
       double worst_force = 0;
       for (std::size_t k = 0; k < model.contacts().size(); ++k) {
         const int i = model.contacts()[k].node;
-        const double f = model.contact_force(k) / (model.masses()[i] * a);
+        const double f = held_force(model, k, a);
         if (f < -kPull && f < worst_force) {
           worst_force = f;
           worst = i;
@@ -879,7 +1116,7 @@ class ContactModule final : public WrappingModule<dim> {
       if (worst < 0 && located && !released) {
         for (std::size_t k = 0; k < model.contacts().size(); ++k) {
           const int i = model.contacts()[k].node;
-          const double f = model.contact_force(k) / (model.masses()[i] * a);
+          const double f = held_force(model, k, a);
           if (f <= kCatchWindow && (worst < 0 || f < worst_force)) {
             worst_force = f;
             worst = i;
@@ -887,6 +1124,7 @@ class ContactModule final : public WrappingModule<dim> {
         }
       }
       if (worst < 0) break;
+      if (arc_) release_on_arc(model, worst, -1);
       held_[static_cast<std::size_t>(worst)] = -1;
       offset_[static_cast<std::size_t>(worst)] = kReleaseGap;
       let_go_at_[static_cast<std::size_t>(worst)] = t;
@@ -896,7 +1134,7 @@ class ContactModule final : public WrappingModule<dim> {
       }
       ++lift_offs_;
       released = true;
-      model.refresh();
+      refresh(model);
     }
     return released;
   }

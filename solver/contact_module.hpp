@@ -48,6 +48,13 @@ struct Obstacle {
   Vec<dim> axis = Vec<dim>::Zero();    ///< cylinder in 3D: its unit axis (unused in 2D)
   double radius = 0;                   ///< cylinder (m)
   double mu = 0;                       ///< Coulomb's coefficient of friction (≥ 0; 0: smooth)
+  /// A smooth circle in 2D whose wrapped string lies on it link by link (docs/model.md §10, "Links along
+  /// the arc"): the links between two held nodes run along the arc (R θ = h), a link with one end or
+  /// both ends free runs round it from the tangent points of its free ends (StringModel::
+  /// bend_link_on_circle), nodes land where their link meets the circle tangentially and leave it where
+  /// their link's arc runs out, and a held node lifts off where its force and its share of its links'
+  /// reactions, per length, would pull. Otherwise the nodes alone are held (the links are chords).
+  bool arc_links = false;
   std::string name;                    ///< for messages: "effects.surface[0]"
   /// A plane bounded by an edge (a table): the unit direction in the plane, normal to the edge's line,
   /// from the edge (at `point`) into the table; zero for an unbounded plane. Beyond the edge there is

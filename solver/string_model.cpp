@@ -22,6 +22,9 @@ constexpr double kCollapsedLink = 1e-6;
 /// A bent link's part on either side of its point may be this short (a node crossing an edge passes
 /// within 1e-8 h of it, shocks/edge_front.hpp).
 constexpr double kBentLinkFloor = 1e-10;
+/// A link bent over a circle: the share of its length below which a free end's straight part is
+/// floored in the quadratic term (n·v)²/s (the end has just left the circle, or is about to land).
+constexpr double kCircleBendFloor = 1e-6;
 /// The projection is converged when every link length is right to the larger of this relative
 /// accuracy and the round-off of its coordinates, kRoundoffUlps · ε · max|x| / h_min: a link's length
 /// cannot be represented more accurately than its end points' coordinates.
@@ -305,8 +308,107 @@ void StringModel<dim>::bend_link(int link, const Vec<dim>& point) {
 }
 
 template <int dim>
+void StringModel<dim>::bend_link_on_circle(int link, const Vec<dim>& center, double radius, double sigma, bool a_on,
+                                           bool b_on) {
+  if (quadratic_) throw InputError("a link bent over a circle needs link elements ([string] elements = \"links\")");
+  if (dim != 2) throw InputError("a link bent over a circle is two-dimensional");
+  if (link < 0 || link >= chain_.num_links()) throw InputError(fmt::format("bend_link_on_circle: no link {}", link));
+  Bend bend;
+  bend.link = link;
+  bend.circle = true;
+  bend.center = center;
+  bend.radius = radius;
+  bend.sigma = sigma;
+  bend.a_on = a_on;
+  bend.b_on = b_on;
+  for (Bend& b : bends_)
+    if (b.link == link) {
+      b = bend;
+      return;
+    }
+  bends_.push_back(bend);
+}
+
+template <int dim>
+void StringModel<dim>::clear_circle_bends() {
+  bends_.erase(std::remove_if(bends_.begin(), bends_.end(), [](const Bend& b) { return b.circle; }), bends_.end());
+}
+
+template <int dim>
+double StringModel<dim>::bend_arc(int link) const {
+  const Bend* bend = bends_.empty() ? nullptr : bend_of(link);
+  return bend && bend->circle ? bend->arc : std::numeric_limits<double>::quiet_NaN();
+}
+
+template <int dim>
+double StringModel<dim>::bend_straight(int link, bool at_end) const {
+  const Bend* bend = bends_.empty() ? nullptr : bend_of(link);
+  if (!bend || !bend->circle) return std::numeric_limits<double>::quiet_NaN();
+  return at_end ? bend->l_plus : bend->l_minus;
+}
+
+template <int dim>
+typename StringModel<dim>::CircleBend StringModel<dim>::circle_bend(const Bend& bend) const {
+  CircleBend out;
+  if constexpr (dim == 2) {
+    const int j = bend.link, a = chain_.link_start(j), b = chain_.link_end(j);
+    const double R = bend.radius, sg = bend.sigma;
+    // One end: its angle on the circle (a free end: the tangent point of the line through it), its
+    // straight part s and its share of the quadratic term. `out_end`: the end node b (the string goes
+    // from the circle to it); the start node a enters the circle.
+    struct End {
+      double theta, s, q;
+    };
+    auto end = [&](int i, bool on, bool out_end) -> End {
+      const Vec<2> r = x_.col(i) - bend.center, v = v_.col(i);
+      const double d = r.norm(), phi = std::atan2(r[1], r[0]);
+      if (on) {  // R σ θ: its second derivative at zero acceleration, −2 σ R (n·v)(t·v)/d²
+        const Vec<2> n = r / d, t(-n[1], n[0]);
+        const double q = -2 * sg * R * n.dot(v) * t.dot(v) / (d * d);
+        return {phi, 0.0, out_end ? q : -q};
+      }
+      // Off the circle: s = √(d² − R²) along the tangent at θ = φ ∓ σ atan(s/R); d²s/dt² − R σ θ̈ at zero
+      // acceleration is (n(θ)·v)²/s (the point-bend's |v⊥|²/l), its s floored where it vanishes.
+      const double s = d > R ? std::sqrt((d - R) * (d + R)) : 0.0;
+      const double theta = phi + (out_end ? -sg : sg) * std::atan2(s, R);
+      const double vn = Vec<2>(std::cos(theta), std::sin(theta)).dot(v);
+      return {theta, s, vn * vn / std::max(s, kCircleBendFloor * chain_.link_length(j))};
+    };
+    const End ea = end(a, bend.a_on, false), eb = end(b, bend.b_on, true);
+    double dtheta = eb.theta - ea.theta;
+    dtheta -= 2 * kPi * std::round(dtheta / (2 * kPi));  // into [−π, π]
+    out.arc = R * sg * dtheta;
+    out.s_a = ea.s;
+    out.s_b = eb.s;
+    out.l = ea.s + out.arc + eb.s;
+    out.q = ea.q + eb.q;
+    out.e_minus = sg * Vec<2>(-std::sin(ea.theta), std::cos(ea.theta));
+    out.e_plus = sg * Vec<2>(-std::sin(eb.theta), std::cos(eb.theta));
+  }
+  return out;
+}
+
+template <int dim>
+Vec<dim> StringModel<dim>::end_direction_at_contact(int j) const {
+  if (!bends_.empty())
+    if (const Bend* bend = bend_of(j); bend && bend->circle) return bend->e_plus;
+  return e_.col(j);
+}
+
+template <int dim>
 void StringModel<dim>::bend_links() {
   for (Bend& bend : bends_) {
+    if (bend.circle) {
+      const CircleBend c = circle_bend(bend);
+      l_[bend.link] = c.l;
+      e_.col(bend.link) = c.e_minus;
+      bend.e_plus = c.e_plus;
+      bend.l_minus = c.s_a;
+      bend.l_plus = c.s_b;
+      bend.arc = c.arc;
+      bend.q = c.q;
+      continue;
+    }
     const int j = bend.link, a = chain_.link_start(j), b = chain_.link_end(j);
     const Vec<dim> to_a = bend.point - x_.col(a), from_b = x_.col(b) - bend.point;
     bend.l_minus = to_a.norm();
@@ -346,8 +448,10 @@ template <int dim>
 double StringModel<dim>::current_length(int j) const {
   const Vec<dim>& a = x_.col(chain_.link_start(j));
   const Vec<dim>& b = x_.col(chain_.link_end(j));
-  if (const Bend* bend = bends_.empty() ? nullptr : bend_of(j))  // its length runs over its point
+  if (const Bend* bend = bends_.empty() ? nullptr : bend_of(j)) {  // its length runs over its point
+    if (bend->circle) return circle_bend(*bend).l;
     return (bend->point - a).norm() + (b - bend->point).norm();
+  }
   return (b - a).norm();
 }
 
@@ -519,10 +623,11 @@ void StringModel<dim>::contact_couplings() {
     const auto [jm, jp] = node_links(i);
     const int um = jm >= 0 ? link_unknown_[static_cast<std::size_t>(jm)] : -1;
     const int up = jp >= 0 ? link_unknown_[static_cast<std::size_t>(jp)] : -1;
-    if (um >= 0) system_->add_diagonal(um, w_[i] * std::pow(e_.col(jm).dot(c.normal), 2));
+    const Vec<dim> em = um >= 0 ? end_direction_at_contact(jm) : Vec<dim>::Zero();
+    if (um >= 0) system_->add_diagonal(um, w_[i] * std::pow(em.dot(c.normal), 2));
     if (up >= 0) system_->add_diagonal(up, w_[i] * std::pow(e_.col(jp).dot(c.normal), 2));
     if (um >= 0 && up >= 0)
-      system_->set_coupling(um, w_[i] * (e_.col(jm).dot(e_.col(jp)) - e_.col(jm).dot(c.normal) * e_.col(jp).dot(c.normal)));
+      system_->set_coupling(um, w_[i] * (em.dot(e_.col(jp)) - em.dot(c.normal) * e_.col(jp).dot(c.normal)));
   }
 }
 
@@ -694,6 +799,12 @@ double StringModel<dim>::evaluate_current(double t) {
       if (u < 0) continue;
       const int a = chain_.link_start(j), b = chain_.link_end(j);
       const Vec<dim> em = e_.col(j), ep = bend.e_plus;
+      if (bend.circle) {  // d²l/dt² = e⁺·a_b − e⁻·a_a + q (circle_bend)
+        const double h = chain_.link_length(j), l = l_[j];
+        const double stab = 2 * alpha_ * bend_rate(bend) + beta2_ * 0.5 * (l * l - h * h) / l;
+        system_->rhs(u) = -bend.q - (ep.dot(b_.col(b)) - em.dot(b_.col(a))) - stab;
+        continue;
+      }
       const Vec<dim> va = v_.col(a) - em * em.dot(v_.col(a)), vb = v_.col(b) - ep * ep.dot(v_.col(b));
       const double h = chain_.link_length(j), l = l_[j];
       const double stab = 2 * alpha_ * bend_rate(bend) + beta2_ * 0.5 * (l * l - h * h) / l;
@@ -1349,7 +1460,7 @@ void StringModel<dim>::add_link_responses(Points<dim>& target, const Eigen::Vect
     const int i = c.node;
     const auto [jm, jp] = node_links(i);
     Vec<dim> response = Vec<dim>::Zero();
-    if (jm >= 0 && link_unknown_[static_cast<std::size_t>(jm)] >= 0) response += nu[link_unknown_[static_cast<std::size_t>(jm)]] * e_.col(jm);
+    if (jm >= 0 && link_unknown_[static_cast<std::size_t>(jm)] >= 0) response += nu[link_unknown_[static_cast<std::size_t>(jm)]] * end_direction_at_contact(jm);
     if (jp >= 0 && link_unknown_[static_cast<std::size_t>(jp)] >= 0) response -= nu[link_unknown_[static_cast<std::size_t>(jp)]] * e_.col(jp);
     target.col(i) -= w_[i] * c.normal.dot(response) * c.normal;
   }

@@ -285,6 +285,22 @@ class StringModel final : public OdeSystem {
     chain_.positions().col(node) = x;
     x_.col(node) = x;
   }
+  /// Bends link `link` over a circle (2D; docs/model.md §10, "Links along the arc"): the link runs
+  /// round the circle of `center` and `radius` in the sense `sigma` (+1 counterclockwise from its
+  /// start node to its end node), its constraint l = s_a + R σ (θ_out − θ_in) + s_b = h. An end on the
+  /// circle (`a_on`, `b_on`: held there by the contact module) enters at its own angle with s = 0; a
+  /// free end enters along the line tangent to the circle through it, s its distance from the tangent
+  /// point. Its tension pulls node a along e⁻ = σ t(θ_in) and node b along −e⁺ = −σ t(θ_out) (t the
+  /// circle's counterclockwise tangent), and the circle takes T (e⁻ − e⁺): the string's pressure on
+  /// the arc of the link. Replaces any earlier bend of the same link.
+  void bend_link_on_circle(int link, const Vec<dim>& center, double radius, double sigma, bool a_on, bool b_on);
+  /// Straightens the links bent over circles (bend_link_on_circle); the links bent over points stay.
+  void clear_circle_bends();
+  /// A link bent over a circle after an evaluation: the length of its arc on the circle, R σ (θ_out −
+  /// θ_in) (m, negative where the tangent points have passed each other), and the straight part at its
+  /// start (`at_end` false) or its end node (m, 0 for an end on the circle). NaN for another link.
+  double bend_arc(int link) const;
+  double bend_straight(int link, bool at_end) const;
   /// Straightens every bent link.
   void clear_bends() { bends_.clear(); }
   /// Straightens link `link` if it is bent, the other bends kept (an edge front whose material crosses
@@ -480,6 +496,11 @@ class StringModel final : public OdeSystem {
     Vec<dim> e_plus = Vec<dim>::Zero();
     Vec<dim> e_minus_last = Vec<dim>::Zero(), e_plus_last = Vec<dim>::Zero();  // of the last evaluation
     double l_minus = 0, l_plus = 0;
+    // Bent over a circle (bend_link_on_circle): its centre, radius and sense, which ends are on it; after
+    // links() the arc's length, the quadratic term of d²l/dt² at zero accelerations (q), and its angles.
+    bool circle = false, a_on = false, b_on = false;
+    Vec<dim> center = Vec<dim>::Zero();
+    double radius = 0, sigma = 1, arc = 0, q = 0;
   };
   std::vector<Bend> bends_;
   // Node contacts (refresh(): from the module): held nodes, their normal forces after an evaluation,
@@ -515,6 +536,16 @@ class StringModel final : public OdeSystem {
   /// project(): puts the held nodes back on their surfaces (x −= gap n); returns the largest gap / h.
   double place_contact_nodes();
   void bend_links();               // links(): the bent links' lengths and directions
+  /// A link bent over a circle at x_, v_: its length, arc, straight parts, directions e⁻, e⁺ and the
+  /// quadratic term q of d²l/dt² = e⁺·a_b − e⁻·a_a + q.
+  struct CircleBend {
+    double l = 0, arc = 0, s_a = 0, s_b = 0, q = 0;
+    Vec<dim> e_minus = Vec<dim>::Zero(), e_plus = Vec<dim>::Zero();
+  };
+  CircleBend circle_bend(const Bend& bend) const;
+  /// Link j's direction at its end node: e⁺ for a link bent over a circle, e_j otherwise (a link bent
+  /// over a point keeps e_j there in the held nodes' rows, as before circles).
+  Vec<dim> end_direction_at_contact(int j) const;
   void bend_couplings();           // assemble_matrix(): their couplings at the end node
   double bend_rate(const Bend& bend) const;  // d(l⁻ + l⁺)/dt
   const Bend* bend_of(int link) const;       // the bend of a link, or null

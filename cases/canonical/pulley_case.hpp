@@ -4,9 +4,9 @@
 /// (docs/model.md §10, cases/reduced/exact_solutions.hpp exact::pulley_*): `chainsim compare pulley`.
 /// A chain of length ℓ hangs over a fixed smooth pulley of radius R at the origin (a circle: the contact
 /// module, solver/contact_module.hpp), x2 = ℓ_free/2 − u0 on the left (the shorter side), x1 = ℓ_free/2 +
-/// u0 on the right, the half circle πR between (ℓ_free = ℓ − πR), released at rest. It runs until the
-/// shorter side lifts off the pulley (the contact module's first lift-off event, ContactOptions::
-/// stop_at_lift_off; or the safety stop t_max_over_t0 t0): u = u0 cosh(√(2g/ℓ) t), the tensions
+/// u0 on the right, the half circle πR between (ℓ_free = ℓ − πR), released at rest. The pulley holds the
+/// string link by link (Obstacle::arc_links: links along the arc, docs/model.md §10). It runs to just past
+/// the exact lift-off, 1.005 t* (or the safety stop t_max_over_t0 t0): u = u0 cosh(√(2g/ℓ) t), the tensions
 /// λ x2 (g + ẍ) and λ x1 (g − ẍ) where the sides meet the pulley, and the lift-off where the shorter
 /// side's falls to λ ẋ².
 #include "cases/canonical/canonical_string.hpp"
@@ -38,8 +38,7 @@ struct PulleyCaseSetup {
 ///                               held node; x, ẍ exact,
 ///   max_abs_err_tension_long    the same for τ1 = λ x1 (g − ẍ) where the longer side leaves it (N),
 ///   mean_abs_err_tension_short, mean_abs_err_tension_long   their means over the steps (N),
-///   mean_err_tension_short, mean_err_tension_long   the means of the signed errors (N; negative: the
-///                               landings' impulses carry a share of the pull, docs/model.md §10),
+///   mean_err_tension_short, mean_err_tension_long   the means of the signed errors (N),
 ///   max_rel_err_tension         the larger maximum over λ g ℓ,
 ///   tension_steps               the steps at which both were measured (each side needs two hanging links
 ///                               below the pulley).
