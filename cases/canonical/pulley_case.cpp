@@ -32,10 +32,8 @@ namespace {
 /// links along the arc do not yet follow with closed ledgers (docs/model.md §10).
 constexpr double kPastLiftOff = 1.005;
 
-/// The tension where a hanging side meets the pulley's horizontal diameter (y = 0), extrapolated
-/// linearly in height from the two highest links of the side that lie wholly below it, found going up
-/// from its end node `end` by `step` (+1 from node 0, the shorter side's end; −1 from the last node);
-/// NaN if there are not two.
+}  // namespace
+
 double tension_at_pulley(const Points<2>& x, const Eigen::VectorXd& tension, int end, int step) {
   const int links = static_cast<int>(tension.size());
   auto link_of = [&](int node) { return step > 0 ? node : node - 1; };  // the link from `node` up the side
@@ -48,7 +46,18 @@ double tension_at_pulley(const Points<2>& x, const Eigen::VectorXd& tension, int
   return tension[j] + (tension[j] - tension[k]) / (y1 - y0) * (0 - y1);
 }
 
-}  // namespace
+void PulleyLiftOff::add(double t_step, double margin, double u) {
+  if (t) return;
+  if (have_prev_ && margin_prev_ > 0 && margin <= 0) {
+    const double w = margin_prev_ / (margin_prev_ - margin);
+    t = t_prev_ + w * (t_step - t_prev_);
+    x = x_offset + u_prev_ + w * (u - u_prev_);
+  }
+  t_prev_ = t_step;
+  margin_prev_ = margin;
+  u_prev_ = u;
+  have_prev_ = true;
+}
 
 PulleyComparison compare_pulley_with_exact(const PulleyCaseSetup& setup) {
   setup.validate();
@@ -97,11 +106,10 @@ PulleyComparison compare_pulley_with_exact(const PulleyCaseSetup& setup) {
   // meets the pulley, its speed), interpolated linearly between the steps where it changes sign. The
   // shorter side runs onto the pulley along its tangent (links along the arc, Obstacle::arc_links): no
   // landing shakes the tension, so the margin needs no average over the landings.
-  std::optional<double> t_lift_off, x_lift_off;
-  double t_prev = 0, margin_prev = 0, u_prev = 0;
-  bool have_prev = false;
+  PulleyLiftOff lift;
+  lift.x_offset = 0.5 * free;
   auto compare_at = [&](double t, const Points<2>& x, const Points<2>& v, const Eigen::VectorXd& tension) {
-    if (t_lift_off) return;  // the exact solution holds up to the lift-off
+    if (lift.t) return;  // the exact solution holds up to the lift-off
     const auto [u, u_dot, tau2, tau1] = exact_at(t);
     const double u_string = u_of(x);
     err_x = std::max(err_x, std::abs(u_string - u));
@@ -115,15 +123,7 @@ PulleyComparison compare_pulley_with_exact(const PulleyCaseSetup& setup) {
     signed_long += T1 - tau1;
     ++tension_steps;
     const double speed = 0.5 * (v(1, 0) - v(1, links)), margin = T2 - lambda * speed * speed;
-    if (have_prev && margin_prev > 0 && margin <= 0) {
-      const double w = margin_prev / (margin_prev - margin);
-      t_lift_off = t_prev + w * (t - t_prev);
-      x_lift_off = 0.5 * free + u_prev + w * (u_string - u_prev);
-    }
-    t_prev = t;
-    margin_prev = margin;
-    u_prev = u_string;
-    have_prev = true;
+    lift.add(t, margin, u_string);
   };
   solver.on_step = [&](double t, const Eigen::VectorXd& y) {
     const auto snap = model.snapshot(t, y);
@@ -136,7 +136,7 @@ PulleyComparison compare_pulley_with_exact(const PulleyCaseSetup& setup) {
   }
   // 3. The summary: the string's lift-off and the errors up to it.
   std::optional<MeasuredLiftOff> lift_off;
-  if (t_lift_off) lift_off = MeasuredLiftOff{*t_lift_off, *x_lift_off};
+  if (lift.t) lift_off = MeasuredLiftOff{*lift.t, *lift.x};
   c.summary = exact_comparison_summary(c.run, "pulley", setup.nodes, t_lift, 0.5 * free + u_lift, lift_off, err_x);
   c.summary["u0"] = u0;
   c.summary["R"] = R;

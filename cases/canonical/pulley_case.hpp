@@ -46,6 +46,28 @@ struct PulleyCaseSetup {
 /// lift_off_margin = (τ2 − λ ẋ²)/R (N/m), the contact force per length where the shorter side meets the
 /// pulley: it reaches zero at the lift-off.
 using PulleyComparison = ExactComparison;
+
+/// The tension where a hanging side meets the pulley's horizontal diameter (y = 0, the pulley's centre at
+/// the origin), extrapolated linearly in height from the two highest links of the side that lie wholly
+/// below it, found going up from its end node `end` by `step` (+1 from node 0, the shorter side's end; −1
+/// from the last node); NaN if there are not two.
+double tension_at_pulley(const Points<2>& x, const Eigen::VectorXd& tension, int end, int step);
+
+/// The string's lift-off off the pulley as `compare pulley` measures it: the first zero of its margin
+/// τ2 − λ ẋ² (its tension where the shorter side meets the pulley, its speed), interpolated linearly
+/// between the accepted steps where it changes sign. Fed step by step (a scene's run measures it too:
+/// tests/convergence/test_contact.cpp).
+struct PulleyLiftOff {
+  double x_offset = 0;      ///< ℓ_free/2 (m): the longer side's hanging length is x_offset + u
+  std::optional<double> t;  ///< the lift-off time (s), once found
+  std::optional<double> x;  ///< the longer side's hanging length there, interpolated as t (m)
+  /// The step at time `t_step` with margin τ2 − λ ẋ² (N) and u (m, half the difference of the ends' heights).
+  void add(double t_step, double margin, double u);
+
+ private:
+  double t_prev_ = 0, margin_prev_ = 0, u_prev_ = 0;
+  bool have_prev_ = false;
+};
 PulleyComparison compare_pulley_with_exact(const PulleyCaseSetup& setup);
 
 }  // namespace chainsim

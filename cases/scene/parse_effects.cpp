@@ -88,7 +88,7 @@ void parse_obstacles(const Section& effects, Context& ctx) {
   }
   const auto cylinders = table_array(effects, "cylinder", "cylinder");
   for (std::size_t k = 0; k < cylinders.size(); ++k) {
-    Section e(*cylinders[k], fmt::format("effects.cylinder[{}]", k), ctx, {"center", "radius", "axis", "mu"});
+    Section e(*cylinders[k], fmt::format("effects.cylinder[{}]", k), ctx, {"center", "radius", "axis", "mu", "contact"});
     if (!e.has("center")) e.missing("center", "m, the centre of the circle (2D) or a point of the axis (3D)");
     if (!e.has("radius")) e.missing("radius", "m, > 0");
     CylinderEntry cylinder;
@@ -96,6 +96,9 @@ void parse_obstacles(const Section& effects, Context& ctx) {
     cylinder.radius = *e.positive("radius");
     if (e.has("axis")) cylinder.axis = e.vector("axis");
     cylinder.mu = friction_coefficient(e);
+    // How the string touches it (docs/scenes.md): its nodes (the links are chords), or its links lying
+    // along the arc (Obstacle::arc_links; where it applies is checked in string_scene.cpp).
+    cylinder.contact = e.choice("contact", {"nodes", "arc"}, "nodes");
     ctx.spec.effects.cylinders.push_back(cylinder);
   }
 }

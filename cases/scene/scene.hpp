@@ -116,6 +116,9 @@ struct CylinderEntry {
   double radius = 0;           ///< m, > 0
   std::optional<std::vector<double>> axis;  ///< 3D: the axis (any length > 0); 2D: not given
   double mu = 0;                            ///< Coulomb's coefficient of friction (≥ 0; 0: smooth)
+  /// How the string touches it: "nodes" (its nodes are held, its links are chords) or "arc" (its links lie
+  /// along the arc, Obstacle::arc_links: a smooth circle in 2D only).
+  std::string contact = "nodes";
 };
 
 /// A stop event: [[stop.front]].

@@ -113,6 +113,8 @@ json effects_json(const SceneSpec::Effects& fx) {
     for (const CylinderEntry& e : fx.cylinders) {
       j["cylinder"].push_back({{"center", e.center}, {"radius", e.radius}});
       if (e.axis) j["cylinder"].back()["axis"] = *e.axis;
+      // Only where it is not the default, so that a scene without the key writes what it always wrote.
+      if (e.contact != "nodes") j["cylinder"].back()["contact"] = e.contact;
     }
   }
   return j;

@@ -48,6 +48,23 @@ void refuse_friction_with_slack(const SceneSpec& spec) {
     if (fx.cylinders[k].mu > 0) refuse(fmt::format("effects.cylinder[{}].mu", k), fx.cylinders[k].mu);
 }
 
+/// effects.cylinder[k].contact = "arc" (links along the arc, docs/model.md §10) where it is built and
+/// tested: refused, located at that key, where it is not.
+void check_arc_contact(const SceneSpec& spec, std::size_t k) {
+  const std::string key = fmt::format("effects.cylinder[{}].contact", k);
+  auto refuse = [&](const std::string& why, const std::string& allowed) {
+    scene_build::fail_at(spec, key, fmt::format("{} = \"arc\" {}: allowed \"nodes\" (node contact), or \"arc\" {}",
+                                                key, why, allowed));
+  };
+  if (spec.dimension == 3)
+    refuse("in 3D: the links along the arc are built for a circle in 2D (a helix on a cylinder is not)",
+           "with string.dimension = 2");
+  if (spec.effects.cylinders[k].mu > 0)
+    refuse(fmt::format("with mu = {:g}: Coulomb friction along the links' arcs (the capstan) is not built",
+                       spec.effects.cylinders[k].mu),
+           "with mu = 0 (a smooth cylinder)");
+}
+
 }  // namespace
 
 /// The scene's obstacles (solver/contact_module.hpp), each checked at its key; and what they do not
@@ -103,6 +120,10 @@ std::vector<Obstacle<dim>> contact_obstacles(const SceneSpec& spec) {
                                                             "out-of-plane axis; allowed: no axis key",
                                                             key, scene_build::text_of(spec, key + ".axis")));
     }
+    if (c.contact == "arc") {
+      check_arc_contact(spec, k);
+      o.arc_links = true;
+    }
     obstacles.push_back(o);
   }
   if (fx.plane && fx.plane->surface) {
@@ -150,6 +171,7 @@ StringScene<dim> build_string_scene(const SceneSpec& spec) {
       obstacles.push_back({{"kind", "cylinder"}, {"center", e.center}, {"radius", e.radius}});
       if (e.axis) obstacles.back()["axis"] = *e.axis;
       if (e.mu > 0) obstacles.back()["mu"] = e.mu;
+      if (e.contact != "nodes") obstacles.back()["contact"] = e.contact;
     }
     if (spec.effects.plane && spec.effects.plane->surface)
       obstacles.push_back({{"kind", "surface"}, {"point", spec.effects.plane->point},
