@@ -261,8 +261,25 @@ class ContactModule final : public WrappingModule<dim> {
       if (gap <= kInitialContact * h_) held_[static_cast<std::size_t>(i)] = k;
     }
     if (arc_) {
-      // The sense each circle is wrapped in: that of the first two consecutive nodes held on it.
-      sense_.assign(obstacles_.size(), 1.0);
+      // The sense each circle is wrapped in: that of the first two consecutive nodes held on it; on a
+      // circle that holds no two consecutive nodes (a coarse mesh: one node on the pulley, its two links
+      // running round it from free ends), that of the string through its first held node (r × the chord
+      // of its neighbours). Without this a lone held node kept the default +1 however the string ran: on 5
+      // nodes over the Atwood pulley its links ran round the wrong way, the node was let go at once, and
+      // the chain fell through the pulley (energy ledger 1.7e-3).
+      sense_.assign(obstacles_.size(), 0.0);
+      for (int i = 0; i < n; ++i) {
+        const int k = held_[static_cast<std::size_t>(i)];
+        if (k < 0 || sense_[static_cast<std::size_t>(k)] != 0) continue;
+        const int before = i > 0 ? i - 1 : chain.closed() ? n - 1 : i;
+        const int after = i < n - 1 ? i + 1 : chain.closed() ? 0 : i;
+        if (before == after) continue;
+        const Vec<dim> r = model.x().col(i) - obstacles_[static_cast<std::size_t>(k)].point;
+        const Vec<dim> d = model.x().col(after) - model.x().col(before);
+        sense_[static_cast<std::size_t>(k)] = r[0] * d[1] - r[1] * d[0] >= 0 ? 1.0 : -1.0;
+      }
+      for (double& sense : sense_)
+        if (sense == 0) sense = 1.0;
       for (int j = 0; j < chain.num_links(); ++j) {
         const int a = chain.link_start(j), b = chain.link_end(j), k = held_[static_cast<std::size_t>(a)];
         if (k < 0 || held_[static_cast<std::size_t>(b)] != k) continue;
