@@ -59,6 +59,13 @@ void check_arc_contact(const SceneSpec& spec, std::size_t k) {
   if (spec.dimension == 3)
     refuse("in 3D: the links along the arc are built for a circle in 2D (a helix on a cylinder is not)",
            "with string.dimension = 2");
+  if (spec.closed.value_or(spec.shape.kind == "circle"))
+    refuse("on a closed string: a closed loop running round a pulley closes its energy ledger only to 1e-2 with "
+           "links along the arc (node contact: 7e-9)",
+           "on an open string");
+  if (spec.has_fronts())
+    refuse("with fronts (heaps, folds, edges, kinks, or solver.kinks = \"insert\"): links along the arc are not built beside the front tracker",
+           "on a scene without fronts");
   if (spec.effects.cylinders[k].mu > 0)
     refuse(fmt::format("with mu = {:g}: Coulomb friction along the links' arcs (the capstan) is not built",
                        spec.effects.cylinders[k].mu),

@@ -454,6 +454,16 @@ TEST_CASE("solver.slack and solver.max_wall_s are parsed and checked, and check_
        "s.toml:21:6: effects.cylinder[0].mu = 0.3 with solver.slack = \"allow\": friction does not meet unilateral links "
        "(their complementarity problem needs the symmetric tension matrix of smooth obstacles): allowed mu = 0, or "
        "solver.slack = \"stop\""},
+      {"a cylinder's contact of another kind", kBase + "[[effects.cylinder]]\ncenter = [0.5, -0.5]\nradius = 0.1\ncontact = \"links\"\n",
+       R"(s.toml:21:11: effects.cylinder[0].contact = "links" is not allowed; valid values: nodes, arc)"},
+      {"links along the arc with friction", kBase + "[[effects.cylinder]]\ncenter = [0.5, -0.5]\nradius = 0.1\nmu = 0.3\ncontact = \"arc\"\n",
+       R"(s.toml:22:11: effects.cylinder[0].contact = "arc" with mu = 0.3: Coulomb friction along the links' arcs (the capstan) is not built: allowed "nodes" (node contact), or "arc" with mu = 0 (a smooth cylinder))"},
+      {"links along the arc on a closed string", edit(edit(edit(kBase, kPolyline, "kind = \"circle\"\ncenter = [0.0, 0.0]\nradius = 0.5"), "[ends]\nstart = \"fixed\"\n", ""), "length = 1.0\n", "") + "[[effects.cylinder]]\ncenter = [0.5, -0.5]\nradius = 0.1\ncontact = \"arc\"\n",
+       R"(s.toml:19:11: effects.cylinder[0].contact = "arc" on a closed string: a closed loop running round a pulley closes its energy ledger only to 1e-2 with links along the arc (node contact: 7e-9): allowed "nodes" (node contact), or "arc" on an open string)"},
+      {"links along the arc with a front", kBase + "[[effects.cylinder]]\ncenter = [0.5, -0.5]\nradius = 0.1\ncontact = \"arc\"\n[solver]\nkinks = \"insert\"\n",
+       R"(s.toml:21:11: effects.cylinder[0].contact = "arc" with fronts (heaps, folds, edges, kinks, or solver.kinks = "insert"): links along the arc are not built beside the front tracker: allowed "nodes" (node contact), or "arc" on a scene without fronts)"},
+      {"links along the arc on a string off the circle", kBase + "[[effects.cylinder]]\ncenter = [0.5, -0.5]\nradius = 0.1\ncontact = \"arc\"\n",
+       R"(s.toml:18:1: effects.cylinder[0].contact = "arc": no node of the string starts on the circle (within 0.001 of a link length): links along the arc are built for a string that starts wrapped on it; allowed "nodes" for a string that reaches the cylinder from off it)"},
       {"no wall time", kBase + "\n[solver]\nmax_wall_s = 0\n",
        "s.toml:20:14: solver.max_wall_s = 0 is out of range: allowed max_wall_s > 0"},
       {"a negative wall time", kBase + "\n[solver]\nmax_wall_s = -5.0\n",

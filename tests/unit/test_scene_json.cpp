@@ -55,3 +55,15 @@ TEST_CASE("every effect table of the scene format is written back to scene_effec
     CHECK(scene_to_json(again)["effects"] == effective["effects"]);
   }
 }
+
+TEST_CASE("a cylinder's contact is written back where it is not the default", "[unit][scene]") {
+  const std::string base = test::edit(test::kSceneBase, "[effects.gravity]\ng = [0.0, -9.81]\n", "");
+  const std::string cylinder = "[[effects.cylinder]]\ncenter = [0.5, -0.5]\nradius = 0.1\n";
+  // Without the key: nothing new in scene_effective (a scene without it writes what it always wrote).
+  const nlohmann::json nodes = scene_to_json(parse_scene_text(base + cylinder, "nodes.toml"));
+  CHECK(!nodes["effects"]["cylinder"][0].contains("contact"));
+  const nlohmann::json arc = scene_to_json(parse_scene_text(base + cylinder + "contact = \"arc\"\n", "arc.toml"));
+  CHECK(arc["effects"]["cylinder"][0]["contact"] == "arc");
+  const SceneSpec again = parse_scene_text(scene_toml_text(written(arc)), "again.toml");
+  CHECK(again.effects.cylinders.at(0).contact == "arc");
+}
