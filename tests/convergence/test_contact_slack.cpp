@@ -127,3 +127,30 @@ TEST_CASE("contact with slack: the Atwood chain runs past its lift-off and its w
   CHECK(s.relative_energy_drift() < 1e-7);
   CHECK(s.relative_momentum_residual() < 1e-10);
 }
+
+TEST_CASE("contact with slack: the Atwood chain with links along the arc runs past its lift-off and its whip",
+          "[contact][slack]") {
+  // atwood_pulley.toml with effects.cylinder[0].contact = "arc" and slack = "allow" to 1.6 s: the shorter side
+  // lifts off and unwraps, its end whips over the pulley (snaps). A snap was not located at 0.38 s when links
+  // along the arc were first tried on scenes; now the run completes with its ledgers closed: energy 7.6e-10
+  // on 101 nodes. (On 51 nodes 1.2e-6: the unwrapping's ledger, docs/model.md §10, is not yet at round-off.)
+  const std::filesystem::path file = std::filesystem::path(CHAINSIM_SOURCE_DIR) / "cases" / "scenes" / "atwood_pulley.toml";
+  const SceneSpec spec = parse_scene(file, {"effects.cylinder[0].contact=arc", "solver.slack=allow", "stop.t_end=1.6",
+                                            "output.interval=0.1", "string.nodes=101"});
+  StringScene<2> scene = build_string_scene<2>(spec);
+  StringSolver<2> solver(*scene.model, scene.solver);
+  const RunSummary& s = solver.run();
+  const auto& last = solver.frames().back();
+  bool finite = true;
+  for (const auto& frame : solver.frames()) finite = finite && frame.x.allFinite() && frame.v.allFinite();
+  std::printf("\nAtwood, links along the arc, allow to 1.6 s: %s at t = %.6g s, impacts %g, lift-offs %g, snaps %g, "
+              "energy residual %.3g, momentum residual %.3g\n",
+              s.status.c_str(), last.t, last.terms["impacts"], last.terms["lift_offs"], last.terms["snaps"],
+              s.relative_energy_drift(), s.relative_momentum_residual());
+  REQUIRE(s.status == "completed");
+  CHECK(finite);
+  CHECK(last.terms["lift_offs"] > 0);
+  CHECK(last.terms["snaps"] > 0);
+  CHECK(s.relative_energy_drift() < 1e-8);
+  CHECK(s.relative_momentum_residual() < 1e-10);
+}
