@@ -298,8 +298,16 @@ template <int dim>
 EventAction FrontTracker<dim>::handle_events(StringModel<dim>& model, double t, Eigen::Ref<Eigen::VectorXd> ledger,
                                              const std::vector<int>& found) {
   const int nf = static_cast<int>(fronts_.size());
+  // A stop at a node's coordinate is reached at that node's crossing, an event a hair's breadth before it (an
+  // edge crosses at 1e-8 h, and moves the material 2e-8 h on): its root function changes sign inside the
+  // crossing's own handling, where no root is looked for (an edge's stop at s0 = 0.2 m on chain_over_peg.toml,
+  // a node every 0.01 m, was passed by, and the run went on to the lift-off). It stops at any event within
+  // kStopWindow h of its s0.
+  constexpr double kStopWindow = 1e-6;
   for (std::size_t k = 0; k < options_.stop_at.size(); ++k)
-    if (found[static_cast<std::size_t>(2 * nf) + k] != 0)
+    if (found[static_cast<std::size_t>(2 * nf) + k] != 0 ||
+        std::abs(fs_[static_cast<std::size_t>(options_.stop_at[k].front)].s0 - options_.stop_at[k].s) <=
+            kStopWindow * material_.h)
       return {EventAction::Kind::kStop,
               fmt::format("front {} reached s0 = {:.9g} m", options_.stop_at[k].front, options_.stop_at[k].s)};
   std::optional<std::size_t> forming;  // a front not yet in the string whose formation was found

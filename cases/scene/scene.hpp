@@ -123,7 +123,7 @@ struct CylinderEntry {
 
 /// A stop event: [[stop.front]].
 struct FrontStop {
-  std::string front;  ///< "fold" | "heap_start" | "heap_end"
+  std::string front;  ///< "fold" | "heap_start" | "heap_end" | "edge<k>" (the [[effects.edge]] of index k)
   double s0 = 0;      ///< stop when that front reaches this material coordinate (m)
 };
 

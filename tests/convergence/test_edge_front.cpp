@@ -2,9 +2,12 @@
 // a sharp edge against its exact solution (cases/reduced/exact_solutions.hpp: exact::edge_*), the
 // heavy Atwood chain over a peg, the energy ledger with the edge's dissipation booked, and the hard cases.
 #include <catch2/catch.hpp>
+#include <fmt/format.h>
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <filesystem>
 #include <memory>
 #include <string>
 #include <vector>
@@ -486,5 +489,28 @@ TEST_CASE("edge: 4 links with x0 = 0.3 m and 0.25 m (the edge on a node) lift of
       const double x_star = exact::edge_lift_off_x(f, x0, 1.0, kG);
       CHECK(r.t_lift == Approx(exact::edge_time(f, x_star, x0, 1.0, kG)).epsilon(1e-6));
     }
+  }
+}
+
+TEST_CASE("edge front: a scene's [[stop.front]] stops when its peg reaches s0, at a node's coordinate too",
+          "[edge][scene]") {
+  // chain_over_peg.toml (f = 0.5, 101 nodes, a node every 0.01 m) with a stop event on its edge (front =
+  // "edge0"; before, only fold and heaps were accepted). The peg's s0 is the shorter side's length ℓ − x:
+  // the run stops where the exact solution has x = ℓ − s0 (exact::peg_time). s0 = 0.2 and 0.15 m are node
+  // coordinates: there the front reaches s0 inside a node's crossing, and the run was passed by to the
+  // lift-off (0.4948 s).
+  const std::filesystem::path file = std::filesystem::path(CHAINSIM_SOURCE_DIR) / "cases" / "scenes" / "chain_over_peg.toml";
+  for (const double s0 : {0.203, 0.2, 0.15}) {
+    CAPTURE(s0);
+    const std::string text = read_scene_file(file) + fmt::format("\n[[stop.front]]\nfront = \"edge0\"\ns0 = {}\n", s0);
+    StringScene<2> scene = build_string_scene<2>(parse_scene_text(text, "chain_over_peg.toml"));
+    StringSolver<2> solver(*scene.model, scene.solver);
+    const RunSummary& s = solver.run();
+    const double t_exact = exact::peg_time(0.5, 1.0 - s0, 0.6, 1.0, kG);
+    std::printf("\nchain over a peg, stop at edge0 s0 = %g m: %s at t = %.9g s (exact %.9g s), %s\n", s0,
+                s.status.c_str(), s.t_stop, t_exact, s.stop_reason.c_str());
+    CHECK(s.status == "stopped");
+    CHECK_THAT(s.stop_reason, Catch::Matchers::Contains("reached s0"));
+    CHECK(std::abs(s.t_stop - t_exact) < 1e-7);  // measured 6e-9 to 7e-9 s
   }
 }
