@@ -278,6 +278,33 @@ void HeapFront<dim>::initialize(StringModel<dim>& model) {
     throw InputError(fmt::format("the normal of the heap's plane must point to the string's side: node {} is "
                                  "{:.6g} m from the plane along it",
                                  e.inner, height));
+  // The front on the plane is where the curve through the last three nodes before it meets the plane
+  // (heap_geometry). Where the initial shape turns at the middle one of them (a corner of a polyline
+  // within two links of the heap on a coarse mesh), that curve bends away from the last link and meets
+  // the plane elsewhere: the tracker would refuse the front's place with "place the heap point at s0",
+  // which it is (chain_into_heap_on_table.toml on 5 nodes: s0 = 0.859 m for 1 m, its corner at node 2).
+  // Refused here with that cause.
+  const int links = model.arcs()[static_cast<std::size_t>(e.arc)].num_links();
+  if (links < 2) return;
+  const int step = after_ ? -1 : 1, node = e.node;
+  const Vec<dim> d1 = model.x().col(node + step) - model.x().col(node + 2 * step);
+  const Vec<dim> d0 = model.x().col(node) - model.x().col(node + step);
+  const double turn = std::acos(std::clamp(d1.normalized().dot(d0.normalized()), -1.0, 1.0));
+  try {
+    const HeapGeometry<dim> geo = heap_geometry<dim>(model.x(), model.v(), true, point_, normal_, last_direction_,
+                                                     last_curvature_, node, after_, links, this->m_.h);
+    const double sk = model.chain().node_coordinate(node), s0 = after_ ? sk + geo.l : sk - geo.l;
+    if (std::abs(s0 - this->expected_s0) <= std::max(1e-6 * model.chain().length(), 0.1 * this->m_.h)) return;
+    if (!(turn > 0.1)) return;  // the tracker's own message (a straight end: the heap point is elsewhere)
+    throw InputError(fmt::format(
+        "the heap front on the plane is found where the curve through the last three nodes before it (nodes {}, "
+        "{}, {}) meets the plane, and the initial shape turns by {:.3g} degrees at node {} (links of h = {:.6g} m): "
+        "that curve puts the front at s0 = {:.9g} m, not at s0 = {:.9g} m; allowed a string that runs straight "
+        "over its last two links before the heap: more nodes (string.nodes), or the corner further from the heap",
+        node + 2 * step, node + step, node, turn * 180 / kPi, node + step, this->m_.h, s0, this->expected_s0));
+  } catch (const RecoverableError&) {
+    return;  // the tracker's refresh says what is wrong
+  }
 }
 
 template <int dim>

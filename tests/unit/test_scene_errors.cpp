@@ -2,6 +2,7 @@
 // of the key at fault (the value, or the key itself when it is unknown, or the section header when
 // a key is missing), the key, the value as written, and what is allowed. Errors found while
 // building the model (dimensions, lengths, ends, frames) are located the same way.
+#include <filesystem>
 #include <string>
 
 #include <catch2/catch.hpp>
@@ -505,4 +506,20 @@ TEST_CASE("a plane's normal of any representable size is a direction (issue #21)
   CHECK(error_of(edit(huge, "model = \"string\"", "model = \"reduced\"")).empty());
   CHECK_THAT(error_of(edit(test::kFallingBase, "normal = [0.0, 1.0]", "normal = [0.0, 0.0]")),
              Catch::Contains("effects.plane.normal = [0.0, 0.0] is zero"));
+}
+
+TEST_CASE("a heap on a plane too close to a corner on a coarse mesh is refused with that cause", "[unit][scene]") {
+  // chain_into_heap_on_table.toml on 5 nodes: its corner (s = 0.5 m) is node 2, two links from the heap. The
+  // front on the plane is found on the curve through nodes 1, 2, 3, which folds back at the corner, so it
+  // lands at s0 = 0.859 m; the message was "place the heap point at the string's material point s0", which
+  // it is.
+  const std::filesystem::path file =
+      std::filesystem::path(CHAINSIM_SOURCE_DIR) / "cases" / "scenes" / "chain_into_heap_on_table.toml";
+  const std::string text = edit(read_scene_file(file), "nodes = 81", "nodes = 5");
+  CHECK(error_of(text) ==
+        "s.toml:26:1: effects.heap[0]: the heap front on the plane is found where the curve through the last three "
+        "nodes before it (nodes 1, 2, 3) meets the plane, and the initial shape turns by 143 degrees at node 2 (links "
+        "of h = 0.25 m): that curve puts the front at s0 = 0.859047822 m, not at s0 = 1 m; allowed a string that runs "
+        "straight over its last two links before the heap: more nodes (string.nodes), or the corner further from the "
+        "heap");
 }
