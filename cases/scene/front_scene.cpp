@@ -557,6 +557,24 @@ std::unique_ptr<StringModel<dim>> build_front_model(const SceneSpec& spec, scene
     }
   });
   scene.front_names = ordered_names;
+  // A kink already in the shape at t = 0 (a sharp polyline corner, the turn over an edge or a peg): the
+  // formation's root function starts negative, where no root is found, and the insertion is made for
+  // events that form in the run (it stopped the run at t = 0, or failed an internal check at the start).
+  for (std::size_t k = 0; k < ordered_names.size(); ++k)
+    if (ordered_names[k] == "kink_formed") {
+      const double margin = kind_of[k]->formation_margin(*model);
+      if (!(margin < 0)) continue;
+      const double turn =
+          std::acos(std::clamp(margin + std::cos(spec.solver.kink_turn * kPi / 180), -1.0, 1.0)) * 180 / kPi;
+      fail_at(spec, "solver.kinks",
+              fmt::format("solver.kinks = {}: the initial shape already turns by {:.4g} deg over kink_window = {:g} m, "
+                          "past kink_turn = {:g} deg: a corner present at t = 0 (a sharp polyline vertex, or the turn "
+                          "over an edge or a peg), which insertion cannot take (it inserts the kinks that form during "
+                          "the run); allowed: a shape that turns by less than kink_turn over kink_window at t = 0 "
+                          "(round a corner with shape.corner_radius or declare it with [[effects.kink]]{})",
+                          text_of(spec, "solver.kinks"), turn, kinks.back().window, spec.solver.kink_turn,
+                          turn < 179 ? fmt::format(", or raise solver.kink_turn above {:.4g} deg", turn) : ""));
+    }
   for (const TableSide<dim>& table : tables) {  // where each table ends (the plot tool draws it up to there)
     nlohmann::json& o = d["obstacles"][table.surface];
     o["edge_point"] = to_array<dim>(edges[table.edge].point);

@@ -496,3 +496,30 @@ TEST_CASE("a plane's normal of any representable size is a direction (issue #21)
   CHECK_THAT(error_of(edit(test::kFallingBase, "normal = [0.0, 1.0]", "normal = [0.0, 0.0]")),
              Catch::Contains("effects.plane.normal = [0.0, 0.0] is zero"));
 }
+
+TEST_CASE("kinks = \"insert\" on a shape that already has a corner at t = 0 is refused at the key (issue 27)",
+          "[unit][scene][kink]") {
+  // A corner at t = 0 (a sharp polyline vertex, the turn over an edge or a peg) starts the formation's root
+  // function negative, where ARKODE finds no root. Before this refusal a sharp L stopped at an internal check
+  // ("a check failed at the start must stop the run", exit 1), as did the chain over two pegs, and the chain
+  // over one peg or off a table's edge stopped at t = 0 ("a kink formed at t = 0 s where no link fits it").
+  const std::string sharp = edit(kBase, "points = [[0.0, 0.0], [0.0, -1.0]]", "points = [[0.0, 0.0], [0.0, -0.5], [0.3, -0.1]]");
+  const std::string insert = "\n[solver]\nkinks = \"insert\"\n";
+  // The L turns by 143.13 deg at its vertex (cos = -0.8), over the default window (ℓ/50 = 0.02 m, one link each side).
+  CHECK(error_of(sharp + insert) ==
+        "s.toml:20:9: solver.kinks = \"insert\": the initial shape already turns by 143.1 deg over kink_window = 0.02 m, "
+        "past kink_turn = 90 deg: a corner present at t = 0 (a sharp polyline vertex, or the turn over an edge or a "
+        "peg), which insertion cannot take (it inserts the kinks that form during the run); allowed: a shape that turns "
+        "by less than kink_turn over kink_window at t = 0 (round a corner with shape.corner_radius or declare it with "
+        "[[effects.kink]], or raise solver.kink_turn above 143.1 deg)");
+  // Accepted: the same L with kink_turn above its turn, with the corner rounded, or without insertion.
+  CHECK(error_of(sharp + insert + "kink_turn = 150\n").empty());
+  CHECK(error_of(edit(edit(sharp, "length = 1.0\n", ""), "[ends]", "corner_radius = 0.15\n\n[ends]") + insert).empty());
+  CHECK(error_of(sharp).empty());
+  // A peg: the string turns by 180 deg over it, which no kink_turn (at most 179) exceeds.
+  const std::string peg = edit(edit(kBase, "points = [[0.0, 0.0], [0.0, -1.0]]", "points = [[0.0, -0.4], [0.0, 0.0], [0.0, -0.6]]"),
+                               "[ends]\nstart = \"fixed\"", "[[effects.edge]]\npoint = [0.0, 0.0]\nf = 0.5");
+  CHECK(error_of(peg).empty());
+  CHECK(error_of(peg + insert).find(
+            "solver.kinks = \"insert\": the initial shape already turns by 180 deg") != std::string::npos);
+}
