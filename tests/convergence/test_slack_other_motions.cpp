@@ -9,12 +9,11 @@
 //    at an observed order above 1 on 41 to 321 nodes, the ledgers closed on every mesh; elastic snaps
 //    (snap_restitution = 1) book no loss;
 //  - the falling chain whose top is jerked down faster than g (a slack part above the heap): once taut again
-//    the heap's front sits at the height of the driven top (closed form), the ledgers closed;
-//  - the folded chain whose free end is pushed down (slack next to the fold): the state converges on 51 to
-//    401 nodes, the ledgers closed.
+//    the heap's front sits at the height of the driven top (closed form), the ledgers closed.
+// (A fold with a slack part is not here: with its support jerked down, the folded chain's fold comes apart at the
+// snap that reaches it on some meshes and output times; docs/model.md §9, "Other slack motions, measured".)
 #include <cmath>
 #include <cstdio>
-#include <filesystem>
 #include <string>
 #include <vector>
 
@@ -304,37 +303,4 @@ TEST_CASE("slack: a falling chain jerked down faster than g goes slack above its
     CHECK(r.summary.relative_energy_drift() < 1e-10);
     CHECK(r.summary.relative_momentum_residual() < 1e-12);
   }
-}
-
-TEST_CASE("slack: the folded chain whose free end is pushed down goes slack next to the fold and converges",
-          "[slack][shocks][convergence]") {
-  // cases/scenes/folded_chain.toml with slack = "allow" and a downward force of 0.5 N on its free end: the links
-  // near the tip go slack and snap (11, 21, 42, 82 snaps on 51, 101, 201, 401 nodes, W_snap = -0.086 J against
-  // W_shocks = -3.14 J). Measured at t = 0.5 s: 3.76e-4, 1.49e-4, 4.38e-5 m on 51 -> 101 -> 201 -> 401 nodes
-  // (orders 1.33, 1.77), the fold at s0 = 0.687725, 0.687913, 0.687987, 0.687965 m, the energy ledger closed to
-  // <= 7e-11 of its scale and the momentum ledger to <= 3e-11 (0.6 s in all).
-  const std::filesystem::path file = std::filesystem::path(CHAINSIM_SOURCE_DIR) / "cases" / "scenes" / "folded_chain.toml";
-  std::vector<Points<2>> states;
-  for (int n = 51; n <= 401; n = 2 * n - 1) {
-    const SceneSpec spec = parse_scene(file, {"string.nodes=" + std::to_string(n), "solver.slack=allow",
-                                              "ends.end={kind=\"loaded\",force=[0.0,-0.5]}", "stop.t_end=0.5",
-                                              "output.interval=0.5"});
-    StringScene<2> scene = build_string_scene<2>(spec);
-    StringSolver<2> solver(*scene.model, scene.solver);
-    const RunSummary s = solver.run();
-    INFO(n << " nodes: " << s.error);
-    REQUIRE(s.status == "completed");
-    CHECK(s.relative_energy_drift() < 1e-9);
-    CHECK(s.relative_momentum_residual() < 1e-10);
-    CHECK(solver.frames().back().terms["snaps"] >= 5);
-    CHECK(solver.frames().back().terms["W_snap"] < -0.05);
-    states.push_back(solver.frames().back().x);
-  }
-  std::vector<double> d;
-  for (std::size_t k = 1; k < states.size(); ++k) d.push_back(mesh_difference<2>(states[k - 1], states[k]));
-  std::printf("folded chain pushed at its free end, t = 0.5 s: %.3e, %.3e, %.3e m on 51 -> 401 nodes, orders %.2f, "
-              "%.2f\n",
-              d[0], d[1], d[2], std::log2(d[0] / d[1]), std::log2(d[1] / d[2]));
-  for (std::size_t k = 1; k < d.size(); ++k) CHECK(std::log2(d[k - 1] / d[k]) > 1.0);
-  CHECK(d.back() < 1e-4);
 }
