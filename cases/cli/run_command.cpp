@@ -143,9 +143,16 @@ int run_string_scene(const SceneSpec& spec, const std::filesystem::path& dir, bo
                               : "");
     out << fmt::format("links      max | |dx| - h | / h = {:.3e} (stabilization time {:g} s)\n",
                        s.max_constraint_violation, s.stabilization_time);
+    const nlohmann::json& slack = summary["slack"];
     out << fmt::format("slack      {} (policy {})\n",
                        s.slack                                   ? s.slack->message()
                        : s.slack_policy == SlackPolicy::kIgnore ? "not checked"
+                       : s.slack_policy == SlackPolicy::kAllow && slack.contains("snaps")
+                           ? fmt::format("allowed: {} snap{} taut by t = {:g} s, W_snap = {:.4g} J, W_snap_supports = "
+                                         "{:.4g} J (W_snap, W_snap_supports, W_links in energy.csv)",
+                                         slack["snaps"].get<long long>(), slack["snaps"] == 1 ? "" : "s",
+                                         slack["ledger_t"].get<double>(), slack["W_snap"].get<double>(),
+                                         slack["W_snap_supports"].get<double>())
                        : s.slack_policy == SlackPolicy::kAllow
                            ? "allowed: links go slack and snap taut (W_snap, W_snap_supports, W_links in energy.csv)"
                            : "none at any accepted step",

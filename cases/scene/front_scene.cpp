@@ -557,6 +557,38 @@ std::unique_ptr<StringModel<dim>> build_front_model(const SceneSpec& spec, scene
     }
   });
   scene.front_names = ordered_names;
+  // A kink already in the shape at t = 0 (a sharp polyline corner, the turn over an edge or a peg): the
+  // formation's root function starts negative, where no root is found, and the insertion is made for
+  // events that form in the run (it stopped the run at t = 0, or failed an internal check at the start).
+  for (std::size_t k = 0; k < ordered_names.size(); ++k)
+    if (ordered_names[k] == "kink_formed") {
+      const double margin = kind_of[k]->formation_margin(*model);
+      // No window fits in an arc: the margin is the measure's "no window" value, 2 − cos(kink_turn), above every
+      // turn's 1 − cos(kink_turn) (a window of 2m links and the links at its ends, m = round(kink_window / 2h)).
+      if (margin > 1.5 - std::cos(spec.solver.kink_turn * kPi / 180)) {
+        const std::string key = spec.solver.kink_window ? "solver.kink_window" : "solver.kinks";
+        fail_at(spec, key,
+                fmt::format("{} = {}: no window of kink_window = {:g} m of material fits inside the string{} ({} "
+                            "links of h = {:g} m; a window is 2m links, m = kink_window / 2h rounded and at least 1, "
+                            "and needs a link beyond it: 2m + 1 links in all), so no kink could ever be inserted; "
+                            "allowed: kink_window below the string's length between its fronts, on at least 3 links",
+                            key, text_of(spec, key), kinks.back().window,
+                            spec.has_fronts_declared() ? " between its fronts" : "", model->chain().num_links(),
+                            model->chain().link_length(0)));
+      }
+      if (!(margin < 0)) continue;
+      const double turn =
+          std::acos(std::clamp(margin + std::cos(spec.solver.kink_turn * kPi / 180), -1.0, 1.0)) * 180 / kPi;
+      fail_at(spec, "solver.kinks",
+              fmt::format("solver.kinks = {}: the initial shape already turns by {:.4g} deg over kink_window = {:g} m, "
+                          "past kink_turn = {:g} deg: a corner present at t = 0 (a sharp polyline vertex, the turn "
+                          "over an edge or a peg, or a bend that turns this much within a window this wide), which "
+                          "insertion cannot take (it inserts the kinks that form during the run); allowed: a shape "
+                          "that turns by less than kink_turn over kink_window at t = 0 (round a corner with "
+                          "shape.corner_radius or declare it with [[effects.kink]], narrow kink_window{})",
+                          text_of(spec, "solver.kinks"), turn, kinks.back().window, spec.solver.kink_turn,
+                          turn < 179 ? fmt::format(", or raise solver.kink_turn above {:.4g} deg", turn) : ""));
+    }
   for (const TableSide<dim>& table : tables) {  // where each table ends (the plot tool draws it up to there)
     nlohmann::json& o = d["obstacles"][table.surface];
     o["edge_point"] = to_array<dim>(edges[table.edge].point);

@@ -163,8 +163,11 @@ SceneParts<dim> build_scene_parts(const SceneSpec& spec) {
       at_key(spec, "shape", [&] { return discretize(*curve, length, spec.density, links, closed, sh.length_tolerance); });
   if (spec.elements == "quadratic") {  // what quadratic elements hold (solver/quadratic_string.hpp)
     std::string why;
-    if (spec.has_fronts())
+    if (spec.has_fronts_declared())
       why = "the scene has a front (a heap, a fold or an edge), which quadratic elements do not meet";
+    else if (spec.has_fronts())
+      why = "solver.kinks = \"insert\" gives the string a kink front where a kink forms, which quadratic elements "
+            "do not meet";
     else if (closed)
       why = "the string is closed; quadratic elements hold open strings only";
     else if (chain.num_nodes() % 2 == 0)

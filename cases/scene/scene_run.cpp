@@ -3,6 +3,8 @@
 
 #include "cases/scene/front_scene.hpp"
 
+#include <cmath>
+
 namespace chainsim {
 
 template <int dim>
@@ -40,7 +42,20 @@ nlohmann::json SceneRun<dim>::description() const {
 
 template <int dim>
 nlohmann::json SceneRun<dim>::summary() const {
-  return front_summary(scene_, solver_->summary());
+  nlohmann::json j = front_summary(scene_, solver_->summary());
+  // With slack = "allow": how many links snapped taut and what the snaps dissipated, at the last frame
+  // (its time `ledger_t`; the same numbers as energy.csv's last row), so that a run whose links went slack
+  // says so ("detected" is the first slack of the other policies).
+  const std::vector<Frame<dim>>& frames = solver_->frames();
+  if (solver_->summary().slack_policy == SlackPolicy::kAllow && !frames.empty()) {
+    const LedgerValues& terms = frames.back().terms;
+    nlohmann::json& slack = j["slack"];
+    slack["snaps"] = static_cast<long long>(std::llround(terms["snaps"]));
+    slack["W_snap"] = terms["W_snap"];
+    slack["W_snap_supports"] = terms["W_snap_supports"];
+    slack["ledger_t"] = frames.back().t;
+  }
+  return j;
 }
 
 template <int dim>

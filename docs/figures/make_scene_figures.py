@@ -5,7 +5,8 @@ Usage: /usr/bin/python3 docs/figures/make_scene_figures.py RESULTS_DIR
 where RESULTS_DIR/<scene>/ holds the outputs of
     build/chainsim run cases/scenes/<scene>.toml --out RESULTS_DIR/<scene>
 for shaken_chain, travelling_loop, whip_crack, pendulum_release, folded_chain_ends_apart, swinging_u,
-pendulum_whip and thrown_chain (string scenes; the last three with slack = "allow"), chain_off_table_edge and
+pendulum_whip and thrown_chain (string scenes; the last three with slack = "allow"), spinning_loop_dropped
+(3D, closed, slack = "allow"), chain_off_table_edge and
 chain_over_peg and chain_over_two_pegs (edges), atwood_pulley and atwood_rough_pulley (cylinders), chain_landing_at_angle (a surface),
 chain_off_real_table (a table bounded by its edge), chain_into_heap_on_table (a heap on a contact surface), streaming_corner (a kink) and
 falling_chain, folded_chain, sliding_chain, swinging_sliding_chain, tilted_falling_chain and
@@ -373,10 +374,23 @@ def thrown_chain(run, ax):
     slack_panel(ax[1], run, "energy lost at the snaps when the chain is caught")
 
 
+def snapshots_3d(ax, run, times, title):
+    """A 3D run's snapshots in its two projections (x-y on ax[0], x-z on ax[1])."""
+    notes = draw_snapshots([ax[0], ax[1]], run, choose_times(run.nodes.times, times)).notes()
+    ax[0].set_title(title + ("\n(" + "; ".join(notes) + ")" if notes else ""), fontsize=9)
+    ax[1].set_title("seen from above (x-z)", fontsize=9)
+
+
+def spinning_loop_dropped(run, ax):
+    snapshots_3d(ax, run, [0, 0.05, 0.1, 0.15, 0.2, 0.3],
+                 'a loop spun and tumbling at 8 rad/s, dropped onto a table (3D, closed, slack = "allow")')
+
+
 SCENES = [shaken_chain, travelling_loop, whip_crack, pendulum_release, falling_chain, folded_chain, sliding_chain,
           swinging_sliding_chain, tilted_falling_chain, curved_falling_chain, folded_chain_ends_apart,
           chain_off_table_edge, swinging_u, pendulum_whip, thrown_chain, chain_over_peg, chain_over_two_pegs,
-          atwood_pulley, atwood_rough_pulley, streaming_corner, chain_landing_at_angle, chain_off_real_table, chain_into_heap_on_table]
+          atwood_pulley, atwood_rough_pulley, streaming_corner, chain_landing_at_angle, chain_off_real_table, chain_into_heap_on_table,
+          spinning_loop_dropped]
 
 
 def main():

@@ -125,6 +125,40 @@ TEST_CASE("slack is found by default and stops the run, and with slack = warn it
   CHECK(ignore["slack"]["detected"] == false);
 }
 
+TEST_CASE("with slack = allow the summary counts the snaps and gives what they dissipated (issue 27)", "[unit][scene][slack]") {
+  // The chain thrown up over its fixed end (cases/scenes/thrown_chain.toml, 21 nodes): it goes slack and is
+  // caught. The summary's "slack" had only {policy, detected: false}, and the text said "allowed: links go slack"
+  // whether any did or not; it now has the count and W_snap, W_snap_supports at the last frame (energy.csv's last
+  // row).
+  const std::string thrown = "[string]\nlength = 1.0\ndensity = 0.1\nnodes = 21\n[shape]\nkind = \"polyline\"\n"
+                             "points = [[0.0, 0.0], [1.0, 0.0]]\n[velocity]\nkind = \"rotation\"\nomega = 7.0\n"
+                             "center = [0.0, 0.0]\n[ends]\nstart = \"fixed\"\n[effects.gravity]\ng = [0.0, -9.81]\n"
+                             "[solver]\nslack = \"allow\"\n[output]\ninterval = 0.25\n[stop]\nt_end = 1.0\n";
+  const auto dir = temp_dir("outputs_snaps");
+  const auto [code, j] = run_json(dir, thrown);
+  REQUIRE(code == 0);
+  const nlohmann::json& slack = j["slack"];
+  CHECK(slack["policy"] == "allow");
+  CHECK(slack["snaps"].get<long long>() >= 1);
+  CHECK(slack["ledger_t"] == 1.0);
+  // energy.csv's last row: t, K, V, W_applied, drift, W_snap, W_snap_supports, W_links.
+  std::ifstream in(dir / "out" / "energy.csv");
+  std::string line, last;
+  while (std::getline(in, line)) last = line;
+  std::vector<double> row;
+  std::stringstream cells(last);
+  for (std::string cell; std::getline(cells, cell, ',');) row.push_back(std::stod(cell));
+  REQUIRE(row.size() == 8);
+  CHECK(slack["W_snap"].get<double>() == row[5]);
+  CHECK(slack["W_snap"].get<double>() < 0);  // perfectly inelastic snaps dissipate
+  CHECK(slack["W_snap_supports"].get<double>() == row[6]);
+  CHECK(nlohmann::json::parse(read(dir / "out" / "stats.json"))["slack"]["snaps"] == slack["snaps"]);
+  // Without allow there is no count.
+  const auto [code_stop, stop] = run_json(dir, thrown.substr(0, thrown.find("[solver]")) + "[stop]\nt_end = 0.1\n");
+  CHECK(code_stop == 0);
+  CHECK_FALSE(stop["slack"].contains("snaps"));
+}
+
 TEST_CASE("[solver] max_wall_s ends a scene's run after that wall-clock time, with its outputs", "[unit][scene]") {
   const auto dir = temp_dir("outputs_max_wall");
   // A hanging chain asked for 1e4 s of motion at rtol 1e-12: minutes of work, cut at 0.2 s of wall time.

@@ -523,3 +523,59 @@ TEST_CASE("a heap on a plane too close to a corner on a coarse mesh is refused w
         "straight over its last two links before the heap: more nodes (string.nodes), or the corner further from the "
         "heap");
 }
+
+TEST_CASE("kinks = \"insert\" on a shape that already has a corner at t = 0 is refused at the key (issue 27)",
+          "[unit][scene][kink]") {
+  // A corner at t = 0 (a sharp polyline vertex, the turn over an edge or a peg) starts the formation's root
+  // function negative, where ARKODE finds no root. Before this refusal a sharp L stopped at an internal check
+  // ("a check failed at the start must stop the run", exit 1), as did the chain over two pegs, and the chain
+  // over one peg or off a table's edge stopped at t = 0 ("a kink formed at t = 0 s where no link fits it").
+  const std::string sharp = edit(kBase, "points = [[0.0, 0.0], [0.0, -1.0]]", "points = [[0.0, 0.0], [0.0, -0.5], [0.3, -0.1]]");
+  const std::string insert = "\n[solver]\nkinks = \"insert\"\n";
+  // The L turns by 143.13 deg at its vertex (cos = -0.8), over the default window (ℓ/50 = 0.02 m, one link each side).
+  CHECK(error_of(sharp + insert) ==
+        "s.toml:20:9: solver.kinks = \"insert\": the initial shape already turns by 143.1 deg over kink_window = 0.02 m, "
+        "past kink_turn = 90 deg: a corner present at t = 0 (a sharp polyline vertex, the turn over an edge or a peg, "
+        "or a bend that turns this much within a window this wide), which insertion cannot take (it inserts the kinks "
+        "that form during the run); allowed: a shape that turns by less than kink_turn over kink_window at t = 0 (round "
+        "a corner with shape.corner_radius or declare it with [[effects.kink]], narrow kink_window, or raise "
+        "solver.kink_turn above 143.1 deg)");
+  // Accepted: the same L with kink_turn above its turn, with the corner rounded, or without insertion.
+  CHECK(error_of(sharp + insert + "kink_turn = 150\n").empty());
+  CHECK(error_of(edit(edit(sharp, "length = 1.0\n", ""), "[ends]", "corner_radius = 0.15\n\n[ends]") + insert).empty());
+  CHECK(error_of(sharp).empty());
+  // A peg: the string turns by 180 deg over it, which no kink_turn (at most 179) exceeds.
+  const std::string peg = edit(edit(kBase, "points = [[0.0, 0.0], [0.0, -1.0]]", "points = [[0.0, -0.4], [0.0, 0.0], [0.0, -0.6]]"),
+                               "[ends]\nstart = \"fixed\"", "[[effects.edge]]\npoint = [0.0, 0.0]\nf = 0.5");
+  CHECK(error_of(peg).empty());
+  CHECK(error_of(peg + insert).find(
+            "solver.kinks = \"insert\": the initial shape already turns by 180 deg") != std::string::npos);
+}
+
+TEST_CASE("kinks = \"insert\" with a window that fits nowhere in the string is refused at the key, and quadratic "
+          "elements name the kink front (issue 27)",
+          "[unit][scene][kink]") {
+  // A window longer than the string (or a mesh too coarse for any window) left the formation's root function
+  // at its "no window" value: the run went on and never inserted a kink (the swinging U with kink_window = 100 m
+  // ran to its end with 0 crossings), and on 3 nodes the U did the same. The refusal reads the kink front's own
+  // measure.
+  const std::string insert = "\n[solver]\nkinks = \"insert\"\n";
+  CHECK(error_of(kBase + insert + "kink_window = 1.5\n") ==
+        "s.toml:21:15: solver.kink_window = 1.5: no window of kink_window = 1.5 m of material fits inside the string "
+        "(10 links of h = 0.1 m; a window is 2m links, m = kink_window / 2h rounded and at least 1, and needs a link "
+        "beyond it: 2m + 1 links in all), so no kink could ever be inserted; allowed: kink_window below the string's "
+        "length between its fronts, on at least 3 links");
+  // 2 links: no window of even 2 links and one more.
+  CHECK(error_of(edit(kBase, "nodes = 11", "nodes = 3") + insert).find(
+            "s.toml:20:9: solver.kinks = \"insert\": no window of kink_window = 0.02 m of material fits inside the string "
+            "(2 links of h = 0.5 m;") == 0);
+  // The largest window that fits: 2m + 1 <= 10 links, m = 4 (kink_window = 0.8 m); and the default window.
+  CHECK(error_of(kBase + insert + "kink_window = 0.8\n").empty());
+  CHECK(error_of(kBase + insert).empty());
+  // Quadratic elements are refused with the reason: the kink front that insertion gives the string (the message
+  // spoke of "a heap, a fold or an edge", which the scene does not have).
+  CHECK(error_of(edit(kBase, "nodes = 11", "nodes = 11\nelements = \"quadratic\"") + insert) ==
+        "s.toml:5:12: string.elements = \"quadratic\" is not allowed here: solver.kinks = \"insert\" gives the string a "
+        "kink front where a kink forms, which quadratic elements do not meet; allowed: \"links\" (any string), "
+        "\"quadratic\" (an open string without fronts, an odd number of nodes)");
+}
