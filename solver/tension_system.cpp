@@ -476,8 +476,8 @@ void TensionSystem::complementarity_failure(double t, const std::vector<int>& vi
   if (violating.size() > 5) which += fmt::format(" and {} more", violating.size() - 5);
   throw NumericalError(fmt::format("at t = {:.9g} s the complementarity problem of the slack links (T >= 0, "
                                    "acceleration of the length <= 0, one of them zero) did not settle after {} "
-                                   "pivoting passes: {} still violate it",
-                                   t, kMaxPasses, which),
+                                   "pivoting passes: {} still {} it",
+                                   t, max_passes(size()), which, violating.size() == 1 ? "violates" : "violate"),
                        t);
 }
 

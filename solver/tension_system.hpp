@@ -180,11 +180,18 @@ class TensionSystem {
   /// settled it changes one unknown a pass (Murty's least-index rule, finite for a P-matrix). The
   /// first pass is a plain solve(): a system with no negative unknown costs nothing more.
   /// `tolerance(max |T|)` gives the absolute tolerance (N or N s); it is called only when a T_u < 0.
-  /// Throws NumericalError, naming t and the unknowns still in violation, after kMaxPasses passes.
+  /// Throws NumericalError, naming t and the unknowns still in violation, after max_passes(n) passes.
   template <class Tolerance>
   const Eigen::VectorXd& solve_complementarity(double t, Tolerance&& tolerance);
   static constexpr int kBlockPasses = 8;
+  /// The passes allowed before the solve gives up: kMaxPasses + 4 n for n unknowns. Murty's rule
+  /// changes one unknown a pass, so a problem whose solution differs from the last block pass in n
+  /// unknowns needs n passes at least: a string nearly in free fall (every tension slightly negative,
+  /// the block pass releasing them all, the solution taking them back one at a time) took n − 1 = 319
+  /// passes on 320 links (the pendulum past its whip on 321 nodes, issue 27), past a cap of 200 that
+  /// did not grow with n. What the cap still catches is a cycle of round-off.
   static constexpr int kMaxPasses = 200;
+  static constexpr int max_passes(int n) { return kMaxPasses + 4 * n; }
   /// What the complementarity solves did: calls that released an unknown, their passes summed and
   /// the most passes one call took.
   struct ComplementarityStats {
@@ -258,7 +265,7 @@ const Eigen::VectorXd& TensionSystem::solve_complementarity(double t, Tolerance&
     lcp_stats_.passes += 1;
     lcp_stats_.max_passes = std::max(lcp_stats_.max_passes, pass);
     if (violating.empty()) return solution_;
-    if (pass >= kMaxPasses) complementarity_failure(t, violating);
+    if (pass >= max_passes(n)) complementarity_failure(t, violating);
     if (pass < kBlockPasses) {
       for (int u : violating) released[static_cast<std::size_t>(u)] ^= 1;
     } else {
