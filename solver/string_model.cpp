@@ -276,10 +276,16 @@ void StringModel<dim>::links() {
       dxj = CMap(x + dim * b) - CMap(x + dim * a);
       Map(dv + dim * j) = CMap(v + dim * b) - CMap(v + dim * a);
       const double l = dxj.norm();
-      if (!(l > kCollapsedLink * h[j]) || !std::isfinite(l))
-        throw RecoverableError(fmt::format("link {} has collapsed to length {:g}", j, l));
       l_of[j] = l;
-      Map(e + dim * j) = dxj / l;
+      if (!(l > kCollapsedLink * h[j]) || !std::isfinite(l)) {
+        // A slack link may be as short as anything, its ends may pass each other (it carries no tension,
+        // its row is out of the system): no direction. A taut one that collapses is a degenerate state.
+        if (!(std::isfinite(l) && link_slack(j)))
+          throw RecoverableError(fmt::format("link {} has collapsed to length {:g}", j, l));
+        Map(e + dim * j).setZero();
+      } else {
+        Map(e + dim * j) = dxj / l;
+      }
       // every node of the arcs once: each link's start, and the end of an open arc's last link
       x_max = std::max(x_max, CMap(x + dim * a).cwiseAbs().maxCoeff());
       if (q + 1 == nl && !arc.closed) x_max = std::max(x_max, CMap(x + dim * b).cwiseAbs().maxCoeff());
