@@ -166,8 +166,8 @@ nlohmann::json to_json(const RunSummary& s) {
     impulsive["message"] = fmt::format(
         "the initial velocities lengthen taut links (slack = \"allow\"): the string snapped taut at t = 0 by the "
         "snap's law (links that shorten went slack); the velocities jumped by up to {:.6g} m/s, the kinetic energy "
-        "changed by {:.6g} J: {:.6g} J dissipated (W_snap at t = 0) and {:.6g} J of the supports' work (W_applied "
-        "at t = 0)",
+        "changed by {:.6g} J: {:.6g} J dissipated (W_snap at t = 0) and {:.6g} J the rest of the jump, the supports' "
+        "work and the normal velocities the obstacles took (W_applied at t = 0)",
         s.impulsive_speed_change, s.impulsive_energy, s.impulsive_dissipated, s.impulsive_energy + s.impulsive_dissipated);
   } else if (s.impulsive_start) {
     impulsive["message"] = fmt::format(
