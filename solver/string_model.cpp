@@ -279,10 +279,16 @@ void StringModel<dim>::links() {
       dxj = CMap(x + dim * b) - CMap(x + dim * a);
       Map(dv + dim * j) = CMap(v + dim * b) - CMap(v + dim * a);
       const double l = dxj.norm();
-      if (!(l > kCollapsedLink * h[j]) || !std::isfinite(l))
-        throw RecoverableError(fmt::format("link {} has collapsed to length {:g}", j, l));
       l_of[j] = l;
-      Map(e + dim * j) = dxj / l;
+      if (!(l > kCollapsedLink * h[j]) || !std::isfinite(l)) {
+        // A slack link may be as short as anything, its ends may pass each other (it carries no tension,
+        // its row is out of the system): no direction. A taut one that collapses is a degenerate state.
+        if (!(std::isfinite(l) && link_slack(j)))
+          throw RecoverableError(fmt::format("link {} has collapsed to length {:g}", j, l));
+        Map(e + dim * j).setZero();
+      } else {
+        Map(e + dim * j) = dxj / l;
+      }
       // every node of the arcs once: each link's start, and the end of an open arc's last link
       x_max = std::max(x_max, CMap(x + dim * a).cwiseAbs().maxCoeff());
       if (q + 1 == nl && !arc.closed) x_max = std::max(x_max, CMap(x + dim * b).cwiseAbs().maxCoeff());
@@ -1201,6 +1207,25 @@ void StringModel<dim>::project_velocities(double t) {
 }
 
 template <int dim>
+void StringModel<dim>::start_impulses(double t0) {
+  // Unilateral links at the start (docs/model.md §9, "The start"): the positions onto the taut links'
+  // lengths as always; the velocities by the snap's law, as if the string snapped taut at t0. A link whose
+  // initial rate shortens it goes slack (P = 0, it flies freely), a lengthening one takes the impulse of
+  // the complementarity problem with the scene's restitution, and the supports' and obstacles' impulses
+  // are what they are at a snap. A rate below kSeparation of the fastest node is the round-off of a
+  // compatible start: it is not a separation, and the bilateral projection that follows (slack links out)
+  // takes it to zero as with slack = "stop".
+  project_positions(t0);
+  double speed = 0;
+  for (int i = 0; i < chain_.num_nodes(); ++i)
+    if (in_arc(i)) speed = std::max(speed, v_.col(i).norm());
+  for (const NodeContact<dim>& c : contacts_) v_.col(c.node) -= c.normal.dot(v_.col(c.node)) * c.normal;
+  const SnapResult r = link_impulses(t0, options_.snap_restitution, speed);
+  impulsive_start_.dissipated += r.dissipated;
+  project_velocities(t0);
+}
+
+template <int dim>
 Eigen::VectorXd StringModel<dim>::projected_state(double t, const Eigen::Ref<const Eigen::VectorXd>& y) {
   unpack_state(t, y);
   refresh();
@@ -1217,7 +1242,9 @@ double StringModel<dim>::make_consistent(double t0) {
     v_.col(p.node) = p.path->velocity(t0);
   }
   for (int j = 0; j < chain_.num_links(); ++j)
-    if (link_slack(j) && !(current_length(j) < (1 - kSlackGap) * chain_.link_length(j)))
+    // (a link made slack by an earlier call's start impulses has its offset: it went slack at full length)
+    if (link_slack(j) && slack_offset_[static_cast<std::size_t>(j)] == 0 &&
+        !(current_length(j) < (1 - kSlackGap) * chain_.link_length(j)))
       throw InputError(fmt::format("link {} is declared slack but is not shorter than its length {:g} m",
                                    j, chain_.link_length(j)));
   const Points<dim> x_start = x_, v_start = v_;
@@ -1225,7 +1252,11 @@ double StringModel<dim>::make_consistent(double t0) {
   try {
     refresh();
     K_start = kinetic_energy();
-    project(t0);
+    if (allows_slack() && system_ && !quadratic_) {
+      start_impulses(t0);
+    } else {
+      project(t0);
+    }
     refresh();
   } catch (const RecoverableError& e) {
     throw InputError(fmt::format("the initial shape is degenerate: {}", e.what()));
@@ -1603,7 +1634,9 @@ typename StringModel<dim>::SnapResult StringModel<dim>::link_impulses(double t, 
   assemble_matrix();
   for_each_link([&](int j, int u, int) {
     u_before[j] = link_rate(j);
-    system_->rhs(u) = -(1 + e) * u_before[j];
+    // Newton's restitution acts on an approach (u⁻ > 0); a link already shortening (a released one not
+    // yet slack, or one shortening at the start) is held only from lengthening: u⁺ ≤ 0.
+    system_->rhs(u) = -u_before[j] - e * std::max(u_before[j], 0.0);
     if (!link_slack(j)) u_scale = std::max(u_scale, std::abs(u_before[j]));
   });
   exclude_slack_links();

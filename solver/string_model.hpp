@@ -140,6 +140,9 @@ class StringModel final : public OdeSystem {
     double kinetic_energy = 0;    ///< J
     double max_speed_change = 0;  ///< m/s
     double speed_scale = 0;       ///< m/s: the largest speed before or after
+    /// With slack = allow the start is a snap taut (start_impulses): the energy its impulses
+    /// dissipated (J, ≥ 0; zero for slack = stop, whose jump is the drivers' work alone).
+    double dissipated = 0;
     /// The velocities changed beyond round-off (kImpulsiveSpeed of the speed scale).
     bool detected() const { return max_speed_change > kImpulsiveSpeed * speed_scale; }
     static constexpr double kImpulsiveSpeed = 1e-9;
@@ -441,6 +444,9 @@ class StringModel final : public OdeSystem {
   /// the velocities onto e_j·Δv_j = 0 and n_i·v_i = 0 (mass-weighted, linear).
   void project_positions(double t);
   void project_velocities(double t);
+  /// make_consistent with slack = allow: the positions projected, the velocities by the snap's law at
+  /// t0 (link_impulses with the scene's restitution; links shortening at the start go slack).
+  void start_impulses(double t0);
   /// project_positions' Newton iteration onto the links' lengths and the held nodes' surfaces.
   void project_link_lengths(double t);
   /// The module's constraints beyond the links (NodeConstraint): evaluate_current, after the tension
