@@ -705,3 +705,127 @@ TEST_CASE("slack: a start whose velocities lengthen some links is the snap law's
     for (int j : {0, 1, 2, 4, 5, 7, 8}) CHECK_FALSE(model.link_slack(j));
   }
 }
+
+namespace {
+
+/// Each link's rate of lengthening (m/s) from a chain's positions and velocities, measured on the links
+/// as they stand: along the chord, or for a link bent over a point p, d(|p − x_a| + |x_b − p|)/dt.
+template <int dim>
+Eigen::VectorXd link_rates_of(const StringModel<dim>& model) {
+  const Points<dim>& x = model.chain().positions();
+  const Points<dim>& v = model.chain().velocities();
+  Eigen::VectorXd rate(model.chain().num_links());
+  for (int j = 0; j < model.chain().num_links(); ++j) {
+    const int a = model.chain().link_start(j), b = model.chain().link_end(j);
+    if (const Vec<dim>* p = model.bend_point(j)) {
+      rate[j] = -(*p - x.col(a)).normalized().dot(v.col(a)) + (x.col(b) - *p).normalized().dot(v.col(b));
+    } else {
+      rate[j] = (x.col(b) - x.col(a)).normalized().dot(v.col(b) - v.col(a));
+    }
+  }
+  return rate;
+}
+
+}  // namespace
+
+TEST_CASE("slack: a tangential start slides along the string: zero rates on straight parts and circles, the corner's "
+          "outgoing link at s (1 - cos theta)", "[slack]") {
+  // The sliding field (StringModelOptions::sliding_speed, docs/scenes.md "The velocity kinds"), judged by
+  // the links' rates it gives, computed here from the positions. A polyline with a 90° corner on node 5
+  // (h = 0.1 m): every link keeps its length but the one the material enters after the corner, which
+  // lengthens at |s| (1 − cos 90°) = |s| (the link after the corner for s > 0, before it for s < 0);
+  // the averaged tangent of the nodes (x_{i+1} − x_{i−1}) shortened the link before the corner at
+  // s (1 − cos 45°). A regular 24-gon (a loop) keeps every link at its length.
+  for (const double speed : {1.0, -1.0}) {
+    Chain<2> chain = Chain<2>::uniform(1.0, 1.0, 10, false);
+    for (int i = 0; i <= 10; ++i) chain.positions().col(i) = i <= 5 ? Vec<2>(0.1 * i, 0.0) : Vec<2>(0.5, -0.1 * (i - 5));
+    StringModelOptions mo = allow_options<2>();
+    mo.sliding_speed = speed;
+    StringModel<2> model(std::move(chain), std::vector<std::unique_ptr<Force<2>>>{}, std::vector<PrescribedNode<2>>{}, mo);
+    const Eigen::VectorXd rate = link_rates_of(model);
+    const int lengthening = speed > 0 ? 5 : 4;
+    for (int j = 0; j < 10; ++j) {
+      CAPTURE(speed, j);
+      CHECK(rate[j] == Approx(j == lengthening ? 1.0 : 0.0).margin(1e-15));
+    }
+    for (int i = 0; i <= 10; ++i) CHECK(model.chain().velocities().col(i).norm() == Approx(1.0).epsilon(1e-15));
+    // The start: the snap's law on link `lengthening` (perfectly inelastic), nothing slack, the momentum
+    // of this free string unchanged, and K loses what the impulses dissipated, the two-body closed form.
+    const Points<2> v0 = model.chain().velocities();
+    model.make_consistent(0.0);
+    const Eigen::VectorXd after = link_rates_of(model);
+    CHECK(after.cwiseAbs().maxCoeff() < 1e-14);
+    for (int j = 0; j < 10; ++j) CHECK_FALSE(model.link_slack(j));
+    CHECK((momentum_of(model, model.chain().velocities()) - momentum_of(model, v0)).norm() < 1e-15);
+    const double lost = kinetic_of(model, v0) - kinetic_of(model, model.chain().velocities());
+    std::printf("\nsliding through a 90 deg corner at %g m/s: K lost at the start %.15g J, dissipated %.15g J\n", speed,
+                lost, model.impulsive_start().dissipated);
+    // The closed form: the impulse is along the lengthening link, across the other side's straight links, so
+    // it moves the corner's node alone on its side (m_c = 0.1 kg) and the whole other side along itself
+    // (M = 0.45 kg): a perfectly inelastic two-body impact at |s| (1 − cos 90°), ½ μ s² with μ = m_c M/(m_c + M).
+    const double mc = model.chain().mass(5), M = 0.45, mu = mc * M / (mc + M);
+    CHECK(lost == Approx(0.5 * mu).epsilon(1e-12));
+    CHECK(model.impulsive_start().dissipated == Approx(lost).epsilon(1e-12));
+  }
+  {
+    const int links = 24;
+    const double pi = 3.141592653589793, R = 0.3;
+    Chain<3> chain = Chain<3>::uniform(1.0, 2 * links * R * std::sin(pi / links), links, true);
+    for (int i = 0; i < links; ++i) {
+      const double a = 2 * pi * i / links;
+      chain.positions().col(i) = R * Vec<3>(std::cos(a), std::sin(a) * std::cos(0.4), std::sin(a) * std::sin(0.4));
+    }
+    StringModelOptions mo = allow_options<3>();
+    mo.sliding_speed = 2.0;
+    StringModel<3> model(std::move(chain), std::vector<std::unique_ptr<Force<3>>>{}, std::vector<PrescribedNode<3>>{}, mo);
+    CHECK(link_rates_of(model).cwiseAbs().maxCoeff() < 1e-14);
+    const double K0 = kinetic_of(model, model.chain().velocities());
+    model.make_consistent(0.0);
+    CHECK(kinetic_of(model, model.chain().velocities()) == Approx(K0).epsilon(1e-14));
+    CHECK(model.impulsive_start().dissipated < 1e-15);
+  }
+}
+
+TEST_CASE("slack: a tangential start over an edge or a peg keeps the bent link at its length (no lift-off at t = 0)",
+          "[slack][edge]") {
+  // Each side of the edge slides along its own line, so the bent link's rate d(l⁻ + l⁺)/dt is zero and so
+  // is every other link's: the start takes nothing (no impulsive start), and the string moves on as the
+  // scene says. Before, the node before the edge took the averaged tangent, which shortened its link at
+  // s (1 − cos 45°) = 0.088 m/s: that link went slack at t = 0 and the edge lifted off at once. (A table
+  // ending at an edge on a node, in 3D: test_table_edge.cpp, "in 3D with slack allowed and an initial speed".)
+  SECTION("2D, a peg inside a link (the corner of the shape half-way along link 5, both sides hanging)") {
+    const std::string text = R"(model = "string"
+[string]
+length = 1.0
+nodes = 12
+[shape]
+kind = "polyline"
+points = [[-0.3, -0.4], [0.0, 0.0], [0.3, -0.4]]
+[velocity]
+kind = "tangential"
+speed = 0.5
+[effects.gravity]
+g = [0.0, -9.81]
+[[effects.edge]]
+point = [0.0, 0.0]
+[solver]
+slack = "allow"
+[stop]
+t_end = 0.2
+)";
+    StringScene<2> scene = build_string_scene<2>(parse_scene_text(text, "peg_speed.toml"));
+    REQUIRE(scene.model->bend_point(5) != nullptr);
+    const Eigen::VectorXd rate = link_rates_of(*scene.model);
+    std::printf("tangential start over a peg inside link 5: its rate %.3g m/s, largest |rate| %.3g m/s\n", rate[5],
+                rate.cwiseAbs().maxCoeff());
+    CHECK(std::abs(rate[5]) < 1e-15);
+    CHECK(rate.cwiseAbs().maxCoeff() < 1e-15);
+    for (int j = 0; j < scene.model->chain().num_links(); ++j) CHECK_FALSE(scene.model->link_slack(j));
+    StringSolver<2> solver(*scene.model, scene.solver);
+    RunSummary run;
+    REQUIRE_NOTHROW(run = solver.run());
+    CHECK_FALSE(run.impulsive_start);
+    CHECK(run.status == "completed");
+    CHECK(run.events.empty());
+  }
+}
