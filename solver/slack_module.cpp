@@ -148,6 +148,9 @@ class SlackModule final : public WrappingModule<dim> {
     }
     return {EventAction::Kind::kTransfer, ""};  // the velocities changed: the integrator restarts
   }
+  void book_start_dissipation(double dissipated, Eigen::Ref<Eigen::VectorXd> ledger) const override {
+    ledger[inner_ledgers()] -= dissipated;  // W_snap: the start's impulses are a snap at t0
+  }
   bool events_need_tensions() const override { return inner_ && inner_->events_need_tensions(); }
   void node_contacts(const StringModel<dim>& model, std::vector<NodeContact<dim>>& out) const override {
     if (inner_) inner_->node_contacts(model, out);

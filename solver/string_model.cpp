@@ -152,6 +152,7 @@ StringModel<dim>::StringModel(Chain<dim> chain, std::vector<std::unique_ptr<Forc
   rebuild();
   if (num_free_ == 0) throw InputError("every node of the string is prescribed: nothing to solve");
   if (module_) module_->initialize(*this);
+  if (options_.sliding_speed) set_sliding_velocities(*options_.sliding_speed);
 }
 
 template <int dim>
@@ -279,10 +280,16 @@ void StringModel<dim>::links() {
       dxj = CMap(x + dim * b) - CMap(x + dim * a);
       Map(dv + dim * j) = CMap(v + dim * b) - CMap(v + dim * a);
       const double l = dxj.norm();
-      if (!(l > kCollapsedLink * h[j]) || !std::isfinite(l))
-        throw RecoverableError(fmt::format("link {} has collapsed to length {:g}", j, l));
       l_of[j] = l;
-      Map(e + dim * j) = dxj / l;
+      if (!(l > kCollapsedLink * h[j]) || !std::isfinite(l)) {
+        // A slack link may be as short as anything, its ends may pass each other (it carries no tension,
+        // its row is out of the system): no direction. A taut one that collapses is a degenerate state.
+        if (!(std::isfinite(l) && link_slack(j)))
+          throw RecoverableError(fmt::format("link {} has collapsed to length {:g}", j, l));
+        Map(e + dim * j).setZero();
+      } else {
+        Map(e + dim * j) = dxj / l;
+      }
       // every node of the arcs once: each link's start, and the end of an open arc's last link
       x_max = std::max(x_max, CMap(x + dim * a).cwiseAbs().maxCoeff());
       if (q + 1 == nl && !arc.closed) x_max = std::max(x_max, CMap(x + dim * b).cwiseAbs().maxCoeff());
@@ -1201,6 +1208,103 @@ void StringModel<dim>::project_velocities(double t) {
 }
 
 template <int dim>
+void StringModel<dim>::start_impulses(double t0) {
+  // Unilateral links at the start (docs/model.md §9, "The start"): the positions onto the taut links'
+  // lengths as always; the velocities by the snap's law, as if the string snapped taut at t0. A link whose
+  // initial rate shortens it goes slack (P = 0, it flies freely), a lengthening one takes the impulse of
+  // the complementarity problem with the scene's restitution, and the supports' and obstacles' impulses
+  // are what they are at a snap. A rate below kSeparation of the fastest node is the round-off of a
+  // compatible start: it is not a separation, and the bilateral projection that follows (slack links out)
+  // takes it to zero as with slack = "stop".
+  project_positions(t0);
+  double speed = 0;
+  for (int i = 0; i < chain_.num_nodes(); ++i)
+    if (in_arc(i)) speed = std::max(speed, v_.col(i).norm());
+  for (const NodeContact<dim>& c : contacts_) v_.col(c.node) -= c.normal.dot(v_.col(c.node)) * c.normal;
+  const SnapResult r = link_impulses(t0, options_.snap_restitution, speed);
+  impulsive_start_.dissipated += r.dissipated;
+  project_velocities(t0);
+}
+
+template <int dim>
+void StringModel<dim>::set_sliding_velocities(double speed) {
+  // The string sliding along itself (docs/scenes.md, "The velocity kinds"). Along the direction of
+  // motion each node has an incoming direction a (the string before it) and an outgoing one b, turned
+  // from a by φ; the node moves at |speed| along m, turned from a by ψ ∈ [0, φ/2] towards b. The link
+  // from node k to node k + 1 then lengthens at |speed| (cos ψ_{k+1} − cos(φ_k − ψ_k)): ≥ 0 as long as
+  // ψ_{k+1} ≤ φ_k − ψ_k. So ψ_{k+1} = min(φ_{k+1}/2, φ_k − ψ_k): the bisector (the central difference,
+  // exact on a circle) wherever the turn does not grow along the motion, else the largest ψ that keeps
+  // that link at its length; at a corner between straight stretches ψ = 0, along the incoming link, and
+  // the outgoing link lengthens at |speed| (1 − cos θ): the start's snap turns the corner's node, the
+  // moving kink of a string sliding through a sharp corner. A link bent over a point gives its ends
+  // the directions of its two sides (the turn at the point is the point's): each side slides along its
+  // own line and the bent link keeps its length exactly.
+  const Points<dim>& x = chain_.positions();
+  auto direction = [&](int j, bool at_end) -> Vec<dim> {
+    const int a = chain_.link_start(j), b = chain_.link_end(j);
+    const Bend* bend = bends_.empty() ? nullptr : bend_of(j);
+    const Vec<dim> d = bend != nullptr && !bend->circle
+                           ? (at_end ? Vec<dim>(x.col(b) - bend->point) : Vec<dim>(bend->point - x.col(a)))
+                           : Vec<dim>(x.col(b) - x.col(a));
+    const double norm = d.norm();
+    if (!(norm > 0))
+      throw InputError(fmt::format("velocity.kind = \"tangential\": the string's direction at node {} is undefined "
+                                   "(coincident nodes)", at_end ? b : a));
+    return d / norm;
+  };
+  const double sense = speed < 0 ? -1.0 : 1.0;
+  for (const ArcRange& arc : arcs_) {
+    const int K = arc.num_nodes();
+    if (K < 2) continue;
+    // In the order of motion: node_of(k), its incoming a_k and outgoing b_k (unit), turn φ_k.
+    auto node_of = [&](int k) { return speed < 0 ? arc.last - k : arc.first + k; };
+    Points<dim> in(dim, K), out(dim, K);
+    Eigen::VectorXd phi(K), psi(K);
+    for (int k = 0; k < K; ++k) {
+      const int i = node_of(k);
+      const bool has_before = arc.closed || i > arc.first, has_after = arc.closed || i < arc.last;
+      const int before = i == arc.first ? arc.last : i - 1;  // the link ending at i (closed: wraps)
+      // the link before node i along s ends at i; the link after starts at i
+      const std::optional<Vec<dim>> along_before =
+          has_before ? std::optional<Vec<dim>>(direction(before, true)) : std::nullopt;
+      const std::optional<Vec<dim>> along_after = has_after ? std::optional<Vec<dim>>(direction(i, false)) : std::nullopt;
+      std::optional<Vec<dim>> a = speed < 0 ? along_after : along_before, b = speed < 0 ? along_before : along_after;
+      if (!a) a = b;
+      if (!b) b = a;
+      in.col(k) = sense * *a;
+      out.col(k) = sense * *b;
+      phi[k] = 2 * std::atan2((in.col(k) - out.col(k)).norm(), (in.col(k) + out.col(k)).norm());
+      psi[k] = 0.5 * phi[k];
+    }
+    if (arc.closed) {
+      // A loop has no first node: sweep from its sharpest turn until a sweep changes nothing.
+      Eigen::Index k0 = 0;
+      phi.maxCoeff(&k0);
+      for (int pass = 0; pass < 4; ++pass) {
+        bool changed = false;
+        for (int step = 1; step <= K; ++step) {
+          const int k = static_cast<int>((k0 + step) % K), prev = (k + K - 1) % K;
+          const double next = std::min(0.5 * phi[k], phi[prev] - psi[prev]);
+          changed = changed || next != psi[k];
+          psi[k] = next;
+        }
+        if (!changed) break;
+      }
+    } else {
+      psi[0] = 0;  // the first node: only its outgoing link (a = b)
+      for (int k = 1; k < K; ++k) psi[k] = std::min(0.5 * phi[k], phi[k - 1] - psi[k - 1]);
+    }
+    for (int k = 0; k < K; ++k) {
+      const double s = std::sin(phi[k]);
+      Vec<dim> m = in.col(k);
+      if (psi[k] > 0 && s > 0) m = (std::sin(phi[k] - psi[k]) * in.col(k) + std::sin(psi[k]) * out.col(k)) / s;
+      chain_.velocities().col(node_of(k)) = std::abs(speed) * m.normalized();
+    }
+  }
+  v_ = chain_.velocities();
+}
+
+template <int dim>
 Eigen::VectorXd StringModel<dim>::projected_state(double t, const Eigen::Ref<const Eigen::VectorXd>& y) {
   unpack_state(t, y);
   refresh();
@@ -1217,7 +1321,9 @@ double StringModel<dim>::make_consistent(double t0) {
     v_.col(p.node) = p.path->velocity(t0);
   }
   for (int j = 0; j < chain_.num_links(); ++j)
-    if (link_slack(j) && !(current_length(j) < (1 - kSlackGap) * chain_.link_length(j)))
+    // (a link made slack by an earlier call's start impulses has its offset: it went slack at full length)
+    if (link_slack(j) && slack_offset_[static_cast<std::size_t>(j)] == 0 &&
+        !(current_length(j) < (1 - kSlackGap) * chain_.link_length(j)))
       throw InputError(fmt::format("link {} is declared slack but is not shorter than its length {:g} m",
                                    j, chain_.link_length(j)));
   const Points<dim> x_start = x_, v_start = v_;
@@ -1225,7 +1331,11 @@ double StringModel<dim>::make_consistent(double t0) {
   try {
     refresh();
     K_start = kinetic_energy();
-    project(t0);
+    if (allows_slack() && system_ && !quadratic_) {
+      start_impulses(t0);
+    } else {
+      project(t0);
+    }
     refresh();
   } catch (const RecoverableError& e) {
     throw InputError(fmt::format("the initial shape is degenerate: {}", e.what()));
@@ -1603,7 +1713,9 @@ typename StringModel<dim>::SnapResult StringModel<dim>::link_impulses(double t, 
   assemble_matrix();
   for_each_link([&](int j, int u, int) {
     u_before[j] = link_rate(j);
-    system_->rhs(u) = -(1 + e) * u_before[j];
+    // Newton's restitution acts on an approach (u⁻ > 0); a link already shortening (a released one not
+    // yet slack, or one shortening at the start) is held only from lengthening: u⁺ ≤ 0.
+    system_->rhs(u) = -u_before[j] - e * std::max(u_before[j], 0.0);
     if (!link_slack(j)) u_scale = std::max(u_scale, std::abs(u_before[j]));
   });
   exclude_slack_links();

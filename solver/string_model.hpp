@@ -88,6 +88,10 @@ struct StringModelOptions {
   /// slack = allow: Newton's coefficient of restitution e of a link that snaps taut (0: perfectly
   /// inelastic, 1: elastic); the approach speed of its ends becomes −e times itself.
   double snap_restitution = 0;
+  /// slack = allow with `[velocity] kind = "tangential"`: the speed (m/s, towards larger s) of the string
+  /// sliding along itself, whose initial velocities the model sets once its module has bent its links
+  /// (StringModel::set_sliding_velocities; docs/scenes.md, the velocity kinds). Unset: the chain's own.
+  std::optional<double> sliding_speed;
   void validate() const;
 };
 
@@ -140,6 +144,9 @@ class StringModel final : public OdeSystem {
     double kinetic_energy = 0;    ///< J
     double max_speed_change = 0;  ///< m/s
     double speed_scale = 0;       ///< m/s: the largest speed before or after
+    /// With slack = allow the start is a snap taut (start_impulses): the energy its impulses
+    /// dissipated (J, ≥ 0; zero for slack = stop, whose jump is the drivers' work alone).
+    double dissipated = 0;
     /// The velocities changed beyond round-off (kImpulsiveSpeed of the speed scale).
     bool detected() const { return max_speed_change > kImpulsiveSpeed * speed_scale; }
     static constexpr double kImpulsiveSpeed = 1e-9;
@@ -441,6 +448,14 @@ class StringModel final : public OdeSystem {
   /// the velocities onto e_j·Δv_j = 0 and n_i·v_i = 0 (mass-weighted, linear).
   void project_positions(double t);
   void project_velocities(double t);
+  /// The initial velocities of the string sliding along itself at `speed` (m/s, towards larger s):
+  /// every node of an arc moves along the string, so that every link's rate of lengthening is ≥ 0 and
+  /// exactly 0 where the string is straight, on a circle, and over a point a link is bent over (each
+  /// of its ends along its own side). docs/scenes.md ("The velocity kinds") derives the rule.
+  void set_sliding_velocities(double speed);
+  /// make_consistent with slack = allow: the positions projected, the velocities by the snap's law at
+  /// t0 (link_impulses with the scene's restitution; links shortening at the start go slack).
+  void start_impulses(double t0);
   /// project_positions' Newton iteration onto the links' lengths and the held nodes' surfaces.
   void project_link_lengths(double t);
   /// The module's constraints beyond the links (NodeConstraint): evaluate_current, after the tension

@@ -249,6 +249,10 @@ class StringModule {
   /// After an impulse the module did not make (a snap of the slack module around it): lets go of the
   /// held nodes whose contact force would now pull; returns whether one was let go.
   virtual bool release_contacts(StringModel<dim>&, double) { return false; }
+  /// The energy (J, ≥ 0) that the links' impulses dissipated at the start of the run (slack = allow: the
+  /// start is a snap taut, StringModel::make_consistent): the module books it in its ledgers' initial
+  /// values `ledger`. Only a module of unilateral links has impulses to book.
+  virtual void book_start_dissipation(double /*dissipated*/, Eigen::Ref<Eigen::VectorXd> /*ledger*/) const {}
   /// The physical events of the run so far (e.g. a chain lifting off an edge), for the run's summary.
   virtual std::vector<RunEvent> run_events() const { return {}; }
   /// The root functions `g` (events() at the start of the run) that say the run cannot go on from

@@ -161,13 +161,22 @@ nlohmann::json to_json(const RunSummary& s) {
   nlohmann::json impulsive = {{"detected", s.impulsive_start},
                               {"kinetic_energy", s.impulsive_energy},
                               {"max_speed_change", s.impulsive_speed_change}};
-  if (s.impulsive_start)
+  if (s.impulsive_start && s.slack_policy == SlackPolicy::kAllow) {
+    impulsive["dissipated"] = s.impulsive_dissipated;
+    impulsive["message"] = fmt::format(
+        "the initial velocities lengthen taut links (slack = \"allow\"): the string snapped taut at t = 0 by the "
+        "snap's law (links that shorten went slack); the velocities jumped by up to {:.6g} m/s, the kinetic energy "
+        "changed by {:.6g} J: {:.6g} J dissipated (W_snap at t = 0) and {:.6g} J the rest of the jump, the supports' "
+        "work and the normal velocities the obstacles took (W_applied at t = 0)",
+        s.impulsive_speed_change, s.impulsive_energy, s.impulsive_dissipated, s.impulsive_energy + s.impulsive_dissipated);
+  } else if (s.impulsive_start) {
     impulsive["message"] = fmt::format(
         "the initial velocities are not compatible with the inextensible string (a driven end moving at t = 0 "
         "while the string is at rest, or [velocity] values that would stretch or shorten links, e.g. a tangential "
         "speed through a corner of the shape): they jumped at t = 0 by up to {:.6g} m/s, giving the string {:.6g} J "
         "of kinetic energy, booked at t = 0 in W_applied",
         s.impulsive_speed_change, s.impulsive_energy);
+  }
   j["impulsive_start"] = impulsive;
   if (!s.error.empty()) j["error"] = s.error;
   if (!s.tolerance_warning.empty()) j["tolerance_warning"] = s.tolerance_warning;
@@ -291,6 +300,9 @@ void StringSolver<dim>::book(double t, const typename StringModel<dim>::Snapshot
   if (!have_start_) {
     // K0 + V0 before an impulsive start, whose energy W_applied holds at t = 0 (zero otherwise).
     e0_ = snap.kinetic + snap.potential - snap.work;
+    // and before what a start by the snap's law dissipated (slack = allow), which W_snap holds at t = 0
+    for (std::size_t k = 0; k < summary_.ledger_terms.size(); ++k)
+      if (summary_.ledger_terms[k].energy() && snap.terms[k] != 0) e0_ -= snap.terms[k];
     v0_ = snap.potential;
     p0_ = snap.momentum;
     have_start_ = true;
@@ -473,6 +485,14 @@ const RunSummary& StringSolver<dim>::run() {
       if (summary_.impulsive_start) {
         summary_.impulsive_energy = impulsive.kinetic_energy;
         y0[model_.work_index()] = impulsive.kinetic_energy;
+        // slack = allow: the start is a snap taut; what its impulses dissipated is W_snap, and W_applied
+        // holds the rest of the jump, the drivers' (supports') work.
+        if (impulsive.dissipated > 0 && model_.module() != nullptr) {
+          summary_.impulsive_dissipated = impulsive.dissipated;
+          y0[model_.work_index()] += impulsive.dissipated;
+          model_.module()->book_start_dissipation(impulsive.dissipated,
+                                                  y0.tail(y0.size() - model_.work_index() - 1));
+        }
       }
       integrator = std::make_unique<Integrator>(model_, t0, y0, options_.integrator);
       record_frame(t0, y0);

@@ -153,6 +153,10 @@ struct RunSummary {
   bool impulsive_start = false;
   double impulsive_energy = 0;        ///< J
   double impulsive_speed_change = 0;  ///< the largest jump of a node's velocity (m/s)
+  /// slack = allow: the start is a snap taut (docs/model.md §9, "The start"), and this is what its
+  /// impulses dissipated (J, ≥ 0), booked at t = 0 in W_snap; W_applied starts at impulsive_energy
+  /// plus it, the supports' work. Zero with slack = stop.
+  double impulsive_dissipated = 0;
   long tension_solves = 0;
   long transfers = 0;              ///< the module's transfers (front tracking: nodes moved across fronts)
   long frames = 0;

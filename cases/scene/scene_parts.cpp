@@ -181,7 +181,13 @@ SceneParts<dim> build_scene_parts(const SceneSpec& spec) {
   }
   const auto& vel = spec.velocity;
   if (vel.kind == "uniform") set_uniform_velocity(chain, as_vec<dim>(spec, vel.value, "velocity.value"));
-  if (vel.kind == "tangential") at_key(spec, "velocity.speed", [&] { set_tangential_velocity(chain, vel.speed); });
+  // (with slack = allow the model sets a tangential speed itself, along the string's sides: StringModelOptions::sliding_speed)
+  if (vel.kind == "tangential")
+    at_key(spec, "velocity.speed", [&] {
+      if (spec.solver.slack != "allow") return set_tangential_velocity(chain, vel.speed);
+      if (!std::isfinite(vel.speed))
+        throw InputError(fmt::format("velocity.speed = {:g} is not a finite number", vel.speed));
+    });
   if (vel.kind == "nodes") {
     const Points<dim> values = as_points<dim>(spec, vel.values, "velocity.values");
     at_key(spec, "velocity.values", [&] { set_node_velocities(chain, values); });
@@ -303,6 +309,9 @@ SceneParts<dim> build_scene_parts(const SceneSpec& spec) {
                                     : SlackPolicy::kStop;
   mo.snap_restitution = so.snap_restitution;
   if (mo.slack == SlackPolicy::kAllow) {
+    // The start is unilateral: a tangential speed is the string sliding along itself exactly (the model
+    // sets it once its fronts have bent their links), not the nodes' averaged tangents (docs/scenes.md).
+    if (spec.velocity.kind == "tangential") mo.sliding_speed = spec.velocity.speed;
     if (spec.elements == "quadratic")
       at_key(spec, "solver.slack", [&] {
         throw InputError("solver.slack = \"allow\" needs link elements: string.elements = \"quadratic\" has no "

@@ -542,3 +542,290 @@ TEST_CASE("slack: a loop travelling along itself keeps zero momentum, judged aga
   CHECK(s.relative_momentum_residual() < 1e-12);
   CHECK(s.relative_energy_drift() < 1e-9);
 }
+
+TEST_CASE("slack: initial velocities that shorten links fly freely from t = 0 (no impulse at the start)", "[slack]") {
+  // The issue's reproducer: a straight string of 4 links whose ends move inwards at 1 m/s. Links 1 and 2
+  // shorten at t = 0: under unilateral links they go slack at once (only a lengthening rate takes an
+  // impulse, as at a snap), so nothing jumps: momentum and energy unchanged, every node on x0 + v0 t until
+  // the first snap. (Before: the bilateral projection of the initial velocities removed them, 0.375 J, and
+  // nothing moved.) The same for a closed 3D loop kicked inwards: every link shortens, every node flies.
+  const std::filesystem::path dir = std::filesystem::temp_directory_path() / "chainsim_slack_start";
+  std::filesystem::create_directories(dir);
+  const std::filesystem::path file = dir / "halves_together.toml";
+  {
+    std::FILE* f = std::fopen(file.string().c_str(), "w");
+    REQUIRE(f != nullptr);
+    std::fputs("[string]\nlength = 1.0\nnodes = 5\n[shape]\nkind = \"polyline\"\npoints = [[0.0,0.0],[1.0,0.0]]\n"
+               "[velocity]\nkind = \"nodes\"\nvalues = [[1.0,0.0],[1.0,0.0],[0.0,0.0],[-1.0,0.0],[-1.0,0.0]]\n"
+               "[solver]\nslack = \"allow\"\n[stop]\nt_end = 0.1\n[output]\ninterval = 0.025\n",
+               f);
+    std::fclose(f);
+  }
+  {
+    StringScene<2> scene = build_string_scene<2>(parse_scene(file, {}));
+    StringSolver<2> solver(*scene.model, scene.solver);
+    const RunSummary s = solver.run();
+    REQUIRE(s.status == "completed");
+    CHECK_FALSE(s.impulsive_start);
+    CHECK(s.impulsive_speed_change == 0.0);
+    const double m = scene.model->chain().mass(1), m_end = scene.model->chain().mass(0);
+    const double K0 = 2 * 0.5 * (m + m_end) * 1.0;  // two nodes at 1 m/s on each side
+    double worst = 0;
+    for (const auto& f : solver.frames()) {
+      for (int i = 0; i < 5; ++i) {
+        const Vec<2> x0(0.25 * i, 0.0), v0(i < 2 ? 1.0 : (i == 2 ? 0.0 : -1.0), 0.0);
+        worst = std::max(worst, (f.x.col(i) - (x0 + v0 * f.t)).norm());
+      }
+      CHECK(f.kinetic == Approx(K0).epsilon(1e-14));
+      CHECK(std::abs(f.terms["W_snap"]) == 0.0);
+    }
+    std::printf("\nhalves flying together: K %.15g J (K0 %.15g J), largest |x - (x0 + v0 t)| %.3g m\n",
+                solver.frames().back().kinetic, K0, worst);
+    CHECK(worst < 1e-14);
+    CHECK(scene.model->link_slack(1));
+    CHECK(scene.model->link_slack(2));
+    CHECK_FALSE(scene.model->link_slack(0));
+    CHECK_FALSE(scene.model->link_slack(3));
+  }
+  {
+    // On to t = 0.6 s: at t = 0.25 s nodes 1, 2 and 3 meet at the middle (links 1 and 2 of length zero: slack
+    // links, no direction needed; before, the run stalled there, "time integration stalled at t = 0.25 s"),
+    // pass each other, and at t = 0.5 s links 1 and 2 are at their length again, lengthening at 1 m/s. The
+    // perfectly inelastic snap makes nodes 1, 2, 3 (at +1, 0, −1 m/s) one body at rest (zero momentum by
+    // symmetry): the energy lost ½ (m_1 + m_3) 1² = 0.25 J. Links 0 and 3 then shorten (nodes 0 and 4 keep
+    // their ±1 m/s towards the stopped nodes): they get no impulse and go slack, nodes 0 and 4 flying on.
+    StringScene<2> scene = build_string_scene<2>(parse_scene(file, {"stop.t_end=0.6", "output.interval=0.05"}));
+    StringSolver<2> solver(*scene.model, scene.solver);
+    const RunSummary s = solver.run();
+    REQUIRE(s.status == "completed");
+    const double K0 = solver.frames().front().kinetic;
+    const double lost = 0.5 * (scene.model->chain().mass(1) + scene.model->chain().mass(3));
+    const auto& last = solver.frames().back();
+    double worst = 0;
+    for (int i = 0; i < 5; ++i) {
+      const Vec<2> x0(0.25 * i, 0.0), v0(i < 2 ? 1.0 : (i == 2 ? 0.0 : -1.0), 0.0);
+      const double flying = (i == 0 || i == 4) ? last.t : 0.5;
+      worst = std::max(worst, (last.x.col(i) - (x0 + flying * v0)).norm());
+    }
+    std::printf("halves passing through each other: snaps %g, W_snap %.15g J (closed form %.15g J), K at 0.6 s %.15g J "
+                "(K0 %.15g J), largest |x - exact| %.3g m, drift %.3g\n",
+                last.terms["snaps"], last.terms["W_snap"], -lost, last.kinetic, K0, worst, s.relative_energy_drift());
+    CHECK(last.terms["snaps"] == 1);
+    CHECK(last.terms["W_snap"] == Approx(-lost).epsilon(1e-9));
+    CHECK(last.kinetic == Approx(K0 - lost).epsilon(1e-9));
+    CHECK(worst < 1e-6);  // the snap located to the scene's rtol (measured 6e-8 m)
+    CHECK(s.relative_energy_drift() < 1e-9);
+    CHECK(scene.model->link_slack(0));
+    CHECK(scene.model->link_slack(3));
+  }
+  {
+    // A closed loop of radius R in 3D, tilted, every node kicked towards the centre at u (and the whole loop
+    // drifting at c): every link shortens, so all go slack and the nodes fly on x0 + v0 t.
+    const int links = 24;
+    const double R = 0.2, u = 0.5, pi = 3.141592653589793;
+    Chain<3> chain = Chain<3>::uniform(0.4, 2 * links * R * std::sin(pi / links), links, true);
+    const Vec<3> c(0.1, -0.2, 0.3);
+    for (int i = 0; i < links; ++i) {
+      const double a = 2 * pi * i / links;
+      const Vec<3> radial(std::cos(a), std::sin(a) * std::cos(0.3), std::sin(a) * std::sin(0.3));
+      chain.positions().col(i) = R * radial;
+      chain.velocities().col(i) = c - u * radial;
+    }
+    const Points<3> x0 = chain.positions(), v0 = chain.velocities();
+    StringModel<3> model(std::move(chain), std::vector<std::unique_ptr<Force<3>>>{}, std::vector<PrescribedNode<3>>{},
+                         allow_options<3>());
+    StringSolver<3> solver(model, run_options<3>(0.2, 0.05));
+    const RunSummary& s = solver.run();
+    REQUIRE(s.status == "completed");
+    CHECK_FALSE(s.impulsive_start);
+    double worst = 0;
+    for (const auto& f : solver.frames())
+      for (int i = 0; i < links; ++i) worst = std::max(worst, (f.x.col(i) - (x0.col(i) + v0.col(i) * f.t)).norm());
+    const double K0 = kinetic_of(model, v0);
+    std::printf("loop kicked inwards: %d of %d links slack, K %.15g J (K0 %.15g J), largest |x - (x0 + v0 t)| %.3g m\n",
+                model.num_slack_links(), links, solver.frames().back().kinetic, K0, worst);
+    CHECK(model.num_slack_links() == links);
+    CHECK(worst < 1e-14);
+    CHECK(solver.frames().back().kinetic == Approx(K0).epsilon(1e-14));
+  }
+}
+
+TEST_CASE("slack: a start whose velocities lengthen some links is the snap law's impulse on those links only",
+          "[slack]") {
+  // A straight string of 9 links on the x axis: nodes 0..3 (A) at −V, 4..6 (B) at +V, 7..9 (C) at −V, all
+  // with U along y. Link 3 (A–B) lengthens at 2V, link 6 (B–C) shortens at 2V, the others keep their length.
+  // Under unilateral links the start is a snap taut of link 3 (the scene's restitution e): A and B collide as
+  // two rigid bodies, C flies on untouched, link 6 goes slack (and link 3 for e > 0). Reference: the two-body
+  // closed form, v_A = v_cm + e 2V M_B/M, v_B = v_cm − e 2V M_A/M, the energy lost ½ μ (1 − e²) (2V)², the
+  // momentum unchanged, every node on x0 + v t afterwards (no force, no tension).
+  const int links = 9;
+  const double h = 0.1, lambda = 0.7, V = 1.2, U = 0.3;
+  for (double e : {0.0, 0.5}) {
+    Chain<2> chain = Chain<2>::uniform(lambda, links * h, links, false);
+    auto group_v = [&](int i) { return Vec<2>(i <= 3 ? -V : (i <= 6 ? V : -V), U); };
+    for (int i = 0; i <= links; ++i) {
+      chain.positions().col(i) = Vec<2>(i * h, 0.0);
+      chain.velocities().col(i) = group_v(i);
+    }
+    const Points<2> x0 = chain.positions(), v0 = chain.velocities();
+    StringModel<2> model(std::move(chain), std::vector<std::unique_ptr<Force<2>>>{}, std::vector<PrescribedNode<2>>{},
+                         allow_options<2>(e));
+    const double M_A = lambda * h * 3.5, M_B = lambda * h * 3, M = M_A + M_B, mu = M_A * M_B / M;
+    const double v_cm = (-M_A * V + M_B * V) / M;
+    const double v_A = v_cm + e * 2 * V * M_B / M, v_B = v_cm - e * 2 * V * M_A / M;
+    const double lost = 0.5 * mu * (1 - e * e) * 4 * V * V;
+    StringSolver<2> solver(model, run_options<2>(0.05, 0.01));
+    const RunSummary& s = solver.run();
+    REQUIRE(s.status == "completed");
+    const auto& first = solver.frames().front();
+    double worst_v = 0, worst_x = 0;
+    for (const auto& f : solver.frames())
+      for (int i = 0; i <= links; ++i) {
+        const Vec<2> v(i <= 3 ? v_A : (i <= 6 ? v_B : -V), U);
+        worst_v = std::max(worst_v, (f.v.col(i) - v).norm());
+        worst_x = std::max(worst_x, (f.x.col(i) - (x0.col(i) + v * f.t)).norm());
+      }
+    const double K0 = kinetic_of(model, v0), K1 = kinetic_of(model, first.v);
+    const Vec<2> dp = momentum_of(model, first.v) - momentum_of(model, v0);
+    std::printf("\nstart as a snap, e = %.1f: K lost %.15g J (closed form %.15g J), W_snap(0) %.15g J, |dp| %.3g N s, "
+                "largest |v - v_exact| %.3g m/s, |x - x_exact| %.3g m, drift %.3g\n",
+                e, K0 - K1, lost, first.terms["W_snap"], dp.norm(), worst_v, worst_x, s.relative_energy_drift());
+    INFO("e = " << e);
+    CHECK(s.impulsive_start);
+    CHECK(s.impulsive_dissipated == Approx(lost).epsilon(1e-12));
+    CHECK(std::abs((K0 - K1) - lost) < 1e-12 * K0);
+    CHECK(std::abs(-first.terms["W_snap"] - lost) < 1e-12 * K0);
+    CHECK(std::abs(first.work) < 1e-14 * K0);  // no support: nothing of the jump is applied work
+    CHECK(dp.norm() < 1e-14 * M * V);
+    CHECK(worst_v < 1e-12 * V);
+    CHECK(worst_x < 1e-12);
+    CHECK(s.relative_energy_drift() < 1e-12);
+    CHECK(model.link_slack(6));
+    CHECK(model.link_slack(3) == (e > 0));
+    for (int j : {0, 1, 2, 4, 5, 7, 8}) CHECK_FALSE(model.link_slack(j));
+  }
+}
+
+namespace {
+
+/// Each link's rate of lengthening (m/s) from a chain's positions and velocities, measured on the links
+/// as they stand: along the chord, or for a link bent over a point p, d(|p − x_a| + |x_b − p|)/dt.
+template <int dim>
+Eigen::VectorXd link_rates_of(const StringModel<dim>& model) {
+  const Points<dim>& x = model.chain().positions();
+  const Points<dim>& v = model.chain().velocities();
+  Eigen::VectorXd rate(model.chain().num_links());
+  for (int j = 0; j < model.chain().num_links(); ++j) {
+    const int a = model.chain().link_start(j), b = model.chain().link_end(j);
+    if (const Vec<dim>* p = model.bend_point(j)) {
+      rate[j] = -(*p - x.col(a)).normalized().dot(v.col(a)) + (x.col(b) - *p).normalized().dot(v.col(b));
+    } else {
+      rate[j] = (x.col(b) - x.col(a)).normalized().dot(v.col(b) - v.col(a));
+    }
+  }
+  return rate;
+}
+
+}  // namespace
+
+TEST_CASE("slack: a tangential start slides along the string: zero rates on straight parts and circles, the corner's "
+          "outgoing link at s (1 - cos theta)", "[slack]") {
+  // The sliding field (StringModelOptions::sliding_speed, docs/scenes.md "The velocity kinds"), judged by
+  // the links' rates it gives, computed here from the positions. A polyline with a 90° corner on node 5
+  // (h = 0.1 m): every link keeps its length but the one the material enters after the corner, which
+  // lengthens at |s| (1 − cos 90°) = |s| (the link after the corner for s > 0, before it for s < 0);
+  // the averaged tangent of the nodes (x_{i+1} − x_{i−1}) shortened the link before the corner at
+  // s (1 − cos 45°). A regular 24-gon (a loop) keeps every link at its length.
+  for (const double speed : {1.0, -1.0}) {
+    Chain<2> chain = Chain<2>::uniform(1.0, 1.0, 10, false);
+    for (int i = 0; i <= 10; ++i) chain.positions().col(i) = i <= 5 ? Vec<2>(0.1 * i, 0.0) : Vec<2>(0.5, -0.1 * (i - 5));
+    StringModelOptions mo = allow_options<2>();
+    mo.sliding_speed = speed;
+    StringModel<2> model(std::move(chain), std::vector<std::unique_ptr<Force<2>>>{}, std::vector<PrescribedNode<2>>{}, mo);
+    const Eigen::VectorXd rate = link_rates_of(model);
+    const int lengthening = speed > 0 ? 5 : 4;
+    for (int j = 0; j < 10; ++j) {
+      CAPTURE(speed, j);
+      CHECK(rate[j] == Approx(j == lengthening ? 1.0 : 0.0).margin(1e-15));
+    }
+    for (int i = 0; i <= 10; ++i) CHECK(model.chain().velocities().col(i).norm() == Approx(1.0).epsilon(1e-15));
+    // The start: the snap's law on link `lengthening` (perfectly inelastic), nothing slack, the momentum
+    // of this free string unchanged, and K loses what the impulses dissipated, the two-body closed form.
+    const Points<2> v0 = model.chain().velocities();
+    model.make_consistent(0.0);
+    const Eigen::VectorXd after = link_rates_of(model);
+    CHECK(after.cwiseAbs().maxCoeff() < 1e-14);
+    for (int j = 0; j < 10; ++j) CHECK_FALSE(model.link_slack(j));
+    CHECK((momentum_of(model, model.chain().velocities()) - momentum_of(model, v0)).norm() < 1e-15);
+    const double lost = kinetic_of(model, v0) - kinetic_of(model, model.chain().velocities());
+    std::printf("\nsliding through a 90 deg corner at %g m/s: K lost at the start %.15g J, dissipated %.15g J\n", speed,
+                lost, model.impulsive_start().dissipated);
+    // The closed form: the impulse is along the lengthening link, across the other side's straight links, so
+    // it moves the corner's node alone on its side (m_c = 0.1 kg) and the whole other side along itself
+    // (M = 0.45 kg): a perfectly inelastic two-body impact at |s| (1 − cos 90°), ½ μ s² with μ = m_c M/(m_c + M).
+    const double mc = model.chain().mass(5), M = 0.45, mu = mc * M / (mc + M);
+    CHECK(lost == Approx(0.5 * mu).epsilon(1e-12));
+    CHECK(model.impulsive_start().dissipated == Approx(lost).epsilon(1e-12));
+  }
+  {
+    const int links = 24;
+    const double pi = 3.141592653589793, R = 0.3;
+    Chain<3> chain = Chain<3>::uniform(1.0, 2 * links * R * std::sin(pi / links), links, true);
+    for (int i = 0; i < links; ++i) {
+      const double a = 2 * pi * i / links;
+      chain.positions().col(i) = R * Vec<3>(std::cos(a), std::sin(a) * std::cos(0.4), std::sin(a) * std::sin(0.4));
+    }
+    StringModelOptions mo = allow_options<3>();
+    mo.sliding_speed = 2.0;
+    StringModel<3> model(std::move(chain), std::vector<std::unique_ptr<Force<3>>>{}, std::vector<PrescribedNode<3>>{}, mo);
+    CHECK(link_rates_of(model).cwiseAbs().maxCoeff() < 1e-14);
+    const double K0 = kinetic_of(model, model.chain().velocities());
+    model.make_consistent(0.0);
+    CHECK(kinetic_of(model, model.chain().velocities()) == Approx(K0).epsilon(1e-14));
+    CHECK(model.impulsive_start().dissipated < 1e-15);
+  }
+}
+
+TEST_CASE("slack: a tangential start over an edge or a peg keeps the bent link at its length (no lift-off at t = 0)",
+          "[slack][edge]") {
+  // Each side of the edge slides along its own line, so the bent link's rate d(l⁻ + l⁺)/dt is zero and so
+  // is every other link's: the start takes nothing (no impulsive start), and the string moves on as the
+  // scene says. Before, the node before the edge took the averaged tangent, which shortened its link at
+  // s (1 − cos 45°) = 0.088 m/s: that link went slack at t = 0 and the edge lifted off at once. (A table
+  // ending at an edge on a node, in 3D: test_table_edge.cpp, "in 3D with slack allowed and an initial speed".)
+  SECTION("2D, a peg inside a link (the corner of the shape half-way along link 5, both sides hanging)") {
+    const std::string text = R"(model = "string"
+[string]
+length = 1.0
+nodes = 12
+[shape]
+kind = "polyline"
+points = [[-0.3, -0.4], [0.0, 0.0], [0.3, -0.4]]
+[velocity]
+kind = "tangential"
+speed = 0.5
+[effects.gravity]
+g = [0.0, -9.81]
+[[effects.edge]]
+point = [0.0, 0.0]
+[solver]
+slack = "allow"
+[stop]
+t_end = 0.2
+)";
+    StringScene<2> scene = build_string_scene<2>(parse_scene_text(text, "peg_speed.toml"));
+    REQUIRE(scene.model->bend_point(5) != nullptr);
+    const Eigen::VectorXd rate = link_rates_of(*scene.model);
+    std::printf("tangential start over a peg inside link 5: its rate %.3g m/s, largest |rate| %.3g m/s\n", rate[5],
+                rate.cwiseAbs().maxCoeff());
+    CHECK(std::abs(rate[5]) < 1e-15);
+    CHECK(rate.cwiseAbs().maxCoeff() < 1e-15);
+    for (int j = 0; j < scene.model->chain().num_links(); ++j) CHECK_FALSE(scene.model->link_slack(j));
+    StringSolver<2> solver(*scene.model, scene.solver);
+    RunSummary run;
+    REQUIRE_NOTHROW(run = solver.run());
+    CHECK_FALSE(run.impulsive_start);
+    CHECK(run.status == "completed");
+    CHECK(run.events.empty());
+  }
+}
