@@ -72,6 +72,7 @@
 #include "shocks/front_kind.hpp"
 #include "shocks/heap_front.hpp"
 #include "solver/string_model.hpp"
+#include "solver/wrapping_module.hpp"
 
 namespace chainsim {
 
@@ -212,10 +213,13 @@ StringModel<dim> make_front_model(Chain<dim> chain, std::vector<std::unique_ptr<
                                   std::optional<FoldSpec> fold, const FrontOptions& fronts,
                                   const StringModelOptions& options = {});
 
-/// The tracker of a string with fronts (nullptr for a string without).
+/// The tracker of a string with fronts (nullptr for a string without), inside the modules that wrap it
+/// (the slack module's, wrapping_module.hpp).
 template <int dim>
 const FrontTracker<dim>* front_tracker(const StringModel<dim>& model) {
-  return dynamic_cast<const FrontTracker<dim>*>(model.module());
+  const StringModule<dim>* module = model.module();
+  while (const auto* wrapper = dynamic_cast<const WrappingModule<dim>*>(module)) module = wrapper->inner();
+  return dynamic_cast<const FrontTracker<dim>*>(module);
 }
 
 }  // namespace chainsim
