@@ -319,7 +319,8 @@ EventAction FrontTracker<dim>::handle_events(StringModel<dim>& model, double t, 
         return {EventAction::Kind::kStop, fronts_[k]->check_failed(model, fs_[k], t)};
       }
   // Energy, momentum and held masses before, to book what the crossing changes.
-  const double E_before = model.kinetic_energy() + model.potential_energy(ledger);
+  const double K_before = model.kinetic_energy();
+  const double E_before = K_before + model.potential_energy(ledger);
   const Vec<dim> p_before = model.momentum();
   std::vector<double> held_before(fronts_.size());
   for (std::size_t k = 0; k < fronts_.size(); ++k) held_before[k] = fronts_[k]->held_mass(fs_[k]);
@@ -362,7 +363,8 @@ EventAction FrontTracker<dim>::handle_events(StringModel<dim>& model, double t, 
   // allowed (perfectly inelastic otherwise), and the energy it changes is the front's last dissipation,
   // booked in W_shocks (docs/model.md §2.5, "A kink at a held end").
   model.refresh();
-  const double E_moved = model.kinetic_energy() + model.potential_energy(ledger);
+  const double K_moved = model.kinetic_energy();
+  const double E_moved = K_moved + model.potential_energy(ledger);
   try {
     if (absorbed)
       model.impact(t, model.options().snap_restitution);
@@ -386,13 +388,13 @@ EventAction FrontTracker<dim>::handle_events(StringModel<dim>& model, double t, 
   const double changed = model.kinetic_energy() + model.potential_energy(ledger) - E_before;
   if (acted) {
     const EventEnergy record{t, forming ? "insert" : absorbed ? "absorb" : "cross", static_cast<int>(*acted),
-                             E_moved - E_before, changed - (E_moved - E_before), jump_before};
+                             E_moved - E_before, K_moved - K_before, changed - (E_moved - E_before), jump_before};
     event_energies_.push_back(record);
     if (trace_)
       std::fprintf(stderr, "%s\n",
-                   fmt::format("front_event t={:.9g} kind={} front={} relayout={:.6e} projection={:.6e} jump_before={:.6e} "
+                   fmt::format("front_event t={:.9g} kind={} front={} relayout={:.6e} relayout_K={:.6e} projection={:.6e} jump_before={:.6e} "
                                "s0={:.9g} s0_dot={:.6g}",
-                               t, record.kind, record.front, record.relayout, record.projection, record.jump_before,
+                               t, record.kind, record.front, record.relayout, record.relayout_kinetic, record.projection, record.jump_before,
                                fs_[*acted].s0, fs_[*acted].s0_dot)
                        .c_str());
   }

@@ -116,7 +116,9 @@ class FrontTracker final : public StringModule<dim> {
     double t = 0;
     std::string kind;  ///< "insert", "cross" or "absorb"
     int front = -1;
-    double relayout = 0, projection = 0;
+    double relayout = 0;
+    double relayout_kinetic = 0;  ///< its part in K (the rest is in V: the parcels' heights, the split link's shape)
+    double projection = 0;
     double jump_before = 0;  ///< |v_a − v_(a−1)| (m/s), 0 where the stencil has no such pair
   };
   const std::vector<EventEnergy>& event_energies() const { return event_energies_; }

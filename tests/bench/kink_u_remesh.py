@@ -7,7 +7,7 @@ the mass parcels and the projection after it change, and the velocity jumps alon
 a-1, a, b, b+1 before it) and prints
   1. W_remesh per event class: the insertion, the crossings in time windows (re-layout / projection), the
      absorption's re-layout (its impact is W_shocks);
-  2. the kink-side velocity jump |v_a - v_(a-1)| at the crossings (median, in the windows): a smooth arm has
+  2. the arm-side velocity jump |v_a - v_(a-1)| at the crossings (median, in the windows): a smooth arm has
      h |dv/ds|, O(h);
   3. the state at the --times: the largest and the RMS distance between the same material points on
      successive meshes (the coarser mesh's nodes, every other node of the finer), where the largest sits, and K.
@@ -78,6 +78,33 @@ def main():
             dv = [e["jump_before"] for e in events if e["kind"] == "cross" and a <= e["t"] < b]
             cells.append(f"{np.median(dv):.3f}" if dv else "-")
         print(f"{n} | {s[1] - s[0]:.5f} | " + " | ".join(cells))
+
+    print("\nafter each crossing: where the front is re-drawn, l-/h of its new split link (1 or 0: where it was), "
+          "median; and the front's mean speed in the material from the crossings (links per s times h) against "
+          "the jump conditions' |s0_dot|, median: N | " + " | ".join(f"[{a:g}, {b:g})" for a, b in WINDOWS))
+    for n, (events, _, frames) in zip(args.nodes, runs):
+        s = frames[min(frames)][0]
+        h = s[1] - s[0]
+        cells = []
+        for a, b in WINDOWS:
+            c = [e for e in events if e["kind"] == "cross" and a <= e["t"] < b]
+            if len(c) < 2:
+                cells.append("-")
+                continue
+            rate = h * (len(c) - 1) / (c[-1]["t"] - c[0]["t"])
+            cells.append(f"{np.median([(e['s0'] / h) % 1 for e in c]):.2f}, {rate:.2f} / "
+                         f"{np.median([abs(e['s0_dot']) for e in c]):.2f} m/s")
+        print(f"{n} | " + " | ".join(cells))
+
+    print("\nre-layout of the crossings in [0.4, 0.8) s (mJ): N | total | its kinetic part | the merge of the node next "
+          "to the kink alone, -(lambda h / 6) sum |v_a - v_(a-1)|^2")
+    for n, (events, _, frames) in zip(args.nodes, runs):
+        s = frames[min(frames)][0]
+        h = s[1] - s[0]
+        c = [e for e in events if e["kind"] == "cross" and 0.4 <= e["t"] < 0.8]
+        lam = 0.1
+        print(f"{n} | {1e3 * sum(e['relayout'] for e in c):.3f} | {1e3 * sum(e['relayout_K'] for e in c):.3f} | "
+              f"{-1e3 * sum(lam * h / 6 * e['jump_before'] ** 2 for e in c):.3f}")
 
     print("\nstate at t: t | meshes | max (m) at s (m) | RMS (m) | K coarse / fine (mJ)")
     for t in args.times:
