@@ -4,6 +4,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
 
 #include <fmt/format.h>
 
@@ -14,7 +16,7 @@ namespace chainsim {
 
 template <int dim>
 FrontTracker<dim>::FrontTracker(std::vector<std::unique_ptr<FrontKind<dim>>> fronts, const FrontOptions& options)
-    : options_(options), fronts_(std::move(fronts)) {
+    : options_(options), fronts_(std::move(fronts)), trace_(std::getenv("CHAINSIM_TRACE_FRONTS") != nullptr) {
   CHAINSIM_VERIFY(!fronts_.empty(), "a front tracker needs a front");
   for (std::size_t k = 1; k < fronts_.size(); ++k)
     if (fronts_[k]->expected_s0 < fronts_[k - 1]->expected_s0)
@@ -325,11 +327,23 @@ EventAction FrontTracker<dim>::handle_events(StringModel<dim>& model, double t, 
         return {EventAction::Kind::kStop, fronts_[k]->check_failed(model, fs_[k], t)};
       }
   // Energy, momentum and held masses before, to book what the crossing changes.
-  const double E_before = model.kinetic_energy() + model.potential_energy(ledger);
+  const double K_before = model.kinetic_energy();
+  const double E_before = K_before + model.potential_energy(ledger);
   const Vec<dim> p_before = model.momentum();
   std::vector<double> held_before(fronts_.size());
   for (std::size_t k = 0; k < fronts_.size(); ++k) held_before[k] = fronts_[k]->held_mass(fs_[k]);
   bool absorbed = false;
+  std::optional<std::size_t> acted = forming;  // the front the event moved
+  // |v_a − v_(a−1)| on the front's stencil (a−1, a, b, b+1) before the event, for event_energies_.
+  double jump_before = 0;
+  if (!forming)
+    for (int f = 0; f < nf; ++f)
+      if ((found[static_cast<std::size_t>(2 * f)] != 0 || found[static_cast<std::size_t>(2 * f + 1)] != 0) &&
+          fronts_[static_cast<std::size_t>(f)]->active) {
+        const std::vector<int> nodes = fronts_[static_cast<std::size_t>(f)]->stencil(model);
+        if (nodes.size() == 4) jump_before = (model.v().col(nodes[1]) - model.v().col(nodes[0])).norm();
+        break;
+      }
   if (forming && !insert_front(model, *forming, t))
     return {EventAction::Kind::kStop,
             fmt::format("a {} formed at t = {:.9g} s where no link fits it (its arms need a full link on either side)",
@@ -339,6 +353,7 @@ EventAction FrontTracker<dim>::handle_events(StringModel<dim>& model, double t, 
     if (e0 == 0 && e1 == 0) continue;
     const auto k = static_cast<std::size_t>(f);
     if (!fronts_[k]->active) continue;
+    acted = k;
     if (fronts_[k]->absorbed(model, fs_[k], e0)) {
       remove_front(model, k, t);
       absorbed = true;
@@ -356,6 +371,8 @@ EventAction FrontTracker<dim>::handle_events(StringModel<dim>& model, double t, 
   // allowed (perfectly inelastic otherwise), and the energy it changes is the front's last dissipation,
   // booked in W_shocks (docs/model.md §2.5, "A kink at a held end").
   model.refresh();
+  const double K_moved = model.kinetic_energy();
+  const double E_moved = K_moved + model.potential_energy(ledger);
   try {
     if (absorbed)
       model.impact(t, model.options().snap_restitution);
@@ -377,6 +394,18 @@ EventAction FrontTracker<dim>::handle_events(StringModel<dim>& model, double t, 
     ledger.template segment<dim>(2 + dim) = moment;
   }
   const double changed = model.kinetic_energy() + model.potential_energy(ledger) - E_before;
+  if (acted) {
+    const EventEnergy record{t, forming ? "insert" : absorbed ? "absorb" : "cross", static_cast<int>(*acted),
+                             E_moved - E_before, K_moved - K_before, changed - (E_moved - E_before), jump_before};
+    event_energies_.push_back(record);
+    if (trace_)
+      std::fprintf(stderr, "%s\n",
+                   fmt::format("front_event t={:.9g} kind={} front={} relayout={:.6e} relayout_K={:.6e} projection={:.6e} jump_before={:.6e} "
+                               "s0={:.9g} s0_dot={:.6g}",
+                               t, record.kind, record.front, record.relayout, record.relayout_kinetic, record.projection, record.jump_before,
+                               fs_[*acted].s0, fs_[*acted].s0_dot)
+                       .c_str());
+  }
   if (absorbed)
     ledger[0] += changed;
   else

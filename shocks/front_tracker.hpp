@@ -72,6 +72,7 @@
 #include "shocks/front_kind.hpp"
 #include "shocks/heap_front.hpp"
 #include "solver/string_model.hpp"
+#include "solver/wrapping_module.hpp"
 
 namespace chainsim {
 
@@ -107,6 +108,20 @@ class FrontTracker final : public StringModule<dim> {
   FrontTracker(std::vector<std::unique_ptr<FrontKind<dim>>> fronts, const FrontOptions& options);
 
   Fronts fronts() const { return Fronts(fronts_); }
+  /// What one front event (an insertion, a crossing, an absorption) changed in K + V: the re-layout of the
+  /// mass parcels (and the insertion's or removal's arcs) and the projection after it (W_remesh), or the
+  /// absorption's impact (W_shocks); with the velocity jump |v_a − v_(a−1)| across the last link of the arc
+  /// before the front's split link, at the event, before it (docs/model.md §9, "W_remesh event by event").
+  struct EventEnergy {
+    double t = 0;
+    std::string kind;  ///< "insert", "cross" or "absorb"
+    int front = -1;
+    double relayout = 0;
+    double relayout_kinetic = 0;  ///< its part in K (the rest is in V: the parcels' heights, the split link's shape)
+    double projection = 0;
+    double jump_before = 0;  ///< |v_a − v_(a−1)| (m/s), 0 where the stencil has no such pair
+  };
+  const std::vector<EventEnergy>& event_energies() const { return event_energies_; }
   /// The state front k wrote at the last evaluation.
   const FrontState<dim>& front_state(std::size_t k) const { return fs_[k]; }
 
@@ -172,6 +187,8 @@ class FrontTracker final : public StringModule<dim> {
   std::vector<RunEvent> events_;
   long transfers_ = 0;
   double w_remesh_ = 0;
+  std::vector<EventEnergy> event_energies_;
+  bool trace_ = false;  ///< CHAINSIM_TRACE_FRONTS set: event_energies_ also on stderr, one line each
   Vec<dim> heap_moment0_ = Vec<dim>::Zero();  // Σ held mass × its first moment at t = 0
 };
 
@@ -198,10 +215,13 @@ StringModel<dim> make_front_model(Chain<dim> chain, std::vector<std::unique_ptr<
                                   std::optional<FoldSpec> fold, const FrontOptions& fronts,
                                   const StringModelOptions& options = {});
 
-/// The tracker of a string with fronts (nullptr for a string without).
+/// The tracker of a string with fronts (nullptr for a string without), inside the modules that wrap it
+/// (the slack module's, wrapping_module.hpp).
 template <int dim>
 const FrontTracker<dim>* front_tracker(const StringModel<dim>& model) {
-  return dynamic_cast<const FrontTracker<dim>*>(model.module());
+  const StringModule<dim>* module = model.module();
+  while (const auto* wrapper = dynamic_cast<const WrappingModule<dim>*>(module)) module = wrapper->inner();
+  return dynamic_cast<const FrontTracker<dim>*>(module);
 }
 
 }  // namespace chainsim

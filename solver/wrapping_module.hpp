@@ -19,6 +19,8 @@ template <int dim>
 class WrappingModule : public StringModule<dim> {
  public:
   explicit WrappingModule(std::unique_ptr<StringModule<dim>> inner) : inner_(std::move(inner)) {}
+  /// The wrapped module (nullptr: none).
+  const StringModule<dim>* inner() const { return inner_.get(); }
 
   std::vector<ArcRange> initial_arcs(const Chain<dim>& chain) override {
     if (inner_) return inner_->initial_arcs(chain);

@@ -454,3 +454,124 @@ TEST_CASE("kinks = insert is refused on a closed string, located at the key", "[
                              Catch::Contains("allowed: \"off\""));
   }
 }
+
+namespace {
+
+/// The swinging U with kinks = "insert" on `nodes` nodes to t = 1 s: its frames at 0, 0.5 and 1 s, and the
+/// tracker's energy change at each front event (FrontTracker::event_energies).
+struct InsertedU {
+  RunSummary run;
+  std::vector<Frame<2>> frames;
+  std::vector<FrontTracker<2>::EventEnergy> events;
+  double w_remesh = 0;
+  /// The events of one kind (and, for crossings, in [t0, t1)): the sum of their re-layout and projection.
+  double sum(const std::string& kind, double t0 = 0, double t1 = 10) const {
+    double total = 0;
+    for (const auto& e : events)
+      if (e.kind == kind && e.t >= t0 && e.t < t1) total += e.relayout + e.projection;
+    return total;
+  }
+};
+
+InsertedU run_inserted_u(int nodes) {
+  const std::filesystem::path file = std::filesystem::path(CHAINSIM_SOURCE_DIR) / "cases" / "scenes" / "swinging_u.toml";
+  const SceneSpec spec =
+      parse_scene(file, {"string.nodes=" + std::to_string(nodes), "solver.kinks=\"insert\"", "output.interval=0.5"});
+  StringScene<2> scene = build_string_scene<2>(spec);
+  StringSolver<2> solver(*scene.model, scene.solver);
+  InsertedU u;
+  u.run = solver.run();
+  u.frames = solver.frames();
+  const FrontTracker<2>* tracker = front_tracker(*scene.model);
+  REQUIRE(tracker);
+  u.events = tracker->event_energies();
+  u.w_remesh = u.frames.back().terms["W_remesh"];
+  return u;
+}
+
+/// The RMS and the largest distance between the same material points of two nested meshes (every node of the
+/// coarser, every other node of the finer) at frame k.
+std::pair<double, double> state_difference(const InsertedU& coarse, const InsertedU& fine, std::size_t k) {
+  const Points<2>& x1 = coarse.frames.at(k).x;
+  const Points<2>& x2 = fine.frames.at(k).x;
+  REQUIRE(x2.cols() == 2 * x1.cols() - 1);
+  double sum = 0, largest = 0;
+  for (Eigen::Index i = 0; i < x1.cols(); ++i) {
+    const double d = (x1.col(i) - x2.col(2 * i)).norm();
+    sum += d * d;
+    largest = std::max(largest, d);
+  }
+  return {std::sqrt(sum / static_cast<double>(x1.cols())), largest};
+}
+
+}  // namespace
+
+TEST_CASE("the swinging U with an inserted kink under refinement: K at 1 s converges at order 2, the insertion's and the "
+          "absorption's W_remesh vanish with h, the state's RMS difference falls, the ledgers close",
+          "[kink][shocks][slack][convergence]") {
+  // docs/model.md §9, "W_remesh event by event" (tests/bench/kink_u_remesh.py): on 101, 201, 401 nodes K(1 s) =
+  // 27.155, 27.659, 27.761 mJ (differences 0.50, 0.10 mJ: order 2.3); the insertion's W_remesh −3.4e-5, −1.1e-6,
+  // +4e-7 J; the absorption's re-layout −1.1e-5, −3.9e-6, −1.6e-6 J (order 1.5, 1.3); the RMS distance at 1 s
+  // 1.53e-3, 8.96e-4 m (101 → 201, 201 → 401).
+  std::vector<InsertedU> u;
+  for (const int nodes : {101, 201, 401}) {
+    u.push_back(run_inserted_u(nodes));
+    const InsertedU& r = u.back();
+    CAPTURE(nodes, r.run.stop_reason, r.run.error);
+    REQUIRE(r.run.status == "completed");
+    REQUIRE(r.frames.size() == 3);
+    // Each event's change is booked: W_remesh is the sum of the insertion's and the crossings' (the absorption's
+    // re-layout and impact go to W_shocks); the ledgers close to round-off plus what is booked.
+    double booked = 0;
+    for (const auto& e : r.events) booked += e.kind == "absorb" ? 0.0 : e.relayout + e.projection;
+    CHECK(booked == Approx(r.w_remesh).margin(1e-12));
+    CHECK(std::abs(r.run.relative_energy_residual()) < 1e-4);
+    CHECK(r.run.relative_momentum_residual() < 1e-9);
+  }
+  const auto K = [&](std::size_t m) { return u[m].frames.back().kinetic; };
+  CHECK(std::abs(K(0) - K(1)) > 3 * std::abs(K(1) - K(2)));  // order > 1.5 (measured 2.3)
+  // The insertion's projection and the absorption's re-layout (booked in W_shocks) are consistent: they vanish
+  // with h.
+  CHECK(std::abs(u[1].sum("insert")) < 0.1 * std::abs(u[0].sum("insert")));
+  CHECK(std::abs(u[2].sum("insert")) < std::abs(u[1].sum("insert")));
+  for (std::size_t m = 0; m + 1 < u.size(); ++m) {
+    double a0 = 0, a1 = 0;
+    for (const auto& e : u[m].events) a0 += e.kind == "absorb" ? e.relayout : 0;
+    for (const auto& e : u[m + 1].events) a1 += e.kind == "absorb" ? e.relayout : 0;
+    CHECK(std::abs(a1) < 0.55 * std::abs(a0));  // order > 0.86
+  }
+  CHECK(std::abs(u[1].w_remesh) < std::abs(u[0].w_remesh));
+  CHECK(std::abs(u[2].w_remesh) < std::abs(u[1].w_remesh));
+  const auto [rms01, max01] = state_difference(u[0], u[1], 2);
+  const auto [rms12, max12] = state_difference(u[1], u[2], 2);
+  CAPTURE(rms01, max01, rms12, max12);
+  CHECK(rms12 < 0.7 * rms01);  // measured 0.59 (order 0.77)
+  CHECK(max12 < 0.7 * max01);
+}
+
+TEST_CASE("the swinging U with an inserted kink on 801 nodes: K at 1 s converged, the crossings' W_remesh does not vanish",
+          "[kink][shocks][slack][convergence][.long]") {
+  // docs/model.md §9, "W_remesh event by event": the limit of the front's discretization that the study on 101 …
+  // 801 nodes shows. K(1 s) converges (differences 0.50, 0.10, 0.001 mJ); the crossings' W_remesh from 0.4 to 0.8 s
+  // is −0.49, −0.40, −0.44, −0.48 mJ on 101, 201, 401, 801 nodes (it does not vanish with h), and the RMS distance at
+  // 1 s stays 8.9e-4 m on 201 → 401 and 401 → 801.
+  std::vector<InsertedU> u;
+  for (const int nodes : {201, 401, 801}) {
+    u.push_back(run_inserted_u(nodes));
+    CAPTURE(nodes, u.back().run.error);
+    REQUIRE(u.back().run.status == "completed");
+    CHECK(std::abs(u.back().run.relative_energy_residual()) < 1e-4);
+    CHECK(u.back().run.relative_momentum_residual() < 1e-9);
+  }
+  const auto K = [&](std::size_t m) { return u[m].frames.back().kinetic; };
+  CHECK(std::abs(K(1) - K(2)) < 0.1 * std::abs(K(0) - K(1)));
+  for (const InsertedU& r : u) {
+    const double crossings = r.sum("cross", 0.4, 0.8);
+    CHECK(crossings < -2e-4);
+    CHECK(crossings > -8e-4);
+  }
+  const auto [rms12, max12] = state_difference(u[1], u[2], 2);
+  const auto [rms01, max01] = state_difference(u[0], u[1], 2);
+  CAPTURE(rms01, rms12, max01, max12);
+  CHECK(rms12 < 1.2 * rms01);
+}
