@@ -703,9 +703,10 @@ Integrator::Outcome Integrator::advance(double t_target, bool one_step, const Ro
       // Another root after the predicted zero (the step past it went where the front may not go, e.g. a
       // fold's arms apart): that step is taken again without the prediction, and the next crossing is
       // predicted again. A late prediction (the first of a run, from the secant before any event's rate)
-      // runs the step far past the zero; the folded compare met its fold's check after its first
-      // prediction (its crossing function 3.9e-5 m past its zero at 200 nodes) and predicted nothing after it (111,715 right-hand sides at
-      // 3,200 nodes, 35 per crossing; 28,803 and 9.1 when predictions resume after the next event).
+      // runs the step far past the zero: the folded compare met its fold's check after its first
+      // prediction (its crossing function 3.9e-5 m past its zero on 200 nodes) and, with the prediction
+      // off for the run, predicted nothing after it (111,715 right-hand sides on 3,200 nodes, 35 per
+      // crossing; 28,803 and 9.1 when predictions resume after the next event).
       const double h = last_step();
       impl_->prediction_off[static_cast<std::size_t>(predicted)] = Impl::kPredictionMissed;
       restart(t_step_start, y_step_start);
