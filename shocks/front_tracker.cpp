@@ -131,8 +131,12 @@ void FrontTracker<dim>::add_mass_and_forces(const StringModel<dim>& model, Eigen
   for (std::size_t k = 0; k < fronts_.size(); ++k)
     if (fronts_[k]->active) fronts_[k]->evaluate(model, fs_[k], mass, force);
   const double lambda = material_.lambda, h = material_.h;
+  // The mass first (a comparison; in_arc and is_prescribed are calls into the solver's library, and this
+  // scan runs at every right-hand side: 4.8 % of the folded compare's instructions on 800 nodes).
+  const double floor = 1e-12 * lambda * h;
+  const double* const m = mass.data();
   for (int i = 0; i < material_.n; ++i)
-    if (model.in_arc(i) && !model.is_prescribed(i) && !(mass[i] > 1e-12 * lambda * h))
+    if (!(m[i] > floor) && model.in_arc(i) && !model.is_prescribed(i))
       throw RecoverableError(fmt::format("node {} has lost its mass (a front overshot it)", i));
 }
 

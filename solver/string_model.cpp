@@ -197,6 +197,7 @@ void StringModel<dim>::rebuild() {
   w_ = Eigen::VectorXd::Zero(n);
   for (int i = 0; i < n; ++i)
     if (slot_[i] >= 0) w_[i] = 1.0 / m_[i];
+  base_w_ = w_;
   // A slack link that left the arcs (taken into a heap, or the folded link at a fold) is no longer a
   // link of the tension system: the front's jump conditions hold its material.
   for (int j = 0; j < L; ++j)
@@ -696,8 +697,12 @@ void StringModel<dim>::refresh() {
   m_ = base_mass_;
   module_force_.setZero();
   module_->add_mass_and_forces(*this, m_, module_force_);
+  // w_i = 1/m_i, the same number as rebuild()'s where the module left the mass as it was (all but the
+  // few nodes of its partial links): a division per node at every right-hand side spared.
+  const double *const m = m_.data(), *const base = base_mass_.data(), *const base_w = base_w_.data();
+  double* const w = w_.data();
   for (int i = 0; i < chain_.num_nodes(); ++i)
-    if (slot_[i] >= 0) w_[i] = 1.0 / m_[i];
+    if (slot_[i] >= 0) w[i] = base[i] > 0 && m[i] == base[i] ? base_w[i] : 1.0 / m[i];
   contacts_.clear();
   module_->node_contacts(*this, contacts_);
   constraints_.clear();

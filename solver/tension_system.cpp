@@ -367,52 +367,50 @@ TensionSystem::TensionSystem(const std::vector<int>& arc_links, const std::vecto
     arcs_.push_back(ArcBlock{n, arc_links[k], arc_closed[k]});
     n += arc_links[k];
   }
-  // 2. Pattern: tridiagonal (cyclic) blocks.
-  std::vector<std::pair<int, int>> entries;
-  for (const ArcBlock& arc : arcs_) {
-    const int f = arc.first_unknown, m = arc.num_links;
-    for (int i = 0; i < m; ++i) {
-      entries.emplace_back(f + i, f + i);
-      if (i + 1 < m) {
-        entries.emplace_back(f + i, f + i + 1);
-        entries.emplace_back(f + i + 1, f + i);
-      }
-    }
-    if (arc.closed) {
-      entries.emplace_back(f, f + m - 1);
-      entries.emplace_back(f + m - 1, f);
-    }
-  }
-  std::sort(entries.begin(), entries.end(), [](auto& a, auto& b) {
-    return a.second != b.second ? a.second < b.second : a.first < b.first;
-  });
-  entries.erase(std::unique(entries.begin(), entries.end()), entries.end());
+  // 2. Pattern: tridiagonal (cyclic) blocks, column by column in the order of the unknowns, each
+  //    column's rows sorted and unique (compressed columns). Built directly, in O(n): the system is
+  //    built again at every front crossing, and sorting the (row, column) pairs took a tenth of the
+  //    folded compare's instructions on 800 nodes.
   pattern_.n = n;
   pattern_.col_ptr.assign(static_cast<std::size_t>(n) + 1, 0);
-  pattern_.row_index.reserve(entries.size());  // exactly: not grown by doubling (up to 4 bytes per entry spare)
-  for (auto [r, c] : entries) {
-    ++pattern_.col_ptr[static_cast<std::size_t>(c) + 1];
-    pattern_.row_index.push_back(r);
-  }
-  std::partial_sum(pattern_.col_ptr.begin(), pattern_.col_ptr.end(), pattern_.col_ptr.begin());
-  values_.assign(entries.size(), 0.0);
-  rhs_ = Eigen::VectorXd::Zero(n);
-  solution_ = Eigen::VectorXd::Zero(n);
-
-  // 3. Slots of the arc entries, so the model writes values without searching.
+  pattern_.row_index.clear();
+  std::size_t nnz = 0;
+  for (const ArcBlock& arc : arcs_) nnz += static_cast<std::size_t>(3 * arc.num_links - 2 + (arc.closed ? 2 : 0));
+  pattern_.row_index.reserve(nnz);  // exactly: not grown by doubling (up to 4 bytes per entry spare)
+  // 3. Slots of the arc entries, so the model writes values without searching: each entry's position
+  //    as it is written, A(u, u) = diag, A(u, next) = next_slot, A(next, u) = prev_slot_of_next.
   diag_slot_.assign(n, -1);
   next_slot_.assign(n, -1);
   prev_slot_of_next_.assign(n, -1);
-  for (int u = 0; u < n; ++u) diag_slot_[u] = pattern_.find(u, u);
   for (const ArcBlock& arc : arcs_) {
     const int f = arc.first_unknown, m = arc.num_links;
+    // The link after link u of the arc (−1: none), as the slots are defined.
+    const auto next_of = [&](int u) { return u + 1 < f + m ? u + 1 : (arc.closed ? f : -1); };
     for (int i = 0; i < m; ++i) {
-      if (i + 1 == m && !arc.closed) break;
-      const int next = i + 1 < m ? f + i + 1 : f;
-      next_slot_[f + i] = pattern_.find(f + i, next);
-      prev_slot_of_next_[f + i] = pattern_.find(next, f + i);
+      const int c = f + i;
+      int rows[5];
+      int k = 0;
+      if (i > 0) rows[k++] = c - 1;          // (c - 1, c): the coupling with the link before
+      rows[k++] = c;                         // the diagonal
+      if (i + 1 < m) rows[k++] = c + 1;      // (c + 1, c): the coupling with the link after
+      if (arc.closed && i == 0) rows[k++] = f + m - 1;  // a closed arc's last link before its first
+      if (arc.closed && i + 1 == m) rows[k++] = f;      // and its first after its last
+      std::sort(rows, rows + k);
+      const int unique = static_cast<int>(std::unique(rows, rows + k) - rows);
+      for (int q = 0; q < unique; ++q) {
+        const int r = rows[q], slot = static_cast<int>(pattern_.row_index.size()) + q;
+        if (r == c) diag_slot_[c] = slot;
+        if (next_of(r) == c && r != c) next_slot_[r] = slot;           // A(r, next of r)
+        if (next_of(c) == r && r != c) prev_slot_of_next_[c] = slot;   // A(next of c, c)
+      }
+      pattern_.row_index.insert(pattern_.row_index.end(), rows, rows + unique);
+      pattern_.col_ptr[static_cast<std::size_t>(c) + 1] = static_cast<int>(pattern_.row_index.size());
     }
   }
+  CHAINSIM_VERIFY(pattern_.row_index.size() == nnz, "the tension system's pattern has its entries");
+  values_.assign(pattern_.row_index.size(), 0.0);
+  rhs_ = Eigen::VectorXd::Zero(n);
+  solution_ = Eigen::VectorXd::Zero(n);
 
   // 4. Backend: symbolic analysis once.
   backend_name_ = backend == "auto" ? "tridiagonal" : backend;

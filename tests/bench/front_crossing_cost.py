@@ -9,13 +9,17 @@ errors against the reduced ODE; then, per problem, the ratio of the CPU time on 
 coarsest.
 
     /usr/bin/python3 tests/bench/front_crossing_cost.py [--binary build/chainsim] [--nodes 200,800,3200]
-        [--problems falling,folded,sliding] [--method erk5]
+        [--problems falling,folded,sliding] [--method erk5] [--repeat 3]
+
+With --repeat N each run is made N times and the times printed are the medians (the counts are the same
+every time: the runs are deterministic).
 
 Not a test: it checks no timing (the counted bound is tests/convergence/test_front_crossing_cost.cpp).
 """
 import argparse
 import json
 import resource
+import statistics
 import subprocess
 import sys
 import tempfile
@@ -28,6 +32,7 @@ def main():
     parser.add_argument("--nodes", default="200,800,3200")
     parser.add_argument("--problems", default="falling,folded,sliding")
     parser.add_argument("--method", default=None, help="the compare's --method (default: its own)")
+    parser.add_argument("--repeat", type=int, default=1, help="runs of each case; the times are the medians")
     args = parser.parse_args()
     meshes = [int(n) for n in args.nodes.split(",")]
     print(f"{'problem':8s} {'nodes':>5s} {'process':>8s} {'solver':>8s} {'cpu':>8s} {'cross':>5s} {'steps':>6s} {'rhs':>7s} "
@@ -36,19 +41,25 @@ def main():
         for problem in args.problems.split(","):
             solver = {}
             for n in meshes:
-                before = resource.getrusage(resource.RUSAGE_CHILDREN)
-                start = time.perf_counter()
                 command = [args.binary, "compare", problem, "--nodes", str(n), "--json", "--out", f"{out}/{problem}{n}"]
                 if args.method:
                     command += ["--method", args.method]
-                run = subprocess.run(command, capture_output=True, text=True)
-                process = time.perf_counter() - start
-                after = resource.getrusage(resource.RUSAGE_CHILDREN)
-                cpu = (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
+                times = []
+                for _ in range(max(args.repeat, 1)):
+                    before = resource.getrusage(resource.RUSAGE_CHILDREN)
+                    start = time.perf_counter()
+                    run = subprocess.run(command, capture_output=True, text=True)
+                    process = time.perf_counter() - start
+                    after = resource.getrusage(resource.RUSAGE_CHILDREN)
+                    if run.returncode != 0:
+                        break
+                    s = json.loads(run.stdout)
+                    times.append((process, s["wall_s"], (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)))
                 if run.returncode != 0:
                     print(f"{problem} {n}: exit {run.returncode}: {run.stdout[-400:]} {run.stderr[-400:]}")
                     continue
-                s = json.loads(run.stdout)
+                process, wall, cpu = (statistics.median(column) for column in zip(*times))
+                s["wall_s"] = wall
                 cross = max(s["transfers"], 1)
                 solver[n] = cpu
                 print(f"{problem:8s} {n:5d} {process:8.2f} {s['wall_s']:8.3f} {cpu:8.2f} {s['transfers']:5d} "
