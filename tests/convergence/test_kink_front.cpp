@@ -581,10 +581,10 @@ TEST_CASE("the swinging U's kink: the corner of the arm next to it is not the ki
           "between crossings",
           "[kink][shocks][slack][convergence]") {
   // docs/model.md §9, "Where the arm's corner comes from" (tests/bench/kink_u_remesh.py): at the crossings from
-  // 0.4 to 0.8 s the arm's turn at a − 1 has a median of 5.5–7° on 101 and 201 nodes, while the kink constraint's
-  // reaction on a − 1, balanced by τ⁻, would turn it by at most 0.27° (median 1e-9°): the hypothesis that the
-  // reaction makes the corner is refuted. Right after each crossing the new a − 1 turns by 2–5°, and it gains
-  // about 3° more before the next crossing: the corner grows in the arm's own dynamics between crossings.
+  // 0.4 to 0.8 s the arm's turn at a − 1 has a median of 5.77°, 5.87° on 101, 201 nodes, while the kink constraint's
+  // reaction on a − 1, balanced by τ⁻, would turn it by at most 0.27°, 0.20° (median 1e-10°): the hypothesis that
+  // the reaction makes the corner is refuted. Right after each crossing the new a − 1 turns by 2.79°, 3.36°
+  // (medians), and it gains 2.5–3° more before the next crossing: the corner grows in the arm's own dynamics.
   for (const int nodes : {101, 201}) {
     const InsertedU u = run_inserted_u(nodes);
     CAPTURE(nodes, u.run.error);
