@@ -301,6 +301,42 @@ std::vector<int> FrontTracker<dim>::event_directions() const {
 }
 
 template <int dim>
+std::pair<double, double> FrontTracker<dim>::arm_corner(const StringModel<dim>& model, std::size_t k, int i, double t,
+                                                       const char* when) const {
+  // The turn of the arm at node i (the node before the front's split link's start, a − 1) against the turn
+  // that the front's constraint reaction on i would make in quasi-static balance with the tension τ⁻ on
+  // either side: τ⁻ (e2 − e1) + F = 0, F = Σ μ ∂C/∂x_i (docs/model.md §9, "Where the arm's corner comes from").
+  if (i < 1 || i + 1 >= model.x().cols()) return {0.0, 0.0};
+  const double prev_deg = i >= 2 ? std::acos(std::clamp((model.x().col(i - 1) - model.x().col(i - 2)).normalized().dot(
+                                                           (model.x().col(i) - model.x().col(i - 1)).normalized()),
+                                                       -1.0, 1.0)) * 180 / kPi
+                                 : 0.0;
+  const Vec<dim> e1 = (model.x().col(i) - model.x().col(i - 1)).normalized();
+  const Vec<dim> e2 = (model.x().col(i + 1) - model.x().col(i)).normalized();
+  Vec<dim> F = Vec<dim>::Zero();
+  const auto& cs = model.node_constraints();
+  const Eigen::VectorXd& mu = model.constraint_multipliers();
+  for (std::size_t c = 0; c < cs.size() && static_cast<Eigen::Index>(c) < mu.size(); ++c)
+    for (std::size_t q = 0; q < cs[c].nodes.size(); ++q)
+      if (cs[c].nodes[q] == i) F += mu[static_cast<Eigen::Index>(c)] * cs[c].gradient.col(static_cast<Eigen::Index>(q));
+  const double tau = fs_[k].tension_minus;
+  const Vec<dim> turn = e2 - e1, predicted = tau > 0 ? Vec<dim>(-F / tau) : Vec<dim>(Vec<dim>::Zero());
+  // Signed along the turn: the share of the corner the reaction accounts for.
+  const double tn = turn.norm();
+  const double along = tn > 0 ? predicted.dot(turn) / tn : 0.0;
+  const double turn_deg = 2 * std::asin(std::min(1.0, 0.5 * tn)) * 180 / kPi;
+  const double reaction_deg = 2 * std::asin(std::min(1.0, 0.5 * predicted.norm())) * 180 / kPi;
+  if (trace_)
+    std::fprintf(stderr, "%s\n",
+                 fmt::format("arm_corner when={} t={:.9g} node={} turn_deg={:.6g} reaction_turn_deg={:.6g} "
+                             "reaction_along_deg={:.6g} reaction_N={:.6e} tau={:.6e} turn_prev_deg={:.6g}",
+                             when, t, i, turn_deg, reaction_deg, 2 * std::asin(std::clamp(0.5 * along, -1.0, 1.0)) * 180 / kPi,
+                             F.norm(), tau, prev_deg)
+                     .c_str());
+  return {turn_deg, reaction_deg};
+}
+
+template <int dim>
 EventAction FrontTracker<dim>::handle_events(StringModel<dim>& model, double t, Eigen::Ref<Eigen::VectorXd> ledger,
                                              const std::vector<int>& found) {
   const int nf = static_cast<int>(fronts_.size());
@@ -340,12 +376,14 @@ EventAction FrontTracker<dim>::handle_events(StringModel<dim>& model, double t, 
   std::optional<std::size_t> acted = forming;  // the front the event moved
   // |v_a − v_(a−1)| on the front's stencil (a−1, a, b, b+1) before the event, for event_energies_.
   double jump_before = 0;
+  std::pair<double, double> corner_before{0.0, 0.0};
   if (!forming)
     for (int f = 0; f < nf; ++f)
       if ((found[static_cast<std::size_t>(2 * f)] != 0 || found[static_cast<std::size_t>(2 * f + 1)] != 0) &&
           fronts_[static_cast<std::size_t>(f)]->active) {
         const std::vector<int> nodes = fronts_[static_cast<std::size_t>(f)]->stencil(model);
         if (nodes.size() == 4) jump_before = (model.v().col(nodes[1]) - model.v().col(nodes[0])).norm();
+        if (nodes.size() == 4) corner_before = arm_corner(model, static_cast<std::size_t>(f), nodes[0], t, "before");
         break;
       }
   if (forming && !insert_front(model, *forming, t))
@@ -398,9 +436,15 @@ EventAction FrontTracker<dim>::handle_events(StringModel<dim>& model, double t, 
     ledger.template segment<dim>(2 + dim) = moment;
   }
   const double changed = model.kinetic_energy() + model.potential_energy(ledger) - E_before;
+  double corner_after = 0;
+  if (acted && !forming && !absorbed) {
+    const std::vector<int> nodes = fronts_[*acted]->stencil(model);
+    if (nodes.size() == 4) corner_after = arm_corner(model, *acted, nodes[0], t, "after").first;
+  }
   if (acted) {
     const EventEnergy record{t, forming ? "insert" : absorbed ? "absorb" : "cross", static_cast<int>(*acted),
-                             E_moved - E_before, K_moved - K_before, changed - (E_moved - E_before), jump_before};
+                             E_moved - E_before, K_moved - K_before, changed - (E_moved - E_before), jump_before,
+                             corner_before.first, corner_after, corner_before.second};
     event_energies_.push_back(record);
     if (trace_)
       std::fprintf(stderr, "%s\n",

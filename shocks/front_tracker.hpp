@@ -120,6 +120,9 @@ class FrontTracker final : public StringModule<dim> {
     double relayout_kinetic = 0;  ///< its part in K (the rest is in V: the parcels' heights, the split link's shape)
     double projection = 0;
     double jump_before = 0;  ///< |v_a − v_(a−1)| (m/s), 0 where the stencil has no such pair
+    /// The arm's turn (deg) at a − 1 before the event and at the new a − 1 after it (projection done), and the turn
+    /// the front's constraint reaction on a − 1 would make against τ⁻ before it (0 without a constraint).
+    double arm_turn_before = 0, arm_turn_after = 0, reaction_turn = 0;
   };
   const std::vector<EventEnergy>& event_energies() const { return event_energies_; }
   /// The state front k wrote at the last evaluation.
@@ -146,6 +149,9 @@ class FrontTracker final : public StringModule<dim> {
   }
   void events(const StringModel<dim>& model, Eigen::Ref<Eigen::VectorXd> g) const override;
   std::vector<int> event_directions() const override;
+  /// The arm's turn (deg) at node i (a − 1 of front k's stencil) and the turn its constraint reaction would
+  /// make against the front's tension τ⁻ (deg); with CHAINSIM_TRACE_FRONTS one `arm_corner` line on stderr.
+  std::pair<double, double> arm_corner(const StringModel<dim>& model, std::size_t k, int i, double t, const char* when) const;
   EventAction handle_events(StringModel<dim>& model, double t, Eigen::Ref<Eigen::VectorXd> ledger,
                             const std::vector<int>& found) override;
   long transfers() const override { return transfers_; }

@@ -9,7 +9,9 @@ a-1, a, b, b+1 before it) and prints
      absorption's re-layout (its impact is W_shocks);
   2. the arm-side velocity jump |v_a - v_(a-1)| at the crossings (median, in the windows): a smooth arm has
      h |dv/ds|, O(h);
-  3. the state at the --times: the largest and the RMS distance between the same material points on
+  3. the arm's corner at the crossings: its turn at a-1 and a-2 before, at the new a-1 and a-2 after (the
+     `arm_corner` lines), and the turn the kink constraint's reaction on a-1 would make against tau-;
+  4. the state at the --times: the largest and the RMS distance between the same material points on
      successive meshes (the coarser mesh's nodes, every other node of the finer), where the largest sits, and K.
 
     /usr/bin/python3 tests/bench/kink_u_remesh.py --binary build/chainsim --nodes 101 201 401 801 --out /tmp/kink_u
@@ -41,6 +43,10 @@ def run(binary, scene, n, interval, directory):
     for line in open(trace):
         if line.startswith("front_event"):
             events.append({k: (v if k == "kind" else float(v)) for k, v in re.findall(r"(\w+)=(\S+)", line)})
+        elif line.startswith("arm_corner"):  # the arm's corner at a - 1 before / after each crossing
+            row = {k: (v if k == "when" else float(v)) for k, v in re.findall(r"(\w+)=(\S+)", line)}
+            row["kind"] = "corner_" + row.pop("when")
+            events.append(row)
     energy = list(csv.DictReader(open(os.path.join(directory, "energy.csv"))))
     return events, energy, load(directory)
 
@@ -66,7 +72,7 @@ def main():
             c = [e for e in events if e["kind"] == "cross" and a <= e["t"] < b]
             cells.append(f"{1e3 * sum(e['relayout'] for e in c):.3f}/{1e3 * sum(e['projection'] for e in c):.3f} ({len(c)})")
         absorb = sum(e["relayout"] for e in events if e["kind"] == "absorb")
-        total = sum(e["relayout"] + e["projection"] for e in events if e["kind"] != "absorb")
+        total = sum(e["relayout"] + e["projection"] for e in events if e["kind"] in ("insert", "cross"))
         print(f"{n} | {1e3 * ins:.4f} | " + " | ".join(cells) + f" | {1e3 * absorb:.4f} | {1e3 * total:.3f} | "
               f"{1e3 * float(energy[-1]['W_remesh']):.3f}")
 
@@ -105,6 +111,23 @@ def main():
         lam = 0.1
         print(f"{n} | {1e3 * sum(e['relayout'] for e in c):.3f} | {1e3 * sum(e['relayout_K'] for e in c):.3f} | "
               f"{-1e3 * sum(lam * h / 6 * e['jump_before'] ** 2 for e in c):.3f}")
+
+    print("\nthe arm's corner at the crossings (deg, medians): the turn at a-1 and a-2 before the crossing, at the new "
+          "a-1 and a-2 after it (projection done), and the largest turn the kink constraint's reaction on a-1 would make "
+          "against tau: N | window: before a-1, a-2 | after a-1, a-2 | reaction")
+    for n, (events, _, _) in zip(args.nodes, runs):
+        cells = []
+        for a, b in [(0.4, 0.6), (0.6, 0.7), (0.7, 0.8)]:
+            bf = [e for e in events if e["kind"] == "corner_before" and a <= e["t"] < b]
+            af = [e for e in events if e["kind"] == "corner_after" and a <= e["t"] < b]
+            if not bf or not af:
+                cells.append("-")
+                continue
+            med = lambda rows, k: np.median([r[k] for r in rows])  # noqa: E731
+            cells.append(f"[{a:g}, {b:g}): {med(bf, 'turn_deg'):.2f}, {med(bf, 'turn_prev_deg'):.2f} | "
+                         f"{med(af, 'turn_deg'):.2f}, {med(af, 'turn_prev_deg'):.2f} | "
+                         f"{max(r['reaction_turn_deg'] for r in bf):.1e}")
+        print(f"{n} | " + " || ".join(cells))
 
     print("\nstate at t: t | meshes | max (m) at s (m) | RMS (m) | K coarse / fine (mJ)")
     for t in args.times:
