@@ -208,7 +208,9 @@ TEST_CASE("slack: a chain pendulum spun about the vertical whips in 3D and conve
           "[slack][convergence]") {
   // Measured at t = 0.6 s: 2.53e-2, 8.84e-3, 3.77e-3 m on 41 -> 81 -> 161 -> 321 nodes (orders 1.51, 1.24; the
   // RMS 5.7e-3, 2.2e-3, 1.0e-3 m), W_snap -8e-6 to -3e-5 J, ledgers closed to <= 2.4e-10 and 1e-14 (1 s in all).
-  // snap_restitution = 1 (elastic) books W_snap = 0 to 1e-19 J and moves the state by < 1e-3 of these differences.
+  // snap_restitution = 1 (elastic) books W_snap = 0 to the accuracy of the snaps' impulse solves and moves the state
+  // by < 1e-3 of these differences: since the start is a snap and restitution applies only on an approach, measured
+  // W_snap = 7.8e-14, 7.8e-13, 1.5e-13 J on 41, 81, 161 nodes (71, 11, 186 snaps), against an energy scale of 0.98 J.
   std::vector<Points<3>> states;
   for (int n = 41; n <= 321; n = 2 * n - 1) {
     const SceneRunResult<3> r = run_text<3>(kWhip3, {"string.nodes=" + std::to_string(n)});
@@ -230,7 +232,8 @@ TEST_CASE("slack: a chain pendulum spun about the vertical whips in 3D and conve
         run_text<3>(kWhip3, {"string.nodes=" + std::to_string(n), "solver.snap_restitution=1"});
     REQUIRE(elastic.summary.status == "completed");
     const double scale = elastic.summary.energy_scale;
-    CHECK(std::abs(elastic.frames.back().terms["W_snap"]) < 1e-15 * scale);
+    INFO("W_snap " << elastic.frames.back().terms["W_snap"] << " J, energy scale " << scale << " J");
+    CHECK(std::abs(elastic.frames.back().terms["W_snap"]) < 1e-11 * scale);
     CHECK(elastic.summary.relative_energy_drift() < 1e-9);
   }
 }
