@@ -229,7 +229,8 @@ class StringModel final : public OdeSystem {
   /// The impact at the current state (a slack link reached its length): the links within
   /// kSnapWindow of their length become taut, and the impulsive tensions P ≥ 0 of the taut links
   /// solve the complementarity problem u⁺ = u⁻ + A P ≤ −e u⁻, P (u⁺ + e u⁻) = 0 (u: rate of
-  /// lengthening); the velocities jump, and links that separate afterwards go slack.
+  /// lengthening); the velocities jump, and links that separate afterwards go slack. A caught link whose
+  /// rebounds would accumulate (rebounds_accumulate) takes e = 0.
   SnapResult snap(double t);
   /// The impact of nodes landing on obstacles (a contact module has just held them): the state onto
   /// the constraints of the links and the held nodes, the velocities by a perfectly inelastic impact.
