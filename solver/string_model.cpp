@@ -87,6 +87,8 @@ StringModel<dim>::StringModel(Chain<dim> chain, std::vector<std::unique_ptr<Forc
     module_ = make_slack_module<dim>(std::move(module_));
     slack_.assign(static_cast<std::size_t>(L), 0);
     slack_offset_.assign(static_cast<std::size_t>(L), 0.0);
+    rebound_time_.assign(static_cast<std::size_t>(L), NAN);
+    rebound_speed_.assign(static_cast<std::size_t>(L), NAN);
   }
   // 1. The arcs: the whole string, or the module's layout.
   if (module_) {
@@ -924,12 +926,18 @@ void StringModel<dim>::events(double t, const Eigen::Ref<const Eigen::VectorXd>&
 }
 
 template <int dim>
-Eigen::VectorXd StringModel<dim>::state_scale() const {
-  if (!module_) return {};
+double StringModel<dim>::speed_scale() const {
   const double ell = chain_.length();
   double v2 = uniform_field().norm() * ell;
   for (int i = 0; i < chain_.num_nodes(); ++i) v2 = std::max(v2, chain_.velocities().col(i).squaredNorm());
-  const double speed = v2 > 0 ? std::sqrt(v2) : ell;
+  return v2 > 0 ? std::sqrt(v2) : ell;
+}
+
+template <int dim>
+Eigen::VectorXd StringModel<dim>::state_scale() const {
+  if (!module_) return {};
+  const double ell = chain_.length();
+  const double speed = speed_scale();
   const double mass = chain_.density() * ell;
   Eigen::VectorXd scale(size());
   const int voff = dim * num_free_;
@@ -1637,7 +1645,10 @@ void StringModel<dim>::accept_step(double t, const Eigen::Ref<const Eigen::Vecto
     if (!link_slack(j)) {
       // (Released: no tension at the step's last evaluation. A link short only by the drift of the
       // constraints, which at loose tolerances is far above kSlackGap, keeps its tension: it is taut.)
-      if (gap > kSlackGap && !(link_tension(j) > 0)) set_slack(j, true);
+      if (gap > kSlackGap && !(link_tension(j) > 0)) {
+        set_slack(j, true);
+        rebound_time_[static_cast<std::size_t>(j)] = NAN;  // released by the tensions: a flight, not a rebound
+      }
     } else if (gap + slack_offset_[static_cast<std::size_t>(j)] < -kSlackGap) {
       throw NumericalError(fmt::format("at t = {:.9g} s slack link {} (s = {:.6g} m) is {:.3g} of its length past it: "
                                        "its snap taut was not located",
@@ -1653,10 +1664,12 @@ typename StringModel<dim>::SnapResult StringModel<dim>::snap(double t) {
   links();
   const int L = chain_.num_links();
   // 1. The slack links at their length are caught: taut again.
+  std::vector<int> caught;
   for (int j = 0; j < L; ++j)
     if (link_slack(j) && (chain_.link_length(j) - l_[j]) / chain_.link_length(j) + slack_offset_[static_cast<std::size_t>(j)] <= kSnapWindow) {
       set_slack(j, false);
       ++result.caught;
+      caught.push_back(j);
     }
   if (result.caught == 0) {
     // The root was located on ARKODE's interpolant; the state of the step recomputed to the event
@@ -1675,12 +1688,39 @@ typename StringModel<dim>::SnapResult StringModel<dim>::snap(double t) {
     if (nearest < 0 || !(nearest_gap < kCatchWindow)) return result;
     set_slack(nearest, false);
     ++result.caught;
+    caught.push_back(nearest);
   }
-  const SnapResult impulses = link_impulses(t, options_.snap_restitution);
+  // 2. The accumulation rule (docs/model.md §9, "Accumulating rebounds"): a caught link whose rebounds would
+  //    accumulate within the motion's time over a link takes e = 0. Only for 0 < e < 1 (e = 0 is inelastic
+  //    already; e = 1 never accumulates).
+  const double e = options_.snap_restitution;
+  std::vector<char> inelastic;
+  if (e > 0 && e < 1) {
+    inelastic.assign(static_cast<std::size_t>(L), 0);
+    for (int j : caught)
+      if (rebounds_accumulate(j, t, e)) inelastic[static_cast<std::size_t>(j)] = 1;
+  }
+  const SnapResult impulses = link_impulses(t, e, 0, inelastic.empty() ? nullptr : &inelastic);
   result.dissipated = impulses.dissipated;
   result.support_work = impulses.support_work;
   result.support_impulse = impulses.support_impulse;
   return result;
+}
+
+template <int dim>
+bool StringModel<dim>::rebounds_accumulate(int j, double t, double e) const {
+  // Link j separated at its previous snap, at t_s with speed u_s, flew for τ = t − t_s and is back at
+  // approach speed u. Its ends' closing acceleration over the flight is a = (u_s + u)/τ; held at that a, the
+  // rebounds that e would give, e u, e² u, …, last 2 e u / ((1 − e) a) in all and end with the link taut,
+  // having dissipated ½ μ u², what one perfectly inelastic snap dissipates now. The rule takes that snap when
+  // the accumulation would end within kAccumulation of the time h_j / U the motion takes to cross the link.
+  const std::size_t k = static_cast<std::size_t>(j);
+  if (k >= rebound_time_.size() || std::isnan(rebound_time_[k])) return false;
+  const double u = link_rate(j), tau = t - rebound_time_[k];
+  if (!(u > 0) || !(tau > 0)) return false;
+  const double a = (rebound_speed_[k] + u) / tau;
+  const double accumulation = 2 * e * u / ((1 - e) * a);
+  return accumulation < kAccumulation * chain_.link_length(j) / speed_scale();
 }
 
 template <int dim>
@@ -1704,7 +1744,8 @@ void StringModel<dim>::impact(double t, double e) {
 }
 
 template <int dim>
-typename StringModel<dim>::SnapResult StringModel<dim>::link_impulses(double t, double e, double u_floor) {
+typename StringModel<dim>::SnapResult StringModel<dim>::link_impulses(double t, double e, double u_floor,
+                                                                      const std::vector<char>* inelastic) {
   SnapResult result;
   const int L = chain_.num_links();
   links();
@@ -1720,7 +1761,8 @@ typename StringModel<dim>::SnapResult StringModel<dim>::link_impulses(double t, 
     u_before[j] = link_rate(j);
     // Newton's restitution acts on an approach (u⁻ > 0); a link already shortening (a released one not
     // yet slack, or one shortening at the start) is held only from lengthening: u⁺ ≤ 0.
-    system_->rhs(u) = -u_before[j] - e * std::max(u_before[j], 0.0);
+    const double e_j = inelastic && (*inelastic)[static_cast<std::size_t>(j)] ? 0.0 : e;
+    system_->rhs(u) = -u_before[j] - e_j * std::max(u_before[j], 0.0);
     if (!link_slack(j)) u_scale = std::max(u_scale, std::abs(u_before[j]));
   });
   exclude_slack_links();
@@ -1763,6 +1805,10 @@ typename StringModel<dim>::SnapResult StringModel<dim>::link_impulses(double t, 
       // is zero at a restart, and would miss the link's return to its length if it came at once.
       slack_offset_[static_cast<std::size_t>(j)] =
           std::max(0.0, (l_[j] - chain_.link_length(j)) / chain_.link_length(j)) + kSlackGap;
+      if (static_cast<std::size_t>(j) < rebound_time_.size()) {
+        rebound_time_[static_cast<std::size_t>(j)] = t;
+        rebound_speed_[static_cast<std::size_t>(j)] = -u_after;
+      }
     }
   });
   return result;

@@ -229,7 +229,8 @@ class StringModel final : public OdeSystem {
   /// The impact at the current state (a slack link reached its length): the links within
   /// kSnapWindow of their length become taut, and the impulsive tensions P ≥ 0 of the taut links
   /// solve the complementarity problem u⁺ = u⁻ + A P ≤ −e u⁻, P (u⁺ + e u⁻) = 0 (u: rate of
-  /// lengthening); the velocities jump, and links that separate afterwards go slack.
+  /// lengthening); the velocities jump, and links that separate afterwards go slack. A caught link whose
+  /// rebounds would accumulate (rebounds_accumulate) takes e = 0.
   SnapResult snap(double t);
   /// The impact of nodes landing on obstacles (a contact module has just held them): the state onto
   /// the constraints of the links and the held nodes, the velocities by a perfectly inelastic impact.
@@ -254,6 +255,8 @@ class StringModel final : public OdeSystem {
   /// After a snap, a taut link goes slack when it separates faster than this share of the largest
   /// approach speed of the snap (slower, it stays taut and the tension solve releases it if it must).
   static constexpr double kSeparation = 1e-6;
+  /// The accumulation rule's time, in units of the time h_j / U the motion takes to cross link j.
+  static constexpr double kAccumulation = 1.0;
 
   // --- access -------------------------------------------------------------------------------
   const Chain<dim>& chain() const { return chain_; }
@@ -477,7 +480,14 @@ class StringModel final : public OdeSystem {
   /// problem on the tension matrix, contact-reduced at held nodes): the velocities jump, links that
   /// separate go slack (faster than kSeparation of the larger of their approach speed and u_floor);
   /// the dissipated energy, the supports' and obstacles' impulses and work.
-  SnapResult link_impulses(double t, double e, double u_floor = 0);
+  /// `inelastic`: per link, 1 where the snap takes e = 0 for that link (the accumulation rule, snap()).
+  SnapResult link_impulses(double t, double e, double u_floor = 0, const std::vector<char>* inelastic = nullptr);
+  /// The accumulation rule of snap() (docs/model.md §9, "Accumulating rebounds"): link j's snap is perfectly
+  /// inelastic if it rebounded at its previous snap and the rebounds that would follow end within
+  /// kAccumulation · h_j / U (U: the state's speed scale).
+  bool rebounds_accumulate(int j, double t, double e) const;
+  /// The speed scale of the state: max(√(|g| ℓ), the fastest node) (ℓ if both are zero).
+  double speed_scale() const;
   /// Excludes the slack links from the assembled tension system (their T = 0).
   void exclude_slack_links();
   template <class Visit>
@@ -587,6 +597,7 @@ class StringModel final : public OdeSystem {
   ImpulsiveStart impulsive_start_;
   std::vector<char> slack_;            // per link: slack (slack = allow)
   std::vector<double> slack_offset_;   // per link: its root function's offset
+  std::vector<double> rebound_time_, rebound_speed_;  // per link: when and how fast it separated at its last snap (NaN: it did not)
   int num_slack_ = 0;
 };
 

@@ -307,3 +307,37 @@ TEST_CASE("slack: a falling chain jerked down faster than g goes slack above its
     CHECK(r.summary.relative_momentum_residual() < 1e-12);
   }
 }
+
+TEST_CASE("slack: partly elastic snaps do not accumulate: the falling chain jerked down at e = 0.5 ends with a "
+          "bounded number of snaps and closed ledgers",
+          "[slack][shocks]") {
+  // At snap_restitution = 0.5 a link that snapped rebounds, is pulled back and snaps again at half the speed, a
+  // bouncing ball's Zeno sequence: before the accumulation rule (docs/model.md §9, "Accumulating rebounds") this
+  // run took 31,224 snaps and 62,513 steps on 41 nodes and stopped at max_steps at t = 0.2259 s on 161 nodes
+  // (exit 3). The rule takes a rebound sequence that would end within the motion's time over a link as one
+  // perfectly inelastic snap; the ledgers stay closed with its loss booked in W_snap (measured: 14 and 94 snaps in
+  // 74 and 285 steps on 41 and 161 nodes, relative energy residual 8.5e-11 and 7.4e-13, momentum 2.2e-11 and
+  // 2.7e-15: the integration error at rtol 1e-8, as on the e = 0 run of the test above).
+  for (const int n : {41, 161}) {
+    const SceneRunResult<2> r =
+        run_text<2>(kFallDriven, {"string.nodes=" + std::to_string(n), "solver.snap_restitution=0.5"});
+    INFO(n << " nodes: " << r.summary.error);
+    REQUIRE(r.summary.status == "completed");
+    const Frame<2>& last = r.frames.back();
+    std::printf("falling chain jerked down at e = 0.5, %d nodes: snaps %g, steps %ld, W_snap %.6f J, energy residual "
+                "%.2e, momentum residual %.2e\n",
+                n, last.terms["snaps"], r.summary.stats.steps, last.terms["W_snap"],
+                r.summary.relative_energy_drift(), r.summary.relative_momentum_residual());
+    CHECK(last.terms["snaps"] >= 1);
+    CHECK(last.terms["snaps"] <= 10 * n);
+    CHECK(last.terms["W_snap"] < -1);
+    CHECK(r.summary.relative_energy_drift() < 1e-10);
+    CHECK(r.summary.relative_momentum_residual() < 1e-10);
+    // Inextensible: the material s0 from the top to the heap's front is at least the top's height, the distance
+    // it spans. (At e = 0.5 the catch at 0.184 s throws the chain back down on some meshes, so it need not be equal.)
+    for (const Frame<2>& f : r.frames) {
+      REQUIRE(f.fronts.size() == 1);
+      CHECK(f.fronts[0].s0 >= 1 - 0.1 * (1 - std::cos(20 * f.t)) - 1e-6);  // the links held to ~2e-7 h each
+    }
+  }
+}
