@@ -1278,14 +1278,11 @@ void StringModel<dim>::set_sliding_velocities(double speed) {
       const bool has_before = arc.closed || i > arc.first, has_after = arc.closed || i < arc.last;
       const int before = i == arc.first ? arc.last : i - 1;  // the link ending at i (closed: wraps)
       // the link before node i along s ends at i; the link after starts at i
-      const std::optional<Vec<dim>> along_before =
-          has_before ? std::optional<Vec<dim>>(direction(before, true)) : std::nullopt;
-      const std::optional<Vec<dim>> along_after = has_after ? std::optional<Vec<dim>>(direction(i, false)) : std::nullopt;
-      std::optional<Vec<dim>> a = speed < 0 ? along_after : along_before, b = speed < 0 ? along_before : along_after;
-      if (!a) a = b;
-      if (!b) b = a;
-      in.col(k) = sense * *a;
-      out.col(k) = sense * *b;
+      // An end of an open string has one link: its direction serves before and after.
+      const Vec<dim> along_before = has_before ? direction(before, true) : direction(i, false);
+      const Vec<dim> along_after = has_after ? direction(i, false) : along_before;
+      in.col(k) = sense * (speed < 0 ? along_after : along_before);
+      out.col(k) = sense * (speed < 0 ? along_before : along_after);
       phi[k] = 2 * std::atan2((in.col(k) - out.col(k)).norm(), (in.col(k) + out.col(k)).norm());
       psi[k] = 0.5 * phi[k];
     }
