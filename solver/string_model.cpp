@@ -1697,7 +1697,7 @@ typename StringModel<dim>::SnapResult StringModel<dim>::snap(double t) {
     for (int j : caught)
       if (rebounds_accumulate(j, t, e)) inelastic[static_cast<std::size_t>(j)] = 1;
   }
-  const SnapResult impulses = link_impulses(t, e, 0, inelastic.empty() ? nullptr : &inelastic);
+  const SnapResult impulses = link_impulses(t, e, 0, inelastic.empty() ? nullptr : &inelastic, true);
   result.dissipated = impulses.dissipated;
   result.support_work = impulses.support_work;
   result.support_impulse = impulses.support_impulse;
@@ -1742,7 +1742,8 @@ void StringModel<dim>::impact(double t, double e) {
 
 template <int dim>
 typename StringModel<dim>::SnapResult StringModel<dim>::link_impulses(double t, double e, double u_floor,
-                                                                      const std::vector<char>* inelastic) {
+                                                                      const std::vector<char>* inelastic,
+                                                                      bool rebounds) {
   SnapResult result;
   const int L = chain_.num_links();
   links();
@@ -1802,8 +1803,10 @@ typename StringModel<dim>::SnapResult StringModel<dim>::link_impulses(double t, 
       // is zero at a restart, and would miss the link's return to its length if it came at once.
       slack_offset_[static_cast<std::size_t>(j)] =
           std::max(0.0, (l_[j] - chain_.link_length(j)) / chain_.link_length(j)) + kSlackGap;
+      // A rebound of snap() is recorded for the accumulation rule; a link that separates at the start or
+      // at a landing begins a flight, not a rebound.
       if (static_cast<std::size_t>(j) < rebound_time_.size()) {
-        rebound_time_[static_cast<std::size_t>(j)] = t;
+        rebound_time_[static_cast<std::size_t>(j)] = rebounds ? t : NAN;
         rebound_speed_[static_cast<std::size_t>(j)] = -u_after;
       }
     }

@@ -481,12 +481,14 @@ class StringModel final : public OdeSystem {
   /// separate go slack (faster than kSeparation of the larger of their approach speed and u_floor);
   /// the dissipated energy, the supports' and obstacles' impulses and work.
   /// `inelastic`: per link, 1 where the snap takes e = 0 for that link (the accumulation rule, snap()).
-  SnapResult link_impulses(double t, double e, double u_floor = 0, const std::vector<char>* inelastic = nullptr);
+  SnapResult link_impulses(double t, double e, double u_floor = 0, const std::vector<char>* inelastic = nullptr,
+                           bool rebounds = false);
   /// The accumulation rule of snap() (docs/model.md §9, "Accumulating rebounds"): link j's snap is perfectly
   /// inelastic if it rebounded at its previous snap and the rebounds that would follow end within
-  /// kAccumulation · h_j / U (U: the state's speed scale).
+  /// kAccumulation · h_j / U (U: speed_scale(), the motion's scale at the start). Only snap() records
+  /// rebounds (link_impulses' `rebounds`): a link that separates at the start or at a landing begins a flight.
   bool rebounds_accumulate(int j, double t, double e) const;
-  /// The speed scale of the state: max(√(|g| ℓ), the fastest node) (ℓ if both are zero).
+  /// The speed scale of the motion: max(√(|g| ℓ), the fastest node of the initial state) (ℓ if both are zero).
   double speed_scale() const;
   /// Excludes the slack links from the assembled tension system (their T = 0).
   void exclude_slack_links();

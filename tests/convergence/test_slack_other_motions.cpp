@@ -329,7 +329,7 @@ TEST_CASE("slack: partly elastic snaps do not accumulate: the falling chain jerk
                 n, last.terms["snaps"], r.summary.stats.steps, last.terms["W_snap"],
                 r.summary.relative_energy_drift(), r.summary.relative_momentum_residual());
     CHECK(last.terms["snaps"] >= 1);
-    CHECK(last.terms["snaps"] <= 10 * n);
+    CHECK(last.terms["snaps"] <= (n == 41 ? 45 : 300));  // measured 14 and 94: 3 times those
     CHECK(last.terms["W_snap"] < -1);
     CHECK(r.summary.relative_energy_drift() < 1e-10);
     CHECK(r.summary.relative_momentum_residual() < 1e-10);

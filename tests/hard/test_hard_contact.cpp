@@ -257,7 +257,7 @@ TEST_CASE("hard contact: the Atwood pulley at loose tolerances ends in seconds, 
 TEST_CASE("hard contact: the Atwood pulley at loose tolerances with links along the arc completes", "[hard][contact]") {
   // effects.cylinder[0].contact = "arc" at rtol 1e-4 and 1e-2 (atol 1e-2): no landing across a bend, so the
   // run completes; its energy ledger closes to the accuracy asked for (measured 1.1e-5 and 6.9e-4, a
-  // fraction of rtol: a global error), as node contact's at rtol 1e-2 (1.04e-2).
+  // fraction of rtol: a global error; bounds 3 times those), where node contact's at rtol 1e-2 is 1.04e-2.
   const std::filesystem::path file = std::filesystem::path(CHAINSIM_SOURCE_DIR) / "cases" / "scenes" / "atwood_pulley.toml";
   for (const char* rtol : {"1e-4", "1e-2"}) {
     CAPTURE(rtol);
@@ -267,7 +267,7 @@ TEST_CASE("hard contact: the Atwood pulley at loose tolerances with links along 
     CHECK(r.seconds < CHAINSIM_WALL_FACTOR * 20);
     CHECK(r.finite);
     CHECK(r.status == "completed");
-    CHECK(r.drift < 3 * std::stod(rtol));
+    CHECK(r.drift < (std::string(rtol) == "1e-4" ? 3.3e-5 : 2.1e-3));
     CHECK(r.momentum < 1e-12);
   }
 }
