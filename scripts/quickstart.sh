@@ -77,7 +77,7 @@ elif [ "$job" = docs ]; then
   echo "== site (Doxygen XML, then Sphinx -W into build/site)"
   rm -rf build/doxygen && mkdir -p build/doxygen
   CHAINSIM_DOXYGEN_OUT=build/doxygen doxygen docs/Doxyfile
-  CHAINSIM_BUILD_DIR=build $py -m sphinx -b html -W --keep-going -q docs build/site
+  CHAINSIM_BUILD_DIR=build $py -m sphinx -b html -E -W --keep-going -q docs build/site
   echo "site     build/site/index.html"
   echo "== numbers quoted in the docs"
   $py scripts/check_doc_numbers.py --build build
