@@ -21,6 +21,7 @@
 
 #include "cases/scene/scene.hpp"
 #include "solver/string_solver.hpp"
+#include "slack_test_support.hpp"
 
 using namespace chainsim;
 
@@ -245,27 +246,7 @@ namespace {
 // heap goes slack; the falling part catches up with the top and snaps taut (at t = 0.189 s), and the heap's front
 // then sits at the top's height (the chain straight and vertical from the top down to the table), also while
 // the top rises again and draws the chain back out of the heap.
-const std::string kFallDriven = R"([string]
-length = 1.0
-density = 1.0
-nodes = 41
-[shape]
-kind = "polyline"
-points = [[0.0, 1.0], [0.0, 0.0]]
-[ends]
-start = { kind = "driven", path = "shake", amplitude = [0.0, -0.1], omega = 20.0 }
-[effects.gravity]
-g = [0.0, -9.81]
-[[effects.heap]]
-side = "end"
-s0 = 1.0
-f = 0.5
-point = [0.0, 0.0]
-on_plane = true
-[effects.plane]
-point = [0.0, 0.0]
-normal = [0.0, 1.0]
-[solver]
+const std::string kFallDriven = test::shaken_heap_scene(41) + R"([solver]
 slack = "allow"
 [output]
 interval = 0.04
