@@ -326,12 +326,18 @@ std::pair<double, double> FrontTracker<dim>::arm_corner(const StringModel<dim>& 
   const double along = tn > 0 ? predicted.dot(turn) / tn : 0.0;
   const double turn_deg = 2 * std::asin(std::min(1.0, 0.5 * tn)) * 180 / kPi;
   const double reaction_deg = 2 * std::asin(std::min(1.0, 0.5 * predicted.norm())) * 180 / kPi;
+  // The front's own turn, its speed and l⁻/h, and the tension of the arm's link (i − 1, i) from the last
+  // solve: the jump conditions ask τ⁻ = λ ṡ0² to match the arm's tension at the kink (docs/model.md §9).
+  const double front_turn_deg = 180 - fs_[k].opening * 180 / kPi;
+  const double arm_tension = i >= 1 ? model.link_tension(i - 1) : 0.0;
   if (trace_)
     std::fprintf(stderr, "%s\n",
                  fmt::format("arm_corner when={} t={:.9g} node={} turn_deg={:.6g} reaction_turn_deg={:.6g} "
-                             "reaction_along_deg={:.6g} reaction_N={:.6e} tau={:.6e} turn_prev_deg={:.6g}",
+                             "reaction_along_deg={:.6g} reaction_N={:.6e} tau={:.6e} turn_prev_deg={:.6g} "
+                             "front_turn_deg={:.6g} s0_dot={:.6g} l_minus_h={:.6g} arm_tension={:.6e}",
                              when, t, i, turn_deg, reaction_deg, 2 * std::asin(std::clamp(0.5 * along, -1.0, 1.0)) * 180 / kPi,
-                             F.norm(), tau, prev_deg)
+                             F.norm(), tau, prev_deg, front_turn_deg, fs_[k].s0_dot, fs_[k].l_minus / material_.h,
+                             arm_tension)
                      .c_str());
   return {turn_deg, reaction_deg};
 }

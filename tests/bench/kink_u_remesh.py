@@ -10,7 +10,8 @@ a-1, a, b, b+1 before it) and prints
   2. the arm-side velocity jump |v_a - v_(a-1)| at the crossings (median, in the windows): a smooth arm has
      h |dv/ds|, O(h);
   3. the arm's corner at the crossings: its turn at a-1 and a-2 before, at the new a-1 and a-2 after (the
-     `arm_corner` lines), and the turn the kink constraint's reaction on a-1 would make against tau-;
+     `arm_corner` lines), and the turn the kink constraint's reaction on a-1 would make against tau-; and the
+     front itself before and after: its own turn, its speed, tau- = lambda s0_dot^2 against the arm's tension;
   4. the state at the --times: the largest and the RMS distance between the same material points on
      successive meshes (the coarser mesh's nodes, every other node of the finer), where the largest sits, and K.
 
@@ -127,6 +128,23 @@ def main():
             cells.append(f"[{a:g}, {b:g}): {med(bf, 'turn_deg'):.2f}, {med(bf, 'turn_prev_deg'):.2f} | "
                          f"{med(af, 'turn_deg'):.2f}, {med(af, 'turn_prev_deg'):.2f} | "
                          f"{max(r['reaction_turn_deg'] for r in bf):.1e}")
+        print(f"{n} | " + " || ".join(cells))
+
+    print("\nthe front at the crossings (medians): its own turn (deg), its speed |s0_dot| (m/s), tau- = lambda s0_dot^2 "
+          "and the tension of the arm's link (a-2, a-1) from the last solve (N), before the crossing | after it "
+          "(projection done): N | window: turn, |s0_dot|, tau-, arm T | the same after")
+    for n, (events, _, _) in zip(args.nodes, runs):
+        cells = []
+        for a, b in [(0.4, 0.6), (0.6, 0.7), (0.7, 0.8)]:
+            bf = [e for e in events if e["kind"] == "corner_before" and a <= e["t"] < b and "front_turn_deg" in e]
+            af = [e for e in events if e["kind"] == "corner_after" and a <= e["t"] < b and "front_turn_deg" in e]
+            if not bf or not af:
+                cells.append("-")
+                continue
+            med = lambda rows, k: np.median([abs(r[k]) for r in rows])  # noqa: E731
+            cells.append(f"[{a:g}, {b:g}): " + " | ".join(
+                f"{med(rows, 'front_turn_deg'):.1f}, {med(rows, 's0_dot'):.2f}, {med(rows, 'tau'):.3f}, "
+                f"{med(rows, 'arm_tension'):.3f}" for rows in (bf, af)))
         print(f"{n} | " + " || ".join(cells))
 
     print("\nstate at t: t | meshes | max (m) at s (m) | RMS (m) | K coarse / fine (mJ)")
