@@ -198,11 +198,13 @@ typename TouchdownFront<dim>::Margins TouchdownFront<dim>::margins(const StringM
       m.low_node = i;
     }
   }
-  if (this->dissipation > 0) {
-    // ṡ0 per the speed of the split link's ends (a take-off: the material leaves the plane).
-    const double speed = std::max((model.v().col(B.first) - model.v().col(B.first - 1)).norm(), 1e-300);
-    m.take_off = std::min(1.0, s.s0_dot / speed + 1e-9);
-  }
+  // The plane's push at the front, N = n·(the front's reaction, the constraint's share included), per the
+  // scale λ |[v]|² of the jump conditions' forces, less 10⁻⁶ of it (N = 0 for f = 0): a take-off with f > 0
+  // (N = −f λ ṡ0² sin θ) and a front whose compatibility would need a pull both stop the run.
+  const Vec<dim> jump_v = model.v().col(B.first) - model.v().col(B.first - 1);
+  const double scale = this->m_.lambda * jump_v.squaredNorm();
+  const double push = normal_.dot(recorded_reaction(model, s));
+  m.take_off = scale > 0 ? std::min(1.0, push / scale + 1e-6) : 1.0;
   return m;
 }
 
@@ -218,10 +220,11 @@ std::string TouchdownFront<dim>::check_failed(const StringModel<dim>& model, con
   const double least = std::min({m.angle, m.height, m.take_off});
   if (least == m.take_off)
     return fmt::format(
-        "lifted off {} at t = {:.9g} s: material starts to leave the plane at the touchdown front (s0 = {:.9g} m, "
-        "ds0/dt = {:.4g} m/s, the arc at {:.4g} deg), and a take-off front with f = {:g} > 0 would need the plane to "
-        "pull (N = -f lambda ds0/dt^2 sin theta): a string peels off a smooth plane without dissipation (f = 0)",
-        surface_, t, s.s0, s.s0_dot, theta_ * 180 / kPi, this->dissipation);
+        "lifted off {} at t = {:.9g} s: the plane would have to pull the string at the touchdown front (its reaction "
+        "N = {:.6g} N; s0 = {:.9g} m, ds0/dt = {:.4g} m/s, the arc at {:.4g} deg, f = {:g}): a take-off with f > 0 "
+        "needs N = -f lambda ds0/dt^2 sin theta < 0 (a string peels off a smooth plane only without dissipation, f = 0), "
+        "and a lying part whose own motion disagrees with the arc's end needs a pull to stay taut (docs/model.md §10)",
+        surface_, t, normal_.dot(recorded_reaction(model, s)), s.s0, s.s0_dot, theta_ * 180 / kPi, this->dissipation);
   if (least == m.height)
     return fmt::format(
         "node {} of the arc reaches {} at t = {:.9g} s away from its touchdown front (s0 = {:.9g} m): a string that "

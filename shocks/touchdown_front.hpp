@@ -19,7 +19,9 @@
 /// the loads and the material moved from b to a change, is normal to the plane) and work at exactly
 /// W_s = −½ f λ |ṡ0| |[v]|². The reaction N n, N = f λ ṡ0 |ṡ0| sin θ on the compatible state, is
 /// what forces.csv shows. A take-off with f > 0 (ṡ0 < 0) would need the plane to pull: the front's
-/// check stops the run there (a lift-off event); f = 0 peels off without a reaction.
+/// check stops the run there (a lift-off event); f = 0 peels off without a reaction. The split link's
+/// material is held by a constraint (the partial link continues the arc's first link to the plane),
+/// whose multiplier adds a normal force at the front where the two sides' motions disagree.
 /// Crossings are the split link's (SplitLinkFront): a node of B that reaches x0 (landing) joins A with
 /// A's velocity and is put on the plane, where the contact module holds it.
 #include <string>
@@ -65,7 +67,8 @@ class TouchdownFront final : public SplitLinkFront<dim> {
   void crossings(const StringModel<dim>& model, const FrontState<dim>& state, double* g) const override;
   EventAction cross(StringModel<dim>& model, const FrontState<dim>& state, int e0) override;
   /// One: positive while the arc meets the plane at more than kMinAngleDeg, no other node of the arc
-  /// reaches the plane, and (f > 0) material lands (ṡ0 ≥ 0).
+  /// reaches the plane, and the plane pushes at the front (its reaction's normal component).
+  bool checks_need_tensions() const override { return true; }
   int num_checks() const override { return 1; }
   void checks(const StringModel<dim>& model, const FrontState<dim>& state, double* g) const override;
   std::string check_failed(const StringModel<dim>& model, const FrontState<dim>& state, double t) const override;
