@@ -11,7 +11,8 @@
 ///   - its share of the ledgers: the material it holds outside the arcs (`held_mass`, its first
 ///     moment), and the potential energy of its partial links (`potential_moment`).
 /// Implementations: HeapFront (heap_front.hpp), FoldFront (fold_front.hpp), KinkFront (kink_front.hpp; the
-/// fold and the kink share SplitLinkFront, split_link_front.hpp), EdgeFront (edge_front.hpp).
+/// fold, the kink and the touchdown share SplitLinkFront, split_link_front.hpp), EdgeFront (edge_front.hpp),
+/// TouchdownFront (touchdown_front.hpp).
 #include <algorithm>
 #include <cmath>
 #include <optional>
