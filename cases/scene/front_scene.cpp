@@ -198,6 +198,12 @@ std::unique_ptr<StringModel<dim>> build_front_model(const SceneSpec& spec, scene
     fail_at(spec, "solver.kinks",
             "solver.kinks = \"insert\" on a closed string: kink fronts are tracked on open strings only (string.closed = "
             "true); allowed: \"off\"");
+  for (std::size_t k = 0; k < fx.surfaces.size() && chain.closed(); ++k)
+    if (fx.surfaces[k].f)
+      fail_at(spec, fmt::format("effects.surface[{}].f", k),
+              fmt::format("effects.surface[{}].f = {} on a closed string: a touchdown front is tracked on open strings "
+                          "only (string.closed = true); leave out f (node contact) or open the string",
+                          k, text_of(spec, fmt::format("effects.surface[{}].f", k))));
   check_open_string(chain.closed(), !fx.heaps.empty(), keys);
   if (chain.num_links() < 2) {
     const std::string key = spec.link_length ? "string.link_length" : "string.nodes";

@@ -126,6 +126,10 @@ TEST_CASE("touchdown front: the scene refuses what is not built", "[touchdown]")
   std::string lifted = base;
   lifted.replace(lifted.find("point = [0.0, 0.0]\nnormal"), 18, "point = [0.0, -0.1]");
   CHECK(refused(lifted, "from the surface"));
+  CHECK(refused("model = \"string\"\n[string]\ndensity = 1.0\nnodes = 40\n[shape]\nkind = \"circle\"\nradius = 0.2\n"
+                "center = [0.0, 0.2]\n[[effects.surface]]\npoint = [0.0, 0.0]\nnormal = [0.0, 1.0]\nf = 0.5\n[stop]\n"
+                "t_end = 0.1\n",
+                "closed string"));
   CHECK_THROWS_AS(build_string_scene<3>(parse_scene_text(
                       "model = \"string\"\n[string]\ndimension = 3\ndensity = 1.0\nnodes = 20\n[shape]\nkind = "
                       "\"polyline\"\npoints = [[-0.5, 0.0, 0.0], [0.0, 0.0, 0.0], [0.25, 0.4330127018922193, "
