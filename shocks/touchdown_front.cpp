@@ -106,7 +106,7 @@ void TouchdownFront<dim>::evaluate(const StringModel<dim>& model, FrontState<dim
   // The front's reaction: what the loads and the material moved from b to a change in the lumped
   // momentum (normal to the plane by τ⁻'s choice); the constraint's share is added where it is known.
   s.reaction = tau_m * e - tau_p * g.t + lambda * sd * (v.col(a) - v.col(b));
-  s.power_shock = t_jump != 0 || sd == 0 ? -jump::dissipation_rate(f, lambda, sd, jump2) : 0.0;
+  s.power_shock = -jump::dissipation_rate(f, lambda, sd, jump2);
   // The reaction's work on node a's drift off the plane (zero on the plane): the loads' power is W_s plus
   // this, exactly.
   s.power_heap = s.reaction.dot(normal_) * normal_.dot(v.col(a));
@@ -120,7 +120,6 @@ void TouchdownFront<dim>::constraints(const StringModel<dim>& model, const Front
   // link's angle to the plane). Its gradient on a is along e (a held node moves along the plane).
   const Geometry g = geometry(model);
   const Points<dim>& x = model.x();
-  const Points<dim>& v = model.v();
   const Vec<dim>& e = along_;
   const Vec<dim>& n = normal_;
   const double T = g.tan_half, T1 = 1 / (1 + g.cos);  // tan(θ/2) and its derivative in θ
@@ -132,7 +131,6 @@ void TouchdownFront<dim>::constraints(const StringModel<dim>& model, const Front
   c.gradient.col(2) = g.y * T1 * g.t_perp / g.L;
   c.value = (x.col(g.b) - x.col(g.a)).dot(e) + g.y * T - this->m_.h;
   // C̈ at zero accelerations: 2 ẏ T' θ̇ + y (T' T θ̇² + T' θ̈0), θ̈0 = −2 θ̇ (t·w)/L.
-  (void)v;
   c.curvature = 2 * g.y_dot * T1 * g.theta_dot +
                 g.y * (T1 * T * g.theta_dot * g.theta_dot - 2 * T1 * g.theta_dot * g.t_w / g.L);
   out.push_back(std::move(c));

@@ -7,21 +7,23 @@
 /// The string before the front (s < s0, arc A) lies on the plane, held there node by node by the
 /// contact module (the surface holds arc A's nodes only: Obstacle::carries, touchdown_surface); the
 /// string after it (arc B) is free. The split link (a, b) between A's last node and B's first node
-/// holds the front: its material runs along the plane from x_a to x0 = x_a + l⁻ e and straight from x0
-/// to x_b, l⁻ + l⁺ = h, which places x0 (u = x_b − x_a, p = u·e):
-///     l⁻ = (h² − |u|²) / (2 (h − p)),   t⁺ = (x_b − x0)/l⁺,   cos θ = t⁺·e,
-///     ṡ0 = dl⁻/dt = −t⁺·(v_b − v_a) / (1 − cos θ)
-/// (e the plane's direction along arc A, towards larger s). With [v] = v_b − v_a, the front loads
-///     node b:  −τ⁺ t⁺,   τ⁺ = (1 − f sgn ṡ0) λ |[v]|² / (2 (1 − cos θ))
-///     node a:  τ⁻ e,      τ⁻ = λ ṡ0 [v]·e + τ⁺ cos θ
+/// holds the front: its material runs along the plane from x_a to x0 and on from x0 to x_b along arc B's
+/// first link (b, c), of direction t at the angle θ to the plane (e the plane's direction along arc A,
+/// towards larger s; n its outward normal; y_b the height of b):
+///     l⁺ = y_b / sin θ,   l⁻ = h − l⁺,   x0 = x_b − l⁺ t,   ṡ0 = −dl⁺/dt,
+/// and a constraint keeps the material, C = (x_b − x_a)·e + y_b tan(θ/2) − h = 0 (its gradient on the
+/// held node a along e; its net force μ tan(θ/2) n, booked with the front's reaction). With
+/// [v] = v_b − v_a the front loads
+///     node b:  −τ⁺ t,   τ⁺ = (1 − f sgn ṡ0) λ ṡ0 |[v]|² / (2 (−t·[v]))
+///     node a:  τ⁻ e,    τ⁻ = λ ṡ0 [v]·e + τ⁺ cos θ
 /// (τ⁺ = (1 − f sgn ṡ0) λ ṡ0², τ⁻ = λ ṡ0² (1 − f sgn ṡ0 cos θ) where the two sides are compatible,
-/// [v] = −ṡ0 [t]) keep the lumped momentum along the plane exact (the front's reaction, the momentum
-/// the loads and the material moved from b to a change, is normal to the plane) and work at exactly
-/// W_s = −½ f λ |ṡ0| |[v]|². The reaction N n, N = f λ ṡ0 |ṡ0| sin θ on the compatible state, is
-/// what forces.csv shows. A take-off with f > 0 (ṡ0 < 0) would need the plane to pull: the front's
-/// check stops the run there (a lift-off event); f = 0 peels off without a reaction. The split link's
-/// material is held by a constraint (the partial link continues the arc's first link to the plane),
-/// whose multiplier adds a normal force at the front where the two sides' motions disagree.
+/// [v] = −ṡ0 [t]), which keep the lumped momentum along the plane exact (the front's reaction, the
+/// momentum the loads and the material moved from b to a change, is normal to the plane) and work at
+/// exactly W_s = −½ f λ |ṡ0| |[v]|². The reaction N n, N = f λ ṡ0 |ṡ0| sin θ on the compatible state
+/// (the constraint's share zero there), is what forces.csv shows. A take-off with f > 0 (ṡ0 < 0) would
+/// need the plane to pull, and so would a lying part whose motion disagrees with the arc's end (the
+/// constraint's multiplier): the front's check stops the run where its reaction reaches zero (a
+/// lift-off event); f = 0 peels off without a reaction.
 /// Crossings are the split link's (SplitLinkFront): a node of B that reaches x0 (landing) joins A with
 /// A's velocity and is put on the plane, where the contact module holds it.
 #include <string>
@@ -47,8 +49,8 @@ class TouchdownFront final : public SplitLinkFront<dim> {
   /// The run stops when the arc meets the plane at less than this angle (its front is then a
   /// tangential touchdown, no shock, whose position the split link no longer resolves).
   static constexpr double kMinAngleDeg = 5;
-  /// A node of the arc joins the lying arc when it comes this close to x0 (in links): t⁺ = (x_b − x0)/l⁺
-  /// loses its digits as l⁺ → 0 (the positions' integration error over l⁺).
+  /// A node of the arc joins the lying arc when it comes this close to x0 (in links), so that the
+  /// lying arc's l⁻ starts just above zero after the crossing (as an edge's kCross).
   static constexpr double kCross = 1e-8;
 
   explicit TouchdownFront(const TouchdownSpec<dim>& spec);
