@@ -11,7 +11,8 @@
 ///   - its share of the ledgers: the material it holds outside the arcs (`held_mass`, its first
 ///     moment), and the potential energy of its partial links (`potential_moment`).
 /// Implementations: HeapFront (heap_front.hpp), FoldFront (fold_front.hpp), KinkFront (kink_front.hpp; the
-/// fold and the kink share SplitLinkFront, split_link_front.hpp), EdgeFront (edge_front.hpp).
+/// fold, the kink and the touchdown share SplitLinkFront, split_link_front.hpp), EdgeFront (edge_front.hpp),
+/// TouchdownFront (touchdown_front.hpp).
 #include <algorithm>
 #include <cmath>
 #include <optional>
@@ -164,6 +165,10 @@ class FrontKind {
   /// compatibility), at the string's current state, after `evaluate`.
   virtual void constraints(const StringModel<dim>& /*model*/, const FrontState<dim>& /*state*/,
                            std::vector<NodeConstraint<dim>>& /*out*/) const {}
+  /// The net force of the front's constraints on the string at their current multipliers (after the
+  /// tension solve): zero for constraints that only couple nodes (a kink's); the momentum ledger books it.
+  virtual Vec<dim> constraint_force(const StringModel<dim>& /*model*/) const { return Vec<dim>::Zero(); }
+  virtual bool has_constraint_force() const { return false; }
   /// Root functions of the front's own that stop the run (positive while it may go on).
   virtual int num_checks() const { return 0; }
   virtual void checks(const StringModel<dim>& /*model*/, const FrontState<dim>& /*state*/, double* /*g*/) const {}

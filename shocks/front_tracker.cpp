@@ -183,6 +183,7 @@ void FrontTracker<dim>::ledger_rates(const StringModel<dim>& model, Eigen::Ref<E
     w_shocks += s.power_shock;
     w_heaps += s.power_heap;
     external += s.reaction;
+    if (fronts_[k]->has_constraint_force()) external += fronts_[k]->constraint_force(model);
     fronts_[k]->add_held_moment_rate(s, heap_moment_rate);
   }
   rates[0] = w_shocks;

@@ -18,6 +18,7 @@
 #include "cases/scene/scene_front_keys.hpp"
 #include "mesh/errors.hpp"
 #include "solver/output.hpp"
+#include "shocks/touchdown_front.hpp"
 #include "solver/string_solver.hpp"
 
 namespace chainsim {
@@ -90,6 +91,9 @@ template <int dim>
 std::string fit_key_of(const SceneSpec& spec, const std::optional<FoldSpec>& fold, const std::vector<HeapSpec<dim>>& heaps) {
   if (!heaps.empty()) return "effects.heap[0]";
   if (fold) return "effects.fold.s0";
+  for (std::size_t k = 0; k < spec.effects.surfaces.size(); ++k)
+    if (spec.effects.surfaces[k].f && spec.effects.edges.empty() && spec.effects.kinks.empty())
+      return fmt::format("effects.surface[{}].f", k);
   if (spec.effects.edges.empty() && !spec.effects.kinks.empty()) return "effects.kink[0].s0";
   return spec.effects.edges.empty() ? "effects.fold" : "effects.edge[0]";
 }
@@ -194,6 +198,12 @@ std::unique_ptr<StringModel<dim>> build_front_model(const SceneSpec& spec, scene
     fail_at(spec, "solver.kinks",
             "solver.kinks = \"insert\" on a closed string: kink fronts are tracked on open strings only (string.closed = "
             "true); allowed: \"off\"");
+  for (std::size_t k = 0; k < fx.surfaces.size() && chain.closed(); ++k)
+    if (fx.surfaces[k].f)
+      fail_at(spec, fmt::format("effects.surface[{}].f", k),
+              fmt::format("effects.surface[{}].f = {} on a closed string: a touchdown front is tracked on open strings "
+                          "only (string.closed = true); leave out f (node contact) or open the string",
+                          k, text_of(spec, fmt::format("effects.surface[{}].f", k))));
   check_open_string(chain.closed(), !fx.heaps.empty(), keys);
   if (chain.num_links() < 2) {
     const std::string key = spec.link_length ? "string.link_length" : "string.nodes";
@@ -474,6 +484,65 @@ std::unique_ptr<StringModel<dim>> build_front_model(const SceneSpec& spec, scene
                                 key, text_of(spec, key + ".direction"), side, show<dim>(tangent)));
     }
 
+  // 4d. Touchdown fronts ([[effects.surface]] with f): where the initial shape leaves the surface.
+  std::vector<std::pair<std::size_t, TouchdownSpec<dim>>> touchdowns;
+  for (std::size_t k = 0; k < fx.surfaces.size(); ++k) {
+    if (!fx.surfaces[k].f) continue;
+    const std::string key = fmt::format("effects.surface[{}]", k);
+    if constexpr (dim == 3)
+      fail_at(spec, key + ".f",
+              fmt::format("{}.f = {}: a touchdown front is built in 2D only (string.dimension = 2); in 3D leave out f "
+                          "(node contact lands the string, f = 1 in the limit)",
+                          key, text_of(spec, key + ".f")));
+    if (!fx.heaps.empty() || fx.fold || !fx.edges.empty() || !fx.kinks.empty() || spec.solver.kinks == "insert" ||
+        !touchdowns.empty() || !fx.cylinders.empty())
+      fail_at(spec, key + ".f",
+              fmt::format("{}.f = {}: a touchdown front is supported as the scene's only front and obstacle besides "
+                          "unbounded surfaces without f (no heap, fold, edge, kink, cylinder or second surface with f)",
+                          key, text_of(spec, key + ".f")));
+    TouchdownSpec<dim> td;
+    td.point = as_vec<dim>(spec, fx.surfaces[k].point, key + ".point");
+    td.normal = as_vec<dim>(spec, fx.surfaces[k].normal, key + ".normal").stableNormalized();
+    td.dissipation = *fx.surfaces[k].f;
+    td.name = key;
+    const double h = chain.link_length(0), tol = 1e-11 * ell;
+    auto height = [&](double s) { return td.normal.dot(parts.curve->point(s) - td.point); };
+    if (!(std::abs(height(0)) <= tol))
+      fail_at(spec, key + ".f",
+              fmt::format("{}.f = {}: the string's start (s = 0) is {:.6g} m from the surface; a touchdown front needs "
+                          "the string lying on the surface from its start (s = 0) to where it leaves it: list the "
+                          "shape from its lying end",
+                          key, text_of(spec, key + ".f"), height(0)));
+    const int samples = std::max(4000, 40 * chain.num_links());
+    int first_off = -1;
+    for (int i = 1; i <= samples && first_off < 0; ++i)
+      if (!(std::abs(height(ell * i / samples)) <= tol)) first_off = i;
+    if (first_off < 0)
+      fail_at(spec, key + ".f",
+              fmt::format("{}.f = {}: the whole string lies on the surface: a touchdown front needs a string that "
+                          "leaves it",
+                          key, text_of(spec, key + ".f")));
+    double lo = ell * (first_off - 1) / samples, hi = ell * first_off / samples;
+    for (int it = 0; it < 200 && hi - lo > 1e-15 * ell; ++it) {
+      const double mid = 0.5 * (lo + hi);
+      (std::abs(height(mid)) <= tol ? lo : hi) = mid;
+    }
+    td.s0 = lo;
+    const double frac = td.s0 / h - std::floor(td.s0 / h);
+    if (std::min(frac, 1 - frac) < 1e-6)
+      fail_at(spec, key + ".f",
+              fmt::format("{}.f = {}: the shape leaves the surface at s = {:.9g} m, on node {} of the string: the "
+                          "touchdown front needs that point inside a link; change string.nodes or the shape",
+                          key, text_of(spec, key + ".f"), td.s0, static_cast<long>(std::lround(td.s0 / h))));
+    for (int i = 0; i < chain.num_nodes(); ++i)
+      if (chain.node_coordinate(i) > td.s0 && !(td.normal.dot(chain.positions().col(i) - td.point) > tol))
+        fail_at(spec, key + ".f",
+                fmt::format("{}.f = {}: node {} (s = {:g} m) is on or below the surface after the string leaves it at "
+                            "s = {:.9g} m: a touchdown front needs the string above the surface past its front",
+                            key, text_of(spec, key + ".f"), i, chain.node_coordinate(i), td.s0));
+    touchdowns.emplace_back(k, td);
+  }
+
   // 5. Stop events: a front reaching a material coordinate inside the string.
   const std::vector<std::string> names = scene_build::front_names(spec);
   const std::vector<int> stop_fronts = scene_build::front_stop_indices(spec);
@@ -489,6 +558,10 @@ std::unique_ptr<StringModel<dim>> build_front_model(const SceneSpec& spec, scene
                            : name == "heap_start"       ? s_lo
                            : name == "heap_end"         ? s_hi
                            : name == "kink_formed"      ? std::numeric_limits<double>::quiet_NaN()
+                           : name.rfind("touchdown", 0) == 0
+                               ? std::find_if(touchdowns.begin(), touchdowns.end(),
+                                              [&](const auto& p) { return name == fmt::format("touchdown{}", p.first); })
+                                     ->second.s0
                            : name.rfind("kink", 0) == 0 ? kinks[std::stoul(name.substr(4))].s0
                                                         : edges[std::stoul(name.substr(4))].s0;
     if (std::abs(s - s_start) <= kPlaceTolerance * ell)
@@ -521,6 +594,12 @@ std::unique_ptr<StringModel<dim>> build_front_model(const SceneSpec& spec, scene
         all.emplace_back(std::move(edge), names[n++]);
       }
       for (const KinkSpec& kink : kinks) all.emplace_back(std::make_unique<KinkFront<dim>>(kink), names[n++]);
+      std::vector<const TouchdownFront<dim>*> touchdown_fronts;  // held by the tracker
+      for (const auto& [k, td] : touchdowns) {
+        auto front = std::make_unique<TouchdownFront<dim>>(td);
+        touchdown_fronts.push_back(front.get());
+        all.emplace_back(std::move(front), names[n++]);
+      }
       std::stable_sort(all.begin(), all.end(),
                        [](const auto& p, const auto& q) { return p.first->expected_s0 < q.first->expected_s0; });
       for (auto& [kind, name] : all) {
@@ -545,6 +624,8 @@ std::unique_ptr<StringModel<dim>> build_front_model(const SceneSpec& spec, scene
                             o.name);
         o.mu = mu;
       }
+      for (std::size_t q = 0; q < touchdowns.size(); ++q)  // a surface with f holds the lying arc only
+        touchdown_surface<dim>(*touchdown_fronts[q], obstacles[touchdowns[q].first]);
       return std::make_unique<StringModel<dim>>(
           std::move(parts.chain), std::move(parts.forces), std::move(parts.prescribed), mo,
           make_contact_module<dim>(std::move(obstacles),
@@ -608,6 +689,11 @@ std::unique_ptr<StringModel<dim>> build_front_model(const SceneSpec& spec, scene
       if constexpr (dim == 3) f["direction"] = to_array<dim>(edges[e].axis);
     } else if (name == "fold") {
       f["s0"] = fold->s0;
+    } else if (name.rfind("touchdown", 0) == 0) {
+      const auto& td = *std::find_if(touchdowns.begin(), touchdowns.end(),
+                                     [&](const auto& p) { return name == fmt::format("touchdown{}", p.first); });
+      f["s0"] = td.second.s0;
+      f["surface"] = td.first;
     } else if (name == "kink_formed") {  // not in the string until a kink forms
       f["inserted"] = true;
       f["s0"] = kinks.back().s0;  // ℓ: the list is in order of s until it forms

@@ -67,10 +67,10 @@ double friction_coefficient(const Section& e) { return e.number_in("mu", 0.0, 0.
 void parse_obstacles(const Section& effects, Context& ctx) {
   const auto surfaces = table_array(effects, "surface", "surface");
   for (std::size_t k = 0; k < surfaces.size(); ++k) {
-    Section e(*surfaces[k], fmt::format("effects.surface[{}]", k), ctx, {"point", "normal", "mu", "edge"});
+    Section e(*surfaces[k], fmt::format("effects.surface[{}]", k), ctx, {"point", "normal", "mu", "edge", "f"});
     if (!e.has("point")) e.missing("point", "m, a point of the plane");
     if (!e.has("normal")) e.missing("normal", "a vector normal to the plane (any length > 0), pointing to the side the string is on");
-    SurfaceEntry surface{e.vector("point"), e.vector("normal"), friction_coefficient(e), std::nullopt};
+    SurfaceEntry surface{e.vector("point"), e.vector("normal"), friction_coefficient(e), std::nullopt, std::nullopt};
     if (e.has("edge")) {
       const long long edges = static_cast<long long>(ctx.spec.effects.edges.size());
       if (edges == 0)
@@ -83,6 +83,18 @@ void parse_obstacles(const Section& effects, Context& ctx) {
           e.fail("edge", fmt::format("{} = {}: effects.surface[{}] already ends at effects.edge[{}]; allowed one "
                                      "table per edge",
                                      e.full("edge"), *surface.edge, j, *surface.edge));
+    }
+    if (e.has("f")) {
+      // A touchdown front where the string leaves the surface (docs/model.md §10): smooth, unbounded.
+      surface.f = e.number_in("f", 0.0, 0.0, 1.0);
+      if (surface.edge)
+        e.fail("f", fmt::format("{} = {} with {}.edge: a touchdown front on a table bounded by its edge is not "
+                                "supported; allowed f on an unbounded surface (no edge)",
+                                e.full("f"), e.text("f"), fmt::format("effects.surface[{}]", k)));
+      if (surface.mu > 0)
+        e.fail("f", fmt::format("{} = {} with mu = {}: a touchdown front with Coulomb friction is not built; "
+                                "allowed f on a smooth surface (mu = 0 or absent)",
+                                e.full("f"), e.text("f"), surface.mu));
     }
     ctx.spec.effects.surfaces.push_back(surface);
   }

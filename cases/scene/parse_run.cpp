@@ -125,12 +125,15 @@ void parse_stop(const Section& top, Context& ctx) {
   const auto tables = table_array(s, "front", "stop event");
   for (std::size_t k = 0; k < tables.size(); ++k) {
     Section f(*tables[k], fmt::format("stop.front[{}]", k), ctx, {"front", "s0"});
-    if (!f.has("front")) f.missing("front", "which front: fold, heap_start, heap_end or edge<k> (an [[effects.edge]])");
+    if (!f.has("front")) f.missing("front", "which front: fold, heap_start, heap_end, edge<k> (an [[effects.edge]]) or touchdown<k> (an [[effects.surface]] with f)");
     if (!f.has("s0")) f.missing("s0", "m, stop when that front reaches this material coordinate");
     // Edges and pegs are fronts that move along the material too: "edge<k>", k the index of an [[effects.edge]]
     // (parsed before [stop]), as the fronts are named in the run's summary.
     std::vector<std::string> fronts = {"fold", "heap_start", "heap_end"};
     for (std::size_t e = 0; e < ctx.spec.effects.edges.size(); ++e) fronts.push_back(fmt::format("edge{}", e));
+    // A touchdown front: "touchdown<k>", k the index of its [[effects.surface]] (with f).
+    for (std::size_t e = 0; e < ctx.spec.effects.surfaces.size(); ++e)
+      if (ctx.spec.effects.surfaces[e].f) fronts.push_back(fmt::format("touchdown{}", e));
     ctx.spec.stop.fronts.push_back({f.choice("front", fronts, ""), *f.number("s0")});
   }
 }

@@ -36,6 +36,7 @@
 /// A scene with a heap or a fold runs on FrontModel (cases/scene/front_scene.hpp); one without runs on
 /// StringModel; model = "reduced" runs the reduced ODE of the canonical problem the scene is
 /// (cases/scene/reduced_scene.hpp).
+#include <algorithm>
 #include <filesystem>
 #include <map>
 #include <memory>
@@ -108,6 +109,8 @@ struct SurfaceEntry {
   double mu = 0;               ///< Coulomb's coefficient of friction (≥ 0; 0: smooth)
   /// The [[effects.edge]] (its index) the surface ends at: a table bounded by its edge.
   std::optional<long long> edge;
+  /// f of a touchdown front where the string leaves the surface (docs/model.md §10); absent: node contact.
+  std::optional<double> f;
 };
 
 /// A rigid smooth cylinder (a circle in 2D): a pulley, a peg with a radius: [[effects.cylinder]].
@@ -197,7 +200,8 @@ struct SceneSpec {
   bool has_fronts() const { return has_fronts_declared() || solver.kinks == "insert"; }
   /// A front declared among the effects (not only a kink that may form).
   bool has_fronts_declared() const {
-    return !effects.heaps.empty() || effects.fold.has_value() || !effects.edges.empty() || !effects.kinks.empty();
+    return !effects.heaps.empty() || effects.fold.has_value() || !effects.edges.empty() || !effects.kinks.empty() ||
+           std::any_of(effects.surfaces.begin(), effects.surfaces.end(), [](const SurfaceEntry& e) { return e.f.has_value(); });
   }
   // [solver]
   struct Solver {

@@ -106,6 +106,7 @@ json effects_json(const SceneSpec::Effects& fx) {
     for (const SurfaceEntry& e : fx.surfaces) {
       j["surface"].push_back({{"point", e.point}, {"normal", e.normal}});
       if (e.edge) j["surface"].back()["edge"] = *e.edge;
+      if (e.f) j["surface"].back()["f"] = *e.f;
     }
   }
   if (!fx.cylinders.empty()) {

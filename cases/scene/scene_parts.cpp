@@ -345,6 +345,8 @@ std::vector<std::string> front_names(const SceneSpec& spec) {
   for (std::size_t k = 0; k < spec.effects.edges.size(); ++k) names.push_back(fmt::format("edge{}", k));
   for (std::size_t k = 0; k < spec.effects.kinks.size(); ++k) names.push_back(fmt::format("kink{}", k));
   if (spec.solver.kinks == "insert") names.push_back("kink_formed");  // not in the string until it forms
+  for (std::size_t k = 0; k < spec.effects.surfaces.size(); ++k)
+    if (spec.effects.surfaces[k].f) names.push_back(fmt::format("touchdown{}", k));  // k: the surface's index
   return names;
 }
 
@@ -355,7 +357,8 @@ std::vector<int> front_stop_indices(const SceneSpec& spec) {
     const std::string& front = spec.stop.fronts[k].front;
     const auto it = std::find(names.begin(), names.end(), front);
     if (it == names.end()) {
-      const std::string what = front == "fold" ? "fold ([effects.fold])"
+      const std::string what = front == "fold"                      ? "fold ([effects.fold])"
+                               : front.rfind("touchdown", 0) == 0 ? fmt::format("touchdown front ([[effects.surface]] {} with f)", front.substr(9))
                                                : fmt::format("heap on side \"{}\"", front.substr(5));
       fail_at(spec, fmt::format("stop.front[{}].front", k),
               fmt::format("stop.front[{}].front = \"{}\" but the scene has no {}; {}", k, front, what,

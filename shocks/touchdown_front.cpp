@@ -1,0 +1,265 @@
+// A touchdown front: see touchdown_front.hpp (the scheme) and docs/model.md §10 (the physics).
+#include "touchdown_front.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include <fmt/format.h>
+
+#include "mesh/errors.hpp"
+#include "shocks/jump_conditions.hpp"
+
+namespace chainsim {
+
+template <int dim>
+TouchdownFront<dim>::TouchdownFront(const TouchdownSpec<dim>& spec)
+    : point_(spec.point), normal_(spec.normal.normalized()), surface_(spec.name) {
+  this->dissipation = spec.dissipation;
+  this->expected_s0 = spec.s0;
+}
+
+template <int dim>
+void TouchdownFront<dim>::cut(FrontLayout& layout) {
+  SplitLinkFront<dim>::cut(layout);
+  lying_last_ = layout.splits.back();
+}
+
+template <int dim>
+void TouchdownFront<dim>::initialize(StringModel<dim>& model) {
+  const Points<dim>& x = model.x();
+  const int a = lying_last_, b = a + 1;
+  const Vec<dim> d = a > 0 ? Vec<dim>(x.col(a) - x.col(a - 1)) : Vec<dim>(x.col(b) - x.col(a));
+  along_ = d - d.dot(normal_) * normal_;
+  if (!(along_.norm() > 0))
+    throw InputError(fmt::format("{}: the string does not run along the plane where it leaves it", surface_));
+  along_.normalize();
+}
+
+template <int dim>
+typename TouchdownFront<dim>::Geometry TouchdownFront<dim>::geometry(const StringModel<dim>& model) const {
+  const Points<dim>& x = model.x();
+  const Points<dim>& v = model.v();
+  Geometry g;
+  g.a = this->node_a(model);
+  g.b = this->node_b(model);
+  g.c = g.b + 1;
+  const ArcRange& B = model.arcs()[static_cast<std::size_t>(this->arc_plus)];
+  if (B.num_links() < 1) throw RecoverableError("the arc after the touchdown front has no full link");
+  const Vec<dim>& e = along_;
+  const Vec<dim>& n = normal_;
+  const Vec<dim> link = x.col(g.c) - x.col(g.b), w = v.col(g.c) - v.col(g.b);
+  g.L = link.norm();
+  g.t = link / g.L;
+  g.cos = g.t.dot(e);
+  g.sin = g.t.dot(n);
+  if (!(g.sin > 0)) throw RecoverableError("the arc after the touchdown front does not rise from the plane");
+  g.t_perp = g.cos * n - g.sin * e;
+  g.theta_dot = g.t_perp.dot(w) / g.L;
+  g.t_w = g.t.dot(w);
+  g.y = n.dot(x.col(g.b) - point_);
+  g.y_dot = n.dot(v.col(g.b));
+  g.tan_half = (1 - g.cos) / g.sin;
+  g.l_plus = g.y / g.sin;
+  g.l_minus = this->m_.h - g.l_plus;
+  g.x0 = x.col(g.b) - g.l_plus * g.t;
+  g.s0_dot = -g.y_dot / g.sin + g.y * g.cos * g.theta_dot / (g.sin * g.sin);
+  return g;
+}
+
+template <int dim>
+void TouchdownFront<dim>::evaluate(const StringModel<dim>& model, FrontState<dim>& s, Eigen::VectorXd& mass,
+                                   Points<dim>& force) {
+  const Points<dim>& v = model.v();
+  const double lambda = this->m_.lambda, f = this->dissipation;
+  const Geometry g = geometry(model);
+  const int a = g.a, b = g.b;
+  lying_last_ = a;
+  theta_ = std::atan2(g.sin, g.cos);
+  const Vec<dim>& e = along_;
+  const double sd = g.s0_dot;
+  // The jump conditions with the discrete [v] = v_b − v_a: the arc's end pulled along its first link t by τ⁺,
+  // so that the loads work at −½ f λ |ṡ0| |[v]|² exactly (τ⁺ = (1 − f sgn ṡ0) λ ṡ0² where the sides are
+  // compatible, −t·[v] = ṡ0 (1 − cos θ)); the lying end along e by τ⁻, so that the momentum along the
+  // plane is exact.
+  const Vec<dim> ud = v.col(b) - v.col(a);
+  const double jump2 = ud.squaredNorm(), t_jump = -g.t.dot(ud);
+  const double weight = 1 - f * jump::sign(sd);
+  const double tau_p = std::abs(t_jump) > 1e-9 * std::sqrt(jump2) * (1 - g.cos)
+                           ? weight * 0.5 * lambda * sd * jump2 / t_jump
+                           : weight * lambda * sd * sd;
+  const double tau_m = lambda * sd * ud.dot(e) + tau_p * g.cos;
+  s.s0 = model.chain().node_coordinate(a) + g.l_minus;
+  s.s0_dot = sd;
+  s.l_minus = g.l_minus;
+  s.l_plus = g.l_plus;
+  s.direction = e;
+  s.position = g.x0;
+  s.tension_minus = tau_m;
+  s.tension_plus = tau_p;
+  s.opening = theta_;
+  s.inflow = 0;
+  s.plane_normal = normal_;
+  mass[a] += lambda * g.l_minus;
+  mass[b] += lambda * g.l_plus;
+  force.col(a) += tau_m * e;
+  force.col(b) -= tau_p * g.t;
+  // The front's reaction: what the loads and the material moved from b to a change in the lumped
+  // momentum (normal to the plane by τ⁻'s choice); the constraint's share is added where it is known.
+  s.reaction = tau_m * e - tau_p * g.t + lambda * sd * (v.col(a) - v.col(b));
+  s.power_shock = -jump::dissipation_rate(f, lambda, sd, jump2);
+  // The reaction's work on node a's drift off the plane (zero on the plane): the loads' power is W_s plus
+  // this, exactly.
+  s.power_heap = s.reaction.dot(normal_) * normal_.dot(v.col(a));
+}
+
+template <int dim>
+void TouchdownFront<dim>::constraints(const StringModel<dim>& model, const FrontState<dim>& /*state*/,
+                                      std::vector<NodeConstraint<dim>>& out) const {
+  // The split link's material: along the plane from x_a to x0, and on from x0 to x_b along the arc's first
+  // link: C = (x_b − x_a)·e + y_b tan(θ/2) − h = l⁻ + l⁺ − h on the plane (y_b the height of b, θ the
+  // link's angle to the plane). Its gradient on a is along e (a held node moves along the plane).
+  const Geometry g = geometry(model);
+  const Points<dim>& x = model.x();
+  const Vec<dim>& e = along_;
+  const Vec<dim>& n = normal_;
+  const double T = g.tan_half, T1 = 1 / (1 + g.cos);  // tan(θ/2) and its derivative in θ
+  NodeConstraint<dim> c;
+  c.nodes = {g.a, g.b, g.c};
+  c.gradient.resize(dim, 3);
+  c.gradient.col(0) = -e;
+  c.gradient.col(1) = e + T * n - g.y * T1 * g.t_perp / g.L;
+  c.gradient.col(2) = g.y * T1 * g.t_perp / g.L;
+  c.value = (x.col(g.b) - x.col(g.a)).dot(e) + g.y * T - this->m_.h;
+  // C̈ at zero accelerations: 2 ẏ T' θ̇ + y (T' T θ̇² + T' θ̈0), θ̈0 = −2 θ̇ (t·w)/L.
+  c.curvature = 2 * g.y_dot * T1 * g.theta_dot +
+                g.y * (T1 * T * g.theta_dot * g.theta_dot - 2 * T1 * g.theta_dot * g.t_w / g.L);
+  out.push_back(std::move(c));
+}
+
+template <int dim>
+Vec<dim> TouchdownFront<dim>::constraint_force(const StringModel<dim>& model) const {
+  // The constraint's forces sum to μ tan(θ/2) n (it ties the string to the plane): the plane's share of the
+  // front's reaction that the multiplier carries.
+  const auto& cs = model.node_constraints();
+  const Eigen::VectorXd& mu = model.constraint_multipliers();
+  const int a = this->node_a(model);
+  for (std::size_t k = 0; k < cs.size() && static_cast<Eigen::Index>(k) < mu.size(); ++k)
+    if (cs[k].nodes.size() == 3 && cs[k].nodes[0] == a) {
+      Vec<dim> sum = Vec<dim>::Zero();
+      for (int q = 0; q < 3; ++q) sum += cs[k].gradient.col(q);
+      return mu[static_cast<Eigen::Index>(k)] * sum;
+    }
+  return Vec<dim>::Zero();
+}
+
+template <int dim>
+Vec<dim> TouchdownFront<dim>::recorded_reaction(const StringModel<dim>& model, const FrontState<dim>& s) const {
+  return s.reaction + constraint_force(model);
+}
+
+template <int dim>
+void TouchdownFront<dim>::crossings(const StringModel<dim>& /*model*/, const FrontState<dim>& s, double* g) const {
+  g[0] = s.l_plus / this->m_.h - kCross;
+  g[1] = s.l_minus / this->m_.h + kCross;
+}
+
+template <int dim>
+EventAction TouchdownFront<dim>::cross(StringModel<dim>& model, const FrontState<dim>& state, int e0) {
+  const int b = this->node_b(model);
+  EventAction action = SplitLinkFront<dim>::cross(model, state, e0);
+  if (action.kind == EventAction::Kind::kStop) return action;
+  if (e0 != 0) {
+    // Node b has reached x0 (to the root's accuracy) and joined the lying arc with its velocity: it lies
+    // on the plane, where the contact module holds it.
+    Points<dim>& x = model.x();
+    x.col(b) -= normal_.dot(x.col(b) - point_) * normal_;
+    Points<dim>& v = model.v();
+    v.col(b) -= normal_.dot(v.col(b)) * normal_;
+    lying_last_ = b;
+  } else {
+    lying_last_ = b - 2;
+  }
+  return action;
+}
+
+template <int dim>
+typename TouchdownFront<dim>::Margins TouchdownFront<dim>::margins(const StringModel<dim>& model,
+                                                                   const FrontState<dim>& s) const {
+  Margins m;
+  m.angle = std::sin(theta_) - std::sin(kMinAngleDeg * kPi / 180);
+  if (theta_ > 0.5 * kPi) m.angle = 1;  // a steep arc is fine; only a grazing one is refused
+  const ArcRange& B = model.arcs()[static_cast<std::size_t>(this->arc_plus)];
+  for (int i = B.first + 1; i <= B.last; ++i) {
+    const double height = normal_.dot(model.x().col(i) - point_) / this->m_.h;
+    if (height < m.height) {
+      m.height = height;
+      m.low_node = i;
+    }
+  }
+  // The plane's push at the front, N = n·(the front's reaction, the constraint's share included), per the
+  // scale λ |[v]|² of the jump conditions' forces, less 10⁻⁶ of it (N = 0 for f = 0): a take-off with f > 0
+  // (N = −f λ ṡ0² sin θ) and a front whose compatibility would need a pull both stop the run.
+  const Vec<dim> jump_v = model.v().col(B.first) - model.v().col(B.first - 1);
+  const double scale = this->m_.lambda * jump_v.squaredNorm();
+  const double push = normal_.dot(recorded_reaction(model, s));
+  m.take_off = scale > 0 ? std::min(1.0, push / scale + 1e-6) : 1.0;
+  return m;
+}
+
+template <int dim>
+void TouchdownFront<dim>::checks(const StringModel<dim>& model, const FrontState<dim>& s, double* g) const {
+  const Margins m = margins(model, s);
+  g[0] = std::min({m.angle, m.height, m.take_off});
+}
+
+template <int dim>
+std::string TouchdownFront<dim>::check_failed(const StringModel<dim>& model, const FrontState<dim>& s, double t) const {
+  const Margins m = margins(model, s);
+  const double least = std::min({m.angle, m.height, m.take_off});
+  if (least == m.take_off)
+    return fmt::format(
+        "lifted off {} at t = {:.9g} s: the plane would have to pull the string at the touchdown front (its reaction "
+        "N = {:.6g} N; s0 = {:.9g} m, ds0/dt = {:.4g} m/s, the arc at {:.4g} deg, f = {:g}): a take-off with f > 0 "
+        "needs N = -f lambda ds0/dt^2 sin theta < 0 (a string peels off a smooth plane only without dissipation, f = 0), "
+        "and a lying part whose own motion disagrees with the arc's end needs a pull to stay taut (docs/model.md §10)",
+        surface_, t, normal_.dot(recorded_reaction(model, s)), s.s0, s.s0_dot, theta_ * 180 / kPi, this->dissipation);
+  if (least == m.height)
+    return fmt::format(
+        "node {} of the arc reaches {} at t = {:.9g} s away from its touchdown front (s0 = {:.9g} m): a string that "
+        "lands elsewhere than at its front is not supported with f (node contact lands it: leave out f)",
+        m.low_node, surface_, t, s.s0);
+  return fmt::format(
+      "the arc meets {} at {:.4g} deg at t = {:.9g} s (s0 = {:.9g} m, ds0/dt = {:.4g} m/s): a touchdown front needs "
+      "at least {:g} deg (a grazing touchdown is no shock, and the split link no longer places it)",
+      surface_, theta_ * 180 / kPi, t, s.s0, s.s0_dot, kMinAngleDeg);
+}
+
+template <int dim>
+std::optional<RunEvent> TouchdownFront<dim>::check_event(const StringModel<dim>& model, const FrontState<dim>& s,
+                                                         double t) const {
+  const Margins m = margins(model, s);
+  if (std::min({m.angle, m.height, m.take_off}) != m.take_off) return std::nullopt;
+  RunEvent e;
+  e.kind = "lift_off";
+  e.t = t;
+  e.position.assign(s.position.data(), s.position.data() + dim);
+  e.values = {{"s0", s.s0},
+              {"s0_dot", s.s0_dot},
+              {"tension_minus", s.tension_minus},
+              {"tension_plus", s.tension_plus},
+              {"angle_deg", theta_ * 180 / kPi}};
+  return e;
+}
+
+template <int dim>
+void touchdown_surface(const TouchdownFront<dim>& front, Obstacle<dim>& surface) {
+  const TouchdownFront<dim>* f = &front;
+  surface.carries = [f](int i) { return i <= f->lying_last(); };
+}
+
+template class TouchdownFront<2>;
+template class TouchdownFront<3>;
+template void touchdown_surface<2>(const TouchdownFront<2>&, Obstacle<2>&);
+template void touchdown_surface<3>(const TouchdownFront<3>&, Obstacle<3>&);
+
+}  // namespace chainsim

@@ -1,0 +1,118 @@
+#pragma once
+/// @file touchdown_front.hpp
+/// A touchdown front (front_kind.hpp): where a string lying on a smooth plane leaves it, or a moving
+/// arc lands on it, an internal shock of dissipation f that slides along the plane (docs/model.md §10,
+/// "A touchdown front"; 2D).
+///
+/// The string before the front (s < s0, arc A) lies on the plane, held there node by node by the
+/// contact module (the surface holds arc A's nodes only: Obstacle::carries, touchdown_surface); the
+/// string after it (arc B) is free. The split link (a, b) between A's last node and B's first node
+/// holds the front: its material runs along the plane from x_a to x0 and on from x0 to x_b along arc B's
+/// first link (b, c), of direction t at the angle θ to the plane (e the plane's direction along arc A,
+/// towards larger s; n its outward normal; y_b the height of b):
+///     l⁺ = y_b / sin θ,   l⁻ = h − l⁺,   x0 = x_b − l⁺ t,   ṡ0 = −dl⁺/dt,
+/// and a constraint keeps the material, C = (x_b − x_a)·e + y_b tan(θ/2) − h = 0 (its gradient on the
+/// held node a along e; its net force μ tan(θ/2) n, booked with the front's reaction). With
+/// [v] = v_b − v_a the front loads
+///     node b:  −τ⁺ t,   τ⁺ = (1 − f sgn ṡ0) λ ṡ0 |[v]|² / (2 (−t·[v]))
+///     node a:  τ⁻ e,    τ⁻ = λ ṡ0 [v]·e + τ⁺ cos θ
+/// (τ⁺ = (1 − f sgn ṡ0) λ ṡ0², τ⁻ = λ ṡ0² (1 − f sgn ṡ0 cos θ) where the two sides are compatible,
+/// [v] = −ṡ0 [t]), which keep the lumped momentum along the plane exact (the front's reaction, the
+/// momentum the loads and the material moved from b to a change, is normal to the plane) and work at
+/// exactly W_s = −½ f λ |ṡ0| |[v]|². The reaction N n, N = f λ ṡ0 |ṡ0| sin θ on the compatible state
+/// (the constraint's share zero there), is what forces.csv shows. A take-off with f > 0 (ṡ0 < 0) would
+/// need the plane to pull, and so would a lying part whose motion disagrees with the arc's end (the
+/// constraint's multiplier): the front's check stops the run where its reaction reaches zero (a
+/// lift-off event); f = 0 peels off without a reaction.
+/// Crossings are the split link's (SplitLinkFront): a node of B that reaches x0 (landing) joins A with
+/// A's velocity and is put on the plane, where the contact module holds it.
+#include <string>
+
+#include "shocks/split_link_front.hpp"
+#include "solver/contact_module.hpp"
+
+namespace chainsim {
+
+/// A touchdown front on the plane through `point` with unit outward normal `normal`.
+template <int dim>
+struct TouchdownSpec {
+  Vec<dim> point = Vec<dim>::Zero();
+  Vec<dim> normal = Vec<dim>::Zero();
+  double dissipation = 0;  ///< f, in [0, 1]
+  double s0 = 0;           ///< where the initial shape leaves the plane (m)
+  std::string name = "effects.surface[0]";  ///< the surface, for messages
+};
+
+template <int dim>
+class TouchdownFront final : public SplitLinkFront<dim> {
+ public:
+  /// The run stops when the arc meets the plane at less than this angle (its front is then a
+  /// tangential touchdown, no shock, whose position the split link no longer resolves).
+  static constexpr double kMinAngleDeg = 5;
+  /// A node of the arc joins the lying arc when it comes this close to x0 (in links), so that the
+  /// lying arc's l⁻ starts just above zero after the crossing (as an edge's kCross).
+  static constexpr double kCross = 1e-8;
+
+  explicit TouchdownFront(const TouchdownSpec<dim>& spec);
+
+  const char* name() const override { return "touchdown"; }
+  const char* placed() const override { return "touchdown"; }
+  /// The last node of the lying arc (A), which the surface holds, and all before it.
+  int lying_last() const { return lying_last_; }
+
+  void cut(FrontLayout& layout) override;
+  void initialize(StringModel<dim>& model) override;
+  void evaluate(const StringModel<dim>& model, FrontState<dim>& state, Eigen::VectorXd& mass,
+                Points<dim>& force) override;
+  /// g[0] = l⁺/h − kCross (a landing: the front reaches arc B's first node), g[1] = l⁻/h + kCross (a
+  /// take-off: it passes arc A's last node; l⁻ starts at 0 after a landing).
+  void crossings(const StringModel<dim>& model, const FrontState<dim>& state, double* g) const override;
+  EventAction cross(StringModel<dim>& model, const FrontState<dim>& state, int e0) override;
+  /// One: positive while the arc meets the plane at more than kMinAngleDeg, no other node of the arc
+  /// reaches the plane, and the plane pushes at the front (its reaction's normal component).
+  bool checks_need_tensions() const override { return true; }
+  int num_checks() const override { return 1; }
+  void checks(const StringModel<dim>& model, const FrontState<dim>& state, double* g) const override;
+  std::string check_failed(const StringModel<dim>& model, const FrontState<dim>& state, double t) const override;
+  std::optional<RunEvent> check_event(const StringModel<dim>& model, const FrontState<dim>& state,
+                                      double t) const override;
+
+  void constraints(const StringModel<dim>& model, const FrontState<dim>& state,
+                   std::vector<NodeConstraint<dim>>& out) const override;
+  Vec<dim> constraint_force(const StringModel<dim>& model) const override;
+  bool has_constraint_force() const override { return true; }
+  Vec<dim> recorded_reaction(const StringModel<dim>& model, const FrontState<dim>& state) const override;
+
+  /// The angle θ (rad) at which the arc leaves the plane, after an evaluation.
+  double angle() const { return theta_; }
+
+ private:
+  /// The split link's geometry: arc B's first link (b, c) at angle θ to the plane, continued to the plane
+  /// at x0; l⁺ = y_b / sin θ, l⁻ = h − l⁺, ṡ0 = −dl⁺/dt.
+  struct Geometry {
+    int a = 0, b = 0, c = 0;
+    Vec<dim> t = Vec<dim>::Zero(), t_perp = Vec<dim>::Zero(), x0 = Vec<dim>::Zero();
+    double L = 0, cos = 0, sin = 0, theta_dot = 0, t_w = 0, y = 0, y_dot = 0, tan_half = 0;
+    double l_plus = 0, l_minus = 0, s0_dot = 0;
+  };
+  Geometry geometry(const StringModel<dim>& model) const;
+  /// The margins of checks(): angle, other nodes' heights (per h), take-off.
+  struct Margins {
+    double angle = 1, height = 1, take_off = 1;
+    int low_node = -1;
+  };
+  Margins margins(const StringModel<dim>& model, const FrontState<dim>& state) const;
+
+  Vec<dim> point_ = Vec<dim>::Zero(), normal_ = Vec<dim>::Zero();
+  Vec<dim> along_ = Vec<dim>::Zero();  ///< e: the plane's direction along arc A towards larger s
+  std::string surface_;
+  int lying_last_ = -1;
+  double theta_ = 0;
+};
+
+/// The surface's obstacle holding the lying arc of `front` only (its nodes up to front.lying_last()).
+/// `front` must outlive it.
+template <int dim>
+void touchdown_surface(const TouchdownFront<dim>& front, Obstacle<dim>& surface);
+
+}  // namespace chainsim
