@@ -479,12 +479,13 @@ InsertedU run_inserted_u(int nodes) {
   const SceneSpec spec =
       parse_scene(file, {"string.nodes=" + std::to_string(nodes), "solver.kinks=\"insert\"", "output.interval=0.5"});
   StringScene<2> scene = build_string_scene<2>(spec);
+  FrontTracker<2>* tracker = front_tracker(*scene.model);
+  REQUIRE(tracker);
+  tracker->record_event_energies();
   StringSolver<2> solver(*scene.model, scene.solver);
   InsertedU u;
   u.run = solver.run();
   u.frames = solver.frames();
-  const FrontTracker<2>* tracker = front_tracker(*scene.model);
-  REQUIRE(tracker);
   u.events = tracker->event_energies();
   u.w_remesh = u.frames.back().terms["W_remesh"];
   return u;
