@@ -18,6 +18,7 @@
 #include "shocks/front_tracker.hpp"
 #include "shocks/kink_front.hpp"
 #include "solver/string_solver.hpp"
+#include "nested_mesh_support.hpp"
 
 using namespace chainsim;
 
@@ -497,13 +498,8 @@ std::pair<double, double> state_difference(const InsertedU& coarse, const Insert
   const Points<2>& x1 = coarse.frames.at(k).x;
   const Points<2>& x2 = fine.frames.at(k).x;
   REQUIRE(x2.cols() == 2 * x1.cols() - 1);
-  double sum = 0, largest = 0;
-  for (Eigen::Index i = 0; i < x1.cols(); ++i) {
-    const double d = (x1.col(i) - x2.col(2 * i)).norm();
-    sum += d * d;
-    largest = std::max(largest, d);
-  }
-  return {std::sqrt(sum / static_cast<double>(x1.cols())), largest};
+  const test::NestedDifference d = test::nested_mesh_difference<2>(x1, x2);
+  return {d.rms, d.largest};
 }
 
 }  // namespace

@@ -23,6 +23,7 @@
 
 #include "cases/scene/scene.hpp"
 #include "solver/string_solver.hpp"
+#include "nested_mesh_support.hpp"
 #include "slack_test_support.hpp"
 
 using namespace chainsim;
@@ -49,15 +50,6 @@ SceneRunResult<dim> run_text(const std::string& text, const std::vector<std::str
   r.frames = solver.frames();
   r.masses = scene.model->masses();
   return r;
-}
-
-/// The largest distance between the same material points of two meshes, node i of the coarser being node 2i
-/// of the finer (open strings, N and 2N − 1 nodes).
-template <int dim>
-double mesh_difference(const Points<dim>& coarse, const Points<dim>& fine) {
-  double d = 0;
-  for (Eigen::Index i = 0; i < coarse.cols(); ++i) d = std::max(d, (coarse.col(i) - fine.col(2 * i)).norm());
-  return d;
 }
 
 // A loop of radius 0.15 m, its centre 0.17 m (2D) or 0.12 m (3D, tilted by 60 deg) above a smooth table,
@@ -225,7 +217,7 @@ TEST_CASE("slack: a chain pendulum spun about the vertical whips in 3D and conve
     states.push_back(r.frames.back().x);
   }
   std::vector<double> d;
-  for (std::size_t k = 1; k < states.size(); ++k) d.push_back(mesh_difference<3>(states[k - 1], states[k]));
+  for (std::size_t k = 1; k < states.size(); ++k) d.push_back(test::nested_mesh_difference<3>(states[k - 1], states[k]).largest);
   std::printf("3D whip at t = 0.6 s: %.3e, %.3e, %.3e m on 41 -> 321 nodes, orders %.2f, %.2f\n", d[0], d[1], d[2],
               std::log2(d[0] / d[1]), std::log2(d[1] / d[2]));
   for (std::size_t k = 1; k < d.size(); ++k) CHECK(std::log2(d[k - 1] / d[k]) > 1.0);
