@@ -74,6 +74,12 @@ void FoldFront<dim>::evaluate(const StringModel<dim>& model, FrontState<dim>& s,
 }
 
 template <int dim>
+void FoldFront<dim>::crossings(const StringModel<dim>& /*model*/, const FrontState<dim>& s, double* g) const {
+  g[0] = s.l_plus + kHysteresis * this->m_.h;
+  g[1] = s.l_minus + kHysteresis * this->m_.h;
+}
+
+template <int dim>
 void FoldFront<dim>::checks(const StringModel<dim>& /*model*/, const FrontState<dim>& s, double* g) const {
   g[0] = std::min(std::cos(s.opening) - std::cos(kMaxOpeningDeg * kPi / 180), max_chord() - chord_);
 }

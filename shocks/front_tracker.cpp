@@ -16,7 +16,8 @@ namespace chainsim {
 
 template <int dim>
 FrontTracker<dim>::FrontTracker(std::vector<std::unique_ptr<FrontKind<dim>>> fronts, const FrontOptions& options)
-    : options_(options), fronts_(std::move(fronts)), trace_(std::getenv("CHAINSIM_TRACE_FRONTS") != nullptr) {
+    : options_(options), fronts_(std::move(fronts)), trace_(std::getenv("CHAINSIM_TRACE_FRONTS") != nullptr),
+      record_(trace_) {
   CHAINSIM_VERIFY(!fronts_.empty(), "a front tracker needs a front");
   for (std::size_t k = 1; k < fronts_.size(); ++k)
     if (fronts_[k]->expected_s0 < fronts_[k - 1]->expected_s0)
@@ -381,10 +382,11 @@ EventAction FrontTracker<dim>::handle_events(StringModel<dim>& model, double t, 
   for (std::size_t k = 0; k < fronts_.size(); ++k) held_before[k] = fronts_[k]->held_mass(fs_[k]);
   bool absorbed = false;
   std::optional<std::size_t> acted = forming;  // the front the event moved
-  // |v_a − v_(a−1)| on the front's stencil (a−1, a, b, b+1) before the event, for event_energies_.
+  // |v_a − v_(a−1)| on the front's stencil (a−1, a, b, b+1) before the event, for event_energies_ (only when
+  // they are recorded, as the arm's corner and K + V between the re-layout and the projection below).
   double jump_before = 0;
   std::pair<double, double> corner_before{0.0, 0.0};
-  if (!forming)
+  if (record_ && !forming)
     for (int f = 0; f < nf; ++f)
       if ((found[static_cast<std::size_t>(2 * f)] != 0 || found[static_cast<std::size_t>(2 * f + 1)] != 0) &&
           fronts_[static_cast<std::size_t>(f)]->active) {
@@ -420,8 +422,8 @@ EventAction FrontTracker<dim>::handle_events(StringModel<dim>& model, double t, 
   // allowed (perfectly inelastic otherwise), and the energy it changes is the front's last dissipation,
   // booked in W_shocks (docs/model.md §2.5, "A kink at a held end").
   model.refresh();
-  const double K_moved = model.kinetic_energy();
-  const double E_moved = K_moved + model.potential_energy(ledger);
+  const double K_moved = record_ ? model.kinetic_energy() : 0.0;
+  const double E_moved = record_ ? K_moved + model.potential_energy(ledger) : 0.0;
   try {
     if (absorbed)
       model.impact(t, model.options().snap_restitution);
@@ -444,11 +446,11 @@ EventAction FrontTracker<dim>::handle_events(StringModel<dim>& model, double t, 
   }
   const double changed = model.kinetic_energy() + model.potential_energy(ledger) - E_before;
   double corner_after = 0;
-  if (acted && !forming && !absorbed) {
+  if (record_ && acted && !forming && !absorbed) {
     const std::vector<int> nodes = fronts_[*acted]->stencil(model);
     if (nodes.size() == 4) corner_after = arm_corner(model, *acted, nodes[0], t, "after").first;
   }
-  if (acted) {
+  if (record_ && acted) {
     const EventEnergy record{t, forming ? "insert" : absorbed ? "absorb" : "cross", static_cast<int>(*acted),
                              E_moved - E_before, K_moved - K_before, changed - (E_moved - E_before), jump_before,
                              corner_before.first, corner_after, corner_before.second};

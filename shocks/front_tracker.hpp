@@ -124,7 +124,12 @@ class FrontTracker final : public StringModule<dim> {
     /// the front's constraint reaction on a − 1 would make against τ⁻ before it (0 without a constraint).
     double arm_turn_before = 0, arm_turn_after = 0, reaction_turn = 0;
   };
+  /// The records of the events since record_event_energies() was called (or since the start with
+  /// CHAINSIM_TRACE_FRONTS set); empty otherwise: a run that reads none pays nothing for them.
   const std::vector<EventEnergy>& event_energies() const { return event_energies_; }
+  /// Keeps an EventEnergy for each front event from now on (two evaluations of K + V and the arm's corner per
+  /// event, docs/shocks.md "What a crossing costs"). Call it before the run.
+  void record_event_energies() { record_ = true; }
   /// The state front k wrote at the last evaluation.
   const FrontState<dim>& front_state(std::size_t k) const { return fs_[k]; }
 
@@ -195,6 +200,7 @@ class FrontTracker final : public StringModule<dim> {
   double w_remesh_ = 0;
   std::vector<EventEnergy> event_energies_;
   bool trace_ = false;  ///< CHAINSIM_TRACE_FRONTS set: event_energies_ also on stderr, one line each
+  bool record_ = false;  ///< event_energies_ kept: record_event_energies() called or trace_ set
   Vec<dim> heap_moment0_ = Vec<dim>::Zero();  // Σ held mass × its first moment at t = 0
 };
 
@@ -228,6 +234,12 @@ const FrontTracker<dim>* front_tracker(const StringModel<dim>& model) {
   const StringModule<dim>* module = model.module();
   while (const auto* wrapper = dynamic_cast<const WrappingModule<dim>*>(module)) module = wrapper->inner();
   return dynamic_cast<const FrontTracker<dim>*>(module);
+}
+
+/// The same, to change it (FrontTracker::record_event_energies before a run).
+template <int dim>
+FrontTracker<dim>* front_tracker(StringModel<dim>& model) {
+  return const_cast<FrontTracker<dim>*>(front_tracker(static_cast<const StringModel<dim>&>(model)));
 }
 
 }  // namespace chainsim

@@ -105,6 +105,8 @@ json effects_json(const SceneSpec::Effects& fx) {
     j["surface"] = json::array();
     for (const SurfaceEntry& e : fx.surfaces) {
       j["surface"].push_back({{"point", e.point}, {"normal", e.normal}});
+      // mu only where it is not the default (smooth), so that a scene without the key writes what it always wrote.
+      if (e.mu != 0) j["surface"].back()["mu"] = e.mu;
       if (e.edge) j["surface"].back()["edge"] = *e.edge;
       if (e.f) j["surface"].back()["f"] = *e.f;
     }
@@ -114,7 +116,8 @@ json effects_json(const SceneSpec::Effects& fx) {
     for (const CylinderEntry& e : fx.cylinders) {
       j["cylinder"].push_back({{"center", e.center}, {"radius", e.radius}});
       if (e.axis) j["cylinder"].back()["axis"] = *e.axis;
-      // Only where it is not the default, so that a scene without the key writes what it always wrote.
+      // mu and contact only where they are not the default, so that a scene without them writes what it always wrote.
+      if (e.mu != 0) j["cylinder"].back()["mu"] = e.mu;
       if (e.contact != "nodes") j["cylinder"].back()["contact"] = e.contact;
     }
   }

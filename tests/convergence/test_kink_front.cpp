@@ -18,6 +18,7 @@
 #include "shocks/front_tracker.hpp"
 #include "shocks/kink_front.hpp"
 #include "solver/string_solver.hpp"
+#include "nested_mesh_support.hpp"
 
 using namespace chainsim;
 
@@ -479,12 +480,13 @@ InsertedU run_inserted_u(int nodes) {
   const SceneSpec spec =
       parse_scene(file, {"string.nodes=" + std::to_string(nodes), "solver.kinks=\"insert\"", "output.interval=0.5"});
   StringScene<2> scene = build_string_scene<2>(spec);
+  FrontTracker<2>* tracker = front_tracker(*scene.model);
+  REQUIRE(tracker);
+  tracker->record_event_energies();
   StringSolver<2> solver(*scene.model, scene.solver);
   InsertedU u;
   u.run = solver.run();
   u.frames = solver.frames();
-  const FrontTracker<2>* tracker = front_tracker(*scene.model);
-  REQUIRE(tracker);
   u.events = tracker->event_energies();
   u.w_remesh = u.frames.back().terms["W_remesh"];
   return u;
@@ -496,13 +498,8 @@ std::pair<double, double> state_difference(const InsertedU& coarse, const Insert
   const Points<2>& x1 = coarse.frames.at(k).x;
   const Points<2>& x2 = fine.frames.at(k).x;
   REQUIRE(x2.cols() == 2 * x1.cols() - 1);
-  double sum = 0, largest = 0;
-  for (Eigen::Index i = 0; i < x1.cols(); ++i) {
-    const double d = (x1.col(i) - x2.col(2 * i)).norm();
-    sum += d * d;
-    largest = std::max(largest, d);
-  }
-  return {std::sqrt(sum / static_cast<double>(x1.cols())), largest};
+  const test::NestedDifference d = test::nested_mesh_difference<2>(x1, x2);
+  return {d.rms, d.largest};
 }
 
 }  // namespace

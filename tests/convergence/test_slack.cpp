@@ -22,6 +22,7 @@
 #include "mesh/errors.hpp"
 #include "solver/string_solver.hpp"
 #include "solver/tension_system.hpp"
+#include "nested_mesh_support.hpp"
 
 using namespace chainsim;
 
@@ -439,17 +440,13 @@ TEST_CASE("slack: the swinging U on 51 to 401 nodes: the differences of the stat
     double diff = 0;
     if (x.size() > 1) {
       const Points<2>& coarse = x[x.size() - 2];
-      for (Eigen::Index i = 0; i < coarse.cols(); ++i) diff = std::max(diff, (coarse.col(i) - x.back().col(2 * i)).norm());
+      diff = test::nested_mesh_difference<2>(coarse, x.back()).largest;
     }
     std::printf("  %6d  %10ld  %12.4e  %12.3e  %12.3e\n", n, s.stats.steps, w_snap, s.relative_energy_drift(), diff);
     CHECK(s.relative_energy_drift() < 1e-5);  // the ledger with W_snap booked (measured <= 1.4e-6)
   }
   std::vector<double> differences;
-  for (std::size_t k = 1; k < x.size(); ++k) {
-    double diff = 0;
-    for (Eigen::Index i = 0; i < x[k - 1].cols(); ++i) diff = std::max(diff, (x[k - 1].col(i) - x[k].col(2 * i)).norm());
-    differences.push_back(diff);
-  }
+  for (std::size_t k = 1; k < x.size(); ++k) differences.push_back(test::nested_mesh_difference<2>(x[k - 1], x[k]).largest);
   for (std::size_t k = 1; k < differences.size(); ++k) CHECK(differences[k] < differences[k - 1]);
   CHECK(differences.back() < 0.01);
 }
@@ -512,7 +509,7 @@ TEST_CASE("slack: the swinging U on 201 to 1601 nodes: the largest differences a
     double diff = 0;
     if (x.size() > 1) {
       const Points<2>& coarse = x[x.size() - 2];
-      for (Eigen::Index i = 0; i < coarse.cols(); ++i) diff = std::max(diff, (coarse.col(i) - x.back().col(2 * i)).norm());
+      diff = test::nested_mesh_difference<2>(coarse, x.back()).largest;
       differences.push_back(diff);
     }
     std::printf("  %6d  %10ld  %12.4e  %12.3e  %12.3e\n", n, s.stats.steps, w_snap, s.relative_energy_drift(), diff);

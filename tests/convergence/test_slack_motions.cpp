@@ -13,6 +13,7 @@
 
 #include "cases/scene/scene.hpp"
 #include "solver/string_solver.hpp"
+#include "nested_mesh_support.hpp"
 
 using namespace chainsim;
 
@@ -52,8 +53,7 @@ std::vector<double> mesh_differences(const std::string& name, int nodes0, int me
   std::printf("\n%s at t = %g s\n", name.c_str(), t);
   for (std::size_t k = 1; k < runs.size(); ++k) {
     const Points<2>& coarse = runs[k - 1].x;
-    double diff = 0;
-    for (Eigen::Index i = 0; i < coarse.cols(); ++i) diff = std::max(diff, (coarse.col(i) - runs[k].x.col(2 * i)).norm());
+    const double diff = test::nested_mesh_difference<2>(coarse, runs[k].x).largest;
     differences.push_back(diff);
     std::printf("  %5ld -> %5ld nodes: %.3e m%s\n", static_cast<long>(coarse.cols()),
                 static_cast<long>(runs[k].x.cols()), diff,

@@ -67,3 +67,30 @@ TEST_CASE("a cylinder's contact is written back where it is not the default", "[
   const SceneSpec again = parse_scene_text(scene_toml_text(written(arc)), "again.toml");
   CHECK(again.effects.cylinders.at(0).contact == "arc");
 }
+
+TEST_CASE("a surface's and a cylinder's mu are written back where they are not the default, and read again",
+          "[unit][scene]") {
+  const std::string base = test::edit(test::kSceneBase, "[effects.gravity]\ng = [0.0, -9.81]\n", "");
+  const std::string obstacles = "[[effects.surface]]\npoint = [0.0, -2.0]\nnormal = [0.0, 1.0]\n{}"
+                                "[[effects.cylinder]]\ncenter = [0.5, -0.5]\nradius = 0.1\n{}";
+  const auto scene = [&](const std::string& surface_mu, const std::string& cylinder_mu) {
+    std::string text = obstacles;
+    text.replace(text.find("{}"), 2, surface_mu);
+    text.replace(text.find("{}"), 2, cylinder_mu);
+    return base + text;
+  };
+  // Without the key: no mu in scene_effective (a scene without it writes what it always wrote).
+  const nlohmann::json smooth = scene_to_json(parse_scene_text(scene("", ""), "smooth.toml"));
+  CHECK(!smooth["effects"]["surface"][0].contains("mu"));
+  CHECK(!smooth["effects"]["cylinder"][0].contains("mu"));
+  // With it: written as given, and the scene written back as TOML reads the same coefficients.
+  const SceneSpec rough = parse_scene_text(scene("mu = 0.35\n", "mu = 0.2\n"), "rough.toml");
+  const nlohmann::json effective = scene_to_json(rough);
+  INFO("scene_effective: " << effective.dump());
+  CHECK(effective["effects"]["surface"][0].value("mu", 0.0) == 0.35);
+  CHECK(effective["effects"]["cylinder"][0].value("mu", 0.0) == 0.2);
+  const SceneSpec again = parse_scene_text(scene_toml_text(written(effective)), "again.toml");
+  CHECK(again.effects.surfaces.at(0).mu == rough.effects.surfaces.at(0).mu);
+  CHECK(again.effects.cylinders.at(0).mu == rough.effects.cylinders.at(0).mu);
+  CHECK(scene_to_json(again)["effects"] == effective["effects"]);
+}
