@@ -116,7 +116,7 @@ void KinkFront<dim>::evaluate(const StringModel<dim>& model, FrontState<dim>& s,
   if (!(dd > 0)) throw RecoverableError("the kink's arms are on one line");
   const Vec<dim> chord = x.col(b) - x.col(a), u = v.col(b) - v.col(a);
   const Vec<dim> w = chord - h * tB, w_rate = u - h * tB_rate;
-  const double lA = w.dot(d) / dd, lB = h - lA;
+  const double lA = meeting_point(d, dd, w), lB = h - lA;
   const double lA_rate = (w_rate.dot(d) + w.dot(d_rate)) / dd - 2 * w.dot(d) * d.dot(d_rate) / (dd * dd);
   const double sd = u.dot(d) / dd;
   chord_ = chord.norm() / h;
@@ -215,6 +215,31 @@ EventAction KinkFront<dim>::cross(StringModel<dim>& model, const FrontState<dim>
     return {EventAction::Kind::kStop,
             fmt::format("the kink has reached the {} of the string (its arms need a full link on either side)",
                         to_A ? "end" : "start")};
+  // Across node n (b, or a) the kinked link becomes an arm and the arc's next link the other arm. The new arms
+  // meet at l⁻ from the new kinked link's start, usually inside it (a partial link of −10⁻² h is routine and
+  // harmless: the front moves on into the link); where the string turns sharply one link beyond n (a free
+  // end's tip curling), they meet more than h/2 outside it, and the re-lumped node there, λ (h/2 + l⁻) or
+  // λ (h/2 + l⁺), would have no mass: the discrete kink cannot pass that corner (docs/model.md §9).
+  const Points<dim>& x = model.x();
+  const double h = this->m_.h;
+  const int n = to_A ? B.first : A.last;
+  const int p = to_A ? n : n - 1;  // the new kinked link (p, p + 1), its arms (p − 1, p) and (p + 1, p + 2)
+  const Vec<dim> tA = (x.col(p) - x.col(p - 1)).normalized(), tB = (x.col(p + 2) - x.col(p + 1)).normalized();
+  const Vec<dim> d = tA - tB;
+  const double dd = d.squaredNorm();
+  const double lA = dd > 0 ? meeting_point(d, dd, Vec<dim>(x.col(p + 1) - x.col(p) - h * tB)) : 0.5 * h;
+  if (!(lA > -0.5 * h && lA < 1.5 * h)) {
+    const int corner = to_A ? n + 1 : n - 1;
+    const Vec<dim> t_in = (x.col(to_A ? n + 1 : n) - x.col(to_A ? n : n - 1)).normalized(), t_out = to_A ? tB : tA;
+    const double corner_deg = std::acos(std::clamp(t_in.dot(t_out), -1.0, 1.0)) * 180 / kPi;
+    return {EventAction::Kind::kStop,
+            fmt::format("the kink at s0 = {:.6g} m (its arms turning by {:.3g} degrees) has reached node {} with a second "
+                        "corner one link beyond it: the string turns by {:.3g} degrees at node {}, so that across node "
+                        "{} the kink's arms would meet {:.3g} h outside the next link and node {} would keep no mass "
+                        "(the discrete kink's arms need a straight link on either side; docs/model.md §9)",
+                        state.s0, 180 - state.opening * 180 / kPi, n, corner_deg, corner, n,
+                        lA < 0 ? -lA / h : lA / h - 1, lA < 0 ? p : p + 1)};
+  }
   return SplitLinkFront<dim>::cross(model, state, e0);
 }
 

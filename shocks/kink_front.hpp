@@ -65,6 +65,9 @@ class KinkFront final : public SplitLinkFront<dim> {
 
  private:
   double turn_margin(const FrontState<dim>& state) const;
+  /// Where the arms meet in the kinked link (a, b): l⁻ = w·d / |d|², the least-squares solution of
+  /// x_b − x_a = l⁻ t_A + (h − l⁻) t_B, with d = t_A − t_B (dd = |d|²) and w = x_b − x_a − h t_B.
+  static double meeting_point(const Vec<dim>& d, double dd, const Vec<dim>& w) { return w.dot(d) / dd; }
 
   double chord_ = 0;  ///< |x_b − x_a| / h of the kinked link
   KinkSpec spec_;

@@ -602,3 +602,49 @@ TEST_CASE("the swinging U's kink: the corner of the arm next to it is not the ki
     CHECK(turn - median(after) > 1.5);             // it grows between crossings
   }
 }
+
+TEST_CASE("the thrown chain's inserted kink runs into the curled tip: a located stop, not a node without mass",
+          "[kink][slack]") {
+  // cases/scenes/thrown_chain.toml with kinks = "insert": the kink forms at 0.696 s and runs to the free end. On 81
+  // nodes it reaches the end (its arms need a full link on either side); on 161 nodes the tip has curled by 73°
+  // at node 159 when the kink reaches node 158, the arms (157, 158) and (159, 160) meet 0.78 h before link
+  // (158, 159), and the crossing used to leave node 158 without mass (exit 3, docs/model.md §9).
+  const std::filesystem::path file = std::filesystem::path(CHAINSIM_SOURCE_DIR) / "cases" / "scenes" / "thrown_chain.toml";
+  std::vector<double> t_stop;
+  for (const int nodes : {81, 161}) {
+    const SceneSpec spec = parse_scene(file, {"string.nodes=" + std::to_string(nodes), "solver.kinks=\"insert\"",
+                                              "output.interval=0.5"});
+    StringScene<2> scene = build_string_scene<2>(spec);
+    StringSolver<2> solver(*scene.model, scene.solver);
+    const RunSummary r = solver.run();
+    CAPTURE(nodes, r.stop_reason, r.error);
+    REQUIRE(r.status == "stopped");
+    t_stop.push_back(r.t_stop);
+    // The ledgers at the stop (measured relative energy residual 1.3e-5 and 6.6e-6, momentum 0).
+    CHECK(std::abs(r.relative_energy_residual()) < 4e-5);
+    CHECK(r.relative_momentum_residual() < 1e-9);
+    if (nodes == 81) {
+      CHECK(r.stop_reason.find("has reached the end of the string") != std::string::npos);
+      continue;
+    }
+    CHECK(r.stop_reason.find("reached node 158 with a second corner") != std::string::npos);
+    // The arms' lines, intersected by Cramer's rule (the kink computes a least-squares meeting point): at the stop
+    // the kink sits on node 158, and the lines of links (157, 158) and (159, 160) cross more than h/2 before
+    // node 158, where the re-lumped node 158, λ (h/2 + l⁻), would have no mass (measured l = −1.34 h; the
+    // least-squares meeting point the stop reports, −0.78 h).
+    const Points<2>& x = scene.model->x();
+    const double h = 1.0 / 160;
+    const Vec<2> tA = (x.col(158) - x.col(157)).normalized(), tB = (x.col(160) - x.col(159)).normalized();
+    const Vec<2> rhs = x.col(159) - x.col(158);  // x158 + l tA = x159 − m tB: l tA + m tB = rhs
+    const double det = tA[0] * tB[1] - tA[1] * tB[0];
+    REQUIRE(std::abs(det) > 0.1);
+    const double l = (rhs[0] * tB[1] - rhs[1] * tB[0]) / det;
+    CAPTURE(l / h);
+    CHECK(l < -0.5 * h);
+    const Vec<2> t_tip = (x.col(159) - x.col(158)).normalized();
+    CHECK(std::acos(t_tip.dot(tB)) * 180 / kPi > 45);
+  }
+  // The kink reaches the tip at one time on both meshes (measured 0.72360 and 0.72365 s).
+  CHECK(t_stop[0] == Approx(0.7236).margin(2e-4));
+  CHECK(std::abs(t_stop[1] - t_stop[0]) < 2e-4);
+}
