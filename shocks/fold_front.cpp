@@ -75,8 +75,8 @@ void FoldFront<dim>::evaluate(const StringModel<dim>& model, FrontState<dim>& s,
 
 template <int dim>
 void FoldFront<dim>::crossings(const StringModel<dim>& /*model*/, const FrontState<dim>& s, double* g) const {
-  g[0] = s.l_plus + kHysteresis * this->m_.h;
-  g[1] = s.l_minus + kHysteresis * this->m_.h;
+  g[0] = s.l_plus + kCrossingHysteresis * this->m_.h;
+  g[1] = s.l_minus + kCrossingHysteresis * this->m_.h;
 }
 
 template <int dim>

@@ -29,17 +29,16 @@ class FoldFront final : public SplitLinkFront<dim> {
   /// docs/shocks.md "A fold whose arms turn apart").
   static double max_chord() { return 1 / std::cos(0.5 * kMaxOpeningDeg * kPi / 180); }
 
-  /// The fold crosses a node when a partial link reaches −kHysteresis h, not 0 (as a heap's thresholds are
-  /// moved out, heap_front.cpp): a crossing leaves the new split link's other partial link at about 0, and a
-  /// fold placed on a node starts there, so that a fold at rest on a node (a folded chain in free fall,
-  /// ṡ0 = 0) sits kHysteresis h from either threshold instead of on one, where round-off of 1e-17 m decided
-  /// the crossings (docs/shocks.md, "A fold at rest on a node").
-  static constexpr double kHysteresis = 1e-6;
   const char* name() const override { return "fold"; }
   const char* placed() const override { return "fold"; }
 
   void check_initial(const FrontState<dim>& state) const override;
-  /// g[0] = l⁺ + kHysteresis h (the fold reaches arc B's first node), g[1] = l⁻ + kHysteresis h (arc A's last).
+  /// g[0] = l⁺ + kCrossingHysteresis h (the fold reaches arc B's first node), g[1] = l⁻ + kCrossingHysteresis h
+  /// (arc A's last). The thresholds lie past the nodes, not on them (as a heap's are moved out, heap_front.cpp):
+  /// a crossing leaves the new split link's other partial link at about 0, and a fold placed on a node starts
+  /// there, so a fold at rest on a node (a folded chain in free fall, ṡ0 = 0) sits kCrossingHysteresis h from
+  /// either threshold instead of on one, where round-off of 1e-17 m decided the crossings (docs/shocks.md,
+  /// "A fold at rest on a node").
   void crossings(const StringModel<dim>& model, const FrontState<dim>& state, double* g) const override;
   void evaluate(const StringModel<dim>& model, FrontState<dim>& state, Eigen::VectorXd& mass,
                 Points<dim>& force) override;

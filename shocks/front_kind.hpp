@@ -27,6 +27,13 @@
 
 namespace chainsim {
 
+/// How far past a node's layout a front's crossing threshold lies, in links: a root function that a
+/// crossing, or the initial layout, leaves exactly at zero is not reported by ARKODE (it finds sign
+/// changes), and a front at rest on its threshold crosses back and forth on round-off. Heaps widen their
+/// band [h/2, 3h/2] by it (heap_front.cpp), folds cross at a partial link of −kCrossingHysteresis·h
+/// (fold_front.hpp; docs/shocks.md, "A fold at rest on a node").
+inline constexpr double kCrossingHysteresis = 1e-6;
+
 /// The material the fronts cut: set once the chain is known.
 struct FrontMaterial {
   double h = 0;       ///< material length of a link (m)

@@ -16,9 +16,9 @@ namespace chainsim {
 namespace {
 /// A heap takes in an arc's end node when its partial link shrinks to kRemove·h and gives out a new
 /// node when it grows to kInsert·h: the partial link stays in [h/2, 3h/2], away from zero length
-/// (where its direction is undefined), widened by kHysteresis·h on either side. The initial layout
+/// (where its direction is undefined), widened by kCrossingHysteresis·h on either side (front_kind.hpp). The initial layout
 /// puts the partial link in [h/2, 3h/2) (up to 1e-9 h), and a crossing moves it by h, so that every
-/// root function starts at least ~kHysteresis·h from zero. With the thresholds at exactly h/2 and
+/// root function starts at least ~kCrossingHysteresis·h from zero. With the thresholds at exactly h/2 and
 /// 3h/2, a front starting exactly h/2 past a node had a root function that was zero where the
 /// integration starts, which ARKODE does not report: the falling chain from eta0 = 0.5 on 4, 6 and 10
 /// nodes ran past it unseen and stalled. Crossing it at t = 0 instead left the partial link on the
@@ -26,8 +26,7 @@ namespace {
 /// the partial link (1e-23 m against 1e-17 m): that sign noise gave the opposite crossing at
 /// t = 1.5e-9 s (14 nodes). A band wider by a quarter link avoided both but used the end interpolant
 /// further from the nodes and cost the swinging sliding chain its convergence (order -1.08).
-constexpr double kHysteresis = 1e-6;
-constexpr double kRemove = 0.5 - kHysteresis, kInsert = 1.5 + kHysteresis;
+constexpr double kRemove = 0.5 - kCrossingHysteresis, kInsert = 1.5 + kCrossingHysteresis;
 /// The last node of an arc cannot be taken in; the run stops when its partial link is this short.
 constexpr double kLastPartial = 1e-3;
 /// A heap whose content is below this fraction of the string's length (64 ε) is empty.
@@ -208,7 +207,7 @@ HeapFront<dim>::HeapFront(const HeapSpec<dim>& spec)
 
 template <int dim>
 void HeapFront<dim>::trim(FrontLayout& layout) const {
-  // The partial link starts in [h/2, 3h/2) (up to 1e-9 h), inside the thresholds by about kHysteresis·h.
+  // The partial link starts in [h/2, 3h/2) (up to 1e-9 h), inside the thresholds by about kCrossingHysteresis·h.
   const double h = this->m_.h;
   const int n = this->m_.n;
   if (!after_)

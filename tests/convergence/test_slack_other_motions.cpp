@@ -286,7 +286,7 @@ TEST_CASE("slack: a folded chain jerked down, its fold at rest on a node until t
   // the fold "come apart" (its folded link 1.0154 h long); with one frame at 0.2 s it made 6 such crossings and
   // finished; on 401 nodes it came apart with one frame and with frames every 0.01 s. Each output time further
   // apart than the steps is a stop time that shortens one step, so the interval changes the step path and the
-  // state's round-off, and with it the result. The thresholds are now −kHysteresis h (FoldFront). Measured: both
+  // state's round-off, and with it the result. The thresholds are now −kCrossingHysteresis h (shocks/front_kind.hpp). Measured: both
   // intervals complete with 10 crossings on 101 nodes and 40 on 401 (s0(0.2 s) = 0.40094, 0.40096 m); the states
   // at 0.2 s differ by 1.5e-13 m on 101 nodes and by 1.9e-6 m on 401 (s0 by 3e-14 and 9.5e-7 m); relative energy
   // residuals ≤ 2.8e-11, momentum ≤ 5.1e-12. The 401-node difference is the slack chain's, before the fold moves:
