@@ -159,25 +159,38 @@ Vec<dim> TouchdownFront<dim>::recorded_reaction(const StringModel<dim>& model, c
 
 template <int dim>
 void TouchdownFront<dim>::crossings(const StringModel<dim>& /*model*/, const FrontState<dim>& s, double* g) const {
-  g[0] = s.l_plus / this->m_.h - kCross;
-  g[1] = s.l_minus / this->m_.h + kCross;
+  g[0] = s.l_plus / this->m_.h + kHysteresis;
+  g[1] = s.l_minus / this->m_.h + kHysteresis;
 }
 
 template <int dim>
 EventAction TouchdownFront<dim>::cross(StringModel<dim>& model, const FrontState<dim>& state, int e0) {
-  const int b = this->node_b(model);
+  const int a = this->node_a(model), b = this->node_b(model);
+  const double h = this->m_.h;
+  Points<dim>& x = model.x();
+  // Where the crossing node's material is: a landing node b (the front kHysteresis h past it) lies on the
+  // plane at h from a, so that the link (a, b) keeps its length and s0 runs on; a lifting node a (the front
+  // kHysteresis h behind it) is on the arc's first link at h from b. The node moves by about kHysteresis h
+  // (the root's l± = −kHysteresis h), and the new split link's other partial link starts at kHysteresis h.
+  Vec<dim> placed = Vec<dim>::Zero();
+  if (e0 != 0) {
+    placed = x.col(a) - normal_.dot(x.col(a) - point_) * normal_ + h * along_;
+  } else if (b + 1 < static_cast<int>(x.cols())) {
+    const Vec<dim> link = x.col(b + 1) - x.col(b);
+    placed = x.col(b) - h * link.normalized();
+  }
   EventAction action = SplitLinkFront<dim>::cross(model, state, e0);
   if (action.kind == EventAction::Kind::kStop) return action;
   if (e0 != 0) {
-    // Node b has reached x0 (to the root's accuracy) and joined the lying arc with its velocity: it lies
-    // on the plane, where the contact module holds it.
-    Points<dim>& x = model.x();
-    x.col(b) -= normal_.dot(x.col(b) - point_) * normal_;
+    // Node b has joined the lying arc with its velocity: it lies on the plane, where the contact module
+    // holds it.
+    x.col(b) = placed;
     Points<dim>& v = model.v();
     v.col(b) -= normal_.dot(v.col(b)) * normal_;
     lying_last_ = b;
   } else {
-    lying_last_ = b - 2;
+    x.col(a) = placed;
+    lying_last_ = a - 1;
   }
   return action;
 }
