@@ -24,6 +24,7 @@
 namespace chainsim {
 
 using scene_build::as_vec;
+using scene_build::as_unit_vec;
 using scene_build::at_key;
 using scene_build::fail_at;
 using scene_build::text_of;
@@ -202,7 +203,7 @@ std::unique_ptr<StringModel<dim>> build_front_model(const SceneSpec& spec, scene
     if (fx.surfaces[k].f)
       fail_at(spec, fmt::format("effects.surface[{}].f", k),
               fmt::format("effects.surface[{}].f = {} on a closed string: a touchdown front is tracked on open strings "
-                          "only (string.closed = true); leave out f (node contact) or open the string",
+                          "only (string.closed = false); allowed: leave out f (node contact) or open the string",
                           k, text_of(spec, fmt::format("effects.surface[{}].f", k))));
   check_open_string(chain.closed(), !fx.heaps.empty(), keys);
   if (chain.num_links() < 2) {
@@ -492,7 +493,7 @@ std::unique_ptr<StringModel<dim>> build_front_model(const SceneSpec& spec, scene
     if constexpr (dim == 3)
       fail_at(spec, key + ".f",
               fmt::format("{}.f = {}: a touchdown front is built in 2D only (string.dimension = 2); in 3D leave out f "
-                          "(node contact lands the string, f = 1 in the limit)",
+                          "(node contact lands the string: it loses the energy of an f = 1 front, not its momentum, docs/model.md §10)",
                           key, text_of(spec, key + ".f")));
     if (!fx.heaps.empty() || fx.fold || !fx.edges.empty() || !fx.kinks.empty() || spec.solver.kinks == "insert" ||
         !touchdowns.empty() || !fx.cylinders.empty())
@@ -502,7 +503,7 @@ std::unique_ptr<StringModel<dim>> build_front_model(const SceneSpec& spec, scene
                           key, text_of(spec, key + ".f")));
     TouchdownSpec<dim> td;
     td.point = as_vec<dim>(spec, fx.surfaces[k].point, key + ".point");
-    td.normal = as_vec<dim>(spec, fx.surfaces[k].normal, key + ".normal").stableNormalized();
+    td.normal = as_unit_vec<dim>(spec, fx.surfaces[k].normal, key + ".normal", "a normal");
     td.dissipation = *fx.surfaces[k].f;
     td.name = key;
     const double h = chain.link_length(0), tol = 1e-11 * ell;
