@@ -211,11 +211,15 @@ typename TouchdownFront<dim>::Margins TouchdownFront<dim>::margins(const StringM
   }
   // The plane's push at the front, N = n·(the front's reaction, the constraint's share included), per the
   // scale λ |[v]|² of the jump conditions' forces, less 10⁻⁶ of it (N = 0 for f = 0): a take-off with f > 0
-  // (N = −f λ ṡ0² sin θ) and a front whose compatibility would need a pull both stop the run.
+  // (N = −f λ ṡ0² sin θ) and a front whose compatibility would need a pull both stop the run. A round-off floor
+  // of 10⁻⁸ of the string's physical tension scale (StringModel::physical_scales) keeps a front with f = 0
+  // that comes to rest (ṡ0 → 0, [v] → 0, N the integration error of the constraint's share: 3.4e-11 N on the
+  // reversing drawn string of test [touchdown], 1.4e-12 of its scale) from stopping the run.
   const Vec<dim> jump_v = model.v().col(B.first) - model.v().col(B.first - 1);
   const double scale = this->m_.lambda * jump_v.squaredNorm();
+  const double floor = 1e-8 * model.physical_scales().tension;
   const double push = normal_.dot(recorded_reaction(model, s));
-  m.take_off = scale > 0 ? std::min(1.0, push / scale + 1e-6) : 1.0;
+  m.take_off = scale + floor > 0 ? std::min(1.0, (push + 1e-6 * scale + floor) / (scale + 1e6 * floor)) : 1.0;
   return m;
 }
 
