@@ -543,6 +543,14 @@ std::unique_ptr<StringModel<dim>> build_front_model(const SceneSpec& spec, scene
                             key, text_of(spec, key + ".f"), i, chain.node_coordinate(i), td.s0));
     touchdowns.emplace_back(k, td);
   }
+  // The touchdown front named touchdown<k> (k: its surface's index), which front_names lists for every surface
+  // with f.
+  auto touchdown_named = [&](const std::string& name) -> const std::pair<std::size_t, TouchdownSpec<dim>>& {
+    const auto it = std::find_if(touchdowns.begin(), touchdowns.end(),
+                                 [&](const auto& p) { return name == fmt::format("touchdown{}", p.first); });
+    CHAINSIM_VERIFY(it != touchdowns.end(), fmt::format("the front {} has no surface with f", name));
+    return *it;
+  };
 
   // 5. Stop events: a front reaching a material coordinate inside the string.
   const std::vector<std::string> names = scene_build::front_names(spec);
@@ -559,10 +567,7 @@ std::unique_ptr<StringModel<dim>> build_front_model(const SceneSpec& spec, scene
                            : name == "heap_start"       ? s_lo
                            : name == "heap_end"         ? s_hi
                            : name == "kink_formed"      ? std::numeric_limits<double>::quiet_NaN()
-                           : name.rfind("touchdown", 0) == 0
-                               ? std::find_if(touchdowns.begin(), touchdowns.end(),
-                                              [&](const auto& p) { return name == fmt::format("touchdown{}", p.first); })
-                                     ->second.s0
+                           : name.rfind("touchdown", 0) == 0 ? touchdown_named(name).second.s0
                            : name.rfind("kink", 0) == 0 ? kinks[std::stoul(name.substr(4))].s0
                                                         : edges[std::stoul(name.substr(4))].s0;
     if (std::abs(s - s_start) <= kPlaceTolerance * ell)
@@ -691,8 +696,7 @@ std::unique_ptr<StringModel<dim>> build_front_model(const SceneSpec& spec, scene
     } else if (name == "fold") {
       f["s0"] = fold->s0;
     } else if (name.rfind("touchdown", 0) == 0) {
-      const auto& td = *std::find_if(touchdowns.begin(), touchdowns.end(),
-                                     [&](const auto& p) { return name == fmt::format("touchdown{}", p.first); });
+      const auto& td = touchdown_named(name);
       f["s0"] = td.second.s0;
       f["surface"] = td.first;
     } else if (name == "kink_formed") {  // not in the string until a kink forms
