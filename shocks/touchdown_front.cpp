@@ -133,6 +133,7 @@ void TouchdownFront<dim>::constraints(const StringModel<dim>& model, const Front
   // C̈ at zero accelerations: 2 ẏ T' θ̇ + y (T' T θ̇² + T' θ̈0), θ̈0 = −2 θ̇ (t·w)/L.
   c.curvature = 2 * g.y_dot * T1 * g.theta_dot +
                 g.y * (T1 * T * g.theta_dot * g.theta_dot - 2 * T1 * g.theta_dot * g.t_w / g.L);
+  constraint_index_ = out.size();
   out.push_back(std::move(c));
 }
 
@@ -142,14 +143,11 @@ Vec<dim> TouchdownFront<dim>::constraint_force(const StringModel<dim>& model) co
   // front's reaction that the multiplier carries.
   const auto& cs = model.node_constraints();
   const Eigen::VectorXd& mu = model.constraint_multipliers();
-  const int a = this->node_a(model);
-  for (std::size_t k = 0; k < cs.size() && static_cast<Eigen::Index>(k) < mu.size(); ++k)
-    if (cs[k].nodes.size() == 3 && cs[k].nodes[0] == a) {
-      Vec<dim> sum = Vec<dim>::Zero();
-      for (int q = 0; q < 3; ++q) sum += cs[k].gradient.col(q);
-      return mu[static_cast<Eigen::Index>(k)] * sum;
-    }
-  return Vec<dim>::Zero();
+  const std::size_t k = constraint_index_;
+  if (k >= cs.size() || static_cast<Eigen::Index>(k) >= mu.size()) return Vec<dim>::Zero();  // none solved yet
+  Vec<dim> sum = Vec<dim>::Zero();
+  for (int q = 0; q < 3; ++q) sum += cs[k].gradient.col(q);
+  return mu[static_cast<Eigen::Index>(k)] * sum;
 }
 
 template <int dim>

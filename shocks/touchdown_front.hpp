@@ -112,6 +112,9 @@ class TouchdownFront final : public SplitLinkFront<dim> {
   std::string surface_;
   int lying_last_ = -1;
   double theta_ = 0;
+  /// The index of this front's constraint in the model's list (constraints() appends it to the list the model
+  /// rebuilds from every front), for constraint_force.
+  mutable std::size_t constraint_index_ = static_cast<std::size_t>(-1);
 };
 
 /// The surface's obstacle holding the lying arc of `front` only (its nodes up to front.lying_last()).
