@@ -82,12 +82,9 @@ void TouchdownFront<dim>::evaluate(const StringModel<dim>& model, FrontState<dim
   // compatible, −t·[v] = ṡ0 (1 − cos θ)); the lying end along e by τ⁻, so that the momentum along the
   // plane is exact.
   const Vec<dim> ud = v.col(b) - v.col(a);
-  const double jump2 = ud.squaredNorm(), t_jump = -g.t.dot(ud);
-  const double weight = 1 - f * jump::sign(sd);
-  const double tau_p = std::abs(t_jump) > 1e-9 * std::sqrt(jump2) * (1 - g.cos)
-                           ? weight * 0.5 * lambda * sd * jump2 / t_jump
-                           : weight * lambda * sd * sd;
-  const double tau_m = lambda * sd * ud.dot(e) + tau_p * g.cos;
+  const double jump2 = ud.squaredNorm();
+  const double tau_p = jump::touchdown_tension_plus<dim>(g.t, g.cos, ud, f, lambda, sd);
+  const double tau_m = jump::touchdown_tension_minus<dim>(tau_p, e, g.cos, ud, lambda, sd);
   s.s0 = model.chain().node_coordinate(a) + g.l_minus;
   s.s0_dot = sd;
   s.l_minus = g.l_minus;
@@ -105,7 +102,7 @@ void TouchdownFront<dim>::evaluate(const StringModel<dim>& model, FrontState<dim
   force.col(b) -= tau_p * g.t;
   // The front's reaction: what the loads and the material moved from b to a change in the lumped
   // momentum (normal to the plane by τ⁻'s choice); the constraint's share is added where it is known.
-  s.reaction = tau_m * e - tau_p * g.t + lambda * sd * (v.col(a) - v.col(b));
+  s.reaction = jump::touchdown_reaction<dim>(e, g.t, tau_m, tau_p, ud, lambda, sd);
   s.power_shock = -jump::dissipation_rate(f, lambda, sd, jump2);
   // The reaction's work on node a's drift off the plane (zero on the plane): the loads' power is W_s plus
   // this, exactly.
