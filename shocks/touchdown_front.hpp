@@ -24,8 +24,10 @@
 /// need the plane to pull, and so would a lying part whose motion disagrees with the arc's end (the
 /// constraint's multiplier): the front's check stops the run where its reaction reaches zero (a
 /// lift-off event); f = 0 peels off without a reaction.
-/// Crossings are the split link's (SplitLinkFront): a node of B that reaches x0 (landing) joins A with
-/// A's velocity and is put on the plane, where the contact module holds it.
+/// Crossings are the split link's (SplitLinkFront), kHysteresis h past a node: a node of B that the front
+/// passes (landing) joins A with A's velocity and is put on the plane at h from A's last node, where the
+/// contact module holds it; a node of A that it passes (take-off) joins B, put on B's first link at h from
+/// B's first node.
 #include <string>
 
 #include "shocks/split_link_front.hpp"

@@ -529,6 +529,14 @@ std::unique_ptr<StringModel<dim>> build_front_model(const SceneSpec& spec, scene
       (std::abs(height(mid)) <= tol ? lo : hi) = mid;
     }
     td.s0 = lo;
+    // lo is the last point within the height tolerance, tol / sin θ before where the shape leaves the plane: the
+    // height's secant just past hi puts s0 where the height is zero (exact on a straight arc; the run refuses
+    // arcs under 5°, so the step is at most 12 tol).
+    const double d = 1e-6 * ell, y1 = height(hi), y2 = height(hi + d);
+    if (y1 > 0 && y2 > y1) {
+      const double s_zero = hi - y1 * d / (y2 - y1);
+      if (s_zero <= hi && s_zero >= hi - 100 * tol) td.s0 = s_zero;
+    }
     const double frac = td.s0 / h - std::floor(td.s0 / h);
     if (std::min(frac, 1 - frac) < 1e-6)
       fail_at(spec, key + ".f",
