@@ -216,4 +216,40 @@ double pinned_lift_off_margin(const Vector<dim>& force, const Vector<dim>& t_min
   return std::min(force.dot(pm), -force.dot(pp));
 }
 
+// --- A touchdown front: a string leaving or landing on a smooth plane (docs/model.md §10) ------------
+// The lying side (s < s0) runs along the plane in the direction e, the arc (s > s0) leaves it along t at the
+// angle θ (cos θ = t·e); [v] = v⁺ − v⁻ is the jump of the velocities across the front (in the discrete front,
+// of its two nodes). On a compatible state, [v] = −ṡ0 (t − e), the three give the closed forms
+//   τ⁺ = (1 − f sgn ṡ0) λ ṡ0²,  τ⁻ = λ ṡ0² (1 − f sgn ṡ0 cos θ),  R = f λ ṡ0 |ṡ0| sin θ n
+// (R normal to the plane, n on the arc's side), and the loads −τ⁺ t, τ⁻ e work at exactly −½ f λ |ṡ0| |[v]|².
+
+/// τ⁺ = (1 − f sgn ṡ0) λ ṡ0 |[v]|² / (2 (−t·[v])), the arc's tension at a touchdown front (N): the value that
+/// makes the loads' power −½ f λ |ṡ0| |[v]|² for any [v]; (1 − f sgn ṡ0) λ ṡ0² where −t·[v] vanishes (no jump,
+/// or one normal to t).
+template <int dim>
+double touchdown_tension_plus(const Vector<dim>& t, double cos_theta, const Vector<dim>& jump_v, double dissipation,
+                              double density, double s0_dot) {
+  const double jump2 = jump_v.squaredNorm(), t_jump = -t.dot(jump_v);
+  const double weight = 1 - dissipation * sign(s0_dot);
+  return std::abs(t_jump) > 1e-9 * std::sqrt(jump2) * (1 - cos_theta)
+             ? weight * 0.5 * density * s0_dot * jump2 / t_jump
+             : weight * density * s0_dot * s0_dot;
+}
+
+/// τ⁻ = λ ṡ0 [v]·e + τ⁺ cos θ, the lying side's tension at a touchdown front (N): the value that keeps the
+/// momentum along the plane (e) exact.
+template <int dim>
+double touchdown_tension_minus(double tension_plus, const Vector<dim>& e, double cos_theta, const Vector<dim>& jump_v,
+                               double density, double s0_dot) {
+  return density * s0_dot * jump_v.dot(e) + tension_plus * cos_theta;
+}
+
+/// R = τ⁻ e − τ⁺ t − λ ṡ0 [v]: the plane's force on the string at a touchdown front (N), the momentum the
+/// loads and the material moved across the front change; normal to the plane by τ⁻'s choice.
+template <int dim>
+Vector<dim> touchdown_reaction(const Vector<dim>& e, const Vector<dim>& t, double tension_minus, double tension_plus,
+                               const Vector<dim>& jump_v, double density, double s0_dot) {
+  return tension_minus * e - tension_plus * t - density * s0_dot * jump_v;
+}
+
 }  // namespace chainsim::jump

@@ -82,12 +82,9 @@ void TouchdownFront<dim>::evaluate(const StringModel<dim>& model, FrontState<dim
   // compatible, −t·[v] = ṡ0 (1 − cos θ)); the lying end along e by τ⁻, so that the momentum along the
   // plane is exact.
   const Vec<dim> ud = v.col(b) - v.col(a);
-  const double jump2 = ud.squaredNorm(), t_jump = -g.t.dot(ud);
-  const double weight = 1 - f * jump::sign(sd);
-  const double tau_p = std::abs(t_jump) > 1e-9 * std::sqrt(jump2) * (1 - g.cos)
-                           ? weight * 0.5 * lambda * sd * jump2 / t_jump
-                           : weight * lambda * sd * sd;
-  const double tau_m = lambda * sd * ud.dot(e) + tau_p * g.cos;
+  const double jump2 = ud.squaredNorm();
+  const double tau_p = jump::touchdown_tension_plus<dim>(g.t, g.cos, ud, f, lambda, sd);
+  const double tau_m = jump::touchdown_tension_minus<dim>(tau_p, e, g.cos, ud, lambda, sd);
   s.s0 = model.chain().node_coordinate(a) + g.l_minus;
   s.s0_dot = sd;
   s.l_minus = g.l_minus;
@@ -105,7 +102,7 @@ void TouchdownFront<dim>::evaluate(const StringModel<dim>& model, FrontState<dim
   force.col(b) -= tau_p * g.t;
   // The front's reaction: what the loads and the material moved from b to a change in the lumped
   // momentum (normal to the plane by τ⁻'s choice); the constraint's share is added where it is known.
-  s.reaction = tau_m * e - tau_p * g.t + lambda * sd * (v.col(a) - v.col(b));
+  s.reaction = jump::touchdown_reaction<dim>(e, g.t, tau_m, tau_p, ud, lambda, sd);
   s.power_shock = -jump::dissipation_rate(f, lambda, sd, jump2);
   // The reaction's work on node a's drift off the plane (zero on the plane): the loads' power is W_s plus
   // this, exactly.
@@ -133,6 +130,7 @@ void TouchdownFront<dim>::constraints(const StringModel<dim>& model, const Front
   // C̈ at zero accelerations: 2 ẏ T' θ̇ + y (T' T θ̇² + T' θ̈0), θ̈0 = −2 θ̇ (t·w)/L.
   c.curvature = 2 * g.y_dot * T1 * g.theta_dot +
                 g.y * (T1 * T * g.theta_dot * g.theta_dot - 2 * T1 * g.theta_dot * g.t_w / g.L);
+  constraint_index_ = out.size();
   out.push_back(std::move(c));
 }
 
@@ -142,14 +140,11 @@ Vec<dim> TouchdownFront<dim>::constraint_force(const StringModel<dim>& model) co
   // front's reaction that the multiplier carries.
   const auto& cs = model.node_constraints();
   const Eigen::VectorXd& mu = model.constraint_multipliers();
-  const int a = this->node_a(model);
-  for (std::size_t k = 0; k < cs.size() && static_cast<Eigen::Index>(k) < mu.size(); ++k)
-    if (cs[k].nodes.size() == 3 && cs[k].nodes[0] == a) {
-      Vec<dim> sum = Vec<dim>::Zero();
-      for (int q = 0; q < 3; ++q) sum += cs[k].gradient.col(q);
-      return mu[static_cast<Eigen::Index>(k)] * sum;
-    }
-  return Vec<dim>::Zero();
+  const std::size_t k = constraint_index_;
+  if (k >= cs.size() || static_cast<Eigen::Index>(k) >= mu.size()) return Vec<dim>::Zero();  // none solved yet
+  Vec<dim> sum = Vec<dim>::Zero();
+  for (int q = 0; q < 3; ++q) sum += cs[k].gradient.col(q);
+  return mu[static_cast<Eigen::Index>(k)] * sum;
 }
 
 template <int dim>
@@ -159,25 +154,38 @@ Vec<dim> TouchdownFront<dim>::recorded_reaction(const StringModel<dim>& model, c
 
 template <int dim>
 void TouchdownFront<dim>::crossings(const StringModel<dim>& /*model*/, const FrontState<dim>& s, double* g) const {
-  g[0] = s.l_plus / this->m_.h - kCross;
-  g[1] = s.l_minus / this->m_.h + kCross;
+  g[0] = s.l_plus / this->m_.h + kHysteresis;
+  g[1] = s.l_minus / this->m_.h + kHysteresis;
 }
 
 template <int dim>
 EventAction TouchdownFront<dim>::cross(StringModel<dim>& model, const FrontState<dim>& state, int e0) {
-  const int b = this->node_b(model);
+  const int a = this->node_a(model), b = this->node_b(model);
+  const double h = this->m_.h;
+  Points<dim>& x = model.x();
+  // Where the crossing node's material is: a landing node b (the front kHysteresis h past it) lies on the
+  // plane at h from a, so that the link (a, b) keeps its length and s0 runs on; a lifting node a (the front
+  // kHysteresis h behind it) is on the arc's first link at h from b. The node moves by about kHysteresis h
+  // (the root's l± = −kHysteresis h), and the new split link's other partial link starts at kHysteresis h.
+  Vec<dim> placed = Vec<dim>::Zero();
+  if (e0 != 0) {
+    placed = x.col(a) - normal_.dot(x.col(a) - point_) * normal_ + h * along_;
+  } else if (b + 1 < static_cast<int>(x.cols())) {
+    const Vec<dim> link = x.col(b + 1) - x.col(b);
+    placed = x.col(b) - h * link.normalized();
+  }
   EventAction action = SplitLinkFront<dim>::cross(model, state, e0);
   if (action.kind == EventAction::Kind::kStop) return action;
   if (e0 != 0) {
-    // Node b has reached x0 (to the root's accuracy) and joined the lying arc with its velocity: it lies
-    // on the plane, where the contact module holds it.
-    Points<dim>& x = model.x();
-    x.col(b) -= normal_.dot(x.col(b) - point_) * normal_;
+    // Node b has joined the lying arc with its velocity: it lies on the plane, where the contact module
+    // holds it.
+    x.col(b) = placed;
     Points<dim>& v = model.v();
     v.col(b) -= normal_.dot(v.col(b)) * normal_;
     lying_last_ = b;
   } else {
-    lying_last_ = b - 2;
+    x.col(a) = placed;
+    lying_last_ = a - 1;
   }
   return action;
 }
@@ -198,11 +206,15 @@ typename TouchdownFront<dim>::Margins TouchdownFront<dim>::margins(const StringM
   }
   // The plane's push at the front, N = n·(the front's reaction, the constraint's share included), per the
   // scale λ |[v]|² of the jump conditions' forces, less 10⁻⁶ of it (N = 0 for f = 0): a take-off with f > 0
-  // (N = −f λ ṡ0² sin θ) and a front whose compatibility would need a pull both stop the run.
+  // (N = −f λ ṡ0² sin θ) and a front whose compatibility would need a pull both stop the run. A round-off floor
+  // of 10⁻⁸ of the string's physical tension scale (StringModel::physical_scales) keeps a front with f = 0
+  // that comes to rest (ṡ0 → 0, [v] → 0, N the integration error of the constraint's share: 3.4e-11 N on the
+  // reversing drawn string of test [touchdown], 1.4e-12 of its scale) from stopping the run.
   const Vec<dim> jump_v = model.v().col(B.first) - model.v().col(B.first - 1);
   const double scale = this->m_.lambda * jump_v.squaredNorm();
+  const double floor = 1e-8 * model.physical_scales().tension;
   const double push = normal_.dot(recorded_reaction(model, s));
-  m.take_off = scale > 0 ? std::min(1.0, push / scale + 1e-6) : 1.0;
+  m.take_off = scale + floor > 0 ? std::min(1.0, (push + 1e-6 * scale + floor) / (scale + 1e6 * floor)) : 1.0;
   return m;
 }
 

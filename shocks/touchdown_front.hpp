@@ -24,8 +24,10 @@
 /// need the plane to pull, and so would a lying part whose motion disagrees with the arc's end (the
 /// constraint's multiplier): the front's check stops the run where its reaction reaches zero (a
 /// lift-off event); f = 0 peels off without a reaction.
-/// Crossings are the split link's (SplitLinkFront): a node of B that reaches x0 (landing) joins A with
-/// A's velocity and is put on the plane, where the contact module holds it.
+/// Crossings are the split link's (SplitLinkFront), kHysteresis h past a node: a node of B that the front
+/// passes (landing) joins A with A's velocity and is put on the plane at h from A's last node, where the
+/// contact module holds it; a node of A that it passes (take-off) joins B, put on B's first link at h from
+/// B's first node.
 #include <string>
 
 #include "shocks/split_link_front.hpp"
@@ -49,9 +51,13 @@ class TouchdownFront final : public SplitLinkFront<dim> {
   /// The run stops when the arc meets the plane at less than this angle (its front is then a
   /// tangential touchdown, no shock, whose position the split link no longer resolves).
   static constexpr double kMinAngleDeg = 5;
-  /// A node of the arc joins the lying arc when it comes this close to x0 (in links), so that the
-  /// lying arc's l⁻ starts just above zero after the crossing (as an edge's kCross).
-  static constexpr double kCross = 1e-8;
+  /// The front crosses a node when a partial link reaches −kHysteresis h, not 0 (as the fold's and a heap's
+  /// thresholds are moved out): the crossing places the node where the material it carries is at that
+  /// moment (a landing node on the plane at h from the lying arc's last node, a lifting node on the arc's
+  /// first link at h from its second node), so that s0 runs on continuously and the new split link's other
+  /// partial link starts at kHysteresis h, on the positive side of its own threshold (a front that reverses
+  /// right after a crossing then crosses back, docs/model.md §10).
+  static constexpr double kHysteresis = 1e-8;
 
   explicit TouchdownFront(const TouchdownSpec<dim>& spec);
 
@@ -64,8 +70,8 @@ class TouchdownFront final : public SplitLinkFront<dim> {
   void initialize(StringModel<dim>& model) override;
   void evaluate(const StringModel<dim>& model, FrontState<dim>& state, Eigen::VectorXd& mass,
                 Points<dim>& force) override;
-  /// g[0] = l⁺/h − kCross (a landing: the front reaches arc B's first node), g[1] = l⁻/h + kCross (a
-  /// take-off: it passes arc A's last node; l⁻ starts at 0 after a landing).
+  /// g[0] = l⁺/h + kHysteresis (a landing: the front passes arc B's first node), g[1] = l⁻/h + kHysteresis
+  /// (a take-off: it passes arc A's last node).
   void crossings(const StringModel<dim>& model, const FrontState<dim>& state, double* g) const override;
   EventAction cross(StringModel<dim>& model, const FrontState<dim>& state, int e0) override;
   /// One: positive while the arc meets the plane at more than kMinAngleDeg, no other node of the arc
@@ -108,6 +114,9 @@ class TouchdownFront final : public SplitLinkFront<dim> {
   std::string surface_;
   int lying_last_ = -1;
   double theta_ = 0;
+  /// The index of this front's constraint in the model's list (constraints() appends it to the list the model
+  /// rebuilds from every front), for constraint_force.
+  mutable std::size_t constraint_index_ = static_cast<std::size_t>(-1);
 };
 
 /// The surface's obstacle holding the lying arc of `front` only (its nodes up to front.lying_last()).

@@ -24,6 +24,7 @@
 namespace chainsim {
 
 using scene_build::as_vec;
+using scene_build::as_unit_vec;
 using scene_build::at_key;
 using scene_build::fail_at;
 using scene_build::text_of;
@@ -202,7 +203,7 @@ std::unique_ptr<StringModel<dim>> build_front_model(const SceneSpec& spec, scene
     if (fx.surfaces[k].f)
       fail_at(spec, fmt::format("effects.surface[{}].f", k),
               fmt::format("effects.surface[{}].f = {} on a closed string: a touchdown front is tracked on open strings "
-                          "only (string.closed = true); leave out f (node contact) or open the string",
+                          "only (string.closed = false); allowed: leave out f (node contact) or open the string",
                           k, text_of(spec, fmt::format("effects.surface[{}].f", k))));
   check_open_string(chain.closed(), !fx.heaps.empty(), keys);
   if (chain.num_links() < 2) {
@@ -492,7 +493,7 @@ std::unique_ptr<StringModel<dim>> build_front_model(const SceneSpec& spec, scene
     if constexpr (dim == 3)
       fail_at(spec, key + ".f",
               fmt::format("{}.f = {}: a touchdown front is built in 2D only (string.dimension = 2); in 3D leave out f "
-                          "(node contact lands the string, f = 1 in the limit)",
+                          "(node contact lands the string: it loses the energy of an f = 1 front, not its momentum, docs/model.md §10)",
                           key, text_of(spec, key + ".f")));
     if (!fx.heaps.empty() || fx.fold || !fx.edges.empty() || !fx.kinks.empty() || spec.solver.kinks == "insert" ||
         !touchdowns.empty() || !fx.cylinders.empty())
@@ -502,7 +503,7 @@ std::unique_ptr<StringModel<dim>> build_front_model(const SceneSpec& spec, scene
                           key, text_of(spec, key + ".f")));
     TouchdownSpec<dim> td;
     td.point = as_vec<dim>(spec, fx.surfaces[k].point, key + ".point");
-    td.normal = as_vec<dim>(spec, fx.surfaces[k].normal, key + ".normal").stableNormalized();
+    td.normal = as_unit_vec<dim>(spec, fx.surfaces[k].normal, key + ".normal", "a normal");
     td.dissipation = *fx.surfaces[k].f;
     td.name = key;
     const double h = chain.link_length(0), tol = 1e-11 * ell;
@@ -528,6 +529,14 @@ std::unique_ptr<StringModel<dim>> build_front_model(const SceneSpec& spec, scene
       (std::abs(height(mid)) <= tol ? lo : hi) = mid;
     }
     td.s0 = lo;
+    // lo is the last point within the height tolerance, tol / sin θ before where the shape leaves the plane: the
+    // height's secant just past hi puts s0 where the height is zero (exact on a straight arc; the run refuses
+    // arcs under 5°, so the step is at most 12 tol).
+    const double d = 1e-6 * ell, y1 = height(hi), y2 = height(hi + d);
+    if (y1 > 0 && y2 > y1) {
+      const double s_zero = hi - y1 * d / (y2 - y1);
+      if (s_zero <= hi && s_zero >= hi - 100 * tol) td.s0 = s_zero;
+    }
     const double frac = td.s0 / h - std::floor(td.s0 / h);
     if (std::min(frac, 1 - frac) < 1e-6)
       fail_at(spec, key + ".f",
@@ -542,6 +551,14 @@ std::unique_ptr<StringModel<dim>> build_front_model(const SceneSpec& spec, scene
                             key, text_of(spec, key + ".f"), i, chain.node_coordinate(i), td.s0));
     touchdowns.emplace_back(k, td);
   }
+  // The touchdown front named touchdown<k> (k: its surface's index), which front_names lists for every surface
+  // with f.
+  auto touchdown_named = [&](const std::string& name) -> const std::pair<std::size_t, TouchdownSpec<dim>>& {
+    const auto it = std::find_if(touchdowns.begin(), touchdowns.end(),
+                                 [&](const auto& p) { return name == fmt::format("touchdown{}", p.first); });
+    CHAINSIM_VERIFY(it != touchdowns.end(), fmt::format("the front {} has no surface with f", name));
+    return *it;
+  };
 
   // 5. Stop events: a front reaching a material coordinate inside the string.
   const std::vector<std::string> names = scene_build::front_names(spec);
@@ -558,10 +575,7 @@ std::unique_ptr<StringModel<dim>> build_front_model(const SceneSpec& spec, scene
                            : name == "heap_start"       ? s_lo
                            : name == "heap_end"         ? s_hi
                            : name == "kink_formed"      ? std::numeric_limits<double>::quiet_NaN()
-                           : name.rfind("touchdown", 0) == 0
-                               ? std::find_if(touchdowns.begin(), touchdowns.end(),
-                                              [&](const auto& p) { return name == fmt::format("touchdown{}", p.first); })
-                                     ->second.s0
+                           : name.rfind("touchdown", 0) == 0 ? touchdown_named(name).second.s0
                            : name.rfind("kink", 0) == 0 ? kinks[std::stoul(name.substr(4))].s0
                                                         : edges[std::stoul(name.substr(4))].s0;
     if (std::abs(s - s_start) <= kPlaceTolerance * ell)
@@ -690,8 +704,7 @@ std::unique_ptr<StringModel<dim>> build_front_model(const SceneSpec& spec, scene
     } else if (name == "fold") {
       f["s0"] = fold->s0;
     } else if (name.rfind("touchdown", 0) == 0) {
-      const auto& td = *std::find_if(touchdowns.begin(), touchdowns.end(),
-                                     [&](const auto& p) { return name == fmt::format("touchdown{}", p.first); });
+      const auto& td = touchdown_named(name);
       f["s0"] = td.second.s0;
       f["surface"] = td.first;
     } else if (name == "kink_formed") {  // not in the string until a kink forms

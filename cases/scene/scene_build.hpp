@@ -56,6 +56,17 @@ Vec<dim> as_vec(const SceneSpec& spec, const std::vector<double>& v, const std::
   return out;
 }
 
+/// A vector key that must be a direction (`what`: "a normal", "an axis"), normalized; throws (located) if it is
+/// zero or not finite.
+template <int dim>
+Vec<dim> as_unit_vec(const SceneSpec& spec, const std::vector<double>& v, const std::string& key,
+                     const std::string& what) {
+  const Vec<dim> u = as_vec<dim>(spec, v, key);
+  if (!(u.norm() > 0) || !u.allFinite())
+    fail_at(spec, key, fmt::format("{} = {} is not {}: allowed a finite nonzero vector", key, text_of(spec, key), what));
+  return Vec<dim>(u.normalized());
+}
+
 /// The string of a scene before a model is made of it.
 template <int dim>
 struct SceneParts {

@@ -91,11 +91,7 @@ std::vector<Obstacle<dim>> contact_obstacles(const SceneSpec& spec) {
                                      "\"erk5\", \"erk8\", ...)",
                                      spec.solver.method));
   auto unit = [&](const std::vector<double>& v, const std::string& key, const std::string& what) {
-    const Vec<dim> u = scene_build::as_vec<dim>(spec, v, key);
-    if (!(u.norm() > 0) || !u.allFinite())
-      scene_build::fail_at(spec, key, fmt::format("{} = {} is not {}: allowed a finite nonzero vector", key,
-                                                  scene_build::text_of(spec, key), what));
-    return Vec<dim>(u.normalized());
+    return scene_build::as_unit_vec<dim>(spec, v, key, what);
   };
   refuse_friction_with_slack(spec);
   std::vector<Obstacle<dim>> obstacles;

@@ -1,5 +1,7 @@
 // shocks/jump_conditions.hpp against states derived by hand from the paper's three problems,
 // a moving front, and the reversal of the orientation of s.
+#include <cmath>
+
 #include <catch2/catch.hpp>
 
 #include "shocks/jump_conditions.hpp"
@@ -344,4 +346,34 @@ TEST_CASE("pinned front: the lift-off margin has the signs of the normal cone's 
   // In 3D the part of F along the edge's line does not count.
   const Vector<3> d(0.0, 0.0, 1.0), tm3(1.0, 0.0, 0.5), tp3(0.0, -1.0, 0.5);
   CHECK_THAT(pinned_lift_off_margin<3>(Vector<3>(1.0, 2.0, 5.0), tm3, tp3, d), WithinAbs(1.0, 1e-12));
+}
+
+TEST_CASE("touchdown front: the tensions and the reaction on a compatible state are the closed forms of docs/model.md §10",
+          "[unit][shocks]") {
+  // A plane y = 0 (e = x, n = y), the arc leaving it at θ; [v] = −ṡ0 (t − e) (the two sides compatible). By hand:
+  // −t·[v] = ṡ0 (1 − cos θ), |[v]|² = 2 ṡ0² (1 − cos θ), so τ⁺ = (1 − f sgn ṡ0) λ ṡ0²; [v]·e = ṡ0 (1 − cos θ), so
+  // τ⁻ = λ ṡ0² (1 − cos θ) + τ⁺ cos θ = λ ṡ0² (1 − f sgn ṡ0 cos θ); R = τ⁻ e − τ⁺ t + λ ṡ0² (t − e)
+  // = f sgn ṡ0 λ ṡ0² (t − cos θ e) = f λ ṡ0 |ṡ0| sin θ n.
+  const double lam = 0.7;
+  const V2 e(1, 0), n(0, 1);
+  for (const double theta_deg : {30.0, 60.0, 120.0})
+    for (const double f : {0.0, 0.5, 1.0})
+      for (const double s0dot : {1.3, -0.8}) {
+        CAPTURE(theta_deg, f, s0dot);
+        const double th = theta_deg * std::acos(-1.0) / 180, c = std::cos(th), sn = std::sin(th), sg = s0dot > 0 ? 1 : -1;
+        const V2 t(c, sn), jump = -s0dot * (t - e);
+        const double taup = touchdown_tension_plus<2>(t, c, jump, f, lam, s0dot);
+        const double taum = touchdown_tension_minus<2>(taup, e, c, jump, lam, s0dot);
+        CHECK(taup == Approx((1 - f * sg) * lam * s0dot * s0dot).epsilon(kExact).margin(kExact));
+        CHECK(taum == Approx(lam * s0dot * s0dot * (1 - f * sg * c)).epsilon(kExact).margin(kExact));
+        const V2 R = touchdown_reaction<2>(e, t, taum, taup, jump, lam, s0dot);
+        CHECK(R.dot(e) == Approx(0).margin(kExact));
+        CHECK(R.dot(n) == Approx(f * lam * s0dot * std::abs(s0dot) * sn).epsilon(kExact).margin(kExact));
+        // The loads' power with the lying side at rest (v⁻ = 0, v⁺ = [v]): −τ⁺ t·[v] = ½ λ ṡ0 |[v]|² − D, the kinetic
+        // energy the material crossing the front changes by, less the dissipation D = ½ f λ |ṡ0| |[v]|².
+        CHECK(-taup * t.dot(jump) ==
+              Approx(-dissipation_rate(f, lam, s0dot, jump.squaredNorm()) + 0.5 * lam * s0dot * jump.squaredNorm())
+                  .epsilon(kExact)
+                  .margin(kExact));
+      }
 }

@@ -430,6 +430,8 @@ TEST_CASE("solver.slack and solver.max_wall_s are parsed and checked, and check_
       {"slack = allow with an implicit method", kBase + "\n[solver]\nmethod = \"dirk3\"\nslack = \"allow\"\n", "s.toml:20:10: solver.method = \"dirk3\" is implicit, and implicit methods do not meet solver.slack = \"allow\" (their Newton systems know no slack link): use an explicit method (\"auto\", \"erk8\", ...)"},
       {"a surface with a zero normal", kBase + "[[effects.surface]]\npoint = [0.0, -2.0]\nnormal = [0.0, 0.0]\n",
        "s.toml:20:10: effects.surface[0].normal = [0.0, 0.0] is not a normal: allowed a finite nonzero vector"},
+      {"a touchdown surface with a zero normal", kBase + "[[effects.surface]]\npoint = [0.0, -2.0]\nnormal = [0.0, 0.0]\nf = 0.5\n",
+       "s.toml:20:10: effects.surface[0].normal = [0.0, 0.0] is not a normal: allowed a finite nonzero vector"},
       {"a surface point of the wrong dimension", kBase + "[[effects.surface]]\npoint = [0.0, -2.0, 1.0]\nnormal = [0.0, 1.0]\n",
        "s.toml:19:9: effects.surface[0].point = [0.0, -2.0, 1.0] has 3 components but string.dimension = 2"},
       {"a cylinder of radius 0", kBase + "[[effects.cylinder]]\ncenter = [0.5, -0.5]\nradius = 0.0\n",

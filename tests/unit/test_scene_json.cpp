@@ -2,6 +2,7 @@
 // Python's Scene.effective) writes back every effect the scene format declares (issue 22, item 5): an
 // effect added to the parser but forgotten in scene_json.cpp fails here.
 #include <catch2/catch.hpp>
+#include <fmt/format.h>
 
 #include <map>
 #include <string>
@@ -93,4 +94,24 @@ TEST_CASE("a surface's and a cylinder's mu are written back where they are not t
   CHECK(again.effects.surfaces.at(0).mu == rough.effects.surfaces.at(0).mu);
   CHECK(again.effects.cylinders.at(0).mu == rough.effects.cylinders.at(0).mu);
   CHECK(scene_to_json(again)["effects"] == effective["effects"]);
+}
+
+TEST_CASE("a surface's f is written back where it is given, and read again", "[unit][scene]") {
+  const std::string base = test::edit(test::kSceneBase, "[effects.gravity]\ng = [0.0, -9.81]\n", "");
+  const std::string surface = "[[effects.surface]]\npoint = [0.0, -2.0]\nnormal = [0.0, 1.0]\n";
+  // Without the key: no f in scene_effective (node contact).
+  CHECK(!scene_to_json(parse_scene_text(base + surface, "contact.toml"))["effects"]["surface"][0].contains("f"));
+  // With it (f = 0 too: a touchdown front without dissipation, not node contact): written as given, read the same.
+  for (const double f : {0.0, 0.35}) {
+    CAPTURE(f);
+    const SceneSpec front = parse_scene_text(base + surface + fmt::format("f = {}\n", f), "front.toml");
+    const nlohmann::json effective = scene_to_json(front);
+    INFO("scene_effective: " << effective.dump());
+    REQUIRE(effective["effects"]["surface"][0].contains("f"));
+    CHECK(effective["effects"]["surface"][0]["f"] == f);
+    const SceneSpec again = parse_scene_text(scene_toml_text(written(effective)), "again.toml");
+    REQUIRE(again.effects.surfaces.at(0).f.has_value());
+    CHECK(*again.effects.surfaces.at(0).f == f);
+    CHECK(scene_to_json(again)["effects"] == effective["effects"]);
+  }
 }
