@@ -91,15 +91,17 @@ TEST_CASE("touchdown front: a string drawn onto a table along itself follows the
       // Measured (rtol 1e-10) on every mesh and f: s0 within 7.8e-16 m, x0 within 8.9e-16 m, N within 9.2e-14 N,
       // the reaction along the plane within 1.2e-16 N, τ⁺ within 1.1e-13 N, W_shocks within 3.7e-15 J, the energy
       // drift within 1.7e-14 and the momentum residual within 2.4e-15 of their scales: round-off (each crossing
-      // puts its node where its material is, so the straight arc is exact between and across crossings).
-      CHECK(err_s0 < 2.5e-15);
-      CHECK(err_x0 < 3e-15);
-      CHECK(err_n < 3e-13);
-      CHECK(err_tx < 4e-16);
-      CHECK(err_tau < 3.5e-13);
-      CHECK(err_w < 1.2e-14);
-      CHECK(run.energy_drift < 5e-14 * run.energy_scale);
-      CHECK(run.max_momentum_residual < 7e-15 * run.momentum_scale);
+      // puts its node where its material is, so the straight arc is exact between and across crossings). The
+      // bounds say "round-off" at about 10³ ulp of each scale (ℓ = 1 m, λU² = 1 N, λU³t), not 3 times the
+      // figures above: the same test runs in the sanitizer build, whose round-off need not be this build's.
+      CHECK(err_s0 < 1e-13);
+      CHECK(err_x0 < 1e-13);
+      CHECK(err_n < 1e-12);
+      CHECK(err_tx < 1e-13);
+      CHECK(err_tau < 1e-12);
+      CHECK(err_w < 1e-13);
+      CHECK(run.energy_drift < 1e-12 * run.energy_scale);
+      CHECK(run.max_momentum_residual < 1e-13 * run.momentum_scale);
       if (f == 0) {
         for (const StepSample& r : run.samples) CHECK(r.terms["W_shocks"] == 0.0);
       }
@@ -189,7 +191,7 @@ TEST_CASE("touchdown front: a string drawn off the table peels off without dissi
     // following links' motion corrects at O(kHysteresis h) each crossing.
     CHECK(err_s0 < 3.3e-9);
     CHECK(err_n < 1e-8);
-    CHECK(run.energy_drift < 4.5e-15 * run.energy_scale);
+    CHECK(run.energy_drift < 1e-12 * run.energy_scale);  // round-off (above)
   }
   StringScene<2> scene = build_string_scene<2>(parse_scene_text(drawn_scene(40, 0.5, -speed, 60), "peel.toml"));
   StringSolver<2> solver(*scene.model, scene.solver);
