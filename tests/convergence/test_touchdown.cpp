@@ -245,7 +245,8 @@ TEST_CASE("touchdown front: a front that reverses just after a crossing crosses 
       double err_s0 = 0;
       for (const StepSample& r : run.samples)
         err_s0 = std::max(err_s0, std::abs(r.fronts[0].s0 - (0.5 - sign * A * std::sin(omega * r.t))));
-      // Measured: s0 within 1.9e-13 m.
-      CHECK(err_s0 < 6e-13);
+      // Measured: s0 within 1.9e-13 m: round-off, bounded as the drawn string's (about 10^4 ulp of 0.5 m; the
+      // sanitizer build runs this test with another compiler).
+      CHECK(err_s0 < 1e-12);
     }
 }
