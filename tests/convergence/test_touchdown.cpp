@@ -56,6 +56,14 @@ t_end = 0.3
                      nodes, 0.5 * c, 0.5 * s, values, -load, -speed * c, -speed * s, f, extra);
 }
 
+/// Builds a scene text in 2D, runs it (no outputs written) and returns its summary.
+RunSummary run_text(const std::string& text, const std::string& name) {
+  StringScene<2> scene = build_string_scene<2>(parse_scene_text(text, name));
+  StringSolver<2> solver(*scene.model, scene.solver);
+  solver.run();
+  return solver.summary();
+}
+
 }  // namespace
 
 TEST_CASE("touchdown front: a string drawn onto a table along itself follows the exact solution", "[touchdown]") {
@@ -64,11 +72,7 @@ TEST_CASE("touchdown front: a string drawn onto a table along itself follows the
   for (const double f : {0.0, 0.5, 1.0})
     for (const int nodes : {20, 40, 80}) {
       CAPTURE(f, nodes);
-      const SceneSpec spec = parse_scene_text(drawn_scene(nodes, f, speed, theta), "drawn.toml");
-      StringScene<2> scene = build_string_scene<2>(spec);
-      StringSolver<2> solver(*scene.model, scene.solver);
-      solver.run();
-      const RunSummary& run = solver.summary();
+      const RunSummary run = run_text(drawn_scene(nodes, f, speed, theta), "drawn.toml");
       REQUIRE(run.status == "completed");
       // s0 runs from 0.5 m to 0.8 m: a crossing for each node passed (nodes ⌊0.5 (N − 1)⌋ + 1 .. ⌊0.8 (N − 1)⌋; the
       // corner is inside a link at both ends).
@@ -151,10 +155,7 @@ TEST_CASE("touchdown front: a lying part pulled harder than the arc supplies sto
   // nodes: t = 0.215621725 s), an event, with the ledgers closed and no NaN.
   std::string text = drawn_scene(40, 0.5, 1.0, 60);
   text.replace(text.find("force = [-0.75"), 14, "force = [-1.0");
-  StringScene<2> scene = build_string_scene<2>(parse_scene_text(text, "pulled.toml"));
-  StringSolver<2> solver(*scene.model, scene.solver);
-  solver.run();
-  const RunSummary& run = solver.summary();
+  const RunSummary run = run_text(text, "pulled.toml");
   CAPTURE(run.stop_reason);
   REQUIRE(run.status == "stopped");
   CHECK(run.stop_reason.find("would have to pull") != std::string::npos);
@@ -174,10 +175,7 @@ TEST_CASE("touchdown front: a string drawn off the table peels off without dissi
   // N = −f λ U² sin θ < 0: the run stops at t = 0, a lift-off event, with that reaction.
   const double speed = 1.0, theta = 60 * kPi / 180;
   {
-    StringScene<2> scene = build_string_scene<2>(parse_scene_text(drawn_scene(40, 0.0, -speed, 60), "peel.toml"));
-    StringSolver<2> solver(*scene.model, scene.solver);
-    solver.run();
-    const RunSummary& run = solver.summary();
+    const RunSummary run = run_text(drawn_scene(40, 0.0, -speed, 60), "peel.toml");
     REQUIRE(run.status == "completed");
     CHECK(run.transfers == 12);  // s0 from 0.5 m to 0.2 m on 40 nodes: nodes 19 down to 8
     double err_s0 = 0, err_n = 0;
@@ -193,10 +191,7 @@ TEST_CASE("touchdown front: a string drawn off the table peels off without dissi
     CHECK(err_n < 1e-8);
     CHECK(run.energy_drift < 1e-12 * run.energy_scale);  // round-off (above)
   }
-  StringScene<2> scene = build_string_scene<2>(parse_scene_text(drawn_scene(40, 0.5, -speed, 60), "peel.toml"));
-  StringSolver<2> solver(*scene.model, scene.solver);
-  solver.run();
-  const RunSummary& run = solver.summary();
+  const RunSummary run = run_text(drawn_scene(40, 0.5, -speed, 60), "peel.toml");
   CAPTURE(run.stop_reason);
   REQUIRE(run.status == "stopped");
   CHECK(run.t_stop == 0.0);
@@ -235,10 +230,7 @@ TEST_CASE("touchdown front: a front that reverses just after a crossing crosses 
                                "[effects.gravity]\ng = [{:.17g}, {:.17g}]\n",
                                sign * A, omega, sign * A * c, sign * A * sn, omega, -G * c, -G * sn));
       text.replace(text.find("t_end = 0.3"), 11, fmt::format("t_end = {:.17g}", kPi / omega));
-      StringScene<2> scene = build_string_scene<2>(parse_scene_text(text, "reversed.toml"));
-      StringSolver<2> solver(*scene.model, scene.solver);
-      solver.run();
-      const RunSummary& run = solver.summary();
+      const RunSummary run = run_text(text, "reversed.toml");
       CAPTURE(run.stop_reason);
       REQUIRE(run.status == "completed");
       CHECK(run.transfers == crossings);
