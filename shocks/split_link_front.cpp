@@ -127,6 +127,21 @@ void SplitLinkFront<dim>::move_parcel(const StringModel<dim>& model, int lo, int
 }
 
 template <int dim>
+void SplitLinkFront<dim>::add_partial_weight(const StringModel<dim>& model, int p, int q, double l, double lambda,
+                                             Points<dim>& force) {
+  const Vec<dim> field = model.uniform_field();
+  if (!(field.squaredNorm() > 0)) return;
+  // The weight at x_p + ½ l u: the power of W on p plus that of the couple, (l / 2L) W⊥·(v_p − v_q) = ½ l W·u̇,
+  // is W·d/dt(x_p + ½ l u) at fixed l, exactly (u̇ = (v_p − v_q)⊥ / L, whether or not L = h).
+  const Vec<dim> link = model.x().col(p) - model.x().col(q);
+  const double L = link.norm();
+  const Vec<dim> u = link / L, W = lambda * l * field;
+  const Vec<dim> couple = (0.5 * l / L) * (W - u.dot(W) * u);
+  force.col(p) += couple;
+  force.col(q) -= couple;
+}
+
+template <int dim>
 void SplitLinkFront<dim>::set_velocities(StringModel<dim>& model, int lo, const Eigen::Ref<const Eigen::VectorXd>& mass,
                                          const Points<dim>& mom) {
   Points<dim> v_new = model.v();

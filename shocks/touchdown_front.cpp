@@ -100,6 +100,10 @@ void TouchdownFront<dim>::evaluate(const StringModel<dim>& model, FrontState<dim
   mass[b] += lambda * g.l_plus;
   force.col(a) += tau_m * e;
   force.col(b) -= tau_p * g.t;
+  // The arc's partial link continues its first link (c, b) beyond b to x0: its weight at its midpoint, so that
+  // it does the work its potential (potential_moment) says as the link turns. The lying partial link needs no
+  // couple: it runs along the plane's fixed e, and its weight on a works as at its midpoint.
+  this->add_partial_weight(model, b, g.c, g.l_plus, lambda, force);
   // The front's reaction: what the loads and the material moved from b to a change in the lumped
   // momentum (normal to the plane by τ⁻'s choice); the constraint's share is added where it is known.
   s.reaction = jump::touchdown_reaction<dim>(e, g.t, tau_m, tau_p, ud, lambda, sd);

@@ -246,6 +246,7 @@ class ContactModule final : public WrappingModule<dim> {
     no_wrap_land_.assign(static_cast<std::size_t>(n), 0);
     entering_.assign(static_cast<std::size_t>(chain.num_links()), 0);
     offset_.assign(static_cast<std::size_t>(n), 0.0);
+    carried_ = carried(model);
     let_go_at_.assign(static_cast<std::size_t>(n), -INFINITY);
     stuck_.assign(static_cast<std::size_t>(n), 0);
     dir_.setZero(dim - 1, n);
@@ -474,6 +475,7 @@ class ContactModule final : public WrappingModule<dim> {
   std::vector<Obstacle<dim>> obstacles_;
   std::vector<int> held_;        // per node: the obstacle it is held on, or −1
   std::vector<double> offset_;   // per node: its landing root function's offset (of h)
+  std::vector<char> carried_;    // per node: some obstacle may hold it, at the last layout (follow_layout)
   std::vector<double> let_go_at_;  // per node: when settle() last let it go (s; −∞: never)
   double h_ = 1;
   long impacts_ = 0, lift_offs_ = 0;
@@ -1106,20 +1108,38 @@ class ContactModule final : public WrappingModule<dim> {
   /// heap, across an edge) are let go, and the free nodes it put on a surface (given out by a heap on
   /// it, brought back over an edge onto the table) are held, with the impact of any normal speed they
   /// have; then the nodes whose force would pull are let go.
+  /// A node let go earlier (its landing root function offset by kReleaseGap or kPassGap) is held here only if
+  /// the layout has just given it back to a surface that did not carry it before (a touchdown front landing a
+  /// node it had lifted off: put on the plane with no normal speed, it would otherwise fall kReleaseGap h into
+  /// it before its landing is seen, and the front's constraint would have to pull it back, docs/model.md §10).
   void follow_layout(StringModel<dim>& model, double t, Eigen::Ref<Eigen::VectorXd> ledger) {
+    std::vector<char> released(held_.size(), 0);
     for (std::size_t i = 0; i < held_.size(); ++i)
       if (held_[i] >= 0 && !holds(model, static_cast<int>(i))) {
         held_[i] = -1;
         offset_[i] = kReleaseGap;
+        released[i] = 1;
       }
+    const std::vector<char> now = carried(model);
     std::vector<std::pair<int, int>> landing;
     for (std::size_t i = 0; i < held_.size(); ++i) {
-      if (held_[i] >= 0 || offset_[i] != 0 || !free_node(model, static_cast<int>(i))) continue;
+      const bool given_back = now[i] && !carried_[i] && !released[i];
+      if (held_[i] >= 0 || (offset_[i] != 0 && !given_back) || !free_node(model, static_cast<int>(i))) continue;
       const auto [k, gap] = nearest(static_cast<int>(i), model.x().col(static_cast<Eigen::Index>(i)));
       if (k >= 0 && gap <= kLandWindow * h_) landing.emplace_back(static_cast<int>(i), k);
     }
+    carried_ = now;
     refresh(model);
     if (!hold(model, t, ledger, landing)) settle(model, t, false);
+  }
+  /// Per node, whether some obstacle may hold it (Obstacle::carries: a touchdown front's lying arc, a table's
+  /// side of its edge; every node for the other obstacles).
+  std::vector<char> carried(const StringModel<dim>& model) const {
+    std::vector<char> c(static_cast<std::size_t>(model.chain().num_nodes()), 0);
+    for (std::size_t i = 0; i < c.size(); ++i)
+      for (const Obstacle<dim>& o : obstacles_)
+        if (o.may_hold(static_cast<int>(i))) c[i] = 1;
+    return c;
   }
   /// Lets go of the held nodes whose normal force pulls, one at a time, most negative first (each
   /// release changes the others' forces), until none pulls; at a located lift-off (`located`) the one
