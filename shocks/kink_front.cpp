@@ -145,6 +145,11 @@ void KinkFront<dim>::evaluate(const StringModel<dim>& model, FrontState<dim>& s,
   const Vec<dim> G = 0.5 * s.tension_minus * sum - 0.5 * lambda * sd * (sum.dot(u) / dd) * d;
   force.col(a) += 0.5 * lambda * lA_rate * u + G;
   force.col(b) += 0.5 * lambda * lA_rate * u - G;
+  // Each partial link continues its arm's link straight beyond a (b): its weight at its midpoint, so that it
+  // does the work its potential (potential_moment) says as the arm turns (docs/model.md §10, "The partial
+  // links' weight"; without it the U's energy ledger closed only to first order, §9).
+  this->add_partial_weight(model, a, a - 1, lA, lambda, force);
+  this->add_partial_weight(model, b, b + 1, lB, lambda, force);
 }
 
 template <int dim>
