@@ -43,7 +43,7 @@ class SplitLinkFront : public FrontKind<dim> {
   /// link's midpoint x_p + ½ l u, where potential_moment counts its potential: the node masses put the weight
   /// W = λ l g on p (g the model's uniform field), and this adds its moment about p as the couple ±(l / 2|x_p − x_q|)
   /// W⊥ on p and q (W⊥ the part of W across the link), whose power ½ l W·u̇ is the weight's work on the partial
-  /// link as it turns with the link (docs/model.md §10, "A touchdown front", the ledger with gravity). Nothing
+  /// link as it turns with the link (docs/model.md §10, "The partial links' weight"). Nothing
   /// without a uniform field.
   static void add_partial_weight(const StringModel<dim>& model, int p, int q, double l, double lambda,
                                  Points<dim>& force);

@@ -60,7 +60,7 @@ t_end = {t_end}
 
 
 def frames(out):
-    """{t: (x of node 0, K)} at the frames: nodes.csv and series.csv (the step rows at the frame times)."""
+    """{t: (x of node 0, K, W_remesh)} at the frames: nodes.csv and series.csv (the step rows at the frame times)."""
     xs = {round(float(r["t"]), 9): float(r["x"]) for r in csv.DictReader(open(os.path.join(out, "nodes.csv")))
           if r["node"] == "0"}
     series = [(float(r["t"]), float(r["K"]), float(r["W_remesh"]))
