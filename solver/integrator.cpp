@@ -185,9 +185,6 @@ struct Integrator::Impl {
   Eigen::VectorXd g_last;
   double g_last_time = 0;
   std::vector<char> prediction_off;
-  // The step the run resumed with after the last event: a predicted step far shorter than it is one of
-  // steps shrinking towards the stop time.
-  double h_event = 0;
   int short_steps = 0;         // accepted steps in a row below the step-size floor
   std::chrono::steady_clock::time_point wall_start = std::chrono::steady_clock::now();
 
@@ -733,9 +730,12 @@ Integrator::Outcome Integrator::advance(double t_target, bool one_step, const Ro
     }
     if (predicted >= 0) {
       // The step may end at the stop time with either flag. Past the zero: the event. Short of it, and at
-      // the stop time, or after refused trial states or a failed error test on the way, or shorter than a
-      // quarter of the step the run resumed with after the last event: no prediction for that function
-      // until the next event (otherwise the steps could shrink towards a stop time they never reach).
+      // the stop time, or after refused trial states or a failed error test on the way: no prediction for
+      // that function until the next event (otherwise the steps could shrink towards a stop time they
+      // never reach). A step that ARKODE's error control ended short of the stop time is no miss: the next
+      // step predicts again. (Counted as one when it was shorter than a quarter of the step the run
+      // resumed with, the zero then located on ARKODE's interpolant after a short remainder, it cost
+      // hole_release_at_rest.toml 517 steps instead of 300 with the heaps' second crossing predicted.)
       if (passed_zero(predicted)) {
         predicted_event(predicted, t_step_start, y_step_start, before_polish);
         return Outcome::kEvent;
@@ -743,8 +743,7 @@ Integrator::Outcome Integrator::advance(double t_target, bool one_step, const Ro
       char& off = impl_->prediction_off[static_cast<std::size_t>(predicted)];
       // (ARKODE ends a step at the stop time up to a few units of round-off short of it, either flag.)
       const bool at_stop = flag == ARK_TSTOP_RETURN || t_stop - t_ <= 1e-6 * (t_stop - t_step_start);
-      if (at_stop || impl_->recoverable_failures > refused_before || fails_after > fails_before ||
-          last_step() < 0.25 * impl_->h_event)
+      if (at_stop || impl_->recoverable_failures > refused_before || fails_after > fails_before)
         off = Impl::kPredictionMissed;
       if (t_ < t_target) {
         if (one_step) return Outcome::kStep;
@@ -927,7 +926,6 @@ int Integrator::polish_event(double t_step_start, const Eigen::VectorXd& y_step_
     last_probe = probe(t_, y_, ydot);
   }
   d.h_resume = std::abs(h_next);
-  d.h_event = d.h_resume;
   // Every function's rate at the event, for the prediction of the next zero of a recurring one.
   std::swap(d.root_rate, d.root_rate_before);
   d.root_time_before = d.root_time;
@@ -979,6 +977,15 @@ double Integrator::predict_recurring_event(double t_target, int& which) {
   // prediction's error (the quadratic's, (interval / time scale)^2), little enough for the polish's
   // Heun correction back to the root.
   constexpr double kAimPast = 1e-4;
+  // The same for a node out of a heap (a front's second crossing function) whose zero lies beyond
+  // ARKODE's next step. ARKODE shortens its next step at the end of each step so as not to pass the
+  // stop time, and a later prediction cannot lengthen it again: aimed 1e-4 past, a prediction early by
+  // 0.04 - 1 % (the rate of a chain leaving a heap while it swings changes faster than the quadratic
+  // follows) left the step before the zero ending short of it and a short remainder after it, and
+  // hole_release_at_rest.toml took 513 steps instead of 300, swinging_sliding_chain.toml 501 instead of
+  // 311. Aimed 1 % past from farther than a step, such a step ends past the zero and the polish corrects
+  // back to it.
+  constexpr double kAimPastFar = 1e-2;
   Impl& d = *impl_;
   which = -1;
   const int nev = d.system.num_events();
@@ -994,13 +1001,11 @@ double Integrator::predict_recurring_event(double t_target, int& which) {
   const bool two = d.root_rate_before.size() == nev && d.root_time > d.root_time_before;
   const bool secant = d.g_last.size() == nev && t_ > d.g_last_time;
   double best = t_target;
-  // Only the first of each front's two crossings (a node into a heap, the fold reaching a node). The
-  // second (a node out of a heap) predicted too, the sliding compare took 8,096 right-hand sides instead
-  // of 22,925 at 800 nodes, but chains leaving a heap while they swing took 1.5 - 1.7 times the steps
-  // (hole_release_at_rest.toml 299 -> 494, swinging_sliding_chain.toml 325 -> 487): predictions early by
-  // about 1 %, each leaving a short remainder after which ARKODE's steps grew back slowly. Not understood
-  // yet (docs/shocks.md, "On fine meshes").
-  for (int j = 0; j < n; j += 2) {
+  // Both of each front's crossing functions: a node into a heap or the fold reaching a node (even j), a
+  // node out of a heap (odd j).
+  sunrealtype h_next = 0;
+  ARKStepGetCurrentStep(d.mem, &h_next);
+  for (int j = 0; j < n; ++j) {
     const int dir = dirs.empty() ? 0 : dirs[static_cast<std::size_t>(j)];
     if (dir == 0 || d.prediction_off[static_cast<std::size_t>(j)] || !(g[j] * dir < 0)) continue;
     const double curvature = two ? (d.root_rate[j] - d.root_rate_before[j]) / (d.root_time - d.root_time_before) : 0.0;
@@ -1014,7 +1019,7 @@ double Integrator::predict_recurring_event(double t_target, int& which) {
       const double slope = rate + curvature * tau;
       tau = slope * dir > 0 ? tau - (g[j] + tau * (rate + 0.5 * curvature * tau)) / slope : NAN;
     }
-    const double t_aim = t_ + (1 + kAimPast) * tau;
+    const double t_aim = t_ + (1 + (j % 2 == 1 && tau > h_next ? kAimPastFar : kAimPast)) * tau;
     if (tau > 0 && t_aim < best) {
       best = t_aim;
       which = j;
@@ -1045,7 +1050,6 @@ void Integrator::predicted_event(int which, double t_step_start, const Eigen::Ve
   if (before_polish) before_polish(t_step_start, t_);
   polish_event(t_step_start, y_step_start, t_, /*from_here=*/true);
   d.h_resume = std::max(d.h_resume, h_allowed);
-  d.h_event = d.h_resume;
 }
 
 // The step the run resumes with after a predicted crossing: ARKODE's next step after a step cut at a

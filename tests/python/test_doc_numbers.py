@@ -43,7 +43,7 @@ def test_drifted_quotes_fail_naming_the_number(tmp_path):
 
 
 def test_current_quotes_pass(tmp_path):
-    fixed = DRIFTED.replace("0.562526", "0.573895").replace("311 steps, 3550 rhs", "241 steps, 2938 rhs")
+    fixed = DRIFTED.replace("0.562526", "0.573895").replace("311 steps, 3550 rhs", "247 steps, 2309 rhs").replace("3531 tension", "3044 tension")
     r = run_on(tmp_path, fixed)
     assert r.returncode == 0, r.stdout + r.stderr
 
