@@ -63,26 +63,33 @@ TEST_CASE("the falling chain's crossings are predicted, not overstepped", "[conv
   }
 }
 
+// A canonical compare whose crossings are predicted: about one step per crossing on the finer mesh, at most
+// `bound_200` and `bound_800` right-hand sides per crossing on 200 and 800 nodes, the errors at the integrator's
+// tolerance.
+static void check_predicted_crossings(Problem problem, const char* name, double bound_200, double bound_800) {
+  for (const int nodes : {200, 800}) {
+    const Comparison c = compare_with_reduced(setup_for(problem, 0.83, nodes));
+    const auto& s = c.summary;
+    INFO(name << ", " << nodes << " nodes");
+    REQUIRE(s["status"] == "stopped");
+    const double crossings = s["transfers"].get<double>();
+    const double per_crossing = s["rhs_evals"].get<double>() / crossings;
+    std::printf("%s %4d nodes: %5.2f right-hand sides and %4.2f steps per crossing\n", name, nodes, per_crossing,
+                s["steps"].get<double>() / crossings);
+    CHECK(per_crossing <= (nodes == 200 ? bound_200 : bound_800));
+    CHECK(s["steps"].get<double>() <= 1.2 * crossings + 150);
+    CHECK(s["rel_err_t_stop"].get<double>() <= 1e-11);
+    CHECK(s["max_abs_err_eta"].get<double>() <= 1e-10);
+  }
+}
+
 // The folded chain's crossings are predicted too. Its first prediction (from the secant, before any
 // event's rate) ran the step past the zero until the fold's check met its root; the prediction was then
 // turned off for the whole run, and every crossing was a root located on ARKODE's interpolant and a
 // recomputed step: 39.7 and 49.0 right-hand sides per crossing on 200 and 800 nodes (2 - 3.6 steps per
 // crossing). Turned off only until the next event: 15.8 and 9.8 (docs/shocks.md "On fine meshes").
 TEST_CASE("the folded chain's crossings are predicted after a refused prediction", "[convergence][shocks]") {
-  for (const int nodes : {200, 800}) {
-    const Comparison c = compare_with_reduced(setup_for(Problem::kFolded, 0.83, nodes));
-    const auto& s = c.summary;
-    INFO(nodes << " nodes");
-    REQUIRE(s["status"] == "stopped");
-    const double crossings = s["transfers"].get<double>();
-    const double per_crossing = s["rhs_evals"].get<double>() / crossings;
-    std::printf("folded %4d nodes: %5.2f right-hand sides and %4.2f steps per crossing\n", nodes, per_crossing,
-                s["steps"].get<double>() / crossings);
-    CHECK(per_crossing <= (nodes == 200 ? 24 : 14));
-    CHECK(s["steps"].get<double>() <= 1.2 * crossings + 150);
-    CHECK(s["rel_err_t_stop"].get<double>() <= 1e-11);
-    CHECK(s["max_abs_err_eta"].get<double>() <= 1e-10);
-  }
+  check_predicted_crossings(Problem::kFolded, "folded", 24, 14);
 }
 
 // The sliding chain's nodes leave its heap: the heap's second crossing function, predicted too, aimed 1 % past
@@ -91,18 +98,5 @@ TEST_CASE("the folded chain's crossings are predicted after a refused prediction
 // ARKODE's interpolant; 15.5 and 10.2 predicted, about one step per crossing on 800 nodes (910 steps, 797
 // crossings; docs/shocks.md "A node out of a heap, predicted").
 TEST_CASE("the sliding chain's nodes out of the heap are predicted and not overstepped", "[convergence][shocks]") {
-  for (const int nodes : {200, 800}) {
-    const Comparison c = compare_with_reduced(setup_for(Problem::kSliding, 0.83, nodes));
-    const auto& s = c.summary;
-    INFO(nodes << " nodes");
-    REQUIRE(s["status"] == "stopped");
-    const double crossings = s["transfers"].get<double>();
-    const double per_crossing = s["rhs_evals"].get<double>() / crossings;
-    std::printf("sliding %4d nodes: %5.2f right-hand sides and %4.2f steps per crossing\n", nodes, per_crossing,
-                s["steps"].get<double>() / crossings);
-    CHECK(per_crossing <= (nodes == 200 ? 20 : 13));
-    CHECK(s["steps"].get<double>() <= 1.2 * crossings + 150);
-    CHECK(s["rel_err_t_stop"].get<double>() <= 1e-11);
-    CHECK(s["max_abs_err_eta"].get<double>() <= 1e-10);
-  }
+  check_predicted_crossings(Problem::kSliding, "sliding", 20, 13);
 }
