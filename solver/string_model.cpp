@@ -199,7 +199,11 @@ void StringModel<dim>::rebuild() {
   w_ = Eigen::VectorXd::Zero(n);
   for (int i = 0; i < n; ++i)
     if (slot_[i] >= 0) w_[i] = 1.0 / m_[i];
-  base_w_ = w_;
+  // refresh()'s copy, with a module only (8 bytes a node: tests/unit/test_memory.cpp).
+  if (module_)
+    base_w_ = w_;
+  else
+    base_w_.resize(0);
   // A slack link that left the arcs (taken into a heap, or the folded link at a fold) is no longer a
   // link of the tension system: the front's jump conditions hold its material.
   for (int j = 0; j < L; ++j)

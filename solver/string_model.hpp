@@ -581,7 +581,7 @@ class StringModel final : public OdeSystem {
   Eigen::VectorXd base_mass_;    // lumped masses of the arcs' links
   Eigen::VectorXd m_;            // current masses (base + module)
   Eigen::VectorXd w_;            // 1/m_i for free nodes, 0 otherwise
-  Eigen::VectorXd base_w_;       // w_ of the base masses (rebuild()): refresh() takes it where m_i is the base mass
+  Eigen::VectorXd base_w_;       // w_ of the base masses (rebuild(), with a module): refresh() takes it where m_i is the base mass
   int num_free_ = 0;
   double alpha_ = 0, beta_ = 0;
   /// β² of the last evaluation: 1/τ_b², capped where its response to round-off would exceed the

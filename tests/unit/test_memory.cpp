@@ -90,7 +90,8 @@ TEST_CASE("peak memory per node stays within a bound of the explicit integrator'
     INFO(method << " (" << large.method << ", " << stages << " stages): " << per_node
                 << " bytes per node, integrator's vectors " << integrator_per_node << " -> ratio "
                 << per_node / integrator_per_node);
-    // Measured 1.482 (erk4) and 1.410 (erk8); 1.548 and 1.454 before the tridiagonal tension backend
+    // Measured 1.481 (erk4) and 1.410 (erk8), 853 and 1173 bytes per node (1.495 and 1.42 while rebuild() kept
+    // refresh()'s copy of 1/m_i without a module, docs/stability.md); 1.548 and 1.454 before the tridiagonal tension backend
     // read the system's slots instead of copying them, the system built its link neighbours only for
     // a released link and the string kept the non-conservative forces only with such a force; 1.71
     // and 1.57 before ARKODE returned its state into the Integrator's own (no second copy), the
