@@ -509,7 +509,7 @@ TEST_CASE("the swinging U with an inserted kink under refinement: K at 1 s conve
           "absorption's W_remesh vanish with h, the state's RMS difference falls, the ledgers close",
           "[kink][shocks][slack][convergence]") {
   // docs/model.md §9, "W_remesh event by event" (tests/bench/kink_u_remesh.py): on 101, 201, 401 nodes K(1 s) =
-  // 27.167, 27.538, 27.738 mJ (differences 0.37, 0.20 mJ: order 0.9; 27.726 on 801 nodes, difference 0.012 mJ); the
+  // 27.167, 27.538, 27.738 mJ (differences 0.37, 0.20 mJ: order 0.9; 27.724 on 801 nodes, difference 0.014 mJ); the
   // insertion's W_remesh −3.4e-5, −1.1e-6, +4e-7 J; the absorption's re-layout −1.1e-5, −3.9e-6, −1.6e-6 J (order
   // 1.5, 1.3); the RMS distance at 1 s 1.55e-3, 9.5e-4 m (101 → 201, 201 → 401). (Before the partial links' weight
   // acted at their midpoints, K(1 s) = 27.155, 27.659, 27.761 mJ, and the energy ledger closed to 5.7e-5 … 9.2e-6.)
@@ -549,7 +549,7 @@ TEST_CASE("the swinging U with an inserted kink under refinement: K at 1 s conve
 TEST_CASE("the swinging U with an inserted kink on 801 nodes: K at 1 s converged, the crossings' W_remesh does not vanish",
           "[kink][shocks][slack][convergence][.long]") {
   // docs/model.md §9, "W_remesh event by event": the limit of the front's discretization that the study on 101 …
-  // 801 nodes shows. K(1 s) converges (differences 0.37, 0.20, 0.012 mJ); the crossings' W_remesh from 0.4 to 0.8 s
+  // 801 nodes shows. K(1 s) converges (differences 0.37, 0.20, 0.014 mJ); the crossings' W_remesh from 0.4 to 0.8 s
   // is −0.38, −0.40, −0.45, −0.48 mJ on 101, 201, 401, 801 nodes (it does not vanish with h), and the RMS distance at
   // 1 s is 9.5e-4 and 7.9e-4 m on 201 → 401 and 401 → 801.
   std::vector<InsertedU> u;

@@ -334,12 +334,14 @@ TEST_CASE("slack: a falling chain jerked down faster than g goes slack above its
           "follows the driven top",
           "[slack][shocks]") {
   // Measured: the front at t = 0.2 and 0.24 s within 5e-9 m of the top's height on 41 nodes and to 1e-12 m on 81
-  // and 161 (at t = 0.12 s, still slack, it is 0.10 m below the top's height); W_snap = -4.0 J, W_shocks = -0.316 J.
+  // and 161 (at t = 0.12 s, still slack, it is 0.10 m below the top's height); W_snap = -4.0 J, W_shocks = -0.316 J (the
+  // -0.186 J written here before was stale: the build before the heaps' second crossing was predicted gives -0.316 J too).
   // The ledgers close to the integrator's tolerance (erk8, rtol 1e-8): the momentum ledger integrates the driven
   // top's reaction, a quadrature along the step path. Measured on 41 nodes, relative energy and momentum residuals
   // 7.5e-11 and 2.0e-11 (with the heaps' second crossing not predicted, another step path: 2.6e-12 and 6.3e-13, and
   // 3.5e-11 and 8.0e-12 at rtol 1e-9); the momentum residual falls with rtol (1.8e-12, 5.8e-13, 5.4e-14 at rtol
-  // 1e-9, 1e-10, 1e-11). On 81 and 161 nodes 4.4e-12 and 4.7e-12 (energy), 1.3e-14 and 5.5e-15 (momentum).
+  // 1e-9, 1e-10, 1e-11). On 81 and 161 nodes 4.4e-12 and 4.7e-12 (energy), 8.5e-14 and 5.5e-15 (momentum;
+  // 1.3e-14 on 81 nodes on another step path).
   for (const int n : {41, 81, 161}) {
     const SceneRunResult<2> r = run_text<2>(kFallDriven, {"string.nodes=" + std::to_string(n)});
     INFO(n << " nodes: " << r.summary.error);
@@ -362,8 +364,8 @@ TEST_CASE("slack: a falling chain jerked down faster than g goes slack above its
     CHECK(last.terms["snaps"] >= 1);
     CHECK(last.terms["W_snap"] < -1);
     CHECK(last.terms["W_shocks"] < 0);
-    CHECK(r.summary.relative_energy_drift() < 2.5e-10);
-    CHECK(r.summary.relative_momentum_residual() < 6e-11);
+    CHECK(r.summary.relative_energy_drift() < (n == 41 ? 2.5e-10 : 1.5e-11));
+    CHECK(r.summary.relative_momentum_residual() < (n == 41 ? 6e-11 : 3e-13));
   }
 }
 
