@@ -114,6 +114,13 @@ void check_scales(const SceneSpec& spec, const std::vector<Scale>& inputs, const
   for (const Scale& s : derived) check(s, kMinScale * kMinScale, kMaxScale * kMaxScale);
 }
 
+/// Whether `[velocity] kind = "tangential"` is the string sliding exactly along itself, set by the model
+/// once its fronts have bent their links (StringModelOptions::sliding_speed), rather than the nodes'
+/// averaged tangents (docs/scenes.md, "The tangential kind"): with slack = "allow" (a unilateral start),
+/// and over an edge or a peg, where a node beside the point would otherwise move along the chord that
+/// crosses the corner and turn the bent link's short piece at speed / (its length).
+bool slides_exactly(const SceneSpec& spec) { return spec.solver.slack == "allow" || !spec.effects.edges.empty(); }
+
 /// Two prescribed ends may never be pulled as far apart as the string is long (it would have to
 /// stretch); sampled over [0, t_end].
 template <int dim>
@@ -181,10 +188,11 @@ SceneParts<dim> build_scene_parts(const SceneSpec& spec) {
   }
   const auto& vel = spec.velocity;
   if (vel.kind == "uniform") set_uniform_velocity(chain, as_vec<dim>(spec, vel.value, "velocity.value"));
-  // (with slack = allow the model sets a tangential speed itself, along the string's sides: StringModelOptions::sliding_speed)
+  // (with slack = allow, or an edge or a peg, the model sets a tangential speed itself, along the string's
+  // sides: StringModelOptions::sliding_speed)
   if (vel.kind == "tangential")
     at_key(spec, "velocity.speed", [&] {
-      if (spec.solver.slack != "allow") return set_tangential_velocity(chain, vel.speed);
+      if (!slides_exactly(spec)) return set_tangential_velocity(chain, vel.speed);
       if (!std::isfinite(vel.speed))
         throw InputError(fmt::format("velocity.speed = {:g} is not a finite number", vel.speed));
     });
@@ -308,10 +316,8 @@ SceneParts<dim> build_scene_parts(const SceneSpec& spec) {
              : so.slack == "allow"  ? SlackPolicy::kAllow
                                     : SlackPolicy::kStop;
   mo.snap_restitution = so.snap_restitution;
+  if (spec.velocity.kind == "tangential" && slides_exactly(spec)) mo.sliding_speed = spec.velocity.speed;
   if (mo.slack == SlackPolicy::kAllow) {
-    // The start is unilateral: a tangential speed is the string sliding along itself exactly (the model
-    // sets it once its fronts have bent their links), not the nodes' averaged tangents (docs/scenes.md).
-    if (spec.velocity.kind == "tangential") mo.sliding_speed = spec.velocity.speed;
     if (spec.elements == "quadratic")
       at_key(spec, "solver.slack", [&] {
         throw InputError("solver.slack = \"allow\" needs link elements: string.elements = \"quadratic\" has no "
