@@ -35,6 +35,29 @@
 
 namespace chainsim {
 
+/// The split link's constraint of a 3D touchdown front (docs/model.md §10, "A touchdown front in 3D"), from the
+/// positions and velocities of the lying part's last link (p, a) (p < 0: none, e given), of arc B's first link
+/// (b, c), the plane (a point and its unit normal n) and the link length h:
+///     C = (x_b − x_a)·e + y_b (1 − t·e)/(t·n) − h,
+/// e = P (x_a − x_p)/|P (x_a − x_p)| (P = I − n nᵀ), t = (x_c − x_b)/|x_c − x_b|, y_b = n·(x_b − point): l⁻ + l⁺ − h
+/// with l⁺ = y_b/(t·n) and l⁻ = (x0 − x_a)·e, x0 = x_b − l⁺ t. In the plane of e and n it is the 2D constraint
+/// (1 − cos θ)/sin θ = tan(θ/2).
+template <int dim>
+struct TouchdownConstraint {
+  Vec<dim> e = Vec<dim>::Zero(), t = Vec<dim>::Zero(), x0 = Vec<dim>::Zero();
+  double cos = 0, sin = 0;  ///< t·e, t·n
+  double l_plus = 0, l_minus = 0, s0_dot = 0;  ///< ṡ0 = −dl⁺/dt
+  double value = 0;          ///< C
+  Points<dim> gradient;      ///< ∂C/∂x at p, a, b, c (p's column zero when p < 0)
+  double curvature = 0;      ///< C̈ at zero accelerations
+};
+template <int dim>
+TouchdownConstraint<dim> touchdown_split_constraint(const Vec<dim>& xp, const Vec<dim>& xa, const Vec<dim>& xb,
+                                                    const Vec<dim>& xc, const Vec<dim>& vp, const Vec<dim>& va,
+                                                    const Vec<dim>& vb, const Vec<dim>& vc, bool has_p,
+                                                    const Vec<dim>& e_fixed, const Vec<dim>& point,
+                                                    const Vec<dim>& normal, double h);
+
 /// A touchdown front on the plane through `point` with unit outward normal `normal`.
 template <int dim>
 struct TouchdownSpec {
@@ -58,6 +81,10 @@ class TouchdownFront final : public SplitLinkFront<dim> {
   /// partial link starts at kHysteresis h, on the positive side of its own threshold (a front that reverses
   /// right after a crossing then crosses back, docs/model.md §10).
   static constexpr double kHysteresis = 1e-8;
+  /// 3D, f > 0: the run stops when the arc leaves the plane at more than this azimuth from the plane of the lying
+  /// part's direction e and the normal n (the jump conditions' balance along n × e needs it zero for f > 0 on a
+  /// moving front; the discrete front books the residual as a sideways load on the lying end, docs/model.md §10).
+  static constexpr double kMaxAzimuthDeg = 1;
 
   explicit TouchdownFront(const TouchdownSpec<dim>& spec);
 
@@ -100,11 +127,20 @@ class TouchdownFront final : public SplitLinkFront<dim> {
     Vec<dim> t = Vec<dim>::Zero(), t_perp = Vec<dim>::Zero(), x0 = Vec<dim>::Zero();
     double L = 0, cos = 0, sin = 0, theta_dot = 0, t_w = 0, y = 0, y_dot = 0, tan_half = 0;
     double l_plus = 0, l_minus = 0, s0_dot = 0;
+    /// 3D: e, the lying part's direction at the front (its last link (p, a) projected on the plane; along_ when
+    /// the lying part is node 0 alone, p = −1), and the split link's constraint (touchdown_split_constraint).
+    Vec<dim> e = Vec<dim>::Zero();
+    int p = -1;
+    TouchdownConstraint<dim> split;
   };
   Geometry geometry(const StringModel<dim>& model) const;
+  /// geometry() in 3D (dim = 3; the 2D one keeps its own arithmetic).
+  Geometry geometry_3d(const StringModel<dim>& model) const;
+  /// evaluate() in 3D (the 2D one keeps its own arithmetic).
+  void evaluate_3d(const StringModel<dim>& model, FrontState<dim>& state, Eigen::VectorXd& mass, Points<dim>& force);
   /// The margins of checks(): angle, other nodes' heights (per h), take-off.
   struct Margins {
-    double angle = 1, height = 1, take_off = 1;
+    double angle = 1, height = 1, take_off = 1, azimuth = 1;
     int low_node = -1;
   };
   Margins margins(const StringModel<dim>& model, const FrontState<dim>& state) const;
@@ -114,6 +150,8 @@ class TouchdownFront final : public SplitLinkFront<dim> {
   std::string surface_;
   int lying_last_ = -1;
   double theta_ = 0;
+  double elevation_ = 1;  ///< 3D: t·n, the sine of the arc's elevation over the plane, after an evaluation
+  double azimuth_ = 0;    ///< 3D: |t·b|/|P t|, the sine of the arc's azimuth from the plane of e and n (b = n × e)
   /// The index of this front's constraint in the model's list (constraints() appends it to the list the model
   /// rebuilds from every front), for constraint_force.
   mutable std::size_t constraint_index_ = static_cast<std::size_t>(-1);
