@@ -232,7 +232,7 @@ void TouchdownFront<dim>::evaluate_3d(const StringModel<dim>& model, FrontState<
   lying_last_ = a;
   along_ = g.e;
   elevation_ = g.sin;
-  azimuth_ = std::abs(g.t.dot(plane_cross<dim>(normal_, g.e))) / (g.t - g.sin * normal_).norm();
+  off_plane_ = std::abs(g.t.dot(plane_cross<dim>(normal_, g.e)));
   const Vec<dim>& e = g.e;
   const Vec<dim> bn = plane_cross<dim>(normal_, e);
   theta_ = std::atan2((g.t - g.cos * e).norm(), g.cos);
@@ -338,7 +338,12 @@ EventAction TouchdownFront<dim>::cross(StringModel<dim>& model, const FrontState
   Vec<dim> placed = Vec<dim>::Zero();
   if (e0 != 0) {
     Vec<dim> e = along_;
-    if constexpr (dim == 3) e = geometry_3d(model).e;  // the lying part's last link, which b continues
+    if constexpr (dim == 3) {  // the lying part's last link projected on the plane, which b continues
+      const ArcRange& A = model.arcs()[static_cast<std::size_t>(this->arc_minus)];
+      const Vec<dim> u = A.num_links() >= 1 ? Vec<dim>(x.col(a) - x.col(a - 1)) : Vec<dim>::Zero();
+      const Vec<dim> pu = u - normal_.dot(u) * normal_;
+      if (pu.norm() > 0) e = pu.normalized();
+    }
     placed = x.col(a) - normal_.dot(x.col(a) - point_) * normal_ + h * e;
   } else if (b + 1 < static_cast<int>(x.cols())) {
     const Vec<dim> link = x.col(b + 1) - x.col(b);
@@ -391,7 +396,7 @@ typename TouchdownFront<dim>::Margins TouchdownFront<dim>::margins(const StringM
   const double push = normal_.dot(recorded_reaction(model, s));
   m.take_off = scale + floor > 0 ? std::min(1.0, (push + 1e-6 * scale + floor) / (scale + 1e6 * floor)) : 1.0;
   if constexpr (dim == 3)
-    if (this->dissipation > 0) m.azimuth = std::sin(kMaxAzimuthDeg * kPi / 180) - azimuth_;
+    if (this->dissipation > 0) m.off_plane = std::sin(kMaxOffPlaneDeg * kPi / 180) - off_plane_;
   return m;
 }
 
@@ -399,22 +404,22 @@ template <int dim>
 void TouchdownFront<dim>::checks(const StringModel<dim>& model, const FrontState<dim>& s, double* g) const {
   const Margins m = margins(model, s);
   g[0] = std::min({m.angle, m.height, m.take_off});
-  if constexpr (dim == 3) g[0] = std::min(g[0], m.azimuth);
+  if constexpr (dim == 3) g[0] = std::min(g[0], m.off_plane);
 }
 
 template <int dim>
 std::string TouchdownFront<dim>::check_failed(const StringModel<dim>& model, const FrontState<dim>& s, double t) const {
   const Margins m = margins(model, s);
-  const double least = std::min({m.angle, m.height, m.take_off, m.azimuth});
-  if (least == m.azimuth && m.azimuth < std::min({m.angle, m.height, m.take_off}))
+  const double least = std::min({m.angle, m.height, m.take_off, m.off_plane});
+  if (least == m.off_plane && m.off_plane < std::min({m.angle, m.height, m.take_off}))
     return fmt::format(
-        "the arc leaves {} at {:.4g} deg from the plane of the lying part's direction and the normal at t = {:.9g} s "
+        "the arc leaves {} at {:.4g} deg to the plane of the lying part's direction and the normal at t = {:.9g} s "
         "(s0 = {:.9g} m, ds0/dt = {:.4g} m/s, f = {:g}): with f > 0 the jump conditions at a moving touchdown front "
-        "need the arc in that plane (their balance along n x e is f lambda ds0/dt^2 (t.b) = 0: a smooth plane cannot "
-        "push sideways), or the lying part turned at the front to the arc's projection, which the front does not "
-        "build; at most {:g} deg (docs/model.md §10, A touchdown front in 3D)",
-        surface_, std::asin(std::min(azimuth_, 1.0)) * 180 / kPi, t, s.s0, s.s0_dot, this->dissipation,
-        kMaxAzimuthDeg);
+        "need the arc in that plane (their balance along b = n x e is f lambda ds0/dt^2 (t.b) = 0: a smooth plane "
+        "cannot push sideways), or the lying part turned at the front to the arc's projection, which the front does "
+        "not build; at most {:g} deg (docs/model.md §10, A touchdown front in 3D)",
+        surface_, std::asin(std::min(off_plane_, 1.0)) * 180 / kPi, t, s.s0, s.s0_dot, this->dissipation,
+        kMaxOffPlaneDeg);
   if (least == m.take_off)
     return fmt::format(
         "lifted off {} at t = {:.9g} s: the plane would have to pull the string at the touchdown front (its reaction "
@@ -438,7 +443,7 @@ template <int dim>
 std::optional<RunEvent> TouchdownFront<dim>::check_event(const StringModel<dim>& model, const FrontState<dim>& s,
                                                          double t) const {
   const Margins m = margins(model, s);
-  if (std::min({m.angle, m.height, m.take_off, m.azimuth}) != m.take_off) return std::nullopt;
+  if (std::min({m.angle, m.height, m.take_off, m.off_plane}) != m.take_off) return std::nullopt;
   RunEvent e;
   e.kind = "lift_off";
   e.t = t;

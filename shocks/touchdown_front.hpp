@@ -5,7 +5,7 @@
 /// "A touchdown front"; in 3D "A touchdown front in 3D": e is then the lying part's last link projected on the
 /// plane, the split link's constraint touchdown_split_constraint, and the load on a has a part τ_b along n × e that
 /// keeps the front's reaction normal to the plane; with f > 0 the run stops where the arc leaves out of the plane of
-/// e and n, kMaxAzimuthDeg).
+/// e and n, kMaxOffPlaneDeg).
 ///
 /// The string before the front (s < s0, arc A) lies on the plane, held there node by node by the
 /// contact module (the surface holds arc A's nodes only: Obstacle::carries, touchdown_surface); the
@@ -84,10 +84,11 @@ class TouchdownFront final : public SplitLinkFront<dim> {
   /// partial link starts at kHysteresis h, on the positive side of its own threshold (a front that reverses
   /// right after a crossing then crosses back, docs/model.md §10).
   static constexpr double kHysteresis = 1e-8;
-  /// 3D, f > 0: the run stops when the arc leaves the plane at more than this azimuth from the plane of the lying
-  /// part's direction e and the normal n (the jump conditions' balance along n × e needs it zero for f > 0 on a
-  /// moving front; the discrete front books the residual as a sideways load on the lying end, docs/model.md §10).
-  static constexpr double kMaxAzimuthDeg = 1;
+  /// 3D, f > 0: the run stops when the arc's tangent t makes more than this angle, asin |t·b|, with the plane of the
+  /// lying part's direction e and the normal n (b = n × e: the jump conditions' balance along b, f λ ṡ0² (t·b) = 0,
+  /// needs it zero for f > 0 on a moving front; the discrete front books the residual as a sideways load on the lying
+  /// end, docs/model.md §10, "A touchdown front in 3D").
+  static constexpr double kMaxOffPlaneDeg = 1;
 
   explicit TouchdownFront(const TouchdownSpec<dim>& spec);
 
@@ -143,7 +144,7 @@ class TouchdownFront final : public SplitLinkFront<dim> {
   void evaluate_3d(const StringModel<dim>& model, FrontState<dim>& state, Eigen::VectorXd& mass, Points<dim>& force);
   /// The margins of checks(): angle, other nodes' heights (per h), take-off.
   struct Margins {
-    double angle = 1, height = 1, take_off = 1, azimuth = 1;
+    double angle = 1, height = 1, take_off = 1, off_plane = 1;
     int low_node = -1;
   };
   Margins margins(const StringModel<dim>& model, const FrontState<dim>& state) const;
@@ -154,7 +155,7 @@ class TouchdownFront final : public SplitLinkFront<dim> {
   int lying_last_ = -1;
   double theta_ = 0;
   double elevation_ = 1;  ///< 3D: t·n, the sine of the arc's elevation over the plane, after an evaluation
-  double azimuth_ = 0;    ///< 3D: |t·b|/|P t|, the sine of the arc's azimuth from the plane of e and n (b = n × e)
+  double off_plane_ = 0;  ///< 3D: |t·b|, the sine of the arc's angle to the plane of e and n (b = n × e)
   /// The index of this front's constraint in the model's list (constraints() appends it to the list the model
   /// rebuilds from every front), for constraint_force.
   mutable std::size_t constraint_index_ = static_cast<std::size_t>(-1);

@@ -458,10 +458,11 @@ TEST_CASE("touchdown front in 3D: without dissipation the arc may leave out of t
 }
 
 TEST_CASE("touchdown front in 3D: with f > 0 an arc out of the plane of the lying part stops the run", "[touchdown]") {
-  // With f > 0 the balance along b needs t·b = 0 on a moving front: the drawn string at the azimuth 40° (f = 0.5)
-  // has no solution with its straight lying part, and the run stops at once, located (the time, the front, the
-  // azimuth); at 0.5° (within TouchdownFront::kMaxAzimuthDeg) it runs, the residual booked as a sideways load on the
-  // lying end, with the plane's reaction still normal to it and the ledgers closed.
+  // With f > 0 the balance along b needs t·b = 0 on a moving front: the drawn string at the azimuth 40° (f = 0.5;
+  // the arc at asin(cos 60° sin 40°) = 18.75° to the plane of e and n) has no solution with its straight lying part,
+  // and the run stops at once, located (the time, the front, the angle); at the azimuth 0.5° (0.25° to that plane,
+  // within TouchdownFront::kMaxOffPlaneDeg) it runs, the residual booked as a sideways load on the lying end, with
+  // the plane's reaction still normal to it and the ledgers closed.
   const Eigen::Matrix3d R = turns()[1];
   const Eigen::Vector3d n = R * Eigen::Vector3d(0, 1, 0);
   {
@@ -470,7 +471,7 @@ TEST_CASE("touchdown front in 3D: with f > 0 an arc out of the plane of the lyin
     REQUIRE(run.status == "stopped");
     CHECK(run.t_stop == 0.0);
     CHECK(run.events.empty());  // not a lift-off
-    CHECK(run.stop_reason.find("at 40 deg from the plane of the lying part's direction and the normal at t = 0 s") !=
+    CHECK(run.stop_reason.find("at 18.75 deg to the plane of the lying part's direction and the normal at t = 0 s") !=
           std::string::npos);
     CHECK(run.stop_reason.find("effects.surface[0]") != std::string::npos);
   }
