@@ -133,6 +133,25 @@ TouchdownConstraint<dim> touchdown_split_constraint(const Vec<dim>& xp, const Ve
   const double F_d = -c_d / s - (1 - c) * s_d / (s * s);
   const double F_dd = -c_dd / s + 2 * c_d * s_d / (s * s) - (1 - c) * s_dd / (s * s) + 2 * (1 - c) * s_d * s_d / (s * s * s);
   k.curvature = 2 * (vb - va).dot(e_d) + (xb - xa).dot(e_dd) + 2 * y_d * F_d + y * F_dd;
+  // The lateral constraint D = (x_b − x_a)·b − y G, G = (t·b)/s, b = n × e: ∂D/∂b = r, and b·δ = (n × δe)·r =
+  // δe·(r × n), so that through e ∂D/∂x_a = (P r×n − (e·r×n) e)/|u| and ∂D/∂x_p its opposite; ∂G/∂t = b/s −
+  // (t·b) n/s².
+  const Vec<dim> bn = plane_cross<dim>(n, e), bn_d = plane_cross<dim>(n, e_d), bn_dd = plane_cross<dim>(n, e_dd);
+  const double beta = t.dot(bn), G = beta / s;
+  k.lateral_value = (xb - xa).dot(bn) - y * G;
+  const Vec<dim> Gt = bn / s - beta / (s * s) * n;
+  const Vec<dim> QGt = Gt - t.dot(Gt) * t;
+  const Vec<dim> rn = plane_cross<dim>(r, n);
+  const Vec<dim> gb = has_p ? Vec<dim>((P * rn - e.dot(rn) * e) / ue) : Vec<dim>::Zero();
+  k.lateral_gradient.resize(dim, 4);
+  k.lateral_gradient.col(0) = -gb;
+  k.lateral_gradient.col(1) = -bn + gb;
+  k.lateral_gradient.col(2) = bn - G * n + (y / L) * QGt;
+  k.lateral_gradient.col(3) = -(y / L) * QGt;
+  const double beta_d = t_d.dot(bn) + t.dot(bn_d), beta_dd = t_dd.dot(bn) + 2 * t_d.dot(bn_d) + t.dot(bn_dd);
+  const double G_d = beta_d / s - beta * s_d / (s * s);
+  const double G_dd = beta_dd / s - 2 * beta_d * s_d / (s * s) - beta * s_dd / (s * s) + 2 * beta * s_d * s_d / (s * s * s);
+  k.lateral_curvature = 2 * (vb - va).dot(bn_d) + (xb - xa).dot(bn_dd) - 2 * y_d * G_d - y * G_dd;
   return k;
 }
 
@@ -277,11 +296,16 @@ void TouchdownFront<dim>::constraints(const StringModel<dim>& model, const Front
     NodeConstraint<dim> c;
     const int first = g.p >= 0 ? 0 : 1;  // the lying part's last link (p, a), if it has one
     for (int q = first; q < 4; ++q) c.nodes.push_back(q == 0 ? g.p : q == 1 ? g.a : q == 2 ? g.b : g.c);
+    NodeConstraint<dim> lateral = c;  // the same nodes
     c.gradient = g.split.gradient.rightCols(4 - first);
     c.value = g.split.value;
     c.curvature = g.split.curvature;
+    lateral.gradient = g.split.lateral_gradient.rightCols(4 - first);
+    lateral.value = g.split.lateral_value;
+    lateral.curvature = g.split.lateral_curvature;
     constraint_index_ = out.size();
     out.push_back(std::move(c));
+    out.push_back(std::move(lateral));
     return;
   }
   const Points<dim>& x = model.x();
@@ -312,7 +336,14 @@ Vec<dim> TouchdownFront<dim>::constraint_force(const StringModel<dim>& model) co
   if (k >= cs.size() || static_cast<Eigen::Index>(k) >= mu.size()) return Vec<dim>::Zero();  // none solved yet
   Vec<dim> sum = Vec<dim>::Zero();
   for (Eigen::Index q = 0; q < cs[k].gradient.cols(); ++q) sum += cs[k].gradient.col(q);
-  return mu[static_cast<Eigen::Index>(k)] * sum;
+  if constexpr (dim == 2) {
+    return mu[static_cast<Eigen::Index>(k)] * sum;
+  } else {  // the lateral constraint's net force, −μ (t·b)/(t·n) n, is the plane's too
+    if (k + 1 >= cs.size() || static_cast<Eigen::Index>(k + 1) >= mu.size()) return mu[static_cast<Eigen::Index>(k)] * sum;
+    Vec<dim> lateral = Vec<dim>::Zero();
+    for (Eigen::Index q = 0; q < cs[k + 1].gradient.cols(); ++q) lateral += cs[k + 1].gradient.col(q);
+    return mu[static_cast<Eigen::Index>(k)] * sum + mu[static_cast<Eigen::Index>(k + 1)] * lateral;
+  }
 }
 
 template <int dim>

@@ -44,7 +44,7 @@ namespace chainsim {
 ///     C = (x_b − x_a)·e + y_b (1 − t·e)/(t·n) − h,
 /// e = P (x_a − x_p)/|P (x_a − x_p)| (P = I − n nᵀ), t = (x_c − x_b)/|x_c − x_b|, y_b = n·(x_b − point): l⁻ + l⁺ − h
 /// with l⁺ = y_b/(t·n) and l⁻ = (x0 − x_a)·e, x0 = x_b − l⁺ t. In the plane of e and n it is the 2D constraint
-/// (1 − cos θ)/sin θ = tan(θ/2).
+/// (1 − cos θ)/sin θ = tan(θ/2). In 3D a second one puts x0 on the lying link's line (lateral_value).
 template <int dim>
 struct TouchdownConstraint {
   Vec<dim> e = Vec<dim>::Zero(), t = Vec<dim>::Zero(), x0 = Vec<dim>::Zero();
@@ -53,6 +53,11 @@ struct TouchdownConstraint {
   double value = 0;          ///< C
   Points<dim> gradient;      ///< ∂C/∂x at p, a, b, c (p's column zero when p < 0)
   double curvature = 0;      ///< C̈ at zero accelerations
+  /// The second constraint, x0 on the lying link's line: D = (x0 − x_a)·b = (x_b − x_a)·b − y_b (t·b)/(t·n),
+  /// b = n × e (3D; zero in 2D), with its gradient (same columns) and D̈ at zero accelerations.
+  double lateral_value = 0;
+  Points<dim> lateral_gradient;
+  double lateral_curvature = 0;
 };
 template <int dim>
 TouchdownConstraint<dim> touchdown_split_constraint(const Vec<dim>& xp, const Vec<dim>& xa, const Vec<dim>& xb,
@@ -157,7 +162,7 @@ class TouchdownFront final : public SplitLinkFront<dim> {
   double elevation_ = 1;  ///< 3D: t·n, the sine of the arc's elevation over the plane, after an evaluation
   double off_plane_ = 0;  ///< 3D: |t·b|, the sine of the arc's angle to the plane of e and n (b = n × e)
   /// The index of this front's constraint in the model's list (constraints() appends it to the list the model
-  /// rebuilds from every front), for constraint_force.
+  /// rebuilds from every front), for constraint_force; in 3D the lateral one follows it.
   mutable std::size_t constraint_index_ = static_cast<std::size_t>(-1);
 };
 
