@@ -3,9 +3,9 @@
 /// A touchdown front (front_kind.hpp): where a string lying on a smooth plane leaves it, or a moving
 /// arc lands on it, an internal shock of dissipation f that slides along the plane (docs/model.md §10,
 /// "A touchdown front"; in 3D "A touchdown front in 3D": e is then the lying part's last link projected on the
-/// plane, the split link's constraint touchdown_split_constraint, and the load on a has a part τ_b along n × e that
-/// keeps the front's reaction normal to the plane; with f > 0 the run stops where the arc leaves out of the plane of
-/// e and n, kMaxOffPlaneDeg).
+/// plane, the split link has two constraints, touchdown_split_constraint (its length, and x0 on the lying link's
+/// line), the load on a has a part τ_b along n × e that keeps the front's reaction normal to the plane, and with f > 0
+/// the run stops where the arc leaves out of the plane of e and n, kMaxOffPlaneDeg).
 ///
 /// The string before the front (s < s0, arc A) lies on the plane, held there node by node by the
 /// contact module (the surface holds arc A's nodes only: Obstacle::carries, touchdown_surface); the

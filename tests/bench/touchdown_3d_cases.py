@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""The numbers of docs/model.md §10, "A touchdown front in 3D", "A lying part that curves in the plane": the drawn
+"""The numbers of docs/model.md §10, "A touchdown front in 3D", *A lying part that curves in the plane*: the drawn
 string with f = 0 whose lying part turns in the plane of the table before the front, so that the direction e of its
 last link turns while the string runs (the front's 3D terms in e), against the exact solution.
 

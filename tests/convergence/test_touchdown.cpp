@@ -406,9 +406,9 @@ TEST_CASE("touchdown front in 3D: the drawn string in a tilted plane follows the
         const DrawnErrors err = drawn_errors(run, nodes, f, speed, theta, R * Eigen::Vector3d(0, 1, 0));
         CAPTURE(err.s0, err.x0, err.normal, err.along, err.tau, err.w, run.relative_energy_drift(),
                 run.relative_momentum_residual());
-        // Measured (rtol 1e-10, every turn, f and mesh): s0 within 1.0e-15 m, x0 within 7.9e-16 m, N within
-        // 2.4e-14 N, the reaction along the plane within 4.4e-16 N, τ⁺ within 6.8e-14 N, W_shocks within 5.7e-16 J,
-        // the energy drift within 2.6e-15 and the momentum residual within 4.7e-15 of their scales: round-off,
+        // Measured (rtol 1e-10, every turn, f and mesh): s0 within 7.8e-16 m, x0 within 8.5e-16 m, N within
+        // 2.5e-14 N, the reaction along the plane within 4.6e-16 N, τ⁺ within 6.8e-14 N, W_shocks within 6.4e-16 J,
+        // the energy drift within 2.5e-15 and the momentum residual within 4.1e-15 of their scales: round-off,
         // bounded as the 2D test's (about 10³ ulp of each scale).
         CHECK(err.s0 < 1e-13);
         CHECK(err.x0 < 1e-13);
@@ -443,9 +443,9 @@ TEST_CASE("touchdown front in 3D: without dissipation the arc may leave out of t
       const DrawnErrors err = drawn_errors(run, nodes, 0.0, speed, 0.0, R * Eigen::Vector3d(0, 1, 0));
       CAPTURE(err.s0, err.x0, err.normal, err.along, err.tau, run.relative_energy_drift(),
               run.relative_momentum_residual());
-      // Measured (every φ and turn): s0 within 5.6e-16 m, x0 within 6.8e-16 m, the reaction normal to the plane
-      // within 1.7e-14 N and along it within 7.1e-16 N, τ⁺ within 4.5e-14 N, the energy drift within 2.6e-15 and
-      // the momentum residual within 1.8e-15 of their scales: round-off, bounded as above.
+      // Measured (every φ and turn): s0 within 7.8e-16 m, x0 within 6.6e-16 m, the reaction normal to the plane
+      // within 1.9e-14 N and along it within 5.8e-16 N, τ⁺ within 4.5e-14 N, the energy drift within 3.3e-15 and
+      // the momentum residual within 1.0e-15 of their scales: round-off, bounded as above.
       CHECK(err.s0 < 1e-13);
       CHECK(err.x0 < 1e-13);
       CHECK(err.normal < 1e-12);
@@ -485,8 +485,8 @@ TEST_CASE("touchdown front in 3D: with f > 0 an arc out of the plane of the lyin
     along = std::max(along, (react - react.dot(n) * n).norm());
   }
   CAPTURE(along, run.relative_energy_drift(), run.relative_momentum_residual());
-  // Measured: the reaction along the plane within 3.8e-16 N, the energy drift 4.2e-15 and the momentum residual
-  // 4.3e-16 of their scales: round-off, bounded as above.
+  // Measured: the reaction along the plane within 3.7e-16 N, the energy drift 3.2e-14 and the momentum residual
+  // 1.7e-15 of their scales: round-off, bounded as above.
   CHECK(along < 1e-13);
   CHECK(run.energy_drift < 1e-12 * run.energy_scale);
   CHECK(run.max_momentum_residual < 1e-13 * run.momentum_scale);
@@ -520,16 +520,16 @@ TEST_CASE("touchdown front in 3D: the split link's constraint, its gradient and 
     const double fd = (C(x + d * dir).value - C(x - d * dir).value) / (2 * d);
     double grad = 0;
     for (int q = has_p ? 0 : 1; q < 4; ++q) grad += k.gradient.col(q).dot(dir.col(q));
-    CHECK(grad == Approx(fd).epsilon(5e-9));  // measured 1.5e-9 (the difference's own error)
+    CHECK(grad == Approx(fd).epsilon(5e-9));  // measured 1.4e-9 (the difference's own error)
     // Central differences in τ, Richardson-extrapolated (their error O(τ⁴)).
     auto second = [&](double dt) { return (C(x + dt * v).value - 2 * k.value + C(x - dt * v).value) / (dt * dt); };
     auto first = [&](double dt) { return -(C(x + dt * v).l_plus - C(x - dt * v).l_plus) / (2 * dt); };
     const double dt = 1e-4;
     const double fd2 = (4 * second(dt / 2) - second(dt)) / 3, fd1 = (4 * first(dt / 2) - first(dt)) / 3;
     CAPTURE(k.curvature, fd2, k.s0_dot, fd1);
-    // Measured: within 1.1e-10 and below 1e-10 (relative).
+    // Measured: within 1.1e-10 and 5.2e-12 (relative).
     CHECK(k.curvature == Approx(fd2).epsilon(4e-10));
-    CHECK(k.s0_dot == Approx(fd1).epsilon(3e-10));  // ṡ0 = −dl⁺/dt
+    CHECK(k.s0_dot == Approx(fd1).epsilon(2e-11));  // ṡ0 = −dl⁺/dt
     // The lateral constraint D = (x0 − x_a)·(n × e) likewise.
     const double fdl = (C(x + d * dir).lateral_value - C(x - d * dir).lateral_value) / (2 * d);
     double gradl = 0;
@@ -539,8 +539,8 @@ TEST_CASE("touchdown front in 3D: the split link's constraint, its gradient and 
     };
     const double fdl2 = (4 * second_l(dt / 2) - second_l(dt)) / 3;
     CAPTURE(k.lateral_value, gradl, fdl, k.lateral_curvature, fdl2);
-    CHECK(gradl == Approx(fdl).epsilon(5e-9));
-    CHECK(k.lateral_curvature == Approx(fdl2).epsilon(4e-10));
+    CHECK(gradl == Approx(fdl).epsilon(2e-9));                // measured 5.5e-10
+    CHECK(k.lateral_curvature == Approx(fdl2).epsilon(3e-10));  // measured 9.5e-11
     CHECK(k.lateral_value == Approx((k.x0 - x.col(1)).dot(n.cross(k.e))).epsilon(1e-13));
   }
   // In the plane of e and n: C = (x_b − x_a)·e + y tan(θ/2) − h.
