@@ -2,7 +2,10 @@
 /// @file touchdown_front.hpp
 /// A touchdown front (front_kind.hpp): where a string lying on a smooth plane leaves it, or a moving
 /// arc lands on it, an internal shock of dissipation f that slides along the plane (docs/model.md §10,
-/// "A touchdown front"; 2D).
+/// "A touchdown front"; in 3D "A touchdown front in 3D": e is then the lying part's last link projected on the
+/// plane, the split link has two constraints, touchdown_split_constraint (its length, and x0 on the lying link's
+/// line), the load on a has a part τ_b along n × e that keeps the front's reaction normal to the plane, and with f > 0
+/// the run stops where the arc leaves out of the plane of e and n, kMaxOffPlaneDeg).
 ///
 /// The string before the front (s < s0, arc A) lies on the plane, held there node by node by the
 /// contact module (the surface holds arc A's nodes only: Obstacle::carries, touchdown_surface); the
@@ -35,6 +38,34 @@
 
 namespace chainsim {
 
+/// The split link's constraint of a 3D touchdown front (docs/model.md §10, "A touchdown front in 3D"), from the
+/// positions and velocities of the lying part's last link (p, a) (p < 0: none, e given), of arc B's first link
+/// (b, c), the plane (a point and its unit normal n) and the link length h:
+///     C = (x_b − x_a)·e + y_b (1 − t·e)/(t·n) − h,
+/// e = P (x_a − x_p)/|P (x_a − x_p)| (P = I − n nᵀ), t = (x_c − x_b)/|x_c − x_b|, y_b = n·(x_b − point): l⁻ + l⁺ − h
+/// with l⁺ = y_b/(t·n) and l⁻ = (x0 − x_a)·e, x0 = x_b − l⁺ t. In the plane of e and n it is the 2D constraint
+/// (1 − cos θ)/sin θ = tan(θ/2). In 3D a second one puts x0 on the lying link's line (lateral_value).
+template <int dim>
+struct TouchdownConstraint {
+  Vec<dim> e = Vec<dim>::Zero(), t = Vec<dim>::Zero(), x0 = Vec<dim>::Zero();
+  double cos = 0, sin = 0;  ///< t·e, t·n
+  double l_plus = 0, l_minus = 0, s0_dot = 0;  ///< ṡ0 = −dl⁺/dt
+  double value = 0;          ///< C
+  Points<dim> gradient;      ///< ∂C/∂x at p, a, b, c (p's column zero when p < 0)
+  double curvature = 0;      ///< C̈ at zero accelerations
+  /// The second constraint, x0 on the lying link's line: D = (x0 − x_a)·b = (x_b − x_a)·b − y_b (t·b)/(t·n),
+  /// b = n × e (3D; zero in 2D), with its gradient (same columns) and D̈ at zero accelerations.
+  double lateral_value = 0;
+  Points<dim> lateral_gradient;
+  double lateral_curvature = 0;
+};
+template <int dim>
+TouchdownConstraint<dim> touchdown_split_constraint(const Vec<dim>& xp, const Vec<dim>& xa, const Vec<dim>& xb,
+                                                    const Vec<dim>& xc, const Vec<dim>& vp, const Vec<dim>& va,
+                                                    const Vec<dim>& vb, const Vec<dim>& vc, bool has_p,
+                                                    const Vec<dim>& e_fixed, const Vec<dim>& point,
+                                                    const Vec<dim>& normal, double h);
+
 /// A touchdown front on the plane through `point` with unit outward normal `normal`.
 template <int dim>
 struct TouchdownSpec {
@@ -58,6 +89,11 @@ class TouchdownFront final : public SplitLinkFront<dim> {
   /// partial link starts at kHysteresis h, on the positive side of its own threshold (a front that reverses
   /// right after a crossing then crosses back, docs/model.md §10).
   static constexpr double kHysteresis = 1e-8;
+  /// 3D, f > 0: the run stops when the arc's tangent t makes more than this angle, asin |t·b|, with the plane of the
+  /// lying part's direction e and the normal n (b = n × e: the jump conditions' balance along b, f λ ṡ0² (t·b) = 0,
+  /// needs it zero for f > 0 on a moving front; the discrete front books the residual as a sideways load on the lying
+  /// end, docs/model.md §10, "A touchdown front in 3D").
+  static constexpr double kMaxOffPlaneDeg = 1;
 
   explicit TouchdownFront(const TouchdownSpec<dim>& spec);
 
@@ -100,11 +136,20 @@ class TouchdownFront final : public SplitLinkFront<dim> {
     Vec<dim> t = Vec<dim>::Zero(), t_perp = Vec<dim>::Zero(), x0 = Vec<dim>::Zero();
     double L = 0, cos = 0, sin = 0, theta_dot = 0, t_w = 0, y = 0, y_dot = 0, tan_half = 0;
     double l_plus = 0, l_minus = 0, s0_dot = 0;
+    /// 3D: e, the lying part's direction at the front (its last link (p, a) projected on the plane; along_ when
+    /// the lying part is node 0 alone, p = −1), and the split link's constraint (touchdown_split_constraint).
+    Vec<dim> e = Vec<dim>::Zero();
+    int p = -1;
+    TouchdownConstraint<dim> split;
   };
   Geometry geometry(const StringModel<dim>& model) const;
+  /// geometry() in 3D (dim = 3; the 2D one keeps its own arithmetic).
+  Geometry geometry_3d(const StringModel<dim>& model) const;
+  /// evaluate() in 3D (the 2D one keeps its own arithmetic).
+  void evaluate_3d(const StringModel<dim>& model, FrontState<dim>& state, Eigen::VectorXd& mass, Points<dim>& force);
   /// The margins of checks(): angle, other nodes' heights (per h), take-off.
   struct Margins {
-    double angle = 1, height = 1, take_off = 1;
+    double angle = 1, height = 1, take_off = 1, off_plane = 1;
     int low_node = -1;
   };
   Margins margins(const StringModel<dim>& model, const FrontState<dim>& state) const;
@@ -114,8 +159,10 @@ class TouchdownFront final : public SplitLinkFront<dim> {
   std::string surface_;
   int lying_last_ = -1;
   double theta_ = 0;
+  double elevation_ = 1;  ///< 3D: t·n, the sine of the arc's elevation over the plane, after an evaluation
+  double off_plane_ = 0;  ///< 3D: |t·b|, the sine of the arc's angle to the plane of e and n (b = n × e)
   /// The index of this front's constraint in the model's list (constraints() appends it to the list the model
-  /// rebuilds from every front), for constraint_force.
+  /// rebuilds from every front), for constraint_force; in 3D the lateral one follows it.
   mutable std::size_t constraint_index_ = static_cast<std::size_t>(-1);
 };
 

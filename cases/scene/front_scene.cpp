@@ -490,11 +490,6 @@ std::unique_ptr<StringModel<dim>> build_front_model(const SceneSpec& spec, scene
   for (std::size_t k = 0; k < fx.surfaces.size(); ++k) {
     if (!fx.surfaces[k].f) continue;
     const std::string key = fmt::format("effects.surface[{}]", k);
-    if constexpr (dim == 3)
-      fail_at(spec, key + ".f",
-              fmt::format("{}.f = {}: a touchdown front is built in 2D only (string.dimension = 2); in 3D leave out f "
-                          "(node contact lands the string: it loses the energy of an f = 1 front, not its momentum, docs/model.md §10)",
-                          key, text_of(spec, key + ".f")));
     if (!fx.heaps.empty() || fx.fold || !fx.edges.empty() || !fx.kinks.empty() || spec.solver.kinks == "insert" ||
         !touchdowns.empty() || !fx.cylinders.empty())
       fail_at(spec, key + ".f",

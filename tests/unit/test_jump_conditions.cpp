@@ -2,6 +2,7 @@
 // a moving front, and the reversal of the orientation of s.
 #include <cmath>
 
+#include <Eigen/Geometry>
 #include <catch2/catch.hpp>
 
 #include "shocks/jump_conditions.hpp"
@@ -376,4 +377,36 @@ TEST_CASE("touchdown front: the tensions and the reaction on a compatible state 
                   .epsilon(kExact)
                   .margin(kExact));
       }
+}
+
+TEST_CASE("touchdown front in 3D: the balance across the plane of e and n is (tau+ - lambda s0dot^2)(t.b) = 0",
+          "[unit][shocks]") {
+  // docs/model.md §10, "A touchdown front in 3D": e, b = n × e, n an orthonormal frame, t = c e + β b + σ n, and the
+  // two sides compatible, [v] = −ṡ0 (t − e). By hand: −t·[v] = ṡ0 (1 − c) and |[v]|² = 2 ṡ0² (1 − c) as in 2D, so
+  // τ⁺ = (1 − f sgn ṡ0) λ ṡ0² and τ⁻ = λ ṡ0² (1 − f sgn ṡ0 c); across, [v]·b = −ṡ0 β, so the load on the lying end
+  // along b that keeps the reaction normal (touchdown_tension_minus with b for e) is τ_b = −λ ṡ0² β + τ⁺ β
+  // = (τ⁺ − λ ṡ0²) β = −f λ ṡ0 |ṡ0| β: zero for f = 0 at any azimuth, nonzero for f > 0 unless β = 0. The reaction
+  // R = τ⁻ e + τ_b b − τ⁺ t − λ ṡ0 [v] = f λ ṡ0 |ṡ0| σ n.
+  const double lam = 0.7;
+  const V3 n = V3(0.2, 1.0, -0.3).normalized(), e = V3(1.0, 0.2, 0.0).cross(n).normalized(), b = n.cross(e);
+  for (const double elevation_deg : {20.0, 60.0})
+    for (const double azimuth_deg : {0.0, 40.0, 90.0, 150.0})
+      for (const double f : {0.0, 0.5, 1.0})
+        for (const double s0dot : {1.3, -0.8}) {
+          CAPTURE(elevation_deg, azimuth_deg, f, s0dot);
+          const double el = elevation_deg * std::acos(-1.0) / 180, az = azimuth_deg * std::acos(-1.0) / 180;
+          const double c = std::cos(el) * std::cos(az), beta = std::cos(el) * std::sin(az), sigma = std::sin(el);
+          const double sg = s0dot > 0 ? 1 : -1;
+          const V3 t = c * e + beta * b + sigma * n, jump = -s0dot * (t - e);
+          const double taup = touchdown_tension_plus<3>(t, c, jump, f, lam, s0dot);
+          const double taum = touchdown_tension_minus<3>(taup, e, c, jump, lam, s0dot);
+          const double taub = touchdown_tension_minus<3>(taup, b, t.dot(b), jump, lam, s0dot);
+          CHECK(taup == Approx((1 - f * sg) * lam * s0dot * s0dot).epsilon(kExact).margin(kExact));
+          CHECK(taum == Approx(lam * s0dot * s0dot * (1 - f * sg * c)).epsilon(kExact).margin(kExact));
+          CHECK(taub == Approx(-f * lam * s0dot * std::abs(s0dot) * beta).epsilon(kExact).margin(kExact));
+          const V3 R = touchdown_reaction<3>(e, t, taum, taup, jump, lam, s0dot) + taub * b;
+          CHECK(R.dot(e) == Approx(0).margin(kExact));
+          CHECK(R.dot(b) == Approx(0).margin(kExact));
+          CHECK(R.dot(n) == Approx(f * lam * s0dot * std::abs(s0dot) * sigma).epsilon(kExact).margin(kExact));
+        }
 }
