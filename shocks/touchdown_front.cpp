@@ -426,8 +426,15 @@ typename TouchdownFront<dim>::Margins TouchdownFront<dim>::margins(const StringM
   const double floor = 1e-8 * model.physical_scales().tension;
   const double push = normal_.dot(recorded_reaction(model, s));
   m.take_off = scale + floor > 0 ? std::min(1.0, (push + 1e-6 * scale + floor) / (scale + 1e6 * floor)) : 1.0;
+  // 3D, f > 0: the sideways pull the front puts on the lying end, f λ ṡ0² |t·b|, beyond f λ ṡ0² sin 1°, per
+  // f λ ṡ0², with the take-off check's round-off floor: the arc's angle to the plane of e and n where the front
+  // moves, nothing where it is at rest (ṡ0 = 0: the balance across holds at any angle).
   if constexpr (dim == 3)
-    if (this->dissipation > 0) m.off_plane = std::sin(kMaxOffPlaneDeg * kPi / 180) - off_plane_;
+    if (this->dissipation > 0) {
+      const double sideways = this->dissipation * this->m_.lambda * s.s0_dot * s.s0_dot;
+      m.off_plane = std::min(1.0, (sideways * (std::sin(kMaxOffPlaneDeg * kPi / 180) - off_plane_) + floor) /
+                                      (sideways + 1e6 * floor));
+    }
   return m;
 }
 
@@ -442,6 +449,7 @@ template <int dim>
 std::string TouchdownFront<dim>::check_failed(const StringModel<dim>& model, const FrontState<dim>& s, double t) const {
   const Margins m = margins(model, s);
   const double least = std::min({m.angle, m.height, m.take_off, m.off_plane});
+  const double angle = dim == 3 ? std::asin(std::clamp(elevation_, -1.0, 1.0)) : theta_;  // 3D: the elevation
   if (least == m.off_plane && m.off_plane < std::min({m.angle, m.height, m.take_off}))
     return fmt::format(
         "the arc leaves {} at {:.4g} deg to the plane of the lying part's direction and the normal at t = {:.9g} s "
@@ -457,13 +465,12 @@ std::string TouchdownFront<dim>::check_failed(const StringModel<dim>& model, con
         "N = {:.6g} N; s0 = {:.9g} m, ds0/dt = {:.4g} m/s, the arc at {:.4g} deg, f = {:g}): a take-off with f > 0 "
         "needs N = -f lambda ds0/dt^2 sin theta < 0 (a string peels off a smooth plane only without dissipation, f = 0), "
         "and a lying part whose own motion disagrees with the arc's end needs a pull to stay taut (docs/model.md §10)",
-        surface_, t, normal_.dot(recorded_reaction(model, s)), s.s0, s.s0_dot, theta_ * 180 / kPi, this->dissipation);
+        surface_, t, normal_.dot(recorded_reaction(model, s)), s.s0, s.s0_dot, angle * 180 / kPi, this->dissipation);
   if (least == m.height)
     return fmt::format(
         "node {} of the arc reaches {} at t = {:.9g} s away from its touchdown front (s0 = {:.9g} m): a string that "
         "lands elsewhere than at its front is not supported with f (node contact lands it: leave out f)",
         m.low_node, surface_, t, s.s0);
-  const double angle = dim == 3 ? std::asin(std::clamp(elevation_, -1.0, 1.0)) : theta_;  // 3D: the elevation
   return fmt::format(
       "the arc meets {} at {:.4g} deg at t = {:.9g} s (s0 = {:.9g} m, ds0/dt = {:.4g} m/s): a touchdown front needs "
       "at least {:g} deg (a grazing touchdown is no shock, and the split link no longer places it)",

@@ -5,7 +5,7 @@
 /// "A touchdown front"; in 3D "A touchdown front in 3D": e is then the lying part's last link projected on the
 /// plane, the split link has two constraints, touchdown_split_constraint (its length, and x0 on the lying link's
 /// line), the load on a has a part τ_b along n × e that keeps the front's reaction normal to the plane, and with f > 0
-/// the run stops where the arc leaves out of the plane of e and n, kMaxOffPlaneDeg).
+/// the run stops where a moving front's arc leaves out of the plane of e and n, kMaxOffPlaneDeg).
 ///
 /// The string before the front (s < s0, arc A) lies on the plane, held there node by node by the
 /// contact module (the surface holds arc A's nodes only: Obstacle::carries, touchdown_surface); the
@@ -111,7 +111,8 @@ class TouchdownFront final : public SplitLinkFront<dim> {
   void crossings(const StringModel<dim>& model, const FrontState<dim>& state, double* g) const override;
   EventAction cross(StringModel<dim>& model, const FrontState<dim>& state, int e0) override;
   /// One: positive while the arc meets the plane at more than kMinAngleDeg, no other node of the arc
-  /// reaches the plane, and the plane pushes at the front (its reaction's normal component).
+  /// reaches the plane, the plane pushes at the front (its reaction's normal component), and (3D, f > 0)
+  /// a moving front's arc stays within kMaxOffPlaneDeg of the plane of e and n.
   bool checks_need_tensions() const override { return true; }
   int num_checks() const override { return 1; }
   void checks(const StringModel<dim>& model, const FrontState<dim>& state, double* g) const override;
@@ -155,7 +156,7 @@ class TouchdownFront final : public SplitLinkFront<dim> {
   Margins margins(const StringModel<dim>& model, const FrontState<dim>& state) const;
 
   Vec<dim> point_ = Vec<dim>::Zero(), normal_ = Vec<dim>::Zero();
-  Vec<dim> along_ = Vec<dim>::Zero();  ///< e: the plane's direction along arc A towards larger s
+  Vec<dim> along_ = Vec<dim>::Zero();  ///< e at the start (2D: always): the plane's direction along arc A towards larger s
   std::string surface_;
   int lying_last_ = -1;
   double theta_ = 0;

@@ -750,8 +750,8 @@ TEST_CASE("table and edge: a chain drawn back over the edge onto the table lands
   // The real table's chain started along itself towards the table (tangential speed −0.5 m/s): the hanging
   // part rises, the edge's crossings give its nodes back to the table, the chain turns at x_m and slides off.
   // With f = 0, ℓẍ = gx: x = x0 cosh ωt + (v0/ω) sinh ωt = x_m cosh ω(t − t_m), x_m² = x0² − v0²/ω²,
-  // tanh ωt_m = −v0/(ω x0), and the edge lifts off at x* = (ℓ + √(ℓ² + 8 x_m²))/4 (the issue's condition
-  // T = λẋ² with T = λ(ℓ − x)ẍ). Before, the tangential kind under slack = "stop" moved the node beside the
+  // tanh ωt_m = −v0/(ω x0), and the edge lifts off at x* = (ℓ + √(ℓ² + 8 x_m²))/4 (where the edge stops pushing,
+  // T = λẋ² with T = λ(ℓ − x)ẍ: docs/model.md §8). Before, the tangential kind under slack = "stop" moved the node beside the
   // edge (2·10⁻¹⁰ m from it) along its neighbours' chord, across the corner: its vertical speed turned
   // the bent link's short piece at 10⁹ rad/s, the tension rose to 10⁸ N and the edge lifted off at
   // t = 1.7·10⁻⁷ s; the nodes given back to a table that did not carry them are held at the crossing

@@ -409,15 +409,15 @@ TEST_CASE("touchdown front in 3D: the drawn string in a tilted plane follows the
         // Measured (rtol 1e-10, every turn, f and mesh): s0 within 7.8e-16 m, x0 within 8.5e-16 m, N within
         // 2.5e-14 N, the reaction along the plane within 4.6e-16 N, τ⁺ within 6.8e-14 N, W_shocks within 6.4e-16 J,
         // the energy drift within 2.5e-15 and the momentum residual within 4.1e-15 of their scales: round-off,
-        // bounded as the 2D test's (about 10³ ulp of each scale).
-        CHECK(err.s0 < 1e-13);
-        CHECK(err.x0 < 1e-13);
-        CHECK(err.normal < 1e-12);
-        CHECK(err.along < 1e-13);
-        CHECK(err.tau < 1e-12);
-        CHECK(err.w < 1e-13);
-        CHECK(run.energy_drift < 1e-12 * run.energy_scale);
-        CHECK(run.max_momentum_residual < 1e-13 * run.momentum_scale);
+        // bounded at 10-20 times these (the sanitizer stage builds the same test with clang, whose round-off differs).
+        CHECK(err.s0 < 1e-14);
+        CHECK(err.x0 < 1e-14);
+        CHECK(err.normal < 3e-13);
+        CHECK(err.along < 1e-14);
+        CHECK(err.tau < 7e-13);
+        CHECK(err.w < 1e-14);
+        CHECK(run.energy_drift < 3e-14 * run.energy_scale);
+        CHECK(run.max_momentum_residual < 5e-14 * run.momentum_scale);
         if (f == 0) {
           for (const StepSample& r : run.samples) CHECK(r.terms["W_shocks"] == 0.0);
         }
@@ -446,14 +446,14 @@ TEST_CASE("touchdown front in 3D: without dissipation the arc may leave out of t
       // Measured (every φ and turn): s0 within 7.8e-16 m, x0 within 6.6e-16 m, the reaction normal to the plane
       // within 1.9e-14 N and along it within 5.8e-16 N, τ⁺ within 4.5e-14 N, the energy drift within 3.3e-15 and
       // the momentum residual within 1.0e-15 of their scales: round-off, bounded as above.
-      CHECK(err.s0 < 1e-13);
-      CHECK(err.x0 < 1e-13);
-      CHECK(err.normal < 1e-12);
-      CHECK(err.along < 1e-12);
-      CHECK(err.tau < 1e-12);
+      CHECK(err.s0 < 1e-14);
+      CHECK(err.x0 < 1e-14);
+      CHECK(err.normal < 3e-13);
+      CHECK(err.along < 1e-14);
+      CHECK(err.tau < 7e-13);
       for (const StepSample& r : run.samples) CHECK(r.terms["W_shocks"] == 0.0);
-      CHECK(run.energy_drift < 1e-12 * run.energy_scale);
-      CHECK(run.max_momentum_residual < 1e-13 * run.momentum_scale);
+      CHECK(run.energy_drift < 5e-14 * run.energy_scale);
+      CHECK(run.max_momentum_residual < 2e-14 * run.momentum_scale);
     }
 }
 
@@ -475,6 +475,15 @@ TEST_CASE("touchdown front in 3D: with f > 0 an arc out of the plane of the lyin
           std::string::npos);
     CHECK(run.stop_reason.find("effects.surface[0]") != std::string::npos);
   }
+  {  // The same string at rest (its end held, no load): an equilibrium, whose front's balance across holds at any
+     // angle (ṡ0 = 0); the check, on the sideways pull f λ ṡ0² |t·b|, lets it be (it used to stop it at t = 0).
+    const RunSummary run = run_text_3d(drawn_scene_3d(40, 0.5, 0.0, 60, 40, R), "at_rest.toml");
+    CAPTURE(run.stop_reason);
+    REQUIRE(run.status == "completed");
+    CHECK(run.transfers == 0);
+    for (const StepSample& r : run.samples) CHECK(r.fronts[0].s0 == Approx(0.5).margin(1e-12));
+    CHECK(run.samples.back().kinetic < 1e-20);
+  }
   const RunSummary run = run_text_3d(drawn_scene_3d(40, 0.5, 1.0, 60, 0.5, R), "near_plane.toml");
   CAPTURE(run.stop_reason);
   REQUIRE(run.status == "completed");
@@ -487,9 +496,9 @@ TEST_CASE("touchdown front in 3D: with f > 0 an arc out of the plane of the lyin
   CAPTURE(along, run.relative_energy_drift(), run.relative_momentum_residual());
   // Measured: the reaction along the plane within 3.7e-16 N, the energy drift 3.2e-14 and the momentum residual
   // 1.7e-15 of their scales: round-off, bounded as above.
-  CHECK(along < 1e-13);
-  CHECK(run.energy_drift < 1e-12 * run.energy_scale);
-  CHECK(run.max_momentum_residual < 1e-13 * run.momentum_scale);
+  CHECK(along < 1e-14);
+  CHECK(run.energy_drift < 5e-13 * run.energy_scale);
+  CHECK(run.max_momentum_residual < 3e-14 * run.momentum_scale);
 }
 
 TEST_CASE("touchdown front in 3D: the split link's constraint, its gradient and its curvature", "[touchdown]") {
@@ -584,13 +593,13 @@ TEST_CASE("touchdown front in 3D: with gravity on a tilted plane it follows the 
     // Measured: s0 at 0.12 s the same in both to 1.3e-13 m (20 nodes) and 1.7e-14 m (40 nodes; 0.87113516094883 m),
     // K to 2.2e-12 and 1.7e-12 J of 4 J; the energy drift 2.4e-14 and 1.3e-13 (rtol 1e-10), 1.3e-15 and 7.2e-16
     // (rtol 1e-12) of its scale, 18 and 177 times less. The two runs' round-off differs, and the adaptive steps may
-    // carry that up to the tolerance (rtol 1e-10): the bounds on s0 and K are that, not round-off; the drifts'
-    // bounds are the 2D test's, and their ratio's a third of the least measured (on 20 nodes the drift at rtol
-    // 1e-10 is already near round-off).
-    CHECK(std::abs(s0_3 - s0_2) < 1e-12);
-    CHECK(std::abs(run3.samples.back().kinetic - run2.samples.back().kinetic) < 1e-10);
-    CHECK(drift[0] < 4.3e-12);
-    CHECK(drift[1] < 2e-14);
+    // carry that up to the tolerance (rtol 1e-10): the bounds on s0 and K are that, not round-off, about 4 times the
+    // measured; the drifts' about 4 times the largest measured, and their ratio's a third of the least measured (on
+    // 20 nodes the drift at rtol 1e-10 is already near round-off).
+    CHECK(std::abs(s0_3 - s0_2) < 5e-13);
+    CHECK(std::abs(run3.samples.back().kinetic - run2.samples.back().kinetic) < 1e-11);
+    CHECK(drift[0] < 5e-13);
+    CHECK(drift[1] < 5e-15);
     CHECK(drift[0] > 6 * drift[1]);
     CHECK(run3.relative_momentum_residual() < 1e-11);
   }
@@ -623,10 +632,10 @@ TEST_CASE("touchdown front in 3D: with gravity across the lying part the energy 
     }
     CAPTURE(nodes, drift[0], drift[1]);
     // Measured: 3.5e-15 and 1.2e-14 at rtol 1e-10, 2.4e-16 and 3.0e-16 at rtol 1e-12 (near round-off already at
-    // 1e-10 on 20 nodes); the bounds are the 2D test's round-off bounds, ten million times below the loss without
+    // 1e-10 on 20 nodes); the bounds about 4 and 10 times the largest, ten million times below the loss without
     // the lateral constraint, and the fall with the tolerance a third of the least measured (12 times).
-    CHECK(drift[0] < 1e-12);
-    CHECK(drift[1] < 2e-14);
+    CHECK(drift[0] < 5e-14);
+    CHECK(drift[1] < 3e-15);
     CHECK(drift[0] > 4 * drift[1]);
   }
 }
