@@ -235,7 +235,7 @@ class Integrator {
   /// Returns -1 (the event is polished), or the event function whose root the recomputed step refutes
   /// (no event: the integrator is back at the step's start).
   int polish_event(double t_step_start, const Eigen::VectorXd& y_step_start, double t_step_end, bool from_here);
-  Eigen::VectorXd error_weights() const;
+  void error_weights(Eigen::VectorXd& weights) const;
   double allowed_step() const;
   void set_root_directions(int ignored = -1);
   double predict_recurring_event(double t_target, int& which);
