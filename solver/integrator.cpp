@@ -198,6 +198,10 @@ struct Integrator::Impl {
   Eigen::VectorXd y_step_start;
   Eigen::VectorXd y_base, f_base, f_euler, y_euler, second, ydot, y_probe, weights;
   N_Vector ewt = nullptr, local_errors = nullptr;
+  // provide_start_rhs(): F at (start_time, the state y wrapped at that time), for the next evaluation.
+  Eigen::VectorXd start_rhs;
+  double start_time = 0;
+  bool start_rhs_ready = false;
   std::chrono::steady_clock::time_point wall_start = std::chrono::steady_clock::now();
 
   explicit Impl(OdeSystem& s) : system(s) {}
@@ -466,11 +470,27 @@ struct Integrator::Impl {
     Eigen::Map<const Eigen::VectorXd> ym(N_VGetArrayPointer(y), n);
     Eigen::Map<Eigen::VectorXd> dm(N_VGetArrayPointer(ydot), n);
     return self->guarded([&] {
+      if (self->start_rhs_ready && self->take_start_rhs(t, ym, dm)) {
+        if (!all_finite(dm)) throw RecoverableError("the right-hand side is not finite");
+        return 0;
+      }
       self->system.rhs(t, ym, dm);
       // a non-finite trial stage: let ARKODE retry with a smaller step
       if (!all_finite(dm)) throw RecoverableError("the right-hand side is not finite");
       return 0;
     });
+  }
+
+  /// The right-hand side given by provide_start_rhs() into ydot if (t, y) is its state (bit for bit: ARKODE's
+  /// copy of the restart's state); it is used up either way.
+  bool take_start_rhs(double t, const Eigen::Map<const Eigen::VectorXd>& ym, Eigen::Map<Eigen::VectorXd>& out) {
+    start_rhs_ready = false;
+    const Eigen::Map<const Eigen::VectorXd> state(N_VGetArrayPointer(y), N_VGetLength(y));
+    if (!(t == start_time && start_rhs.size() == ym.size() && state.size() == ym.size() &&
+          std::equal(ym.data(), ym.data() + ym.size(), state.data())))
+      return false;
+    out = start_rhs;
+    return true;
   }
 
   /// Runs the body of an ARKODE callback: a RecoverableError (a trial state the system cannot use)
@@ -1134,6 +1154,7 @@ void Integrator::restart(double t, const Eigen::VectorXd& y) {
   Impl& d = *impl_;
   CHAINSIM_VERIFY(y.size() == N_VGetLength(d.y), "restart() keeps the state length; use resize()");
   y_ = y;  // the same length: the same storage, which d.y wraps
+  d.start_rhs_ready = false;
   d.check(ARKStepReset(d.mem, t, d.y), "ARKStepReset");
   d.check(ARKStepSetInitStep(d.mem, d.h_resume), "ARKStepSetInitStep");  // 0: ARKODE's estimate
   d.h_resume = 0;
@@ -1150,12 +1171,21 @@ void Integrator::resize(double t, const Eigen::VectorXd& y) {
   N_VDestroy(d.y);
   d.y = ynew;
   d.free_work_vectors();  // (of the old length)
+  d.start_rhs_ready = false;
   d.check(flag, "ARKStepResize");
   d.check(ARKStepSetInitStep(d.mem, d.h_resume), "ARKStepSetInitStep");  // 0: ARKODE's estimate
   d.h_resume = 0;
   d.apply_tolerances();
   if (d.implicit) d.attach_linear_solver();
   t_ = t;
+}
+
+void Integrator::provide_start_rhs(const Eigen::VectorXd& f) {
+  Impl& d = *impl_;
+  CHAINSIM_VERIFY(f.size() == y_.size(), "provide_start_rhs() takes F at the current state");
+  d.start_rhs = f;
+  d.start_time = t_;
+  d.start_rhs_ready = true;
 }
 
 double Integrator::last_step() const {

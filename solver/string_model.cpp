@@ -907,7 +907,11 @@ double StringModel<dim>::evaluate_current(double t) {
 template <int dim>
 void StringModel<dim>::rhs(double t, const Eigen::Ref<const Eigen::VectorXd>& y, Eigen::Ref<Eigen::VectorXd> ydot) {
   unpack_state(t, y);
-  const double power = evaluate_current(t);
+  write_rates(evaluate_current(t), ydot);
+}
+
+template <int dim>
+void StringModel<dim>::write_rates(double power, Eigen::Ref<Eigen::VectorXd> ydot) {
   const int voff = dim * num_free_;
   for (const FreeRun& run : free_runs_) {
     ydot.segment(dim * run.slot, dim * run.count) = Eigen::Map<const Eigen::VectorXd>(v_.col(run.node).data(), dim * run.count);
@@ -1435,11 +1439,16 @@ double StringModel<dim>::potential_energy(const Eigen::Ref<const Eigen::VectorXd
 }
 
 template <int dim>
-typename StringModel<dim>::Snapshot StringModel<dim>::snapshot(double t, const Eigen::Ref<const Eigen::VectorXd>& y) {
+typename StringModel<dim>::Snapshot StringModel<dim>::snapshot(double t, const Eigen::Ref<const Eigen::VectorXd>& y,
+                                                                    Eigen::VectorXd* rates) {
   Snapshot s;
   s.t = t;
   unpack_state(t, y);
   s.power = evaluate_current(t);
+  if (rates) {
+    rates->resize(size());
+    write_rates(s.power, *rates);
+  }
   s.x = x_;
   s.v = v_;
   s.tension = Eigen::VectorXd::Constant(chain_.num_links(), std::numeric_limits<double>::quiet_NaN());
