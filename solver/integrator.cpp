@@ -689,7 +689,12 @@ Integrator::Outcome Integrator::advance(double t_target, bool one_step, const Ro
   for (;;) {
     if (t_ >= t_target) return Outcome::kReachedTarget;
     const double t_step_start = t_;
-    const Eigen::VectorXd& y_step_start = impl_->y_step_start = y_;  // (not reallocated: the same length)
+    // Kept over the run with root functions (a crossing's copy no longer allocated at every step); a
+    // temporary without, as before: a string without events keeps its peak memory
+    // (tests/unit/test_memory.cpp: the temporary is freed while the frames are recorded).
+    Eigen::VectorXd local_start;
+    Eigen::VectorXd& y_step_start = impl_->system.num_events() > 0 ? impl_->y_step_start : local_start;
+    y_step_start = y_;
     int predicted = -1;
     const double t_stop = !ignored.empty() ? t_target : predict_recurring_event(t_target, predicted);
     impl_->muted_events = ignored;

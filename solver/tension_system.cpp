@@ -50,9 +50,9 @@ class TridiagonalBackend final : public TensionBackend {
       const int f = arc.first_unknown, m = arc.num_links;
       covered += m;
       for (int i = 0; i < m; ++i) {
-        CHAINSIM_VERIFY(diag_[f + i] == pattern.find(f + i, f + i) &&
-                            (i + 1 == m || (upper_[f + i] == pattern.find(f + i, f + i + 1) &&
-                                            lower_of_prev_[f + i] == pattern.find(f + i + 1, f + i))),
+        CHAINSIM_VERIFY(pattern.holds(diag_[f + i], f + i, f + i) &&
+                            (i + 1 == m || (pattern.holds(upper_[f + i], f + i, f + i + 1) &&
+                                            pattern.holds(lower_of_prev_[f + i], f + i + 1, f + i))),
                         "the tension system's slots are its pattern's");
       }
       expected += m + 2 * (m - 1);
@@ -395,8 +395,9 @@ TensionSystem::TensionSystem(const std::vector<int>& arc_links, const std::vecto
       if (i + 1 < m) rows[k++] = c + 1;      // (c + 1, c): the coupling with the link after
       if (arc.closed && i == 0) rows[k++] = f + m - 1;  // a closed arc's last link before its first
       if (arc.closed && i + 1 == m) rows[k++] = f;      // and its first after its last
-      std::sort(rows, rows + k);
-      const int unique = static_cast<int>(std::unique(rows, rows + k) - rows);
+      // (An open arc's rows c − 1, c, c + 1 are sorted and unique as written: the sort only for a closed one.)
+      if (arc.closed) std::sort(rows, rows + k);
+      const int unique = arc.closed ? static_cast<int>(std::unique(rows, rows + k) - rows) : k;
       for (int q = 0; q < unique; ++q) {
         const int r = rows[q], slot = static_cast<int>(pattern_.row_index.size()) + q;
         if (r == c) diag_slot_[c] = slot;

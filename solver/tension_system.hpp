@@ -52,6 +52,12 @@ struct SparsePattern {
   int nnz() const { return static_cast<int>(row_index.size()); }
   /// Position of entry (row, col) in the value array, or -1 if it is not in the pattern.
   int find(int row, int col) const;
+  /// Whether `slot` is the position of entry (row, col): find(row, col) == slot without the search (the
+  /// rows of a column are unique), for a check of every slot at each rebuild of the system.
+  bool holds(int slot, int row, int col) const {
+    return col >= 0 && col < n && slot >= col_ptr[static_cast<std::size_t>(col)] &&
+           slot < col_ptr[static_cast<std::size_t>(col) + 1] && row_index[static_cast<std::size_t>(slot)] == row;
+  }
 };
 
 /// Outcome of one factor-and-solve.
