@@ -195,6 +195,7 @@ void StringModel<dim>::rebuild() {
   if (quadratic_) base_mass_ = quadratic_->mass_rows();  // the consistent load M g, momentum 1ᵀ M v
   if (system_) solves_ += system_->num_solves();
   system_ = arc_links.empty() ? nullptr : std::make_unique<TensionSystem>(arc_links, arc_closed, options_.backend);
+  if (system_) system_->set_two_ended(contacts_.empty() && bends_.empty());  // (until the next refresh())
   m_ = base_mass_;
   w_ = Eigen::VectorXd::Zero(n);
   for (int i = 0; i < n; ++i)
@@ -722,6 +723,7 @@ void StringModel<dim>::refresh() {
     }
   }
   if (contact_stuck_ || !locked_.empty()) update_locked_links();
+  if (system_) system_->set_two_ended(contacts_.empty() && bends_.empty());  // (TensionSystem::set_two_ended)
 }
 
 template <int dim>
