@@ -708,8 +708,11 @@ void StringModel<dim>::refresh() {
   // few nodes of its partial links): a division per node at every right-hand side spared.
   const double *const m = m_.data(), *const base = base_mass_.data(), *const base_w = base_w_.data();
   double* const w = w_.data();
-  for (int i = 0; i < chain_.num_nodes(); ++i)
-    if (slot_[i] >= 0) w[i] = base[i] > 0 && m[i] == base[i] ? base_w[i] : 1.0 / m[i];
+  // Over the free nodes' runs (the nodes with a slot), without a test of slot_ per node: a branch per node
+  // less in the loop of every right-hand side.
+  for (const FreeRun& run : free_runs_)
+    for (int i = run.node, end = run.node + run.count; i < end; ++i)
+      w[i] = base[i] > 0 && m[i] == base[i] ? base_w[i] : 1.0 / m[i];
   contacts_.clear();
   module_->node_contacts(*this, contacts_);
   constraints_.clear();
