@@ -452,12 +452,12 @@ TensionSystem::TensionSystem(const std::vector<int>& arc_links, const std::vecto
       if (arc.closed) std::sort(rows, rows + k);
       const int unique = arc.closed ? static_cast<int>(std::unique(rows, rows + k) - rows) : k;
       for (int q = 0; q < unique; ++q) {
-        const int r = rows[q], slot = static_cast<int>(pattern_.row_index.size()) + q;
+        const int r = rows[q], slot = static_cast<int>(pattern_.row_index.size());
         if (r == c) diag_slot_[c] = slot;
         if (next_of(r) == c && r != c) next_slot_[r] = slot;           // A(r, next of r)
         if (next_of(c) == r && r != c) prev_slot_of_next_[c] = slot;   // A(next of c, c)
+        pattern_.row_index.push_back(r);  // (reserved: a store, where insert() called memmove per column)
       }
-      pattern_.row_index.insert(pattern_.row_index.end(), rows, rows + unique);
       pattern_.col_ptr[static_cast<std::size_t>(c) + 1] = static_cast<int>(pattern_.row_index.size());
     }
   }
