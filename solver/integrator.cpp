@@ -190,12 +190,25 @@ struct Integrator::Impl {
   double g_last_time = 0;
   std::vector<char> prediction_off;
   int short_steps = 0;         // accepted steps in a row below the step-size floor
+  // Work vectors kept over the run (a crossing's polish and advance() allocated and freed them at every
+  // event: malloc handed a state's bytes back to the system and took them again, page faults for 11 % of
+  // the folded compare's time on 3,200 nodes): the start of the step advance() takes; the polish's last
+  // integrated state, F there and at its Heun predictor, the predictor and its correction, F at the
+  // event, the probe's state and the error weights; ARKODE's error weights and local errors.
+  Eigen::VectorXd y_step_start;
+  Eigen::VectorXd y_base, f_base, f_euler, y_euler, second, ydot, y_probe, weights;
+  N_Vector ewt = nullptr, local_errors = nullptr;
+  // provide_start_rhs(): F at (start_time, the state y wrapped at that time), for the next evaluation.
+  Eigen::VectorXd start_rhs;
+  double start_time = 0;
+  bool start_rhs_ready = false;
   std::chrono::steady_clock::time_point wall_start = std::chrono::steady_clock::now();
 
   explicit Impl(OdeSystem& s) : system(s) {}
   ~Impl() {
     if (mem) ARKStepFree(&mem);
     free_linear_solver();
+    free_work_vectors();
     if (y) N_VDestroy(y);
     if (ctx) SUNContext_Free(&ctx);
   }
@@ -296,6 +309,19 @@ struct Integrator::Impl {
     jac = SUNDenseMatrix(n, n, ctx);
     ls = SUNLinSol_Dense(y, jac, ctx);
     check(ARKStepSetLinearSolver(mem, ls, jac), "ARKStepSetLinearSolver");
+  }
+
+  /// ARKODE's error weights and local errors are copied into these (made at their first use, and
+  /// again after a resize).
+  void free_work_vectors() {
+    if (ewt) N_VDestroy(ewt);
+    if (local_errors) N_VDestroy(local_errors);
+    ewt = local_errors = nullptr;
+  }
+  N_Vector work_vector(N_Vector& v) const {
+    if (!v) v = N_VClone(y);
+    if (!v) throw Error("N_VClone failed");
+    return v;
   }
 
   void free_linear_solver() {
@@ -444,11 +470,27 @@ struct Integrator::Impl {
     Eigen::Map<const Eigen::VectorXd> ym(N_VGetArrayPointer(y), n);
     Eigen::Map<Eigen::VectorXd> dm(N_VGetArrayPointer(ydot), n);
     return self->guarded([&] {
+      if (self->start_rhs_ready && self->take_start_rhs(t, ym, dm)) {
+        if (!all_finite(dm)) throw RecoverableError("the right-hand side is not finite");
+        return 0;
+      }
       self->system.rhs(t, ym, dm);
       // a non-finite trial stage: let ARKODE retry with a smaller step
       if (!all_finite(dm)) throw RecoverableError("the right-hand side is not finite");
       return 0;
     });
+  }
+
+  /// The right-hand side given by provide_start_rhs() into ydot if (t, y) is its state (bit for bit: ARKODE's
+  /// copy of the restart's state); it is used up either way.
+  bool take_start_rhs(double t, const Eigen::Map<const Eigen::VectorXd>& ym, Eigen::Map<Eigen::VectorXd>& out) {
+    start_rhs_ready = false;
+    const Eigen::Map<const Eigen::VectorXd> state(N_VGetArrayPointer(y), N_VGetLength(y));
+    if (!(t == start_time && start_rhs.size() == ym.size() && state.size() == ym.size() &&
+          std::equal(ym.data(), ym.data() + ym.size(), state.data())))
+      return false;
+    out = start_rhs;
+    return true;
   }
 
   /// Runs the body of an ARKODE callback: a RecoverableError (a trial state the system cannot use)
@@ -647,7 +689,12 @@ Integrator::Outcome Integrator::advance(double t_target, bool one_step, const Ro
   for (;;) {
     if (t_ >= t_target) return Outcome::kReachedTarget;
     const double t_step_start = t_;
-    const Eigen::VectorXd y_step_start = y_;
+    // Kept over the run with root functions (a crossing's copy no longer allocated at every step); a
+    // temporary without, as before: a string without events keeps its peak memory
+    // (tests/unit/test_memory.cpp: the temporary is freed while the frames are recorded).
+    Eigen::VectorXd local_start;
+    Eigen::VectorXd& y_step_start = impl_->system.num_events() > 0 ? impl_->y_step_start : local_start;
+    y_step_start = y_;
     int predicted = -1;
     const double t_stop = !ignored.empty() ? t_target : predict_recurring_event(t_target, predicted);
     impl_->muted_events = ignored;
@@ -800,7 +847,9 @@ int Integrator::polish_event(double t_step_start, const Eigen::VectorXd& y_step_
   ARKStepGetCurrentStep(d.mem, &h_next);
   d.check(ARKStepRootInit(d.mem, 0, nullptr), "ARKStepRootInit");
 
-  Eigen::VectorXd g(nev), g_ahead(nev), ydot(y_.size());
+  Eigen::VectorXd g(nev), g_ahead(nev);
+  Eigen::VectorXd& ydot = d.ydot;
+  ydot.resize(y_.size());
   // The root's bracket: t_lo, the last time at which the function has not reached its zero (the step's
   // start), and t_hi, the first at which a state computed by the method has passed it (NaN: none known;
   // a predicted event's step ends past it).
@@ -809,23 +858,28 @@ int Integrator::polish_event(double t_step_start, const Eigen::VectorXd& y_step_
   double t_lo = t_step_start, t_hi = from_here ? t_ : std::numeric_limits<double>::quiet_NaN();
   double last_probe = 1;
   // The last integrated state, F there, and the error weights of the tolerance (ARKStepGetErrWeights).
+  // (The Impl's work vectors: see there.)
   double t_base = t_step_start;
-  Eigen::VectorXd y_base, f_base, f_euler(y_.size()), weights;
+  bool have_base = false;
+  Eigen::VectorXd &y_base = d.y_base, &f_base = d.f_base, &f_euler = d.f_euler, &weights = d.weights;
+  f_euler.resize(y_.size());
   double t_event = t_;
   // g_ahead: the event functions a short time along the flow F = f from (t, y); returns that time.
   const auto probe = [&](double t, const Eigen::VectorXd& y, const Eigen::VectorXd& f) {
     const double dt_probe = 1e-6 * std::max(t_event - t_step_start, 1e-300);
-    d.system.events(t + dt_probe, y + dt_probe * f, g_ahead);
+    d.y_probe = y + dt_probe * f;
+    d.system.events(t + dt_probe, d.y_probe, g_ahead);
     return dt_probe;
   };
   if (from_here) {
     // (t_, y_) is the end of a step past the root (a predicted one): the corrections start from it.
     t_base = t_;
     y_base = y_;
+    have_base = true;
     f_base.resize(y_.size());
     d.system.events(t_, y_, g);
     d.system.rhs(t_, y_, f_base);
-    weights = error_weights();
+    error_weights(weights);
     const double dt_probe = probe(t_, y_, f_base);
     const double slope = (g_ahead[k] - g[k]) / dt_probe;
     if (slope != 0.0 && std::isfinite(slope)) t_event = std::clamp(t_ - g[k] / slope, t_step_start, t_step_end);
@@ -834,11 +888,12 @@ int Integrator::polish_event(double t_step_start, const Eigen::VectorXd& y_step_
   bool converged = false, bisecting = false, refuted = false;
   for (int iteration = 0; iteration < max_iterations; ++iteration) {
     bool corrected = false;
-    if (y_base.size() > 0) {
+    if (have_base) {
       const double dt = t_event - t_base;
-      const Eigen::VectorXd y_euler = y_base + dt * f_base;
+      Eigen::VectorXd &y_euler = d.y_euler, &second = d.second;
+      y_euler = y_base + dt * f_base;
       d.system.rhs(t_event, y_euler, f_euler);
-      const Eigen::VectorXd second = 0.5 * dt * (f_euler - f_base);
+      second = 0.5 * dt * (f_euler - f_base);
       if (std::sqrt((second.array() * weights.array()).square().mean()) <= kHeunShare) {
         t_ = t_event;
         y_ = y_euler + second;
@@ -870,8 +925,9 @@ int Integrator::polish_event(double t_step_start, const Eigen::VectorXd& y_step_
     if (!corrected) {
       t_base = t_;
       y_base = y_;
+      have_base = true;
       f_base = ydot;
-      weights = error_weights();
+      error_weights(weights);
     }
     const double dt_probe = probe(t_, y_, ydot);
     last_probe = dt_probe;
@@ -955,14 +1011,11 @@ int Integrator::polish_event(double t_step_start, const Eigen::VectorXd& y_step_
   return -1;
 }
 
-// The error weights of the tolerance at the current state (ARKStepGetErrWeights).
-Eigen::VectorXd Integrator::error_weights() const {
-  N_Vector w = N_VClone(impl_->y);
-  const int flag = ARKStepGetErrWeights(impl_->mem, w);
-  Eigen::VectorXd weights = Eigen::Map<Eigen::VectorXd>(N_VGetArrayPointer(w), N_VGetLength(w));
-  N_VDestroy(w);
-  impl_->check(flag, "ARKStepGetErrWeights");
-  return weights;
+// The error weights of the tolerance at the current state (ARKStepGetErrWeights), into `weights`.
+void Integrator::error_weights(Eigen::VectorXd& weights) const {
+  N_Vector w = impl_->work_vector(impl_->ewt);
+  impl_->check(ARKStepGetErrWeights(impl_->mem, w), "ARKStepGetErrWeights");
+  weights = Eigen::Map<Eigen::VectorXd>(N_VGetArrayPointer(w), N_VGetLength(w));
 }
 
 // ARKODE's root directions: the system's, with function `ignored` (>= 0) turned the other way, so
@@ -1080,12 +1133,15 @@ void Integrator::predicted_event(int which, double t_step_start, const Eigen::Ve
 // method's error estimate, of order p), if larger. (With 0.9 the falling chain on 41 nodes with eps = 1e-4 erred by
 // 1.1e-7 in η near its singular end, against 7.8e-8 before the prediction and 2.4e-8 with 0.7.)
 double Integrator::allowed_step() const {
-  const Impl& d = *impl_;
-  N_Vector e = N_VClone(d.y);
+  Impl& d = *impl_;
+  N_Vector e = d.work_vector(d.local_errors);
   const int flag = ARKStepGetEstLocalErrors(d.mem, e);
   const Eigen::Map<const Eigen::VectorXd> error(N_VGetArrayPointer(e), N_VGetLength(e));
-  const double err = flag == ARK_SUCCESS ? std::sqrt((error.array() * error_weights().array()).square().mean()) : 0.0;
-  N_VDestroy(e);
+  double err = 0.0;
+  if (flag == ARK_SUCCESS) {
+    error_weights(d.weights);
+    err = std::sqrt((error.array() * d.weights.array()).square().mean());
+  }
   const double h = std::abs(last_step());
   return err > 0 && std::isfinite(err) ? h * std::min(10.0, 0.7 * std::pow(err, -1.0 / (d.embedding_order + 1))) : 0.0;
 }
@@ -1103,6 +1159,7 @@ void Integrator::restart(double t, const Eigen::VectorXd& y) {
   Impl& d = *impl_;
   CHAINSIM_VERIFY(y.size() == N_VGetLength(d.y), "restart() keeps the state length; use resize()");
   y_ = y;  // the same length: the same storage, which d.y wraps
+  d.start_rhs_ready = false;
   d.check(ARKStepReset(d.mem, t, d.y), "ARKStepReset");
   d.check(ARKStepSetInitStep(d.mem, d.h_resume), "ARKStepSetInitStep");  // 0: ARKODE's estimate
   d.h_resume = 0;
@@ -1118,12 +1175,22 @@ void Integrator::resize(double t, const Eigen::VectorXd& y) {
   const int flag = ARKStepResize(d.mem, ynew, 1.0, t, nullptr, nullptr);
   N_VDestroy(d.y);
   d.y = ynew;
+  d.free_work_vectors();  // (of the old length)
+  d.start_rhs_ready = false;
   d.check(flag, "ARKStepResize");
   d.check(ARKStepSetInitStep(d.mem, d.h_resume), "ARKStepSetInitStep");  // 0: ARKODE's estimate
   d.h_resume = 0;
   d.apply_tolerances();
   if (d.implicit) d.attach_linear_solver();
   t_ = t;
+}
+
+void Integrator::provide_start_rhs(const Eigen::VectorXd& f) {
+  Impl& d = *impl_;
+  CHAINSIM_VERIFY(f.size() == y_.size(), "provide_start_rhs() takes F at the current state");
+  d.start_rhs = f;
+  d.start_time = t_;
+  d.start_rhs_ready = true;
 }
 
 double Integrator::last_step() const {

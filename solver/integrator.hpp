@@ -224,6 +224,12 @@ class Integrator {
   /// Continue with a state of a different length (the OdeSystem's size() must already report it).
   void resize(double t, const Eigen::VectorXd& y);
 
+  /// After restart() or resize(): the right-hand side F(t, y) at the state just given, which the caller has
+  /// evaluated since (e.g. for a record of that state). ARKODE's evaluation at the start of the next step,
+  /// at that same state, is then taken from it instead of evaluated again (its counters count it as
+  /// before); any other first evaluation discards it.
+  void provide_start_rhs(const Eigen::VectorXd& f);
+
   IntegratorStats stats() const;
   /// The size of the last accepted step (s): stats().last_step without the other counters.
   double last_step() const;
@@ -235,7 +241,7 @@ class Integrator {
   /// Returns -1 (the event is polished), or the event function whose root the recomputed step refutes
   /// (no event: the integrator is back at the step's start).
   int polish_event(double t_step_start, const Eigen::VectorXd& y_step_start, double t_step_end, bool from_here);
-  Eigen::VectorXd error_weights() const;
+  void error_weights(Eigen::VectorXd& weights) const;
   double allowed_step() const;
   void set_root_directions(int ignored = -1);
   double predict_recurring_event(double t_target, int& which);

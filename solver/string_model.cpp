@@ -195,6 +195,7 @@ void StringModel<dim>::rebuild() {
   if (quadratic_) base_mass_ = quadratic_->mass_rows();  // the consistent load M g, momentum 1ᵀ M v
   if (system_) solves_ += system_->num_solves();
   system_ = arc_links.empty() ? nullptr : std::make_unique<TensionSystem>(arc_links, arc_closed, options_.backend);
+  if (system_) system_->set_two_ended(contacts_.empty() && bends_.empty());  // (until the next refresh())
   m_ = base_mass_;
   w_ = Eigen::VectorXd::Zero(n);
   for (int i = 0; i < n; ++i)
@@ -707,8 +708,11 @@ void StringModel<dim>::refresh() {
   // few nodes of its partial links): a division per node at every right-hand side spared.
   const double *const m = m_.data(), *const base = base_mass_.data(), *const base_w = base_w_.data();
   double* const w = w_.data();
-  for (int i = 0; i < chain_.num_nodes(); ++i)
-    if (slot_[i] >= 0) w[i] = base[i] > 0 && m[i] == base[i] ? base_w[i] : 1.0 / m[i];
+  // Over the free nodes' runs (the nodes with a slot), without a test of slot_ per node: a branch per node
+  // less in the loop of every right-hand side.
+  for (const FreeRun& run : free_runs_)
+    for (int i = run.node, end = run.node + run.count; i < end; ++i)
+      w[i] = base[i] > 0 && m[i] == base[i] ? base_w[i] : 1.0 / m[i];
   contacts_.clear();
   module_->node_contacts(*this, contacts_);
   constraints_.clear();
@@ -722,6 +726,7 @@ void StringModel<dim>::refresh() {
     }
   }
   if (contact_stuck_ || !locked_.empty()) update_locked_links();
+  if (system_) system_->set_two_ended(contacts_.empty() && bends_.empty());  // (TensionSystem::set_two_ended)
 }
 
 template <int dim>
@@ -907,7 +912,11 @@ double StringModel<dim>::evaluate_current(double t) {
 template <int dim>
 void StringModel<dim>::rhs(double t, const Eigen::Ref<const Eigen::VectorXd>& y, Eigen::Ref<Eigen::VectorXd> ydot) {
   unpack_state(t, y);
-  const double power = evaluate_current(t);
+  write_rates(evaluate_current(t), ydot);
+}
+
+template <int dim>
+void StringModel<dim>::write_rates(double power, Eigen::Ref<Eigen::VectorXd> ydot) {
   const int voff = dim * num_free_;
   for (const FreeRun& run : free_runs_) {
     ydot.segment(dim * run.slot, dim * run.count) = Eigen::Map<const Eigen::VectorXd>(v_.col(run.node).data(), dim * run.count);
@@ -1435,11 +1444,16 @@ double StringModel<dim>::potential_energy(const Eigen::Ref<const Eigen::VectorXd
 }
 
 template <int dim>
-typename StringModel<dim>::Snapshot StringModel<dim>::snapshot(double t, const Eigen::Ref<const Eigen::VectorXd>& y) {
+typename StringModel<dim>::Snapshot StringModel<dim>::snapshot(double t, const Eigen::Ref<const Eigen::VectorXd>& y,
+                                                                    Eigen::VectorXd* rates) {
   Snapshot s;
   s.t = t;
   unpack_state(t, y);
   s.power = evaluate_current(t);
+  if (rates) {
+    rates->resize(size());
+    write_rates(s.power, *rates);
+  }
   s.x = x_;
   s.v = v_;
   s.tension = Eigen::VectorXd::Constant(chain_.num_links(), std::numeric_limits<double>::quiet_NaN());

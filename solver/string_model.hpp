@@ -181,7 +181,8 @@ class StringModel final : public OdeSystem {
     /// The physical scales of this state (physical_scales()): a tension (N) and an energy (J).
     double tension_scale = 0, energy_scale = 0;
   };
-  Snapshot snapshot(double t, const Eigen::Ref<const Eigen::VectorXd>& y);
+  /// With `rates`: also the right-hand side at (t, y), rhs()'s numbers from the same evaluation.
+  Snapshot snapshot(double t, const Eigen::Ref<const Eigen::VectorXd>& y, Eigen::VectorXd* rates = nullptr);
 
   /// max_j | |Δx_j| − h_j | / h_j at (t, y) over the links of the arcs, without a tension solve.
   double max_constraint_violation(double t, const Eigen::Ref<const Eigen::VectorXd>& y) const;
@@ -438,6 +439,8 @@ class StringModel final : public OdeSystem {
   /// Positions and velocities of the nodes in an arc at (t, y) into x, v (the others untouched).
   void fill_moving(double t, const Eigen::Ref<const Eigen::VectorXd>& y, Points<dim>& x, Points<dim>& v) const;
   double evaluate_current(double t);
+  /// rhs()'s output from the evaluation just made (evaluate_current, which returned `power`).
+  void write_rates(double power, Eigen::Ref<Eigen::VectorXd> ydot);
   /// evaluate_current without a module or bent links: the tension forces T_j e_j − T_{j−1} e_{j−1} of
   /// the nodes from the tensions T (per link), in one pass.
   void tension_forces_of_string(const Eigen::VectorXd& T);

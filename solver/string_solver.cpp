@@ -416,8 +416,8 @@ void StringSolver<dim>::record_frame(double t, const Eigen::VectorXd& y) {
 }
 
 template <int dim>
-void StringSolver<dim>::record_sample(double t, const Eigen::VectorXd& y) {
-  const auto snap = model_.snapshot(t, y);
+void StringSolver<dim>::record_sample(double t, const Eigen::VectorXd& y, Eigen::VectorXd* rates) {
+  const auto snap = model_.snapshot(t, y, rates);
   book(t, snap);
   fill_record(t, snap, summary_.samples.emplace_back());
 }
@@ -600,7 +600,12 @@ const RunSummary& StringSolver<dim>::run() {
           integrator->restart(t, state);
         else
           integrator->resize(t, state);
-        if (options_.record_steps) record_sample(t, state);
+        if (options_.record_steps) {
+          // The record evaluates the model at the new state: ARKODE's first evaluation after the restart
+          // (the same state) takes that right-hand side instead of evaluating it again.
+          record_sample(t, state, &restart_rates_);
+          integrator->provide_start_rhs(restart_rates_);
+        }
         if (interrupt_requested()) {  // Ctrl-C between events too: a run whose events keep coming stops
           record_frame(t, state);
           finish("interrupted");

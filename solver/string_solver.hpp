@@ -248,7 +248,8 @@ class StringSolver {
   void record_frame(double t, const Eigen::VectorXd& y);
   /// Sets summary().tolerance_warning when atol is coarser than rtol times the motion's size.
   void check_tolerance();
-  void record_sample(double t, const Eigen::VectorXd& y);
+  /// With `rates`: also the right-hand side at (t, y) (StringModel::snapshot).
+  void record_sample(double t, const Eigen::VectorXd& y, Eigen::VectorXd* rates = nullptr);
   void check_slack(double t, const Eigen::VectorXd& y);
   void book(double t, const typename StringModel<dim>::Snapshot& snap);
   void describe_model();
@@ -269,6 +270,7 @@ class StringSolver {
   mutable std::unique_ptr<Stream> stream_;
   RunSummary summary_;
   Eigen::VectorXd final_state_;
+  Eigen::VectorXd restart_rates_;  // F at an event's new state, from its record (Integrator::provide_start_rhs)
   bool have_start_ = false;
   double e0_ = 0, v0_ = 0;
   Vec<dim> p0_ = Vec<dim>::Zero();

@@ -50,9 +50,9 @@ class TridiagonalBackend final : public TensionBackend {
       const int f = arc.first_unknown, m = arc.num_links;
       covered += m;
       for (int i = 0; i < m; ++i) {
-        CHAINSIM_VERIFY(diag_[f + i] == pattern.find(f + i, f + i) &&
-                            (i + 1 == m || (upper_[f + i] == pattern.find(f + i, f + i + 1) &&
-                                            lower_of_prev_[f + i] == pattern.find(f + i + 1, f + i))),
+        CHAINSIM_VERIFY(pattern.holds(diag_[f + i], f + i, f + i) &&
+                            (i + 1 == m || (pattern.holds(upper_[f + i], f + i, f + i + 1) &&
+                                            pattern.holds(lower_of_prev_[f + i], f + i + 1, f + i))),
                         "the tension system's slots are its pattern's");
       }
       expected += m + 2 * (m - 1);
@@ -82,13 +82,17 @@ class TridiagonalBackend final : public TensionBackend {
       const ArcBlock& arc = arcs_[k];
       SolveStatus status = arc.closed && arc.num_links >= 3
                                ? cyclic(values, rhs, arc, corner_lo_[k], corner_up_[k])
-                               : thomas(values, rhs, arc.first_unknown, arc.num_links, nullptr, nullptr);
+                               : two_ended_ ? twisted(values, rhs, arc.first_unknown, arc.num_links)
+                                            : thomas(values, rhs, arc.first_unknown, arc.num_links, nullptr, nullptr);
       if (!status.ok) return status;
     }
     return {};
   }
 
+  void set_two_ended(bool on) override { two_ended_ = on; }
+
  private:
+  bool two_ended_ = true;
   /// Solves the tridiagonal block [f, f+m) with diagonal `bmod` (if given, else from values) for the
   /// right side r (in place); if `second` is given, applies the same elimination to it.
   SolveStatus thomas(const double* A, double* r, int f, int m, const double* bmod, double* second) {
@@ -112,6 +116,55 @@ class TridiagonalBackend final : public TensionBackend {
     for (int i = m - 2; i >= 0; --i) {
       r[f + i] -= cp_[static_cast<std::size_t>(i)] * r[f + i + 1];
       if (second) second[i] -= cp_[static_cast<std::size_t>(i)] * second[i + 1];
+    }
+    return {};
+  }
+
+  /// The same system as thomas() (without a second right side) eliminated from both ends at once: rows
+  /// 0 … k−1 downwards as Thomas' algorithm does, rows m−1 … k+1 upwards (the mirror image: each row's
+  /// coupling with the row below eliminated), the middle row k = m/2 solved from both, and the two
+  /// halves substituted back outwards from it (a twisted factorisation, "burn at both ends"). The two
+  /// chains are independent: each row's division waits for the previous row's of its own chain only, so
+  /// the processor runs both at once, where Thomas' single chain waits a division's latency per row.
+  /// The same pivots for the top half; the bottom half's and the middle's differ at round-off. The
+  /// matrix is definite on an arc, so every pivot of either direction is safe without pivoting.
+  SolveStatus twisted(const double* A, double* r, int f, int m) {
+    const int k = m / 2;  // rows 0 … k−1 from the top, m−1 … k+1 from the bottom
+    double* const cp = cp_.data();  // top: A(i, i+1) / pivot_i; bottom: A(j, j−1) / pivot_j
+    double* const x = r + f;
+    const auto lower = [&](int i) { return A[lower_of_prev_[f + i - 1]]; };  // A(i, i−1), i >= 1
+    const auto upper = [&](int i) { return A[upper_[f + i]]; };               // A(i, i+1), i <= m−2
+    const auto diag = [&](int i) { return A[diag_[f + i]]; };
+    double cp_top = 0, x_top = 0, cp_bottom = 0, x_bottom = 0;  // the last row's of each chain
+    const int bottom_rows = m - 1 - k;                           // k or k − 1
+    for (int s = 0; s < k; ++s) {
+      {  // top row i = s
+        const int i = s;
+        const double a = i > 0 ? lower(i) : 0.0, b = diag(i);
+        const double piv = b - a * cp_top;
+        if (!(std::abs(piv) > kSingularPivot * std::abs(b))) return {false, f + i, piv, "Thomas elimination"};
+        const double inv = 1.0 / piv;
+        cp[i] = cp_top = upper(i) * inv;
+        x[i] = x_top = (x[i] - a * x_top) * inv;
+      }
+      if (s < bottom_rows) {  // bottom row j = m − 1 − s
+        const int j = m - 1 - s;
+        const double c = j + 1 < m ? upper(j) : 0.0, b = diag(j);
+        const double piv = b - c * cp_bottom;
+        if (!(std::abs(piv) > kSingularPivot * std::abs(b))) return {false, f + j, piv, "Thomas elimination"};
+        const double inv = 1.0 / piv;
+        cp[j] = cp_bottom = lower(j) * inv;
+        x[j] = x_bottom = (x[j] - c * x_bottom) * inv;
+      }
+    }
+    // The middle row k with T(k−1) = x_top − cp_top T(k) and T(k+1) = x_bottom − cp_bottom T(k).
+    const double a = k > 0 ? lower(k) : 0.0, c = k + 1 < m ? upper(k) : 0.0, b = diag(k);
+    const double piv = b - a * cp_top - c * cp_bottom;
+    if (!(std::abs(piv) > kSingularPivot * std::abs(b))) return {false, f + k, piv, "Thomas elimination"};
+    x[k] = (x[k] - a * x_top - c * x_bottom) / piv;
+    for (int s = 1; s <= k; ++s) {
+      x[k - s] -= cp[k - s] * x[k - s + 1];
+      if (s <= bottom_rows) x[k + s] -= cp[k + s] * x[k + s - 1];
     }
     return {};
   }
@@ -395,15 +448,16 @@ TensionSystem::TensionSystem(const std::vector<int>& arc_links, const std::vecto
       if (i + 1 < m) rows[k++] = c + 1;      // (c + 1, c): the coupling with the link after
       if (arc.closed && i == 0) rows[k++] = f + m - 1;  // a closed arc's last link before its first
       if (arc.closed && i + 1 == m) rows[k++] = f;      // and its first after its last
-      std::sort(rows, rows + k);
-      const int unique = static_cast<int>(std::unique(rows, rows + k) - rows);
+      // (An open arc's rows c − 1, c, c + 1 are sorted and unique as written: the sort only for a closed one.)
+      if (arc.closed) std::sort(rows, rows + k);
+      const int unique = arc.closed ? static_cast<int>(std::unique(rows, rows + k) - rows) : k;
       for (int q = 0; q < unique; ++q) {
-        const int r = rows[q], slot = static_cast<int>(pattern_.row_index.size()) + q;
+        const int r = rows[q], slot = static_cast<int>(pattern_.row_index.size());
         if (r == c) diag_slot_[c] = slot;
         if (next_of(r) == c && r != c) next_slot_[r] = slot;           // A(r, next of r)
         if (next_of(c) == r && r != c) prev_slot_of_next_[c] = slot;   // A(next of c, c)
+        pattern_.row_index.push_back(r);  // (reserved: a store, where insert() called memmove per column)
       }
-      pattern_.row_index.insert(pattern_.row_index.end(), rows, rows + unique);
       pattern_.col_ptr[static_cast<std::size_t>(c) + 1] = static_cast<int>(pattern_.row_index.size());
     }
   }

@@ -52,6 +52,12 @@ struct SparsePattern {
   int nnz() const { return static_cast<int>(row_index.size()); }
   /// Position of entry (row, col) in the value array, or -1 if it is not in the pattern.
   int find(int row, int col) const;
+  /// Whether `slot` is the position of entry (row, col): find(row, col) == slot without the search (the
+  /// rows of a column are unique), for a check of every slot at each rebuild of the system.
+  bool holds(int slot, int row, int col) const {
+    return col >= 0 && col < n && slot >= col_ptr[static_cast<std::size_t>(col)] &&
+           slot < col_ptr[static_cast<std::size_t>(col) + 1] && row_index[static_cast<std::size_t>(slot)] == row;
+  }
 };
 
 /// Outcome of one factor-and-solve.
@@ -81,6 +87,9 @@ class TensionBackend {
   /// Numeric factorization of A (values in pattern order) and solve of A x = b; `rhs` holds b on entry
   /// and x on return. Reports a singular (or numerically singular) matrix instead of throwing.
   virtual SolveStatus factor_solve(const double* values, double* rhs) = 0;
+  /// Whether the matrix may be eliminated from both ends of an arc at once (TensionSystem::set_two_ended);
+  /// a backend without such an elimination ignores it.
+  virtual void set_two_ended(bool) {}
 };
 
 /// A sparse LU factorisation of one pattern that keeps its symbolic analysis, and with KLU its pivot
@@ -159,6 +168,14 @@ class TensionSystem {
   double& value(int slot) { return values_[static_cast<std::size_t>(slot)]; }
   const std::vector<double>& values() const { return values_; }
   const Eigen::VectorXd& rhs_vector() const { return rhs_; }
+
+  /// The tridiagonal backend's elimination of an open arc: from both ends at once (on, the default: twice
+  /// the instruction-level parallelism of Thomas' single chain of divisions, the same solution to
+  /// round-off), or from the first link down (Thomas' algorithm, off). StringModel turns it off while
+  /// a module holds nodes on obstacles or bends links over edges (docs/string_solver.md, "The tension
+  /// solve from both ends"): their events decide on quantities at round-off (a reaction on the edge of
+  /// the friction cone, a node that lands and is let go at the same instant), tuned with Thomas' rounding.
+  void set_two_ended(bool on) { backend_->set_two_ended(on); }
 
   /// Factors and solves A T = b. Throws NumericalError naming the link (or junction unknown), the
   /// pivot and the time t when the matrix is singular, or when the solution is not finite. Excluded

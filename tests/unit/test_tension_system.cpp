@@ -175,6 +175,32 @@ TEST_CASE("several arcs: cyclic and open blocks solved per arc, equal to a dense
   }
 }
 
+TEST_CASE("an open arc eliminated from both ends or from the top: the dense solve's tensions on every length",
+          "[unit][tension]") {
+  // Every length from 1 (no chain: the middle row alone) to 12 (even and odd: the top half one row longer or
+  // not), and 1000; symmetric couplings and the non-symmetric ones of a sliding node's friction.
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  std::vector<int> lengths = {1000};
+  for (int m = 1; m <= 12; ++m) lengths.push_back(m);
+  for (const int m : lengths) {
+    for (const bool symmetric : {true, false}) {
+      TensionSystem s({m}, {false}, "tridiagonal");
+      fill_arcs(s, rng);
+      if (!symmetric)
+        for (int j = 0; j + 1 < m; ++j) s.add_couplings(j, 0.3 * u(rng), -0.3 * u(rng));
+      const Eigen::VectorXd expected = dense(s).fullPivLu().solve(s.rhs_vector());
+      s.set_two_ended(true);
+      const Eigen::VectorXd both = s.solve(0.0);
+      s.set_two_ended(false);
+      const Eigen::VectorXd top = s.solve(0.0);
+      INFO(m << " links, " << (symmetric ? "symmetric" : "friction's couplings"));
+      CHECK((both - expected).cwiseAbs().maxCoeff() <= kBackendAgreement * expected.cwiseAbs().maxCoeff());
+      CHECK((top - expected).cwiseAbs().maxCoeff() <= kBackendAgreement * expected.cwiseAbs().maxCoeff());
+    }
+  }
+}
+
 TEST_CASE("a singular tension system names the link, the pivot and the time", "[unit][tension]") {
   for (const std::string& backend : tension_backend_names()) {
     TensionSystem s({4}, {false}, backend);
