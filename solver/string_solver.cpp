@@ -416,6 +416,20 @@ void StringSolver<dim>::record_frame(double t, const Eigen::VectorXd& y) {
 }
 
 template <int dim>
+std::optional<EventAction> StringSolver<dim>::failed_checks(double t, const Eigen::VectorXd& y, bool after_event) {
+  if (model_.module() == nullptr || !model_.module()->checks_at_start() || model_.num_events() == 0) return {};
+  Eigen::VectorXd g(model_.num_events());
+  model_.events(t, y, g);
+  const std::vector<int> found = after_event ? model_.module()->events_failed_after_event(g)
+                                             : model_.module()->events_failed_at_start(g);
+  if (found.empty()) return {};
+  Eigen::VectorXd state = y;
+  const EventAction action = model_.handle_events(t, state, found);
+  CHAINSIM_VERIFY(action.kind == EventAction::Kind::kStop, "a check that has failed must stop the run");
+  return action;
+}
+
+template <int dim>
 void StringSolver<dim>::record_sample(double t, const Eigen::VectorXd& y) {
   const auto snap = model_.snapshot(t, y);
   book(t, snap);
@@ -498,19 +512,11 @@ const RunSummary& StringSolver<dim>::run() {
       record_frame(t0, y0);
       if (options_.record_steps) record_sample(t0, y0);
       check_slack(t0, y0);
-      // A check of the module already failed at the start (StringModule::events_failed_at_start):
-      // the run stops at t0 as at that event (ARKODE finds only sign changes).
-      if (model_.module() != nullptr && model_.module()->checks_at_start() && model_.num_events() > 0) {
-        Eigen::VectorXd g(model_.num_events());
-        model_.events(t0, y0, g);
-        const std::vector<int> found = model_.module()->events_failed_at_start(g);
-        if (!found.empty()) {
-          const EventAction action = model_.handle_events(t0, y0, found);
-          CHAINSIM_VERIFY(action.kind == EventAction::Kind::kStop, "a check failed at the start must stop the run");
-          finish("stopped");
-          summary_.stop_reason = action.reason;
-          return summary_;
-        }
+      // A check of the module already failed at the start: the run stops at t0 as at that event.
+      if (const std::optional<EventAction> stop = failed_checks(t0, y0, false)) {
+        finish("stopped");
+        summary_.stop_reason = stop->reason;
+        return summary_;
       }
     }
     // 2. Step by step to each output time: constraints (and slack) are checked at accepted steps,
@@ -588,7 +594,10 @@ const RunSummary& StringSolver<dim>::run() {
                           t, events_at_one_time, found, integrator->events_found().size()),
               t);
         }
-        const EventAction action = model_.handle_events(t, state, integrator->events_found());
+        EventAction action = model_.handle_events(t, state, integrator->events_found());
+        // A check that the event's handling (a front's crossing, its re-layout) has taken below zero at once.
+        if (action.kind == EventAction::Kind::kTransfer)
+          if (std::optional<EventAction> stop = failed_checks(t, state, true)) action = *stop;
         if (action.kind == EventAction::Kind::kStop) {
           if (options_.record_steps) record_sample(t, state);
           record_frame(t, state);

@@ -250,6 +250,10 @@ class StringSolver {
   void check_tolerance();
   void record_sample(double t, const Eigen::VectorXd& y);
   void check_slack(double t, const Eigen::VectorXd& y);
+  /// The module's checks (a front's take-off, grazing, …) that are already negative at (t, y), the start or
+  /// the state just after an event's handling: ARKODE finds only sign changes, so a check that starts below zero
+  /// is never located. Returns the stop the module's handling makes of them, or nothing.
+  std::optional<EventAction> failed_checks(double t, const Eigen::VectorXd& y, bool after_event);
   void book(double t, const typename StringModel<dim>::Snapshot& snap);
   void describe_model();
   std::vector<double> measured_forces(const typename StringModel<dim>::Snapshot& snap) const;
