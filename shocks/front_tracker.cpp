@@ -228,13 +228,16 @@ std::vector<LedgerTerm> FrontTracker<dim>::ledger_terms() const {
 }
 
 template <int dim>
-std::vector<int> FrontTracker<dim>::events_failed_at_start(const Eigen::Ref<const Eigen::VectorXd>& g) const {
-  // The checks come last in events(), after the crossings and the stops at s0.
-  const auto first = static_cast<Eigen::Index>(2 * fronts_.size() + options_.stop_at.size());
+std::vector<int> FrontTracker<dim>::failed_checks(const Eigen::Ref<const Eigen::VectorXd>& g, bool after_event) const {
+  // The checks come last in events(), after the crossings and the stops at s0, each front's in turn.
+  auto q = static_cast<Eigen::Index>(2 * fronts_.size() + options_.stop_at.size());
   std::vector<int> found(static_cast<std::size_t>(g.size()), 0);
   bool any = false;
-  for (Eigen::Index q = first; q < g.size(); ++q)
-    if (g[q] < 0) found[static_cast<std::size_t>(q)] = -1, any = true;
+  for (const auto& front : fronts_) {
+    const bool watched = front->active && (!after_event || front->checks_after_events());
+    for (int c = 0; c < front->num_checks(); ++c, ++q)
+      if (watched && g[q] < 0) found[static_cast<std::size_t>(q)] = -1, any = true;
+  }
   return any ? found : std::vector<int>{};
 }
 

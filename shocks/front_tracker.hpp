@@ -177,10 +177,19 @@ class FrontTracker final : public StringModule<dim> {
   std::vector<RunEvent> run_events() const override { return events_; }
   ObstacleDrawing obstacles() const override;
   /// The fronts' checks (the lift-off margins) already negative at the start.
-  std::vector<int> events_failed_at_start(const Eigen::Ref<const Eigen::VectorXd>& g) const override;
+  std::vector<int> events_failed_at_start(const Eigen::Ref<const Eigen::VectorXd>& g) const override {
+    return failed_checks(g, false);
+  }
+  std::vector<int> events_failed_after_event(const Eigen::Ref<const Eigen::VectorXd>& g) const override {
+    return failed_checks(g, true);
+  }
   bool checks_at_start() const override { return num_checks() > 0; }
 
  private:
+  /// The active fronts' checks that are negative in g (after an event: of the kinds that watch them there);
+  /// an inactive front's check slot holds its formation, which is not a failure.
+  std::vector<int> failed_checks(const Eigen::Ref<const Eigen::VectorXd>& g, bool after_event) const;
+
   int num_checks() const;
   /// Takes front k out of the string at t (FrontKind::absorbed: a kink at a held end): its arcs merge
   /// (FrontKind::remove), the other fronts' arc indices follow, it becomes inactive, and the run's events

@@ -135,7 +135,7 @@ class SlackModule final : public WrappingModule<dim> {
         model.evaluate(t, model.x(), model.v());
         Eigen::VectorXd g(k);
         inner_->events(model, g);
-        const std::vector<int> failed = inner_->events_failed_at_start(g);
+        const std::vector<int> failed = inner_->events_failed_after_event(g);
         if (!failed.empty()) {
           EventAction stop = inner_->handle_events(model, t, ledger.head(kl), failed);
           if (stop.kind == EventAction::Kind::kStop) {

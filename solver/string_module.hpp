@@ -262,6 +262,11 @@ class StringModule {
   virtual std::vector<int> events_failed_at_start(const Eigen::Ref<const Eigen::VectorXd>& /*g*/) const { return {}; }
   /// Whether events_failed_at_start can find anything (else the runner does not evaluate events() at t0).
   virtual bool checks_at_start() const { return false; }
+  /// The same after an event's handling, at the state the integrator restarts from (e.g. a front's crossing),
+  /// without the checks that a kind of front lets go negative there (FrontKind::checks_after_events).
+  virtual std::vector<int> events_failed_after_event(const Eigen::Ref<const Eigen::VectorXd>& g) const {
+    return events_failed_at_start(g);
+  }
   /// The obstacles to draw in the ParaView output (none by default: no obstacles.vtp is written).
   virtual ObstacleDrawing obstacles() const { return {}; }
 };

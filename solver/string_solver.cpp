@@ -416,6 +416,24 @@ void StringSolver<dim>::record_frame(double t, const Eigen::VectorXd& y) {
 }
 
 template <int dim>
+std::optional<EventAction> StringSolver<dim>::failed_checks(double t, const Eigen::VectorXd& y, bool after_event,
+                                                           bool evaluated) {
+  if (model_.module() == nullptr || !model_.module()->checks_at_start() || model_.num_events() == 0) return {};
+  Eigen::VectorXd g(model_.num_events());
+  if (evaluated)
+    model_.module()->events(model_, g);  // the model's last evaluation was at (t, y), its tensions solved
+  else
+    model_.events(t, y, g);
+  const std::vector<int> found = after_event ? model_.module()->events_failed_after_event(g)
+                                             : model_.module()->events_failed_at_start(g);
+  if (found.empty()) return {};
+  Eigen::VectorXd state = y;
+  const EventAction action = model_.handle_events(t, state, found);
+  CHAINSIM_VERIFY(action.kind == EventAction::Kind::kStop, "a check that has failed must stop the run");
+  return action;
+}
+
+template <int dim>
 void StringSolver<dim>::record_sample(double t, const Eigen::VectorXd& y, Eigen::VectorXd* rates) {
   const auto snap = model_.snapshot(t, y, rates);
   book(t, snap);
@@ -498,19 +516,11 @@ const RunSummary& StringSolver<dim>::run() {
       record_frame(t0, y0);
       if (options_.record_steps) record_sample(t0, y0);
       check_slack(t0, y0);
-      // A check of the module already failed at the start (StringModule::events_failed_at_start):
-      // the run stops at t0 as at that event (ARKODE finds only sign changes).
-      if (model_.module() != nullptr && model_.module()->checks_at_start() && model_.num_events() > 0) {
-        Eigen::VectorXd g(model_.num_events());
-        model_.events(t0, y0, g);
-        const std::vector<int> found = model_.module()->events_failed_at_start(g);
-        if (!found.empty()) {
-          const EventAction action = model_.handle_events(t0, y0, found);
-          CHAINSIM_VERIFY(action.kind == EventAction::Kind::kStop, "a check failed at the start must stop the run");
-          finish("stopped");
-          summary_.stop_reason = action.reason;
-          return summary_;
-        }
+      // A check of the module already failed at the start: the run stops at t0 as at that event.
+      if (const std::optional<EventAction> stop = failed_checks(t0, y0, false, false)) {
+        finish("stopped");
+        summary_.stop_reason = stop->reason;
+        return summary_;
       }
     }
     // 2. Step by step to each output time: constraints (and slack) are checked at accepted steps,
@@ -606,6 +616,15 @@ const RunSummary& StringSolver<dim>::run() {
           record_sample(t, state, &restart_rates_);
           integrator->provide_start_rhs(restart_rates_);
         }
+        // A check that the event's handling (a front's crossing, its re-layout) has taken below zero at once: ARKODE
+        // would find no sign change from here. Read from the record's evaluation of this state where there is one.
+        if (action.kind == EventAction::Kind::kTransfer)
+          if (std::optional<EventAction> stop = failed_checks(t, state, true, options_.record_steps)) {
+            record_frame(t, state);
+            finish("stopped");
+            summary_.stop_reason = stop->reason;
+            return summary_;
+          }
         if (interrupt_requested()) {  // Ctrl-C between events too: a run whose events keep coming stops
           record_frame(t, state);
           finish("interrupted");

@@ -251,6 +251,11 @@ class StringSolver {
   /// With `rates`: also the right-hand side at (t, y) (StringModel::snapshot).
   void record_sample(double t, const Eigen::VectorXd& y, Eigen::VectorXd* rates = nullptr);
   void check_slack(double t, const Eigen::VectorXd& y);
+  /// The module's checks (a front's take-off, grazing, …) that are already negative at (t, y), the start or
+  /// the state just after an event's handling: ARKODE finds only sign changes, so a check that starts below zero
+  /// is never located. Returns the stop the module's handling makes of them, or nothing.
+  /// `evaluated`: the model's last evaluation was at (t, y) (a record of it), and is read as it is.
+  std::optional<EventAction> failed_checks(double t, const Eigen::VectorXd& y, bool after_event, bool evaluated);
   void book(double t, const typename StringModel<dim>::Snapshot& snap);
   void describe_model();
   std::vector<double> measured_forces(const typename StringModel<dim>::Snapshot& snap) const;

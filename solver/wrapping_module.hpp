@@ -53,6 +53,12 @@ class WrappingModule : public StringModule<dim> {
     if (!found.empty()) found.resize(static_cast<std::size_t>(this->num_events()), 0);
     return found;
   }
+  std::vector<int> events_failed_after_event(const Eigen::Ref<const Eigen::VectorXd>& g) const override {
+    if (!inner_) return {};
+    std::vector<int> found = inner_->events_failed_after_event(g.head(inner_events()));
+    if (!found.empty()) found.resize(static_cast<std::size_t>(this->num_events()), 0);
+    return found;
+  }
   bool checks_at_start() const override { return inner_ && inner_->checks_at_start(); }
 
  protected:

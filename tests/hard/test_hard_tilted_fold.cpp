@@ -150,3 +150,32 @@ TEST_CASE("the energy ledger of a tilted fold drifts by the lumped-versus-segmen
     CHECK(integral == Approx(residual).epsilon(1e-3));
   }
 }
+
+TEST_CASE("a fold whose crossing opens it past 20 degrees stops at that crossing", "[hard][shocks]") {
+  // Released 1° tilted with f = 0 on 81 nodes, the fold's crossing at t = 0.3587 s makes the arc's new end link
+  // (the old folded link) its arm, and the arms leave the fold 20.4° from antiparallel at once. ARKODE restarts from
+  // that state and finds only sign changes, so the opening check, negative from the restart, went unseen: the run
+  // went on through 7 more crossings and stopped at t = 0.4035 s on the chord. A check already failed after an
+  // event's handling now stops the run there (StringSolver::failed_checks, FrontKind::checks_after_events).
+  StringCaseSetup s = setup_for(Problem::kFolded, 0.0, 81);
+  s.tilt_deg = 1.0;
+  s.frame_interval = 1.0;
+  const StringCaseRun out = solve_string_case(s);
+  const RunSummary& run = out.run;
+  INFO(run.stop_reason);
+  REQUIRE(run.status == "stopped");
+  CHECK_THAT(run.stop_reason, Contains("has opened"));
+  const double h = 1.0 / 80;
+  const double s0_over_h = run.samples.back().fronts[0].s0 / h;
+  CHECK(s0_over_h - std::floor(s0_over_h) < 0.01);  // just past the node it has crossed (27.006)
+  CHECK(run.t_stop == Approx(0.3587).margin(1e-3));
+  // The arms from the last frame's nodes: arc A's end link (a − 1, a) and arc B's first link (b, b + 1).
+  const Frame<2>& last = out.frames.back();
+  REQUIRE(last.t == Approx(run.t_stop).epsilon(1e-12));
+  const int a = static_cast<int>(run.transfers), b = a + 1;
+  const Vec<2> tA = (last.x.col(a) - last.x.col(a - 1)).normalized(), tB = (last.x.col(b + 1) - last.x.col(b)).normalized();
+  const double from_antiparallel = std::acos(std::clamp(-tA.dot(tB), -1.0, 1.0)) * 180 / kPi;
+  CAPTURE(a, from_antiparallel);
+  CHECK(from_antiparallel > 20.0);
+  CHECK(from_antiparallel < 21.0);
+}
