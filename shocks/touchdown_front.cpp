@@ -186,6 +186,25 @@ typename TouchdownFront<dim>::Geometry TouchdownFront<dim>::geometry_3d(const St
 }
 
 template <int dim>
+void TouchdownFront<dim>::set_state(const StringModel<dim>& model, const Geometry& g, const Vec<dim>& e, double tau_m,
+                                    double tau_p, FrontState<dim>& s, Eigen::VectorXd& mass) const {
+  const double lambda = this->m_.lambda;
+  s.s0 = model.chain().node_coordinate(g.a) + g.l_minus;
+  s.s0_dot = g.s0_dot;
+  s.l_minus = g.l_minus;
+  s.l_plus = g.l_plus;
+  s.direction = e;
+  s.position = g.x0;
+  s.tension_minus = tau_m;
+  s.tension_plus = tau_p;
+  s.opening = theta_;
+  s.inflow = 0;
+  s.plane_normal = normal_;
+  mass[g.a] += lambda * g.l_minus;
+  mass[g.b] += lambda * g.l_plus;
+}
+
+template <int dim>
 void TouchdownFront<dim>::evaluate(const StringModel<dim>& model, FrontState<dim>& s, Eigen::VectorXd& mass,
                                    Points<dim>& force) {
   if constexpr (dim == 3) {
@@ -208,19 +227,7 @@ void TouchdownFront<dim>::evaluate(const StringModel<dim>& model, FrontState<dim
   const double jump2 = ud.squaredNorm();
   const double tau_p = jump::touchdown_tension_plus<dim>(g.t, g.cos, ud, f, lambda, sd);
   const double tau_m = jump::touchdown_tension_minus<dim>(tau_p, e, g.cos, ud, lambda, sd);
-  s.s0 = model.chain().node_coordinate(a) + g.l_minus;
-  s.s0_dot = sd;
-  s.l_minus = g.l_minus;
-  s.l_plus = g.l_plus;
-  s.direction = e;
-  s.position = g.x0;
-  s.tension_minus = tau_m;
-  s.tension_plus = tau_p;
-  s.opening = theta_;
-  s.inflow = 0;
-  s.plane_normal = normal_;
-  mass[a] += lambda * g.l_minus;
-  mass[b] += lambda * g.l_plus;
+  set_state(model, g, e, tau_m, tau_p, s, mass);
   force.col(a) += tau_m * e;
   force.col(b) -= tau_p * g.t;
   // The arc's partial link continues its first link (c, b) beyond b to x0: its weight at its midpoint, so that
@@ -261,19 +268,7 @@ void TouchdownFront<dim>::evaluate_3d(const StringModel<dim>& model, FrontState<
   const double tau_p = jump::touchdown_tension_plus<dim>(g.t, g.cos, ud, f, lambda, sd);
   const double tau_m = jump::touchdown_tension_minus<dim>(tau_p, e, g.cos, ud, lambda, sd);
   const double tau_b = jump::touchdown_tension_minus<dim>(tau_p, bn, g.t.dot(bn), ud, lambda, sd);
-  s.s0 = model.chain().node_coordinate(a) + g.l_minus;
-  s.s0_dot = sd;
-  s.l_minus = g.l_minus;
-  s.l_plus = g.l_plus;
-  s.direction = e;
-  s.position = g.x0;
-  s.tension_minus = tau_m;
-  s.tension_plus = tau_p;
-  s.opening = theta_;
-  s.inflow = 0;
-  s.plane_normal = normal_;
-  mass[a] += lambda * g.l_minus;
-  mass[b] += lambda * g.l_plus;
+  set_state(model, g, e, tau_m, tau_p, s, mass);
   force.col(a) += tau_m * e + tau_b * bn;
   force.col(b) -= tau_p * g.t;
   // Both partial links continue a full link straight: the arc's its first link (c, b) beyond b, the lying one the

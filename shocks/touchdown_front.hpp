@@ -144,6 +144,9 @@ class TouchdownFront final : public SplitLinkFront<dim> {
     TouchdownConstraint<dim> split;
   };
   Geometry geometry(const StringModel<dim>& model) const;
+  /// The front's state and the partial links' masses on a and b, from the geometry, e and the tensions.
+  void set_state(const StringModel<dim>& model, const Geometry& g, const Vec<dim>& e, double tau_m, double tau_p,
+                 FrontState<dim>& s, Eigen::VectorXd& mass) const;
   /// geometry() in 3D (dim = 3; the 2D one keeps its own arithmetic).
   Geometry geometry_3d(const StringModel<dim>& model) const;
   /// evaluate() in 3D (the 2D one keeps its own arithmetic).

@@ -543,8 +543,8 @@ TEST_CASE("touchdown front in 3D: the split link's constraint, its gradient and 
     const double fdl = (C(x + d * dir).lateral_value - C(x - d * dir).lateral_value) / (2 * d);
     double gradl = 0;
     for (int q = has_p ? 0 : 1; q < 4; ++q) gradl += k.lateral_gradient.col(q).dot(dir.col(q));
-    auto second_l = [&](double dt) {
-      return (C(x + dt * v).lateral_value - 2 * k.lateral_value + C(x - dt * v).lateral_value) / (dt * dt);
+    auto second_l = [&](double step) {
+      return (C(x + step * v).lateral_value - 2 * k.lateral_value + C(x - step * v).lateral_value) / (step * step);
     };
     const double fdl2 = (4 * second_l(dt / 2) - second_l(dt)) / 3;
     CAPTURE(k.lateral_value, gradl, fdl, k.lateral_curvature, fdl2);
