@@ -87,16 +87,16 @@ void FoldFront<dim>::checks(const StringModel<dim>& /*model*/, const FrontState<
 template <int dim>
 std::string FoldFront<dim>::check_failed(const StringModel<dim>& model, const FrontState<dim>& s, double t) const {
   const bool apart = max_chord() - chord_ <= std::cos(s.opening) - std::cos(kMaxOpeningDeg * kPi / 180);
-  return apart ? apart_message(model, s, t) : opened_message(s);
+  return apart ? apart_message(model, s, t) : opened_message(s, t);
 }
 
 template <int dim>
-std::string FoldFront<dim>::opened_message(const FrontState<dim>& s) const {
+std::string FoldFront<dim>::opened_message(const FrontState<dim>& s, std::optional<double> t) const {
   return fmt::format(
-      "the fold at s0 = {:.6g} m has opened: its arms leave it {:.3g} degrees from antiparallel (a tight bight allows "
+      "the fold at s0 = {:.6g} m has opened{}: its arms leave it {:.3g} degrees from antiparallel (a tight bight allows "
       "at most {:g}; a dissipative fold needs both arms along one line, and a bight that opens, as in a folded chain "
       "whose ends are apart, is resolved by the string solver without [effects.fold]: docs/shocks.md)",
-      s.s0, s.opening * 180 / kPi, kMaxOpeningDeg);
+      s.s0, t ? fmt::format(" at t = {:.9g} s", *t) : std::string(), s.opening * 180 / kPi, kMaxOpeningDeg);
 }
 
 template <int dim>

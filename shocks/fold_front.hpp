@@ -49,7 +49,8 @@ class FoldFront final : public SplitLinkFront<dim> {
   std::string check_failed(const StringModel<dim>& model, const FrontState<dim>& state, double t) const override;
 
  private:
-  std::string opened_message(const FrontState<dim>& state) const;
+  /// `t`: the time of a run's stop (none at the start's refusal).
+  std::string opened_message(const FrontState<dim>& state, std::optional<double> t = std::nullopt) const;
   std::string apart_message(const StringModel<dim>& model, const FrontState<dim>& state, double t) const;
 
   double chord_ = 0;  ///< |x_b − x_a| / h of the folded link
