@@ -46,16 +46,22 @@ void TouchdownFront<dim>::initialize(StringModel<dim>& model) {
 }
 
 template <int dim>
-typename TouchdownFront<dim>::Geometry TouchdownFront<dim>::geometry(const StringModel<dim>& model) const {
-  if constexpr (dim == 3) return geometry_3d(model);
-  const Points<dim>& x = model.x();
-  const Points<dim>& v = model.v();
+typename TouchdownFront<dim>::Geometry TouchdownFront<dim>::nodes(const StringModel<dim>& model) const {
   Geometry g;
   g.a = this->node_a(model);
   g.b = this->node_b(model);
   g.c = g.b + 1;
   const ArcRange& B = model.arcs()[static_cast<std::size_t>(this->arc_plus)];
   if (B.num_links() < 1) throw RecoverableError("the arc after the touchdown front has no full link");
+  return g;
+}
+
+template <int dim>
+typename TouchdownFront<dim>::Geometry TouchdownFront<dim>::geometry(const StringModel<dim>& model) const {
+  if constexpr (dim == 3) return geometry_3d(model);
+  const Points<dim>& x = model.x();
+  const Points<dim>& v = model.v();
+  Geometry g = nodes(model);
   const Vec<dim>& e = along_;
   const Vec<dim>& n = normal_;
   const Vec<dim> link = x.col(g.c) - x.col(g.b), w = v.col(g.c) - v.col(g.b);
@@ -159,12 +165,7 @@ template <int dim>
 typename TouchdownFront<dim>::Geometry TouchdownFront<dim>::geometry_3d(const StringModel<dim>& model) const {
   const Points<dim>& x = model.x();
   const Points<dim>& v = model.v();
-  Geometry g;
-  g.a = this->node_a(model);
-  g.b = this->node_b(model);
-  g.c = g.b + 1;
-  const ArcRange& B = model.arcs()[static_cast<std::size_t>(this->arc_plus)];
-  if (B.num_links() < 1) throw RecoverableError("the arc after the touchdown front has no full link");
+  Geometry g = nodes(model);
   const ArcRange& A = model.arcs()[static_cast<std::size_t>(this->arc_minus)];
   g.p = A.num_links() >= 1 ? g.a - 1 : -1;
   const int p = std::max(g.p, 0);

@@ -143,6 +143,8 @@ class TouchdownFront final : public SplitLinkFront<dim> {
     int p = -1;
     TouchdownConstraint<dim> split;
   };
+  /// The split link's nodes a, b and the arc's next node c (a geometry with nothing else set yet).
+  Geometry nodes(const StringModel<dim>& model) const;
   Geometry geometry(const StringModel<dim>& model) const;
   /// The front's state and the partial links' masses on a and b, from the geometry, e and the tensions.
   void set_state(const StringModel<dim>& model, const Geometry& g, const Vec<dim>& e, double tau_m, double tau_p,

@@ -118,6 +118,19 @@ t_end = 0.3
                      extra);
 }
 
+/// Whether the scene text is refused, by an InputError that names `key`.
+template <int dim>
+bool refused(const std::string& text, const std::string& key) {
+  try {
+    build_string_scene<dim>(parse_scene_text(text, "s.toml"));
+  } catch (const InputError& e) {
+    CAPTURE(e.what());
+    CHECK(std::string(e.what()).find(key) != std::string::npos);
+    return true;
+  }
+  return false;
+}
+
 /// Three turns of the drawn string's 3D frame, none aligned with the axes.
 std::vector<Eigen::Matrix3d> turns() {
   return {Eigen::AngleAxisd(0.7, Eigen::Vector3d(1, 2, 3).normalized()).toRotationMatrix(),
@@ -201,50 +214,30 @@ TEST_CASE("touchdown front: a string drawn onto a table along itself follows the
 
 TEST_CASE("touchdown front: the scene refuses what is not built", "[touchdown]") {
   const std::string base = drawn_scene(20, 0.5, 1.0, 60);
-  auto refused = [](const std::string& text, const std::string& key) {
-    try {
-      build_string_scene<2>(parse_scene_text(text, "s.toml"));
-    } catch (const InputError& e) {
-      CAPTURE(e.what());
-      CHECK(std::string(e.what()).find(key) != std::string::npos);
-      return true;
-    }
-    return false;
-  };
   std::string rough = base;
   rough.replace(rough.find("f = 0.5"), 7, "f = 0.5\nmu = 0.2");
-  CHECK(refused(rough, "effects.surface[0].f"));
+  CHECK(refused<2>(rough, "effects.surface[0].f"));
   std::string too_much = base;
   too_much.replace(too_much.find("f = 0.5"), 7, "f = 1.5");
-  CHECK(refused(too_much, "effects.surface[0].f"));
+  CHECK(refused<2>(too_much, "effects.surface[0].f"));
   // The corner on a node (21 nodes: s = 0.5 m is node 10).
-  CHECK(refused(drawn_scene(21, 0.5, 1.0, 60), "inside a link"));
+  CHECK(refused<2>(drawn_scene(21, 0.5, 1.0, 60), "inside a link"));
   // The string must lie on the surface from its start.
   std::string lifted = base;
   lifted.replace(lifted.find("point = [0.0, 0.0]\nnormal"), 18, "point = [0.0, -0.1]");
-  CHECK(refused(lifted, "from the surface"));
-  CHECK(refused("model = \"string\"\n[string]\ndensity = 1.0\nnodes = 40\n[shape]\nkind = \"circle\"\nradius = 0.2\n"
+  CHECK(refused<2>(lifted, "from the surface"));
+  CHECK(refused<2>("model = \"string\"\n[string]\ndensity = 1.0\nnodes = 40\n[shape]\nkind = \"circle\"\nradius = 0.2\n"
                 "center = [0.0, 0.2]\n[[effects.surface]]\npoint = [0.0, 0.0]\nnormal = [0.0, 1.0]\nf = 0.5\n[stop]\n"
                 "t_end = 0.1\n",
                 "closed string"));
   // In 3D the same refusals hold (f with mu, on a closed string), and f itself is accepted.
   const std::string base3 = drawn_scene_3d(20, 0.5, 1.0, 60, 0, turns()[0]);
   CHECK_NOTHROW(build_string_scene<3>(parse_scene_text(base3, "s3.toml")));
-  auto refused3 = [](const std::string& text, const std::string& key) {
-    try {
-      build_string_scene<3>(parse_scene_text(text, "s3.toml"));
-    } catch (const InputError& e) {
-      CAPTURE(e.what());
-      CHECK(std::string(e.what()).find(key) != std::string::npos);
-      return true;
-    }
-    return false;
-  };
   std::string rough3 = base3;
   rough3.replace(rough3.find("f = 0.5"), 7, "f = 0.5\nmu = 0.2");
-  CHECK(refused3(rough3, "effects.surface[0].f"));
-  CHECK(refused3(drawn_scene_3d(21, 0.5, 1.0, 60, 0, turns()[1]), "inside a link"));
-  CHECK(refused3("model = \"string\"\n[string]\ndimension = 3\ndensity = 1.0\nnodes = 40\n[shape]\nkind = \"circle\"\n"
+  CHECK(refused<3>(rough3, "effects.surface[0].f"));
+  CHECK(refused<3>(drawn_scene_3d(21, 0.5, 1.0, 60, 0, turns()[1]), "inside a link"));
+  CHECK(refused<3>("model = \"string\"\n[string]\ndimension = 3\ndensity = 1.0\nnodes = 40\n[shape]\nkind = \"circle\"\n"
                  "radius = 0.2\ncenter = [0.0, 0.2, 0.0]\n[[effects.surface]]\npoint = [0.0, 0.0, 0.0]\nnormal = [0.0, 1.0, "
                  "0.0]\nf = 0.5\n[stop]\nt_end = 0.1\n",
                  "closed string"));
