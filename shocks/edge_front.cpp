@@ -100,8 +100,8 @@ void EdgeFront<dim>::initialize(StringModel<dim>& model) {
   }
   const int a = link_;
   set_link(model, a);
-  start_minus_ = bent_minus_;
-  start_plus_ = bent_plus_;
+  start_minus_ = unit_vector<dim>(point_ - x.col(a), "the bent link before the edge");
+  start_plus_ = unit_vector<dim>(x.col(a + 1) - point_, "the bent link after the edge");
   if (table_ == EdgeSpec<dim>::Table::kNone) return;
   // The table: the face the string on its side lies on, through x0, normal to that side's tangent, on
   // the side away from the bend (jump::face_normal).
@@ -129,17 +129,19 @@ void EdgeFront<dim>::initialize(StringModel<dim>& model) {
 template <int dim>
 void EdgeFront<dim>::evaluate(const StringModel<dim>& model, FrontState<dim>& s, Eigen::VectorXd& mass,
                               Points<dim>& force) {
-  const Points<dim>& x = model.x();
   const Points<dim>& v = model.v();
   const double h = this->m_.h, lambda = this->m_.lambda;
   const int a = link_, b = link_ + 1;
-  const Vec<dim> to_a = point_ - x.col(a), from_b = x.col(b) - point_;
-  const double lm = to_a.norm(), lp = from_b.norm();
-  t_minus_ = unit_vector<dim>(to_a, "the bent link before the edge");
-  t_plus_ = unit_vector<dim>(from_b, "the bent link after the edge");
+  // The bent link's two sides, signed (StringModel::bent_sides): a node that a step carries past x0
+  // along its side (within kOvershoot h) has l < 0 and the side's direction, so that everything below
+  // (the masses, the jump, the reaction, the lift-off margin) runs on continuously through the crossing.
+  const typename StringModel<dim>::PointBendSides sides = model.bent_sides(a);
+  const double lm = sides.l_minus, lp = sides.l_plus;
+  t_minus_ = sides.e_minus;
+  t_plus_ = sides.e_plus;
   // A trial stage that carries node a (or b) past x0 by more than kOvershoot h is refused (the
-  // integrator retries a shorter step): past x0 the bent link's geometry turns back on itself, so
-  // a step over a crossing must end within that distance, where the crossing's root is located.
+  // integrator retries a shorter step): a step over a crossing must end within that distance, where
+  // the crossing's root is located.
   if (g_minus(model) < -kOvershoot * h || g_plus(model) < -kOvershoot * h)
     throw RecoverableError(fmt::format("a node of link {} has passed the edge within a step", a));
   slack_ = model.link_slack(a);
@@ -234,11 +236,9 @@ void EdgeFront<dim>::draw(int index, ObstacleDrawing& drawing) const {
 }
 
 template <int dim>
-void EdgeFront<dim>::set_link(StringModel<dim>& model, int a) {
+void EdgeFront<dim>::set_link(StringModel<dim>& model, int a, int received) {
   link_ = a;
-  model.bend_link(a, point_);
-  bent_minus_ = unit_vector<dim>(point_ - model.x().col(a), "the bent link before the edge");
-  bent_plus_ = unit_vector<dim>(model.x().col(a + 1) - point_, "the bent link after the edge");
+  model.bend_link(a, point_, received >= 0, received <= 0);
 }
 
 template <int dim>
@@ -279,27 +279,14 @@ void EdgeFront<dim>::shift_sides(StringModel<dim>& model, int first, int last_mi
 
 template <int dim>
 double EdgeFront<dim>::g_minus(const StringModel<dim>& model) const {
-  const Points<dim>& x = model.x();
-  const int a = link_;
-  const ArcRange& arc = model.arcs()[static_cast<std::size_t>(this->arc_minus)];
-  // The link before a, or its part after the point it is bent over (another edge's).
-  const Vec<dim>* other = a > arc.first ? model.bend_point(a - 1) : nullptr;
-  const Vec<dim> d = other ? Vec<dim>((x.col(a) - *other).normalized())
-                     : a > arc.first ? Vec<dim>((x.col(a) - x.col(a - 1)).normalized())
-                                     : bent_minus_;
-  return d.dot(point_ - x.col(a));
+  // Along the direction the string arrives at a (the link before it, or its part after another edge's
+  // point; at the arc's first node the bent link's direction when it was bent): the sign of l⁻.
+  return model.bend_side_direction(link_, false).dot(point_ - model.x().col(link_));
 }
 
 template <int dim>
 double EdgeFront<dim>::g_plus(const StringModel<dim>& model) const {
-  const Points<dim>& x = model.x();
-  const int b = link_ + 1;
-  const ArcRange& arc = model.arcs()[static_cast<std::size_t>(this->arc_minus)];
-  const Vec<dim>* other = b < arc.last ? model.bend_point(b) : nullptr;  // the link after b bent over another edge
-  const Vec<dim> d = other ? Vec<dim>((*other - x.col(b)).normalized())
-                     : b < arc.last ? Vec<dim>((x.col(b + 1) - x.col(b)).normalized())
-                                    : bent_plus_;
-  return d.dot(x.col(b) - point_);
+  return model.bend_side_direction(link_, true).dot(model.x().col(link_ + 1) - point_);
 }
 
 template <int dim>
@@ -363,7 +350,12 @@ EventAction EdgeFront<dim>::cross(StringModel<dim>& model, const FrontState<dim>
     link_ = b;
   }
   model.unbend_link(a);  // this edge's bend only: another edge's stays
-  set_link(model, link_);
+  // The side the crossing node now lies on keeps |x − x0| as its partial length (unsigned): that node
+  // leaves the point, 2e-8 h past it, with the velocity it crossed with, and where that velocity has a
+  // part across its partial link (a side reaching the edge swinging) the node whirls about the point
+  // as a short rope round a post, which a signed length would not let it do. The side it left, whose
+  // node comes next to the edge, is signed.
+  set_link(model, link_, e0 != 0 ? +1 : -1);
   model.rebuild();
   model.refresh();
   return {EventAction::Kind::kTransfer, {}};

@@ -100,8 +100,9 @@ class EdgeFront final : public FrontKind<dim> {
   double tension_plus(const StringModel<dim>& model) const { return model.link_tension(link_) + jump_; }
 
  private:
-  /// Signed distances (m) from node a to x0 and from x0 to node b, along the sides' end links: a node
-  /// passing x0 between two steps changes their sign (|x0 − x_a| would not).
+  /// Signed distances (m) from node a to x0 and from x0 to node b, along the directions the string
+  /// arrives at a and leaves b (StringModel::bend_side_direction): a node passing x0 changes their sign,
+  /// and the sign of its partial length l∓ with them (StringModel::bent_sides).
   double g_minus(const StringModel<dim>& model) const;
   double g_plus(const StringModel<dim>& model) const;
 
@@ -110,9 +111,6 @@ class EdgeFront final : public FrontKind<dim> {
   typename EdgeSpec<dim>::Table table_ = EdgeSpec<dim>::Table::kNone;
   Vec<dim> table_normal_ = Vec<dim>::Zero();  ///< the table's outward unit normal (set at initialize)
   int link_ = -1;
-  /// The bent link's directions to and from x0 when it was bent (fixed until the next crossing): the
-  /// signed distance of an arc's end node has no link beyond it to measure along (set_link()).
-  Vec<dim> bent_minus_ = Vec<dim>::Zero(), bent_plus_ = Vec<dim>::Zero();
   /// The sides' tangents at the edge at the start (the faces drawn along them).
   Vec<dim> start_minus_ = Vec<dim>::Zero(), start_plus_ = Vec<dim>::Zero();
   /// Moves the nodes first … last_minus (before the edge) and first_plus … last (after it) by `step` (m)
@@ -124,8 +122,10 @@ class EdgeFront final : public FrontKind<dim> {
   /// The direction of the string before (`before`) or after another edge's bent link j: along its part
   /// to or from the point if that is longer than half a link, else along the link beyond it.
   Vec<dim> side_direction(const StringModel<dim>& model, int j, bool before) const;
-  /// Bends link `a` over x0 and fixes its directions.
-  void set_link(StringModel<dim>& model, int a);
+  /// Bends link `a` over x0 (StringModel::bend_link, which keeps its directions for an arc's end node);
+  /// `received` +1 (−1) after a crossing that put a node on the + (−) side: that side's partial length
+  /// stays unsigned (cross()); 0 at the start: both signed.
+  void set_link(StringModel<dim>& model, int a, int received = 0);
   // Of the last evaluation: the tangents on either side, the tension jump [τ] (N).
   Vec<dim> t_minus_ = Vec<dim>::Zero(), t_plus_ = Vec<dim>::Zero();
   double jump_ = 0;

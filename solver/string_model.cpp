@@ -22,6 +22,9 @@ constexpr double kCollapsedLink = 1e-6;
 /// A bent link's part on either side of its point may be this short (a node crossing an edge passes
 /// within 1e-8 h of it, shocks/edge_front.hpp).
 constexpr double kBentLinkFloor = 1e-10;
+/// A bent link's node has passed its point (point_bend_sides: its partial length negative) where the
+/// node lies past the point within this cosine of the side's direction (60°).
+constexpr double kPassedCone = 0.5;
 /// A link bent over a circle: the share of its length below which a free end's straight part is
 /// floored in the quadratic term (n·v)²/s (the end has just left the circle, or is about to land).
 constexpr double kCircleBendFloor = 1e-6;
@@ -308,18 +311,27 @@ void StringModel<dim>::links() {
 }
 
 template <int dim>
-void StringModel<dim>::bend_link(int link, const Vec<dim>& point) {
+void StringModel<dim>::bend_link(int link, const Vec<dim>& point, bool signed_minus, bool signed_plus) {
   if (quadratic_) throw InputError("a link bent over a point (an edge) needs link elements ([string] elements = \"links\")");
   if (link < 0 || link >= chain_.num_links()) throw InputError(fmt::format("bend_link: no link {}", link));
+  // The directions to and from the point now: a side at an end of its arc is signed along them
+  // (side_reference), where no link beyond its node gives the direction the string runs.
+  const Vec<dim> to_a = point - x_.col(chain_.link_start(link)), from_b = x_.col(chain_.link_end(link)) - point;
+  if (!(to_a.norm() > 0) || !(from_b.norm() > 0))
+    throw RecoverableError(fmt::format("link {} is bent over a point on one of its nodes", link));
+  Bend* bend = nullptr;
   for (Bend& b : bends_)
-    if (b.link == link) {
-      b.point = point;
-      return;
-    }
-  Bend bend;
-  bend.link = link;
-  bend.point = point;
-  bends_.push_back(bend);
+    if (b.link == link) bend = &b;
+  if (!bend) {
+    bends_.emplace_back();
+    bend = &bends_.back();
+    bend->link = link;
+  }
+  bend->point = point;
+  bend->bent_minus = to_a / to_a.norm();
+  bend->bent_plus = from_b / from_b.norm();
+  bend->signed_minus = signed_minus;
+  bend->signed_plus = signed_plus;
 }
 
 template <int dim>
@@ -424,26 +436,90 @@ void StringModel<dim>::bend_links() {
       bend.q = c.q;
       continue;
     }
-    const int j = bend.link, a = chain_.link_start(j), b = chain_.link_end(j);
-    const Vec<dim> to_a = bend.point - x_.col(a), from_b = x_.col(b) - bend.point;
-    bend.l_minus = to_a.norm();
-    bend.l_plus = from_b.norm();
-    const double floor = kBentLinkFloor * chain_.link_length(j);
-    // A node within the floor of the point (a root function's search may pass there) keeps the
-    // direction of its side from the last evaluation.
-    const bool near_minus = !(bend.l_minus > floor) && bend.e_minus_last.squaredNorm() > 0;
-    const bool near_plus = !(bend.l_plus > floor) && bend.e_plus_last.squaredNorm() > 0;
-    if (near_minus) bend.l_minus = floor;
-    if (near_plus) bend.l_plus = floor;
-    if (!(bend.l_minus > 0) || !(bend.l_plus > 0) || !std::isfinite(bend.l_minus + bend.l_plus))
-      throw RecoverableError(fmt::format("link {} has reached the point it is bent over ({:g} and {:g} m from it)", j,
-                                         bend.l_minus, bend.l_plus));
+    const PointBendSides sides = point_bend_sides(bend, [this](int i) { return x_.col(i); }, true);
+    const int j = bend.link;
+    bend.l_minus = sides.l_minus;
+    bend.l_plus = sides.l_plus;
     l_[j] = bend.l_minus + bend.l_plus;
-    e_.col(j) = near_minus ? bend.e_minus_last : Vec<dim>(to_a / bend.l_minus);
-    bend.e_plus = near_plus ? bend.e_plus_last : Vec<dim>(from_b / bend.l_plus);
+    e_.col(j) = sides.e_minus;
+    bend.e_plus = sides.e_plus;
     bend.e_minus_last = e_.col(j);
     bend.e_plus_last = bend.e_plus;
   }
+}
+
+template <int dim>
+template <class Position>
+Vec<dim> StringModel<dim>::side_reference(const Bend& bend, bool at_end, const Position& x) const {
+  // Along the link beyond the node (from or to the point it is bent over, if it is bent over one), as
+  // the string runs there; at an end of the arc, the bent link's own direction when it was bent.
+  const int j = bend.link, a = chain_.link_start(j), b = chain_.link_end(j);
+  const int arc = arc_of_[static_cast<std::size_t>(at_end ? b : a)];
+  if (arc >= 0) {
+    const ArcRange& range = arcs_[static_cast<std::size_t>(arc)];
+    if (!at_end && a > range.first) {
+      const Bend* other = bend_of(a - 1);
+      return other && !other->circle ? Vec<dim>((x(a) - other->point).normalized())
+                                     : Vec<dim>((x(a) - x(a - 1)).normalized());
+    }
+    if (at_end && b < range.last) {
+      const Bend* other = bend_of(b);
+      return other && !other->circle ? Vec<dim>((other->point - x(b)).normalized())
+                                     : Vec<dim>((x(b + 1) - x(b)).normalized());
+    }
+  }
+  return at_end ? bend.bent_plus : bend.bent_minus;
+}
+
+template <int dim>
+template <class Position>
+typename StringModel<dim>::PointBendSides StringModel<dim>::point_bend_sides(const Bend& bend, const Position& x,
+                                                                             bool directions) const {
+  const int j = bend.link, a = chain_.link_start(j), b = chain_.link_end(j);
+  const Vec<dim> to_a = bend.point - x(a), from_b = x(b) - bend.point;
+  const double floor = kBentLinkFloor * chain_.link_length(j);
+  PointBendSides out;
+  // One side: d from its node to the point (−) or from the point to its node (+); σ = −1 where the
+  // node has passed the point along the side's direction beyond it, within kPassedCone of that line (a
+  // node on a straight line through the point: l = σ |d| runs on through zero, e = d / l stays; a node
+  // that passes beside the point, further from it than from that line, keeps σ = 1 and its l = |d|
+  // continuous, as before). An unsigned side (bend_link) keeps σ = 1.
+  auto side = [&](const Vec<dim>& d, bool at_end, const Vec<dim>& last, double& l, Vec<dim>& e) {
+    const double r = d.norm();
+    const bool signed_side = at_end ? bend.signed_plus : bend.signed_minus;
+    l = signed_side && side_reference(bend, at_end, x).dot(d) < -kPassedCone * r ? -r : r;
+    if (!directions) return;
+    // A node within the floor of the point (a root function's search may pass there) keeps the
+    // direction of its side from the last evaluation.
+    if (!(r > floor) && last.squaredNorm() > 0) {
+      e = last;
+      return;
+    }
+    if (!(r > 0) || !std::isfinite(r))
+      throw RecoverableError(fmt::format("link {} has reached the point it is bent over ({:g} and {:g} m from it)", j,
+                                         to_a.norm(), from_b.norm()));
+    e = d / l;
+  };
+  side(to_a, false, bend.e_minus_last, out.l_minus, out.e_minus);
+  side(from_b, true, bend.e_plus_last, out.l_plus, out.e_plus);
+  if (directions && !(out.l_minus + out.l_plus > 0 && std::isfinite(out.l_minus + out.l_plus)))
+    throw RecoverableError(fmt::format("link {} has passed the point it is bent over (its parts {:g} and {:g} m)", j,
+                                       out.l_minus, out.l_plus));
+  return out;
+}
+
+template <int dim>
+typename StringModel<dim>::PointBendSides StringModel<dim>::bent_sides(int link) const {
+  const Bend* bend = bends_.empty() ? nullptr : bend_of(link);
+  CHAINSIM_VERIFY(bend && !bend->circle, "bent_sides: the link is not bent over a point");
+  return point_bend_sides(*bend, [this](int i) { return x_.col(i); }, true);
+}
+
+template <int dim>
+Vec<dim> StringModel<dim>::bend_side_direction(int link, bool at_end) const {
+  const Bend* bend = bends_.empty() ? nullptr : bend_of(link);
+  CHAINSIM_VERIFY(bend && !bend->circle, "bend_side_direction: the link is not bent over a point");
+  return side_reference(*bend, at_end, [this](int i) { return x_.col(i); });
 }
 
 template <int dim>
@@ -465,7 +541,8 @@ double StringModel<dim>::current_length(int j) const {
   const Vec<dim>& b = x_.col(chain_.link_end(j));
   if (const Bend* bend = bends_.empty() ? nullptr : bend_of(j)) {  // its length runs over its point
     if (bend->circle) return circle_bend(*bend).l;
-    return (bend->point - a).norm() + (b - bend->point).norm();
+    const PointBendSides sides = point_bend_sides(*bend, [this](int i) { return x_.col(i); }, false);
+    return sides.l_minus + sides.l_plus;
   }
   return (b - a).norm();
 }
@@ -831,7 +908,12 @@ double StringModel<dim>::evaluate_current(double t) {
       const Vec<dim> va = v_.col(a) - em * em.dot(v_.col(a)), vb = v_.col(b) - ep * ep.dot(v_.col(b));
       const double h = chain_.link_length(j), l = l_[j];
       const double stab = 2 * alpha_ * bend_rate(bend) + beta2_ * 0.5 * (l * l - h * h) / l;
-      system_->rhs(u) = -va.squaredNorm() / bend.l_minus - vb.squaredNorm() / bend.l_plus -
+      // |v⊥|²/l with l signed (point_bend_sides); through zero within the floor, where a node passes the point.
+      const double floor = kBentLinkFloor * h;
+      auto turn = [floor](double v2, double part) {
+        return std::abs(part) > floor ? v2 / part : v2 * part / (floor * floor);
+      };
+      system_->rhs(u) = -turn(va.squaredNorm(), bend.l_minus) - turn(vb.squaredNorm(), bend.l_plus) -
                         (ep.dot(b_.col(b)) - em.dot(b_.col(a))) - stab;
     }
     if (contact_stuck_) locked_rhs();
@@ -1525,8 +1607,15 @@ double StringModel<dim>::max_constraint_violation(double t, const Eigen::Ref<con
     const double h = chain_.link_length(j);
     const Vec<dim> a = position(chain_.link_start(j)), b = position(chain_.link_end(j));
     double l = (b - a).norm();
-    for (const Bend& bend : bends_)  // a bent link's length runs over its point
-      if (bend.link == j) l = (bend.point - a).norm() + (b - bend.point).norm();
+    for (const Bend& bend : bends_) {  // a bent link's length runs over its point (signed parts: point_bend_sides)
+      if (bend.link != j) continue;
+      if (bend.circle) {  // (as before: over Bend::point, which a circle's bend leaves at zero; not its arc)
+        l = (bend.point - a).norm() + (b - bend.point).norm();
+      } else {
+        const PointBendSides sides = point_bend_sides(bend, position, false);
+        l = sides.l_minus + sides.l_plus;
+      }
+    }
     worst = std::max(worst, std::abs(l - h) / h);
   });
   return worst;

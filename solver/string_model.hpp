@@ -288,8 +288,10 @@ class StringModel final : public OdeSystem {
   /// tension pulls node a along e⁻ = (point − x_a)/l⁻ and node b along −e⁺ = −(x_b − point)/l⁺, and
   /// the point takes the difference: the string runs over it, its tension a multiplier of the same
   /// tension system. Link elements only; implicit methods refuse a bent link (its linearisation is not
-  /// written). Replaces any earlier bend of the same link.
-  void bend_link(int link, const Vec<dim>& point);
+  /// written). Replaces any earlier bend of the same link. `signed_minus` and `signed_plus`: whether a
+  /// side's partial length turns negative where its node has passed the point (bent_sides); an edge
+  /// front leaves it unsigned on the side its crossing has just put a node on.
+  void bend_link(int link, const Vec<dim>& point, bool signed_minus = true, bool signed_plus = true);
   /// Moves node `node` of the initial shape (and of the current state) to `x`: a module placing its
   /// fronts before the start (an edge moves a node off its point).
   void move_initial_node(int node, const Vec<dim>& x) {
@@ -335,6 +337,27 @@ class StringModel final : public OdeSystem {
   /// A bent link's unit vectors after an evaluation: e⁻ at its start node (`at_end` false), e⁺ at its end
   /// node: the directions its tension pulls along there (T e⁻ on the start node, −T e⁺ on the end node).
   Vec<dim> bent_direction(int link, bool at_end) const { return at_end ? bend_of(link)->e_plus : Vec<dim>(e_.col(link)); }
+  /// The two sides of a link bent over a point (bend_link) at the current positions: its partial lengths
+  /// and unit vectors, the one place they are computed (the constraint, the edge front's masses, tension
+  /// jump, reaction and lift-off margin all read them). The lengths are signed: with d⁻ the direction the
+  /// string arrives at the start node a (bend_side_direction), l⁻ = σ |x0 − x_a| and e⁻ = σ (x0 − x_a)/|x0 − x_a|,
+  /// σ = sign(d⁻·(x0 − x_a)): past the point along d⁻ (a step that ends just past an edge front's crossing,
+  /// inside its overshoot band) l⁻ < 0 and e⁻ still points along the side, so that for a node moving along
+  /// a straight line through the point l⁻ runs on through zero and e⁻ stays; the same at the end node b
+  /// (docs/model.md §8, "Past the point"). σ = −1 only within 60° of that line beyond the point, and
+  /// only on a signed side (bend_link). A side within kBentLinkFloor h of the point keeps its direction
+  /// of the last evaluation. RecoverableError if a side has no direction.
+  struct PointBendSides {
+    double l_minus = 0, l_plus = 0;  ///< signed partial lengths (m), l⁻ + l⁺ = h on the constraint
+    Vec<dim> e_minus = Vec<dim>::Zero(), e_plus = Vec<dim>::Zero();
+  };
+  PointBendSides bent_sides(int link) const;
+  /// The direction the string arrives at the start node a of bent link `link` (`at_end` false: along the
+  /// link before a, or from the point that link is bent over) or leaves its end node b (`at_end` true:
+  /// along the link after b, or to its point), at the current positions; at an end of its arc (no link
+  /// beyond), the bent link's own direction when it was bent. It signs the partial lengths (bent_sides)
+  /// and measures an edge front's crossings.
+  Vec<dim> bend_side_direction(int link, bool at_end) const;
   /// Link j's rate of lengthening after an evaluation (m/s): e_j·Δv_j, a bent link's d(l⁻ + l⁺)/dt.
   double link_rate(int j) const;
   /// The force the points of the bent links exert on the string after an evaluation (N): Σ T (e⁻ − e⁺).
@@ -525,7 +548,10 @@ class StringModel final : public OdeSystem {
     Vec<dim> point = Vec<dim>::Zero();
     Vec<dim> e_plus = Vec<dim>::Zero();
     Vec<dim> e_minus_last = Vec<dim>::Zero(), e_plus_last = Vec<dim>::Zero();  // of the last evaluation
-    double l_minus = 0, l_plus = 0;
+    // The directions from x_a to the point and from it to x_b when it was bent (bend_side_direction at an arc's end).
+    Vec<dim> bent_minus = Vec<dim>::Zero(), bent_plus = Vec<dim>::Zero();
+    bool signed_minus = true, signed_plus = true;  // (bend_link)
+    double l_minus = 0, l_plus = 0;  // a point's: signed (point_bend_sides)
     // Bent over a circle (bend_link_on_circle): its centre, radius and sense, which ends are on it; after
     // links() the arc's length, the quadratic term of d²l/dt² at zero accelerations (q), and its angles.
     bool circle = false, a_on = false, b_on = false;
@@ -578,6 +604,12 @@ class StringModel final : public OdeSystem {
   Vec<dim> end_direction_at_contact(int j) const;
   void bend_couplings();           // assemble_matrix(): their couplings at the end node
   double bend_rate(const Bend& bend) const;  // d(l⁻ + l⁺)/dt
+  /// bend_side_direction and bent_sides at the positions x(i) (a callable: x_, or a state's y); without
+  /// `directions` the lengths only (no error where a side has no direction).
+  template <class Position>
+  Vec<dim> side_reference(const Bend& bend, bool at_end, const Position& x) const;
+  template <class Position>
+  PointBendSides point_bend_sides(const Bend& bend, const Position& x, bool directions) const;
   const Bend* bend_of(int link) const;       // the bend of a link, or null
   /// Link j's length at x_ (a bent link's runs over its point: l⁻ + l⁺), without links().
   double current_length(int j) const;

@@ -514,3 +514,69 @@ TEST_CASE("edge front: a scene's [[stop.front]] stops when its peg reaches s0, a
     CHECK(std::abs(s.t_stop - t_exact) < 1e-7);  // measured 6e-9 to 7e-9 s
   }
 }
+
+TEST_CASE("edge: a state just past a node's crossing has the continuum's tension, reaction and lift-off margin",
+          "[edge][convergence]") {
+  // An accepted step may end with node a up to kOvershoot h past the edge point, before the crossing is
+  // handled. The bent link's sides are signed there (StringModel::bent_sides): l⁻ < 0, t⁻ along the table.
+  // The chain off the table (21 links, 1 m, 1 kg/m, released with 0.2 m hanging) is put on its exact
+  // trajectory (exact::edge_*) at hanging lengths where node a = 16 lies δ before the edge (l⁻ = δ > 0)
+  // or |δ| past it along the table's line (δ < 0), every side straight: the discrete model is exact for
+  // such states, so its tensions, reaction and lift-off margin must be the continuum's at that hanging
+  // length on both sides of the crossing: continuous through it. Before, past the point t⁻ turned round
+  // and the edge's tension was 41.9 N instead of 1.72 N (f = 0.5, δ = −2.9e-5 m; docs/string_solver.md).
+  const int links = 21, a = 16;
+  const double ell = 1.0, lambda = 1.0, x0 = 0.2, h = ell / links;
+  for (const double f : {0.0, 0.5}) {
+    Points<2> vertices(2, 3);
+    vertices << -(ell - x0), 0.0, 0.0, 0.0, 0.0, -x0;
+    Chain<2> chain = discretize<2>(*polyline_curve<2>(vertices), ell, lambda, links, false);
+    std::vector<std::unique_ptr<Force<2>>> forces;
+    forces.push_back(std::make_unique<Gravity<2>>(Vec<2>(0.0, -kG)));
+    EdgeSpec<2> spec;
+    spec.dissipation = f;
+    spec.s0 = ell - x0;
+    spec.table = EdgeSpec<2>::Table::kBefore;
+    std::vector<std::unique_ptr<FrontKind<2>>> fronts;
+    fronts.push_back(std::make_unique<EdgeFront<2>>(spec));
+    const EdgeFront<2>& edge = dynamic_cast<const EdgeFront<2>&>(*fronts.front());
+    auto tracker = std::make_unique<FrontTracker<2>>(std::move(fronts), FrontOptions{});
+    const FrontTracker<2>& fronts_of = *tracker;
+    StringModelOptions options;
+    options.stabilization_time = 0.02 * std::sqrt(ell / kG);
+    StringModel<2> model(std::move(chain), std::move(forces), {}, options, std::move(tracker));
+    REQUIRE(edge.link() == a);
+    double worst = 0;
+    for (const double delta_over_h : {5e-4, 1e-6, 1e-9, -1e-9, -1e-6, -3e-4, -6e-4, -9e-4}) {
+      const double delta = delta_over_h * h, s0 = a * h + delta, x = ell - s0;
+      const double u = std::sqrt(exact::edge_speed_squared(f, x, x0, ell, kG));
+      Points<2> pos(2, links + 1), vel(2, links + 1);
+      for (int i = 0; i <= links; ++i) {
+        const double s = i * h;
+        pos.col(i) = i <= a ? Vec<2>(s - s0, 0.0) : Vec<2>(0.0, -(s - s0));  // node a on the table's line
+        vel.col(i) = i <= a ? Vec<2>(u, 0.0) : Vec<2>(0.0, -u);
+      }
+      model.evaluate(0.0, pos, vel);
+      const FrontState<2>& s = fronts_of.front_state(0);
+      const double tension = lambda * (ell - x) * exact::edge_acceleration(f, x, x0, ell, kG);
+      const double tension_plus = tension + f * lambda * u * u;
+      const Vec<2> reaction(tension - lambda * u * u, tension_plus - lambda * u * u);
+      double margin = 0;
+      edge.checks(model, s, &margin);
+      const double err = std::max({std::abs(edge.tension_minus(model) - tension),
+                                   std::abs(edge.tension_plus(model) - tension_plus),
+                                   (edge.recorded_reaction(model, s) - reaction).norm(),
+                                   std::abs(margin - std::min(reaction.x(), reaction.y()))});
+      worst = std::max(worst, err);
+      INFO("f = " << f << ", l- = " << delta_over_h << " h: tension " << edge.tension_minus(model) << " N (continuum "
+                  << tension << " N), reaction [" << edge.recorded_reaction(model, s).transpose() << "] N, margin "
+                  << margin << " N; largest difference " << err << " N");
+      CHECK(s.l_minus == Approx(delta).margin(1e-15));
+      CHECK(s.s0 == Approx(s0).epsilon(1e-15));
+      CHECK(s.s0_dot == Approx(-u).epsilon(1e-14));
+      CHECK(err < 3.5e-13);  // measured 1.1e-13 N
+    }
+    std::printf("\nedge, f = %g: largest |model - continuum| over the states within kOvershoot h of the crossing "
+                "(tensions, reaction, lift-off margin): %.3g N\n", f, worst);
+  }
+}
