@@ -26,6 +26,9 @@
 /// side) it passes to the other side, put just past x0 (x0 + kMirror kCross h t⁺) with its velocity rotated from
 /// t⁻ to t⁺ (its speed kept: no energy lost), and the link before it is bent instead; the same the
 /// other way; each side moves on rigidly by as much (cross()), so that every link keeps its length.
+/// A step over a crossing may end up to kOvershoot h past it, before it is handled: there the bent
+/// link's partial lengths are signed (StringModel::bent_sides), so that everything above runs on
+/// continuously through the crossing (docs/model.md §8, "Past the point").
 #include <optional>
 #include <string>
 
