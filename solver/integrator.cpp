@@ -190,6 +190,7 @@ struct Integrator::Impl {
   double g_last_time = 0;
   std::vector<char> prediction_off;
   int short_steps = 0;         // accepted steps in a row below the step-size floor
+  long refused_before_short = 0;  // recoverable_failures when the first of them began
   // Work vectors kept over the run (a crossing's polish and advance() allocated and freed them at every
   // event: malloc handed a state's bytes back to the system and took them again, page faults for 11 % of
   // the folded compare's time on 3,200 nodes): the start of the step advance() takes; the polish's last
@@ -670,9 +671,13 @@ void Integrator::watchdog(double t_before, int flag) {
     d.short_steps = 0;
     return;
   }
+  if (d.short_steps == 0) d.refused_before_short = d.recoverable_failures;
   if (++d.short_steps < kStallSteps) return;
+  // What the model refused on the way, if it refused trial states (e.g. a link of the string collapsed):
+  // the cause of the short steps, named.
+  const long refused = d.recoverable_failures - d.refused_before_short;
   throw NumericalError(
-      fmt::format("time integration stalled at t = {:.15g} s: {} accepted steps in a row {} ({}). The solution is "
+      fmt::format("time integration stalled at t = {:.15g} s: {} accepted steps in a row {} ({}){}. The solution is "
                   "probably singular near this time (a speed or a tension that diverges, a cutoff too close to a "
                   "singular end), or the method is unstable at this tolerance: tighten rtol, pick another method "
                   "(e.g. erk8 or dirk5), or stop the run before this time",
@@ -680,7 +685,10 @@ void Integrator::watchdog(double t_before, int flag) {
                   stalled ? "did not advance the time in floating point"
                           : fmt::format("were shorter than the step-size floor {:.3g} s = {:.0e} max(|t|, {:.3g} s)",
                                         floor, kStepFloor, d.system.time_scale()),
-                  diagnosis()),
+                  diagnosis(),
+                  refused > 0 ? fmt::format("; the model refused {} trial states in those steps, the last: {}",
+                                            refused, d.last_recoverable)
+                              : ""),
       t_);
 }
 
@@ -867,7 +875,7 @@ int Integrator::polish_event(double t_step_start, const Eigen::VectorXd& y_step_
   ARKStepGetCurrentStep(d.mem, &h_next);
   d.check(ARKStepRootInit(d.mem, 0, nullptr), "ARKStepRootInit");
 
-  Eigen::VectorXd g(nev), g_ahead(nev);
+  Eigen::VectorXd g(nev), g_ahead(nev), g_start(nev);
   Eigen::VectorXd& ydot = d.ydot;
   ydot.resize(y_.size());
   // The root's bracket: t_lo, the last time at which the function has not reached its zero (the step's
@@ -913,6 +921,9 @@ int Integrator::polish_event(double t_step_start, const Eigen::VectorXd& y_step_
   }
   int max_iterations = 4;
   bool converged = false, bisecting = false, refuted = false;
+  // At the last state computed: the time to the zero by Newton's step, and how far it may be with that
+  // state at its zero.
+  double remaining = INFINITY, margin_last = 0;
   for (int iteration = 0; iteration < max_iterations; ++iteration) {
     bool corrected = false;
     if (have_base) {
@@ -986,11 +997,30 @@ int Integrator::polish_event(double t_step_start, const Eigen::VectorXd& y_step_
     const double t_unit = std::max({std::abs(t_event), std::abs(t_step_start), d.system.time_scale()});
     const double t_tol = 8 * std::numeric_limits<double>::epsilon() * t_unit;
     const bool has_slope = slope != 0.0 && std::isfinite(slope);
-    if (!has_slope && !bisecting) break;
+    const double margin = std::max(t_tol, 1e-8 * (t_step_end - t_step_start));
+    remaining = has_slope ? std::abs(g[k] / slope) : INFINITY;
+    margin_last = margin;
+    if (!has_slope && !bisecting) {
+      // At the step's start the probe has no length (its length is a millionth of the way from the start). If
+      // the function has not reached its zero there, a millionth of the step measures its slope; farther from
+      // its zero than the margin, with a state past the zero known, the bracket is halved. (Reported there,
+      // the state of the event before, the event changed nothing and the same root came back until "events
+      // stalled"; a function at its zero there to round-off is that event, as before.)
+      if (t_event > t_step_start || passed(g[k]) || std::isnan(t_hi)) break;
+      const double dt_start = 1e-6 * (t_step_end - t_step_start);
+      d.y_probe = y_ + dt_start * ydot;
+      d.system.events(t_ + dt_start, d.y_probe, g_start);
+      const double slope_start = (g_start[k] - g[k]) / dt_start;
+      remaining = slope_start != 0.0 && std::isfinite(slope_start) ? std::abs(g[k] / slope_start) : INFINITY;
+      if (remaining <= margin) break;
+      t_event = 0.5 * (t_lo + t_hi);
+      bisecting = true;
+      max_iterations = kMaxBracketIterations;
+      continue;
+    }
     const double t_newton = has_slope ? t_event - g[k] / slope : NAN;
     // Newton's step, inside the step that holds the root (held to it if it leaves it by round-off: a root
     // at the step's start, just after a stop time); once it has left the step, inside the bracket.
-    const double margin = std::max(t_tol, 1e-8 * (t_step_end - t_step_start));
     const bool inside = bisecting ? t_newton >= t_lo - t_tol && t_newton <= t_hi + t_tol
                                   : t_newton >= t_step_start - margin && t_newton <= t_step_end + margin;
     double t_next = 0;
@@ -1012,7 +1042,24 @@ int Integrator::polish_event(double t_step_start, const Eigen::VectorXd& y_step_
       break;
     }
     t_event = t_next;
+    if (iteration + 1 == max_iterations && !bisecting && !(t_ > t_step_start) && !passed(g[k]) &&
+        !(remaining <= margin) && !std::isnan(t_hi)) {
+      // Newton's iterations are spent at the step's start, short of the zero, with a state past it
+      // known: the bracket is halved until it holds the zero to round-off, as when Newton leaves the step.
+      t_event = 0.5 * (t_lo + t_hi);
+      bisecting = true;
+      max_iterations = kMaxBracketIterations;
+    }
   }
+  // The recomputed state has not reached the zero, and Newton's step from it is longer than the margin
+  // (its iterations spent, or no slope there). Without a state past the zero, ARKODE's root was a zero
+  // of its interpolant only: refuted, as when Newton leaves the step. With one, at the step's start (the
+  // state of the event before: reported there, an event changed nothing, and the same root came back
+  // until "events stalled"), the event is the first state known past the zero (below). Inside the step
+  // the state is reported as before: the time has moved, and the contact module's windows judge it
+  // (docs/string_solver.md, "Events at loose tolerances").
+  const bool short_of_zero = !passed(g[k]) && !(remaining <= margin_last);
+  if (short_of_zero && std::isnan(t_hi)) refuted = true;
   if (refuted) {
     // No state recomputed in the step has passed the zero, and Newton points out of the step: ARKODE's
     // root was a zero of its interpolant, not of the method's solution (at loose tolerances the
@@ -1025,7 +1072,7 @@ int Integrator::polish_event(double t_step_start, const Eigen::VectorXd& y_step_
     d.check(ARKStepSetNoInactiveRootWarn(d.mem), "ARKStepSetNoInactiveRootWarn");
     return k;
   }
-  if (!converged && bisecting && !passed(g[k])) {
+  if (!passed(g[k]) && ((!converged && bisecting) || (short_of_zero && !(t_ > t_step_start)))) {
     // (Bisection converges in ~50 halvings of the step: a safeguard.) The event is the first state
     // known to have passed the zero.
     restart(t_step_start, y_step_start);
