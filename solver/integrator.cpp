@@ -1052,13 +1052,14 @@ int Integrator::polish_event(double t_step_start, const Eigen::VectorXd& y_step_
     }
   }
   // The recomputed state has not reached the zero, and Newton's step from it is longer than the margin
-  // (its iterations spent, or no slope there). Without a state past the zero, ARKODE's root was a zero
-  // of its interpolant only: refuted, as when Newton leaves the step. With one, at the step's start (the
-  // state of the event before: reported there, an event changed nothing, and the same root came back
-  // until "events stalled"), the event is the first state known past the zero (below). Inside the step
-  // the state is reported as before: the time has moved, and the contact module's windows judge it
-  // (docs/string_solver.md, "Events at loose tolerances").
-  const bool short_of_zero = !passed(g[k]) && !(remaining <= margin_last);
+  // (its iterations spent). Without a state past the zero, ARKODE's root was a zero of its interpolant
+  // only: refuted, as when Newton leaves the step. With one, at the step's start (the state of the event
+  // before: reported there, an event changed nothing, and the same root came back until "events
+  // stalled"), the event is the first state known past the zero (below). Inside the step the state is
+  // reported as before: the time has moved, and the contact module's windows judge it. A function with
+  // no slope there (one held at its cap, e.g. the lift-off function's 1) says nothing of where its zero
+  // is: reported as before too (docs/string_solver.md, "Events at loose tolerances").
+  const bool short_of_zero = !passed(g[k]) && remaining > margin_last && std::isfinite(remaining);
   if (short_of_zero && std::isnan(t_hi)) refuted = true;
   if (refuted) {
     // No state recomputed in the step has passed the zero, and Newton points out of the step: ARKODE's
