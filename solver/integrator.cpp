@@ -1007,6 +1007,7 @@ int Integrator::polish_event(double t_step_start, const Eigen::VectorXd& y_step_
       // the state of the event before, the event changed nothing and the same root came back until "events
       // stalled"; a function at its zero there to round-off is that event, as before.)
       if (t_event > t_step_start || passed(g[k]) || std::isnan(t_hi)) break;
+      if (secant) d.system.rhs(t_, y_, ydot);
       const double dt_start = 1e-6 * (t_step_end - t_step_start);
       d.y_probe = y_ + dt_start * ydot;
       d.system.events(t_ + dt_start, d.y_probe, g_start);
