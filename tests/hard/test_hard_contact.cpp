@@ -340,8 +340,8 @@ TEST_CASE("hard contact: a landing root that the recomputed solution does not re
   // another event was inside the pulley at that event: its landing function restarted below zero, where
   // ARKODE finds no root, and it fell through (main: the smooth pulley on 201 nodes at rtol = atol = 1e-4
   // completed with a node 0.39 h inside it, 4.9 h at 1e-3). Now every event lands such nodes.
-  // Each run completes, or stops later with a located slack stop (a tension of -1e-3 of its scale: the
-  // integration error at that tolerance decides it). Its energy ledger closes to the order of the tolerance
+  // Each run completes, or stops later with a located slack stop (a tension of -1e-3 of its scale or less,
+  // within the integration error of zero at that tolerance). Its energy ledger closes to the order of the tolerance
   // tau = max(rtol, atol) asked for (a global error; measured 2.21, 0.898, 0.289 and 0.135 tau, bounds about 3
   // times those), its momentum ledger to round-off, and no node enters the pulley beyond the landing
   // functions' offsets (a node let go and caught at one instant restarts at kPassGap = 1e-5 h: measured at most
