@@ -376,8 +376,31 @@ EventAction TouchdownFront<dim>::cross(StringModel<dim>& model, const FrontState
     const Vec<dim> link = x.col(b + 1) - x.col(b);
     placed = x.col(b) - h * link.normalized();
   }
+  // A landing makes the arc's next link (c, d) the new split link's own: its x0 is that link's extension to the plane,
+  // l⁺ = y_c / (t_cd·n), and the new l⁻ = h − l⁺ is the front's place past b before the projection. Where the arc's
+  // first two links meet at an angle (the arc's end whipping, docs/model.md §10, "A falling arc") it lies behind b;
+  // at half a link behind, b would lose its mass in the re-layout: the run stops here, before it, saying why.
+  if (e0 != 0 && b + 2 < static_cast<int>(x.cols())) {
+    const Vec<dim> first = (x.col(b + 1) - x.col(b)).normalized(), next = (x.col(b + 2) - x.col(b + 1)).normalized();
+    const double rise = next.dot(normal_);
+    const double l_minus_new = rise > 0 ? h - normal_.dot(x.col(b + 1) - point_) / rise : -h;
+    if (l_minus_new < -(0.5 - kMaxBehind) * h) {
+      const double kink_deg = std::acos(std::clamp(first.dot(next), -1.0, 1.0)) * 180 / kPi;
+      return {EventAction::Kind::kStop,
+              fmt::format("the touchdown front on {} lands node {} (s0 = {:.9g} m, ds0/dt = {:.4g} m/s) "
+                          "where the arc's first two links meet at {:.4g} deg at node {} (the first at {:.4g} deg to "
+                          "the plane, the next at {:.4g} deg): the new split link, the next link's extension to the "
+                          "plane, would put the front {:.4g} h behind node {}, more than half a link, and the node "
+                          "would lose its mass. The arc's end whips where the lying part does not follow the arc "
+                          "(docs/model.md §10, A falling arc)",
+                          surface_, b, state.s0, state.s0_dot, kink_deg, b + 1,
+                          std::asin(std::clamp(first.dot(normal_), -1.0, 1.0)) * 180 / kPi,
+                          std::asin(std::clamp(rise, -1.0, 1.0)) * 180 / kPi, -l_minus_new / h, b)};
+    }
+  }
   EventAction action = SplitLinkFront<dim>::cross(model, state, e0);
   if (action.kind == EventAction::Kind::kStop) return action;
+  relaid_ = true;
   if (e0 != 0) {
     // Node b has joined the lying arc with its velocity: it lies on the plane, where the contact module
     // holds it.
@@ -422,6 +445,28 @@ typename TouchdownFront<dim>::Margins TouchdownFront<dim>::margins(const StringM
   const double floor = 1e-8 * model.physical_scales().tension;
   const double push = normal_.dot(recorded_reaction(model, s));
   m.take_off = scale + floor > 0 ? std::min(1.0, (push + 1e-6 * scale + floor) / (scale + 1e6 * floor)) : 1.0;
+  // The lying part's last full link (a − 1, a), next to the front: its tension with the front's constraint's share
+  // (the multiplier is imposed after the links' tension solve, so slack = "allow" cannot release it) must not push,
+  // per the same scale and floor (docs/model.md §10, "A falling arc": an arc falling onto the table asks a lying part
+  // at rest to move back at −ṡ0 (1 − cos θ), which only a push starts).
+  const ArcRange& A = model.arcs()[static_cast<std::size_t>(this->arc_minus)];
+  if (A.num_links() >= 1) {
+    m.pushed_link = A.last - 1;
+    m.pushed_tension = model.link_tension(m.pushed_link);
+    m.pushed = std::min(1.0, (m.pushed_tension + floor) / (scale + 1e6 * floor));
+
+  }
+  // The front outside its split link after a crossing (a landing's re-layout can leave it behind the new node a,
+  // docs/model.md §10, "A falling arc"): harmless while it moves back in (the landing goes on), fatal if it moves
+  // further out, past a crossing's root that ARKODE no longer sees (until the node beyond loses its mass). Negative
+  // where the front lies more than kMaxBehind h out on a side and moves away from the link on that side; watched from
+  // a crossing until the front is first seen inside (not before a crossing, where a step past its root would meet
+  // this one too and be taken again: the 3D drawn string took 1,880 right-hand sides instead of 1,009).
+  if (relaid_) {
+    const double out_minus = s.l_minus / this->m_.h + kMaxBehind, out_plus = s.l_plus / this->m_.h + kMaxBehind;
+    if (out_minus >= 0 && out_plus >= 0) relaid_ = false;
+    m.inside = std::min({1.0, out_minus < 0 && s.s0_dot < 0 ? out_minus : 1.0, out_plus < 0 && s.s0_dot > 0 ? out_plus : 1.0});
+  }
   // 3D, f > 0: the sideways pull the front puts on the lying end, f λ ṡ0² |t·b|, beyond f λ ṡ0² sin 1°, per
   // f λ ṡ0², with the take-off check's round-off floor: the arc's angle to the plane of e and n where the front
   // moves, nothing where it is at rest (ṡ0 = 0: the balance across holds at any angle).
@@ -436,16 +481,33 @@ typename TouchdownFront<dim>::Margins TouchdownFront<dim>::margins(const StringM
 
 template <int dim>
 void TouchdownFront<dim>::checks(const StringModel<dim>& model, const FrontState<dim>& s, double* g) const {
-  const Margins m = margins(model, s);
-  g[0] = std::min({m.angle, m.height, m.take_off});
-  if constexpr (dim == 3) g[0] = std::min(g[0], m.off_plane);
+  g[0] = least(margins(model, s));
 }
 
 template <int dim>
 std::string TouchdownFront<dim>::check_failed(const StringModel<dim>& model, const FrontState<dim>& s, double t) const {
   const Margins m = margins(model, s);
-  const double least = std::min({m.angle, m.height, m.take_off, m.off_plane});
+  const double least = TouchdownFront::least(m);
   const double angle = dim == 3 ? std::asin(std::clamp(elevation_, -1.0, 1.0)) : theta_;  // 3D: the elevation
+  if (least == m.inside && m.inside < std::min({m.angle, m.height, m.take_off, m.off_plane, m.pushed}))
+    return fmt::format(
+        "the touchdown front on {} lies {:.4g} h outside its split link, behind node {}, and moves on away from it at "
+        "t = {:.9g} s (s0 = {:.9g} m, ds0/dt = {:.4g} m/s, the arc at {:.4g} deg): a landing's re-layout left it "
+        "there (the new split link takes the arc's next link as its own, and where the arc's first two links meet at "
+        "an angle its x0 lies off the old one), past the crossing's root, so that the front would run on past the "
+        "next node unseen (docs/model.md §10, A falling arc)",
+        surface_, -std::min(s.l_minus, s.l_plus) / this->m_.h,
+        s.l_minus < s.l_plus ? this->node_a(model) : this->node_b(model), t, s.s0, s.s0_dot, angle * 180 / kPi);
+  if (least == m.pushed && m.angle >= 0 && m.pushed < std::min({m.height, m.take_off, m.off_plane}))
+    return fmt::format(
+        "the lying part would have to be pushed at the touchdown front on {} at t = {:.9g} s: its last link next to "
+        "the front (link {}) has the tension T = {:.6g} N < 0 (s0 = {:.9g} m, ds0/dt = {:.4g} m/s, the arc at {:.4g} "
+        "deg, f = {:g}). An arc that falls onto the plane lays its material down faster than the lying part moves "
+        "away (compatibility asks a lying part at rest to move back at -ds0/dt (1 - cos theta), which only a push "
+        "starts): a string cannot push, so the lying part would go slack and pile up at the front, which the "
+        "touchdown front does not build (docs/model.md §10, A falling arc). Leave out f: node contact lands a "
+        "falling arc",
+        surface_, t, m.pushed_link, m.pushed_tension, s.s0, s.s0_dot, angle * 180 / kPi, this->dissipation);
   if (least == m.off_plane && m.off_plane < std::min({m.angle, m.height, m.take_off}))
     return fmt::format(
         "the arc leaves {} at {:.4g} deg to the plane of the lying part's direction and the normal at t = {:.9g} s "
@@ -469,15 +531,20 @@ std::string TouchdownFront<dim>::check_failed(const StringModel<dim>& model, con
         m.low_node, surface_, t, s.s0);
   return fmt::format(
       "the arc meets {} at {:.4g} deg at t = {:.9g} s (s0 = {:.9g} m, ds0/dt = {:.4g} m/s): a touchdown front needs "
-      "at least {:g} deg (a grazing touchdown is no shock, and the split link no longer places it)",
-      surface_, angle * 180 / kPi, t, s.s0, s.s0_dot, kMinAngleDeg);
+      "at least {:g} deg (a grazing touchdown is no shock, and the split link no longer places it; leave out f: node "
+      "contact lands a grazing arc){}",
+      surface_, angle * 180 / kPi, t, s.s0, s.s0_dot, kMinAngleDeg,
+      m.pushed < 0 ? fmt::format("; the lying part would also have to be pushed at the front (link {}: T = {:.6g} N "
+                                 "< 0; docs/model.md §10, A falling arc)",
+                                 m.pushed_link, m.pushed_tension)
+                   : std::string());
 }
 
 template <int dim>
 std::optional<RunEvent> TouchdownFront<dim>::check_event(const StringModel<dim>& model, const FrontState<dim>& s,
                                                          double t) const {
   const Margins m = margins(model, s);
-  if (std::min({m.angle, m.height, m.take_off, m.off_plane}) != m.take_off) return std::nullopt;
+  if (least(m) != m.take_off || m.take_off >= std::min(m.pushed, m.inside)) return std::nullopt;
   RunEvent e;
   e.kind = "lift_off";
   e.t = t;

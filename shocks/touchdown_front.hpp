@@ -31,6 +31,7 @@
 /// passes (landing) joins A with A's velocity and is put on the plane at h from A's last node, where the
 /// contact module holds it; a node of A that it passes (take-off) joins B, put on B's first link at h from
 /// B's first node.
+#include <algorithm>
 #include <string>
 
 #include "shocks/split_link_front.hpp"
@@ -94,6 +95,11 @@ class TouchdownFront final : public SplitLinkFront<dim> {
   /// needs it zero for f > 0 on a moving front; the discrete front books the residual as a sideways load on the lying
   /// end, docs/model.md §10, "A touchdown front in 3D").
   static constexpr double kMaxOffPlaneDeg = 1;
+  /// The run stops when, right after a crossing, the front lies more than this (per h) behind the new split link's
+  /// node on either side: the crossing left it past its own root (l⁻ or l⁺ < −kHysteresis h), where ARKODE, which sees
+  /// sign changes only, would no longer find the next crossing and the front would run past a node until the node
+  /// lost its mass (docs/model.md §10, "A falling arc"). Well below one link and well above the crossing's kHysteresis.
+  static constexpr double kMaxBehind = 1e-6;
 
   explicit TouchdownFront(const TouchdownSpec<dim>& spec);
 
@@ -111,8 +117,11 @@ class TouchdownFront final : public SplitLinkFront<dim> {
   void crossings(const StringModel<dim>& model, const FrontState<dim>& state, double* g) const override;
   EventAction cross(StringModel<dim>& model, const FrontState<dim>& state, int e0) override;
   /// One: positive while the arc meets the plane at more than kMinAngleDeg, no other node of the arc
-  /// reaches the plane, the plane pushes at the front (its reaction's normal component), and (3D, f > 0)
-  /// a moving front's arc stays within kMaxOffPlaneDeg of the plane of e and n.
+  /// reaches the plane, the plane pushes at the front (its reaction's normal component), the lying part's last
+  /// full link next to the front is not pushed (its tension, the front's constraint's share included, ≥ 0: a
+  /// falling arc lays its material down faster than a lying part at rest moves away, docs/model.md §10, "A falling
+  /// arc"), the front lies inside its split link (kMaxBehind), and (3D, f > 0) a moving front's arc stays within
+  /// kMaxOffPlaneDeg of the plane of e and n.
   bool checks_need_tensions() const override { return true; }
   int num_checks() const override { return 1; }
   void checks(const StringModel<dim>& model, const FrontState<dim>& state, double* g) const override;
@@ -155,9 +164,14 @@ class TouchdownFront final : public SplitLinkFront<dim> {
   void evaluate_3d(const StringModel<dim>& model, FrontState<dim>& state, Eigen::VectorXd& mass, Points<dim>& force);
   /// The margins of checks(): angle, other nodes' heights (per h), take-off.
   struct Margins {
-    double angle = 1, height = 1, take_off = 1, off_plane = 1;
-    int low_node = -1;
+    double angle = 1, height = 1, take_off = 1, off_plane = 1, pushed = 1, inside = 1;
+    int low_node = -1, pushed_link = -1;
+    double pushed_tension = 0;
   };
+  /// The least of the margins.
+  static double least(const Margins& m) {
+    return std::min({m.angle, m.height, m.take_off, m.off_plane, m.pushed, m.inside});
+  }
   Margins margins(const StringModel<dim>& model, const FrontState<dim>& state) const;
 
   Vec<dim> point_ = Vec<dim>::Zero(), normal_ = Vec<dim>::Zero();
@@ -170,6 +184,8 @@ class TouchdownFront final : public SplitLinkFront<dim> {
   /// The index of this front's constraint in the model's list (constraints() appends it to the list the model
   /// rebuilds from every front), for constraint_force; in 3D the lateral one follows it.
   mutable std::size_t constraint_index_ = static_cast<std::size_t>(-1);
+  /// Set by a crossing, cleared where the checks first see the front inside its split link (Margins::inside).
+  mutable bool relaid_ = false;
 };
 
 /// The surface's obstacle holding the lying arc of `front` only (its nodes up to front.lying_last()).

@@ -17,6 +17,9 @@ namespace chainsim {
 namespace {
 /// At a landing the free nodes within kLandWindow (of h) of a surface are held; if none is (the state
 /// recomputed to the event ends a little short of the located root), the nearest within kCatchWindow.
+/// Fractions of h, not of the integration error: the event's polish reports a root only where the recomputed
+/// function has reached its zero or is within its margin of it, and refutes the interpolant's roots that the
+/// solution does not reach (docs/string_solver.md, "Events at loose tolerances").
 constexpr double kLandWindow = 1e-7;
 constexpr double kCatchWindow = 1e-5;
 /// A node let go starts its landing root function at +kReleaseGap (ARKODE deactivates a root function
@@ -458,6 +461,11 @@ class ContactModule final : public WrappingModule<dim> {
       changed = wrap_land(model, t, own, found.size() > wrap_at && found[wrap_at] != 0) || changed;
       changed = wrap_leave(model, t, found.size() > wrap_at + 1 && found[wrap_at + 1] != 0) || changed;
     }
+    // A free node whose landing function is below zero has passed a surface unseen (its crossing, inside the
+    // step of another event, was not on ARKODE's interpolant, or came after the recomputed event): at the
+    // restart its function would start below zero, where ARKODE finds no root, and the node would fall
+    // through. It lands here, at this event (docs/string_solver.md, "Events at loose tolerances").
+    changed = hold(model, t, own, passed_through(model)) || changed;
     if (!changed) return {};
     return {EventAction::Kind::kTransfer, ""};  // the velocities or the held set changed: the integrator restarts
   }
@@ -1067,14 +1075,20 @@ class ContactModule final : public WrappingModule<dim> {
     // tolerances the links are off their lengths by up to a few % of h): its landing function would start
     // below zero, where ARKODE never finds its root, and the node would fall through the obstacle. Such
     // nodes land too, at this same instant (at most one round per node).
+    const std::vector<std::pair<int, int>> through = passed_through(model);
+    if (!through.empty() && round < static_cast<int>(held_.size())) hold(model, t, ledger, through, round + 1);
+    return true;
+  }
+  /// The free nodes whose landing function is below zero (node, obstacle): inside a surface, where ARKODE
+  /// would never find their landing root.
+  std::vector<std::pair<int, int>> passed_through(const StringModel<dim>& model) const {
     std::vector<std::pair<int, int>> through;
     for (std::size_t i = 0; i < held_.size(); ++i) {
       if (held_[i] >= 0 || !free_node(model, static_cast<int>(i))) continue;
       const auto [k, gap] = nearest(static_cast<int>(i), model.x().col(static_cast<Eigen::Index>(i)));
       if (k >= 0 && gap / h_ + offset_[i] < 0) through.emplace_back(static_cast<int>(i), k);
     }
-    if (!through.empty() && round < static_cast<int>(held_.size())) hold(model, t, ledger, through, round + 1);
-    return true;
+    return through;
   }
   /// Coulomb's impulse at a landing: each landing node still held on a rough obstacle takes the
   /// tangential impulse −μ P_n t̂ (at most what stops its tangential motion), and the velocities are

@@ -190,6 +190,7 @@ struct Integrator::Impl {
   double g_last_time = 0;
   std::vector<char> prediction_off;
   int short_steps = 0;         // accepted steps in a row below the step-size floor
+  long refused_before_short = 0;  // recoverable_failures when the first of them began
   // Work vectors kept over the run (a crossing's polish and advance() allocated and freed them at every
   // event: malloc handed a state's bytes back to the system and took them again, page faults for 11 % of
   // the folded compare's time on 3,200 nodes): the start of the step advance() takes; the polish's last
@@ -202,6 +203,10 @@ struct Integrator::Impl {
   Eigen::VectorXd start_rhs;
   double start_time = 0;
   bool start_rhs_ready = false;
+  // The first step ARKODE takes after the last restart or resize (0: its own estimate), and whether no step
+  // has been taken since (advance() may then end a predicted step by that first step instead of a stop time).
+  double init_step = 0;
+  bool fresh_start = false;
   std::chrono::steady_clock::time_point wall_start = std::chrono::steady_clock::now();
 
   explicit Impl(OdeSystem& s) : system(s) {}
@@ -211,6 +216,12 @@ struct Integrator::Impl {
     free_work_vectors();
     if (y) N_VDestroy(y);
     if (ctx) SUNContext_Free(&ctx);
+  }
+
+  /// ARKStepSetInitStep, remembered (init_step).
+  void set_init_step(double h) {
+    check(ARKStepSetInitStep(mem, h), "ARKStepSetInitStep");
+    init_step = h;
   }
 
   void check(int flag, const char* call) const {
@@ -565,7 +576,7 @@ Integrator::Integrator(OdeSystem& system, double t0, const Eigen::VectorXd& y0,
   d.check(ARKStepSetMaxNumSteps(d.mem, options.max_steps), "ARKStepSetMaxNumSteps");
   if (options.max_step > 0) d.check(ARKStepSetMaxStep(d.mem, options.max_step), "ARKStepSetMaxStep");
   if (options.initial_step > 0)
-    d.check(ARKStepSetInitStep(d.mem, options.initial_step), "ARKStepSetInitStep");
+    d.set_init_step(options.initial_step);
   if (d.implicit) d.attach_linear_solver();
 
   const int nev = system.num_events();
@@ -630,6 +641,7 @@ int Integrator::evolve(double t_target, bool one_step) {
   d.pending = nullptr;
   d.last_error.clear();
   const int flag = ARKStepEvolve(d.mem, t_target, d.y, &tret, one_step ? ARK_ONE_STEP : ARK_NORMAL);
+  d.fresh_start = false;
   ARKStepGetNumSteps(d.mem, &steps_after);
   d.steps_total += std::max(0L, steps_after - steps_before);
   if (d.pending) std::rethrow_exception(d.pending);
@@ -659,9 +671,13 @@ void Integrator::watchdog(double t_before, int flag) {
     d.short_steps = 0;
     return;
   }
+  if (d.short_steps == 0) d.refused_before_short = d.recoverable_failures;
   if (++d.short_steps < kStallSteps) return;
+  // What the model refused on the way, if it refused trial states (e.g. a link of the string collapsed):
+  // the cause of the short steps, named.
+  const long refused = d.recoverable_failures - d.refused_before_short;
   throw NumericalError(
-      fmt::format("time integration stalled at t = {:.15g} s: {} accepted steps in a row {} ({}). The solution is "
+      fmt::format("time integration stalled at t = {:.15g} s: {} accepted steps in a row {} ({}){}. The solution is "
                   "probably singular near this time (a speed or a tension that diverges, a cutoff too close to a "
                   "singular end), or the method is unstable at this tolerance: tighten rtol, pick another method "
                   "(e.g. erk8 or dirk5), or stop the run before this time",
@@ -669,7 +685,10 @@ void Integrator::watchdog(double t_before, int flag) {
                   stalled ? "did not advance the time in floating point"
                           : fmt::format("were shorter than the step-size floor {:.3g} s = {:.0e} max(|t|, {:.3g} s)",
                                         floor, kStepFloor, d.system.time_scale()),
-                  diagnosis()),
+                  diagnosis(),
+                  refused > 0 ? fmt::format("; the model refused {} trial states in those steps, the last: {}",
+                                            refused, d.last_recoverable)
+                              : ""),
       t_);
 }
 
@@ -701,7 +720,16 @@ Integrator::Outcome Integrator::advance(double t_target, bool one_step, const Ro
     const long refused_before = impl_->recoverable_failures;
     long fails_before = 0, fails_after = 0;
     ARKStepGetNumErrTestFails(impl_->mem, &fails_before);
-    const int flag = evolve(t_stop, /*one_step=*/true);
+    // ARKODE returns a step ended at its stop time through its interpolant (arkEvolve in SUNDIALS 6.4), whose
+    // evaluation costs one right-hand side at degree 4 (methods of order 5), two at degree 5. A predicted
+    // step that is the first after a restart is instead made that first step, ARKODE's stop time left at
+    // the target: no interpolation (on the canonical compares nearly every crossing's step is one).
+    double t_evolve = t_stop;
+    if (predicted >= 0 && impl_->fresh_start && impl_->init_step > 0 && t_stop - t_ < impl_->init_step) {
+      impl_->set_init_step(t_stop - t_);
+      t_evolve = t_target;
+    }
+    const int flag = evolve(t_evolve, /*one_step=*/true);
     impl_->muted_events.clear();
     if (predicted >= 0) set_root_directions();
     ARKStepGetNumErrTestFails(impl_->mem, &fails_after);
@@ -714,10 +742,10 @@ Integrator::Outcome Integrator::advance(double t_target, bool one_step, const Ro
                                          t_step_start, h_retry, impl_->last_recoverable),
                              t_step_start);
       restart(t_step_start, y_step_start);
-      impl_->check(ARKStepSetInitStep(impl_->mem, h_retry), "ARKStepSetInitStep");
+      impl_->set_init_step(h_retry);
       continue;
     }
-    if (retries > 0) impl_->check(ARKStepSetInitStep(impl_->mem, 0.0), "ARKStepSetInitStep");  // estimate again
+    if (retries > 0) impl_->set_init_step(0.0);  // estimate again
     retries = 0;
     h_retry = 0;
     watchdog(t_step_start, flag);
@@ -758,7 +786,7 @@ Integrator::Outcome Integrator::advance(double t_target, bool one_step, const Ro
       const double h = last_step();
       impl_->prediction_off[static_cast<std::size_t>(predicted)] = Impl::kPredictionMissed;
       restart(t_step_start, y_step_start);
-      impl_->check(ARKStepSetInitStep(impl_->mem, h), "ARKStepSetInitStep");
+      impl_->set_init_step(h);
       continue;
     }
     if (flag == ARK_ROOT_RETURN) {
@@ -774,7 +802,7 @@ Integrator::Outcome Integrator::advance(double t_target, bool one_step, const Ro
       // No event (the recomputed step refutes ARKODE's root): the step is taken again from its start,
       // as long as ARKODE's, with that function hidden from ARKODE's rootfinding (its interpolant would
       // find the same root again), and its zero checked at the step's end.
-      impl_->check(ARKStepSetInitStep(impl_->mem, t_step_end - t_step_start), "ARKStepSetInitStep");
+      impl_->set_init_step(t_step_end - t_step_start);
       ignored = were_ignored;  // (the step taken again may meet another function's false root)
       ignored.push_back(refuted);
       continue;
@@ -847,7 +875,7 @@ int Integrator::polish_event(double t_step_start, const Eigen::VectorXd& y_step_
   ARKStepGetCurrentStep(d.mem, &h_next);
   d.check(ARKStepRootInit(d.mem, 0, nullptr), "ARKStepRootInit");
 
-  Eigen::VectorXd g(nev), g_ahead(nev);
+  Eigen::VectorXd g(nev), g_ahead(nev), g_start(nev);
   Eigen::VectorXd& ydot = d.ydot;
   ydot.resize(y_.size());
   // The root's bracket: t_lo, the last time at which the function has not reached its zero (the step's
@@ -856,7 +884,11 @@ int Integrator::polish_event(double t_step_start, const Eigen::VectorXd& y_step_
   const double sense = events_found_[static_cast<std::size_t>(k)];
   const auto passed = [&](double gk) { return gk * sense >= 0; };
   double t_lo = t_step_start, t_hi = from_here ? t_ : std::numeric_limits<double>::quiet_NaN();
-  double last_probe = 1;
+  // Every function's rate along the flow at the last state probed (the step's end for a predicted event,
+  // else the last integrated state: within the correction's dt of the event), for the next prediction.
+  Eigen::VectorXd rates = Eigen::VectorXd::Zero(nev);
+  // The last state at which g_k was evaluated on the current flow, for the secant slope.
+  double t_previous = t_step_start, g_previous = 0;
   // The last integrated state, F there, and the error weights of the tolerance (ARKStepGetErrWeights).
   // (The Impl's work vectors: see there.)
   double t_base = t_step_start;
@@ -881,11 +913,17 @@ int Integrator::polish_event(double t_step_start, const Eigen::VectorXd& y_step_
     d.system.rhs(t_, y_, f_base);
     error_weights(weights);
     const double dt_probe = probe(t_, y_, f_base);
-    const double slope = (g_ahead[k] - g[k]) / dt_probe;
+    rates = (g_ahead - g) / dt_probe;
+    const double slope = rates[k];
     if (slope != 0.0 && std::isfinite(slope)) t_event = std::clamp(t_ - g[k] / slope, t_step_start, t_step_end);
+    t_previous = t_;
+    g_previous = g[k];
   }
   int max_iterations = 4;
   bool converged = false, bisecting = false, refuted = false;
+  // At the last state computed: the time to the zero by Newton's step, and how far it may be with that
+  // state at its zero.
+  double remaining = INFINITY, margin_last = 0;
   for (int iteration = 0; iteration < max_iterations; ++iteration) {
     bool corrected = false;
     if (have_base) {
@@ -907,7 +945,7 @@ int Integrator::polish_event(double t_step_start, const Eigen::VectorXd& y_step_
       double h_try = t_event - t_step_start;
       for (int retries = 0;; ++retries) {
         restart(t_step_start, y_step_start);
-        if (h_try > 0) d.check(ARKStepSetInitStep(d.mem, h_try), "ARKStepSetInitStep");
+        if (h_try > 0) d.set_init_step(h_try);
         int flag = 0;
         while (t_ < t_event && flag != ARK_UNREC_RHSFUNC_ERR) flag = evolve(t_event, /*one_step=*/false);
         if (flag != ARK_UNREC_RHSFUNC_ERR) break;
@@ -921,16 +959,34 @@ int Integrator::polish_event(double t_step_start, const Eigen::VectorXd& y_step_
       }
     }
     d.system.events(t_, y_, g);
-    d.system.rhs(t_, y_, ydot);
-    if (!corrected) {
-      t_base = t_;
-      y_base = y_;
-      have_base = true;
-      f_base = ydot;
-      error_weights(weights);
+    // The slope of g_k along the flow. For a predicted crossing (from_here: a front's crossing function,
+    // smooth in t) a Heun state lies on the same smooth curve of t as the point before it (the base, or
+    // the Heun state of the previous correction), so the secant through the two costs no right-hand side
+    // (with a probe at every Heun state a crossing took one more; measured in docs/shocks.md). Elsewhere,
+    // and at an integrated state (a new base, whose F is needed anyway), the probe: ARKODE's roots are
+    // also of functions with corners (the smallest of the held nodes' normal forces), across which a
+    // secant misleads Newton (two contact tests at rtol 1e-2 then stalled).
+    const double secant_dt = t_ - t_previous;
+    const bool secant =
+        from_here && corrected && std::abs(secant_dt) >= 1e-6 * std::max(t_event - t_step_start, 1e-300);
+    double slope = 0;
+    if (secant) {
+      slope = (g[k] - g_previous) / secant_dt;
+    } else {
+      d.system.rhs(t_, y_, ydot);
+      if (!corrected) {
+        t_base = t_;
+        y_base = y_;
+        have_base = true;
+        f_base = ydot;
+        error_weights(weights);
+      }
+      const double dt_probe = probe(t_, y_, ydot);
+      rates = (g_ahead - g) / dt_probe;
+      slope = rates[k];
     }
-    const double dt_probe = probe(t_, y_, ydot);
-    last_probe = dt_probe;
+    t_previous = t_;
+    g_previous = g[k];
     if (passed(g[k])) {
       if (!(t_ >= t_hi)) t_hi = t_;
     } else if (t_ > t_lo && !(t_ >= t_hi)) {
@@ -940,13 +996,32 @@ int Integrator::polish_event(double t_step_start, const Eigen::VectorXd& y_step_
     // stop early on a short time scale, e.g. a 1 mm chain under 1000 m/s²).
     const double t_unit = std::max({std::abs(t_event), std::abs(t_step_start), d.system.time_scale()});
     const double t_tol = 8 * std::numeric_limits<double>::epsilon() * t_unit;
-    const double slope = (g_ahead[k] - g[k]) / dt_probe;
     const bool has_slope = slope != 0.0 && std::isfinite(slope);
-    if (!has_slope && !bisecting) break;
+    const double margin = std::max(t_tol, 1e-8 * (t_step_end - t_step_start));
+    remaining = has_slope ? std::abs(g[k] / slope) : INFINITY;
+    margin_last = margin;
+    if (!has_slope && !bisecting) {
+      // At the step's start the probe has no length (its length is a millionth of the way from the start). If
+      // the function has not reached its zero there, a millionth of the step measures its slope; farther from
+      // its zero than the margin, with a state past the zero known, the bracket is halved. (Reported there,
+      // the state of the event before, the event changed nothing and the same root came back until "events
+      // stalled"; a function at its zero there to round-off is that event, as before.)
+      if (t_event > t_step_start || passed(g[k]) || std::isnan(t_hi)) break;
+      if (secant) d.system.rhs(t_, y_, ydot);
+      const double dt_start = 1e-6 * (t_step_end - t_step_start);
+      d.y_probe = y_ + dt_start * ydot;
+      d.system.events(t_ + dt_start, d.y_probe, g_start);
+      const double slope_start = (g_start[k] - g[k]) / dt_start;
+      remaining = slope_start != 0.0 && std::isfinite(slope_start) ? std::abs(g[k] / slope_start) : INFINITY;
+      if (remaining <= margin) break;
+      t_event = 0.5 * (t_lo + t_hi);
+      bisecting = true;
+      max_iterations = kMaxBracketIterations;
+      continue;
+    }
     const double t_newton = has_slope ? t_event - g[k] / slope : NAN;
     // Newton's step, inside the step that holds the root (held to it if it leaves it by round-off: a root
     // at the step's start, just after a stop time); once it has left the step, inside the bracket.
-    const double margin = std::max(t_tol, 1e-8 * (t_step_end - t_step_start));
     const bool inside = bisecting ? t_newton >= t_lo - t_tol && t_newton <= t_hi + t_tol
                                   : t_newton >= t_step_start - margin && t_newton <= t_step_end + margin;
     double t_next = 0;
@@ -968,7 +1043,25 @@ int Integrator::polish_event(double t_step_start, const Eigen::VectorXd& y_step_
       break;
     }
     t_event = t_next;
+    if (iteration + 1 == max_iterations && !bisecting && !(t_ > t_step_start) && !passed(g[k]) &&
+        !(remaining <= margin) && !std::isnan(t_hi)) {
+      // Newton's iterations are spent at the step's start, short of the zero, with a state past it
+      // known: the bracket is halved until it holds the zero to round-off, as when Newton leaves the step.
+      t_event = 0.5 * (t_lo + t_hi);
+      bisecting = true;
+      max_iterations = kMaxBracketIterations;
+    }
   }
+  // The recomputed state has not reached the zero, and Newton's step from it is longer than the margin
+  // (its iterations spent). Without a state past the zero, ARKODE's root was a zero of its interpolant
+  // only: refuted, as when Newton leaves the step. With one, at the step's start (the state of the event
+  // before: reported there, an event changed nothing, and the same root came back until "events
+  // stalled"), the event is the first state known past the zero (below). Inside the step the state is
+  // reported as before: the time has moved, and the contact module's windows judge it. A function with
+  // no slope there (one held at its cap, e.g. the lift-off function's 1) says nothing of where its zero
+  // is: reported as before too (docs/string_solver.md, "Events at loose tolerances").
+  const bool short_of_zero = !passed(g[k]) && remaining > margin_last && std::isfinite(remaining);
+  if (short_of_zero && std::isnan(t_hi)) refuted = true;
   if (refuted) {
     // No state recomputed in the step has passed the zero, and Newton points out of the step: ARKODE's
     // root was a zero of its interpolant, not of the method's solution (at loose tolerances the
@@ -981,16 +1074,16 @@ int Integrator::polish_event(double t_step_start, const Eigen::VectorXd& y_step_
     d.check(ARKStepSetNoInactiveRootWarn(d.mem), "ARKStepSetNoInactiveRootWarn");
     return k;
   }
-  if (!converged && bisecting && !passed(g[k])) {
+  if (!passed(g[k]) && ((!converged && bisecting) || (short_of_zero && !(t_ > t_step_start)))) {
     // (Bisection converges in ~50 halvings of the step: a safeguard.) The event is the first state
     // known to have passed the zero.
     restart(t_step_start, y_step_start);
-    d.check(ARKStepSetInitStep(d.mem, t_hi - t_step_start), "ARKStepSetInitStep");
+    d.set_init_step(t_hi - t_step_start);
     int flag = 0;
     while (t_ < t_hi && flag != ARK_UNREC_RHSFUNC_ERR) flag = evolve(t_hi, /*one_step=*/false);
     d.system.events(t_, y_, g);
     d.system.rhs(t_, y_, ydot);
-    last_probe = probe(t_, y_, ydot);
+    rates = (g_ahead - g) / probe(t_, y_, ydot);
   }
   d.h_resume = std::abs(h_next);
   d.stale_stops = 0;
@@ -998,7 +1091,7 @@ int Integrator::polish_event(double t_step_start, const Eigen::VectorXd& y_step_
   // Every function's rate at the event, for the prediction of the next zero of a recurring one.
   std::swap(d.root_rate, d.root_rate_before);
   d.root_time_before = d.root_time;
-  d.root_rate = (g_ahead - g) / last_probe;
+  d.root_rate = rates;
   d.root_time = t_;
   d.g_last.resize(0);
   d.prediction_off.resize(static_cast<std::size_t>(nev), 0);
@@ -1161,7 +1254,8 @@ void Integrator::restart(double t, const Eigen::VectorXd& y) {
   y_ = y;  // the same length: the same storage, which d.y wraps
   d.start_rhs_ready = false;
   d.check(ARKStepReset(d.mem, t, d.y), "ARKStepReset");
-  d.check(ARKStepSetInitStep(d.mem, d.h_resume), "ARKStepSetInitStep");  // 0: ARKODE's estimate
+  d.set_init_step(d.h_resume);  // 0: ARKODE's estimate
+  d.fresh_start = true;
   d.h_resume = 0;
   t_ = t;
 }
@@ -1178,7 +1272,8 @@ void Integrator::resize(double t, const Eigen::VectorXd& y) {
   d.free_work_vectors();  // (of the old length)
   d.start_rhs_ready = false;
   d.check(flag, "ARKStepResize");
-  d.check(ARKStepSetInitStep(d.mem, d.h_resume), "ARKStepSetInitStep");  // 0: ARKODE's estimate
+  d.set_init_step(d.h_resume);  // 0: ARKODE's estimate
+  d.fresh_start = true;
   d.h_resume = 0;
   d.apply_tolerances();
   if (d.implicit) d.attach_linear_solver();

@@ -122,7 +122,7 @@ TableSide<dim> table_side(const SceneSpec& spec, std::size_t k, const EdgeSpec<d
                         "makes that table a contact surface: allowed table = \"none\" with a surface that ends at the "
                         "edge (or no surface)",
                         edge_key, table, key, e));
-  const Vec<dim> n = as_vec<dim>(spec, entry.normal, key + ".normal").stableNormalized();
+  const Vec<dim> n = scene_build::as_unit_vec<dim>(spec, entry.normal, key + ".normal", "a normal");
   const double off = n.dot(edge.point - as_vec<dim>(spec, entry.point, key + ".point"));
   if (!(std::abs(off) <= kPlaceTolerance * ell))
     fail_at(spec, key + ".point",

@@ -65,7 +65,10 @@ TEST_CASE("the falling chain's crossings are predicted, not overstepped", "[conv
 
 // A canonical compare whose crossings are predicted: about one step per crossing on the finer mesh, at most
 // `bound_200` and `bound_800` right-hand sides per crossing on 200 and 800 nodes, the errors at the integrator's
-// tolerance.
+// tolerance. And on 800 nodes at most 16 evaluations of the model in all per crossing (`tension_solves`: ARKODE's,
+// the polish's, the crossing's projection and record): 14.9 (folded) and 14.3 (sliding) since a predicted step
+// ends as ARKODE's first step and the polish's slope is a secant; 16.9 and 16.3 before (docs/work-precision.md,
+// "Two evaluations fewer per crossing").
 static void check_predicted_crossings(Problem problem, const char* name, double bound_200, double bound_800) {
   for (const int nodes : {200, 800}) {
     const Comparison c = compare_with_reduced(setup_for(problem, 0.83, nodes));
@@ -77,6 +80,7 @@ static void check_predicted_crossings(Problem problem, const char* name, double 
     std::printf("%s %4d nodes: %5.2f right-hand sides and %4.2f steps per crossing\n", name, nodes, per_crossing,
                 s["steps"].get<double>() / crossings);
     CHECK(per_crossing <= (nodes == 200 ? bound_200 : bound_800));
+    if (nodes == 800) CHECK(s["tension_solves"].get<double>() / crossings <= 16);
     CHECK(s["steps"].get<double>() <= 1.2 * crossings + 150);
     CHECK(s["rel_err_t_stop"].get<double>() <= 1e-11);
     CHECK(s["max_abs_err_eta"].get<double>() <= 1e-10);

@@ -276,6 +276,9 @@ TEST_CASE("table and edge: inconsistent tables are refused at their keys, file:l
         "s.toml:15:10: effects.surface[0].normal = [0.0, -1.0]: the string leaves the table at effects.edge[0] towards "
         "the side the normal points to; the normal points away from the table, to the side the string lies on, and the "
         "string past the edge turns down, over the edge");
+  // A zero normal is named as such (it was reported at `edge` as a surface the string lies along on both sides).
+  CHECK(error_of(with("normal = [0.0, 1.0]", "normal = [0.0, 0.0]")) ==
+        "s.toml:15:10: effects.surface[0].normal = [0.0, 0.0] is not a normal: allowed a finite nonzero vector");
   CHECK(error_of(with("normal = [0.0, 1.0]", "normal = [1.0, 1.0]")) ==
         "s.toml:16:8: effects.surface[0].edge = 0: the string lies along the surface on neither side of "
         "effects.edge[0] (tangents [1, 0] before it, [0, -1] after it, normal [0.707107, 0.707107]); allowed a table the "
