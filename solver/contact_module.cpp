@@ -17,9 +17,9 @@ namespace chainsim {
 namespace {
 /// At a landing the free nodes within kLandWindow (of h) of a surface are held; if none is (the state
 /// recomputed to the event ends a little short of the located root), the nearest within kCatchWindow.
-/// Fractions of h, not of the integration error: the event's polish reports a root only where the recomputed
-/// function has reached its zero or is within its margin of it, and refutes the interpolant's roots that the
-/// solution does not reach (docs/string_solver.md, "Events at loose tolerances").
+/// Fractions of h, not of the integration error: the event's polish refutes the interpolant's roots that no
+/// recomputed state reaches, and at the step's start reports a root only where the recomputed function has
+/// reached its zero or is within its margin of it (docs/string_solver.md, "Events at loose tolerances").
 constexpr double kLandWindow = 1e-7;
 constexpr double kCatchWindow = 1e-5;
 /// A node let go starts its landing root function at +kReleaseGap (ARKODE deactivates a root function

@@ -725,7 +725,7 @@ Integrator::Outcome Integrator::advance(double t_target, bool one_step, const Ro
     // step that is the first after a restart is instead made that first step, ARKODE's stop time left at
     // the target: no interpolation (on the canonical compares nearly every crossing's step is one).
     double t_evolve = t_stop;
-    if (predicted >= 0 && impl_->fresh_start && impl_->init_step > 0 && t_stop - t_ < impl_->init_step) {
+    if (predicted >= 0 && impl_->fresh_start && impl_->init_step > 0 && t_stop > t_ && t_stop - t_ < impl_->init_step) {
       impl_->set_init_step(t_stop - t_);
       t_evolve = t_target;
     }
@@ -884,11 +884,12 @@ int Integrator::polish_event(double t_step_start, const Eigen::VectorXd& y_step_
   const double sense = events_found_[static_cast<std::size_t>(k)];
   const auto passed = [&](double gk) { return gk * sense >= 0; };
   double t_lo = t_step_start, t_hi = from_here ? t_ : std::numeric_limits<double>::quiet_NaN();
-  // Every function's rate along the flow at the last state probed (the step's end for a predicted event,
-  // else the last integrated state: within the correction's dt of the event), for the next prediction.
+  // Every function's rate along the flow at the last state probed, for the next prediction: mostly the last
+  // iterate, at the root (a correction that stops short of the Heun share integrates again and probes there);
+  // else the step's end for a predicted event, within the correction's dt (10⁻⁴ of the interval) of the root.
   Eigen::VectorXd rates = Eigen::VectorXd::Zero(nev);
   // The last state at which g_k was evaluated on the current flow, for the secant slope.
-  double t_previous = t_step_start, g_previous = 0;
+  double t_previous = t_step_start, g_previous = 0, last_slope = NAN;
   // The last integrated state, F there, and the error weights of the tolerance (ARKStepGetErrWeights).
   // (The Impl's work vectors: see there.)
   double t_base = t_step_start;
@@ -918,6 +919,7 @@ int Integrator::polish_event(double t_step_start, const Eigen::VectorXd& y_step_
     if (slope != 0.0 && std::isfinite(slope)) t_event = std::clamp(t_ - g[k] / slope, t_step_start, t_step_end);
     t_previous = t_;
     g_previous = g[k];
+    last_slope = slope;
   }
   int max_iterations = 4;
   bool converged = false, bisecting = false, refuted = false;
@@ -959,19 +961,26 @@ int Integrator::polish_event(double t_step_start, const Eigen::VectorXd& y_step_
       }
     }
     d.system.events(t_, y_, g);
-    // The slope of g_k along the flow. For a predicted crossing (from_here: a front's crossing function,
-    // smooth in t) a Heun state lies on the same smooth curve of t as the point before it (the base, or
+    // The slope of g_k along the flow. For a predicted crossing (from_here with a recurring function: a
+    // front's crossing function, smooth in t; from_here alone also polishes a contact function found past
+    // its zero at the end of a step taken again, advance()) a Heun state lies on the same smooth curve of t as the point before it (the base, or
     // the Heun state of the previous correction), so the secant through the two costs no right-hand side
     // (with a probe at every Heun state a crossing took one more; measured in docs/shocks.md). Elsewhere,
     // and at an integrated state (a new base, whose F is needed anyway), the probe: ARKODE's roots are
     // also of functions with corners (the smallest of the held nodes' normal forces), across which a
     // secant misleads Newton (two contact tests at rtol 1e-2 then stalled).
+    // A correction below the probe's own length (10⁻⁶ of the interval: the last one, as Newton converges)
+    // keeps the slope it was made with: the secant over it would be round-off, and the slope changes by
+    // less than that over it.
     const double secant_dt = t_ - t_previous;
-    const bool secant =
-        from_here && corrected && std::abs(secant_dt) >= 1e-6 * std::max(t_event - t_step_start, 1e-300);
+    const bool smooth = from_here && k < d.system.num_recurring_events() && corrected;
+    const bool secant = smooth && std::abs(secant_dt) >= 1e-6 * std::max(t_event - t_step_start, 1e-300);
+    const bool kept = smooth && !secant && last_slope != 0.0 && std::isfinite(last_slope);
     double slope = 0;
     if (secant) {
       slope = (g[k] - g_previous) / secant_dt;
+    } else if (kept) {
+      slope = last_slope;
     } else {
       d.system.rhs(t_, y_, ydot);
       if (!corrected) {
@@ -987,6 +996,7 @@ int Integrator::polish_event(double t_step_start, const Eigen::VectorXd& y_step_
     }
     t_previous = t_;
     g_previous = g[k];
+    last_slope = slope;
     if (passed(g[k])) {
       if (!(t_ >= t_hi)) t_hi = t_;
     } else if (t_ > t_lo && !(t_ >= t_hi)) {

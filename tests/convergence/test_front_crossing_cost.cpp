@@ -66,7 +66,7 @@ TEST_CASE("the falling chain's crossings are predicted, not overstepped", "[conv
 // A canonical compare whose crossings are predicted: about one step per crossing on the finer mesh, at most
 // `bound_200` and `bound_800` right-hand sides per crossing on 200 and 800 nodes, the errors at the integrator's
 // tolerance. And on 800 nodes at most 16 evaluations of the model in all per crossing (`tension_solves`: ARKODE's,
-// the polish's, the crossing's projection and record): 14.9 (folded) and 14.3 (sliding) since a predicted step
+// the polish's, the crossing's projection and record): 13.9 (folded) and 13.4 (sliding) since a predicted step
 // ends as ARKODE's first step and the polish's slope is a secant; 16.9 and 16.3 before (docs/work-precision.md,
 // "Two evaluations fewer per crossing").
 static void check_predicted_crossings(Problem problem, const char* name, double bound_200, double bound_800) {
