@@ -375,7 +375,8 @@ double StringModel<dim>::bend_straight(int link, bool at_end) const {
 }
 
 template <int dim>
-typename StringModel<dim>::CircleBend StringModel<dim>::circle_bend(const Bend& bend) const {
+template <class Position>
+typename StringModel<dim>::CircleBend StringModel<dim>::circle_bend(const Bend& bend, const Position& x) const {
   CircleBend out;
   if constexpr (dim == 2) {
     const int j = bend.link, a = chain_.link_start(j), b = chain_.link_end(j);
@@ -387,7 +388,7 @@ typename StringModel<dim>::CircleBend StringModel<dim>::circle_bend(const Bend& 
       double theta, s, q;
     };
     auto end = [&](int i, bool on, bool out_end) -> End {
-      const Vec<2> r = x_.col(i) - bend.center, v = v_.col(i);
+      const Vec<2> r = Vec<2>(x(i)) - bend.center, v = v_.col(i);
       const double d = r.norm(), phi = std::atan2(r[1], r[0]);
       if (on) {  // R σ θ: its second derivative at zero acceleration, −2 σ R (n·v)(t·v)/d²
         const Vec<2> n = r / d, t(-n[1], n[0]);
@@ -1609,8 +1610,8 @@ double StringModel<dim>::max_constraint_violation(double t, const Eigen::Ref<con
     double l = (b - a).norm();
     for (const Bend& bend : bends_) {  // a bent link's length runs over its point (signed parts: point_bend_sides)
       if (bend.link != j) continue;
-      if (bend.circle) {  // (as before: over Bend::point, which a circle's bend leaves at zero; not its arc)
-        l = (bend.point - a).norm() + (b - bend.point).norm();
+      if (bend.circle) {  // its straight parts and its arc on the circle
+        l = circle_bend(bend, position).l;
       } else {
         const PointBendSides sides = point_bend_sides(bend, position, false);
         l = sides.l_minus + sides.l_plus;

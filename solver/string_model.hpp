@@ -598,7 +598,10 @@ class StringModel final : public OdeSystem {
     double l = 0, arc = 0, s_a = 0, s_b = 0, q = 0;
     Vec<dim> e_minus = Vec<dim>::Zero(), e_plus = Vec<dim>::Zero();
   };
-  CircleBend circle_bend(const Bend& bend) const;
+  CircleBend circle_bend(const Bend& bend) const { return circle_bend(bend, [this](int i) { return x_.col(i); }); }
+  /// The same at the positions x(i) (a callable: x_, or a state's y) and the velocities v_ (for q only).
+  template <class Position>
+  CircleBend circle_bend(const Bend& bend, const Position& x) const;
   /// Link j's direction at its end node: e⁺ for a link bent over a circle, e_j otherwise (a link bent
   /// over a point keeps e_j there in the held nodes' rows, as before circles).
   Vec<dim> end_direction_at_contact(int j) const;
