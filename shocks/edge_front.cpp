@@ -238,7 +238,10 @@ void EdgeFront<dim>::draw(int index, ObstacleDrawing& drawing) const {
 template <int dim>
 void EdgeFront<dim>::set_link(StringModel<dim>& model, int a, int received) {
   link_ = a;
-  model.bend_link(a, point_, received >= 0, received <= 0);
+  // A side whose node ends its arc stays unsigned: signed, its mass λ l⁻ (or λ l⁺) would go negative in a stage
+  // past the point, and a crossing there stops the run anyway (review of the signed sides).
+  const ArcRange& arc = model.arcs()[static_cast<std::size_t>(this->arc_minus)];
+  model.bend_link(a, point_, received >= 0 && a > arc.first, received <= 0 && a + 1 < arc.last);
 }
 
 template <int dim>
