@@ -963,15 +963,14 @@ int Integrator::polish_event(double t_step_start, const Eigen::VectorXd& y_step_
     d.system.events(t_, y_, g);
     // The slope of g_k along the flow. For a predicted crossing (from_here with a recurring function: a
     // front's crossing function, smooth in t; from_here alone also polishes a contact function found past
-    // its zero at the end of a step taken again, advance()) a Heun state lies on the same smooth curve of t as the point before it (the base, or
-    // the Heun state of the previous correction), so the secant through the two costs no right-hand side
-    // (with a probe at every Heun state a crossing took one more; measured in docs/shocks.md). Elsewhere,
-    // and at an integrated state (a new base, whose F is needed anyway), the probe: ARKODE's roots are
-    // also of functions with corners (the smallest of the held nodes' normal forces), across which a
-    // secant misleads Newton (two contact tests at rtol 1e-2 then stalled).
-    // A correction below the probe's own length (10⁻⁶ of the interval: the last one, as Newton converges)
-    // keeps the slope it was made with: the secant over it would be round-off, and the slope changes by
-    // less than that over it.
+    // its zero at the end of a step taken again, advance()) a Heun state lies on the same smooth curve of t
+    // as the point before it (the base, or the Heun state of the previous correction), so the secant through
+    // the two costs no right-hand side (with a probe at every Heun state a crossing took one more; measured
+    // in docs/shocks.md). A correction below the probe's own length (10⁻⁶ of the interval: the last one, as
+    // Newton converges) keeps the slope it was made with: the secant over it would be round-off, and the
+    // slope changes by less than that over it. Elsewhere, and at an integrated state (a new base, whose F is
+    // needed anyway), the probe: ARKODE's roots are also of functions with corners (the smallest of the held
+    // nodes' normal forces), across which a secant misleads Newton (two contact tests at rtol 1e-2 stalled).
     const double secant_dt = t_ - t_previous;
     const bool smooth = from_here && k < d.system.num_recurring_events() && corrected;
     const bool secant = smooth && std::abs(secant_dt) >= 1e-6 * std::max(t_event - t_step_start, 1e-300);
