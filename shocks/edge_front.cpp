@@ -95,6 +95,14 @@ void EdgeFront<dim>::initialize(StringModel<dim>& model) {
     const Vec<dim> tm = unit_vector<dim>(point_ - x.col(c - 1), "the string before the edge");
     const Vec<dim> tp = unit_vector<dim>(x.col(c + 1) - point_, "the string after the edge");
     shift_sides(model, 0, c, c + 1, this->m_.n - 1, -nudge, tm, tp);
+    // Node c may have sat off the point by about as much as its material offset (a shape whose length
+    // differs from the string's within shape.length_tolerance holds its nodes L/N apart in arc length, so
+    // the node at a corner can lie just past it, on the other side): it goes exactly to the nudge's
+    // place on its side's line. Left where the shift put it, the bent link's direction, the table's
+    // normal and the lift-off cone would tilt by that offset over the nudge (a table 9° off for an
+    // offset of 8e-11 m). Its links change length by that offset, which the shape's own tolerance allows.
+    Points<dim>& moved = model.x();
+    moved.col(c) = point_ - nudge * tm;
     for (int i = 0; i < this->m_.n; ++i) model.move_initial_node(i, Vec<dim>(x.col(i)));
     link_ = c;
   }
@@ -112,10 +120,15 @@ void EdgeFront<dim>::initialize(StringModel<dim>& model) {
     throw InputError("the string does not turn at the edge: a table needs the string to bend over its edge");
   table_normal_ = jump::face_normal<dim>(before ? tm : tp, tp - tm);
   const Vec<dim> g = model.uniform_field();
-  if (g.dot(table_normal_) > 0)
-    throw InputError(fmt::format("the table under the string {} the edge has its outward normal {} along the uniform "
-                                 "field {}: the field pulls the string off it, so no table holds it",
-                                 before ? "before" : "after", show<dim>(table_normal_), show<dim>(g)));
+  // The table holds its side only by pushing against the field's normal part (its support −m g·n n):
+  // a field along the table or none leaves that side free to leave it, and a field away from it pulls it off.
+  if (!(g.dot(table_normal_) < 0))
+    throw InputError(fmt::format("the table under the string {} the edge has its outward normal {} and the uniform "
+                                 "field is {}: {}, so no table holds it; allowed a table the field presses the string "
+                                 "onto (g·n < 0), or table = \"none\"",
+                                 before ? "before" : "after", show<dim>(table_normal_), show<dim>(g),
+                                 g.dot(table_normal_) > 0 ? "the field pulls the string off it"
+                                                          : "the field does not press the string onto it (g·n = 0)"));
   const int first = before ? 0 : a + 1, last = before ? a : this->m_.n - 1;
   for (int i = first; i <= last; ++i) {
     const double off = table_normal_.dot(x.col(i) - point_);

@@ -334,23 +334,28 @@ std::unique_ptr<StringModel<dim>> build_front_model(const SceneSpec& spec, scene
                             "leave it out)",
                             key, text_of(spec, key + ".direction")));
     }
-    // The nearest point of the initial shape: the closest of fine samples, refined by golden section.
+    // The nearest point of the initial shape: the closest of fine samples, refined by golden section, in
+    // the shape's arc length; the string's nodes sit on the shape at equal arc length (discretize), so the
+    // material point there is that arc length scaled by ℓ / L (the shape's length L may differ from ℓ
+    // within shape.length_tolerance).
+    const double shape_length = parts.curve->length();
     const int samples = std::max(4000, 40 * chain.num_links());
     double best_s = 0, best = INFINITY;
     for (int i = 0; i <= samples; ++i) {
-      const double s = ell * i / samples, dist = (parts.curve->point(s) - point).norm();
+      const double s = shape_length * i / samples, dist = (parts.curve->point(s) - point).norm();
       if (dist < best) best = dist, best_s = s;
     }
-    double lo = std::max(0.0, best_s - ell / samples), hi = std::min(ell, best_s + ell / samples);
-    for (int it = 0; it < 100 && hi - lo > 1e-15 * ell; ++it) {
+    double lo = std::max(0.0, best_s - shape_length / samples), hi = std::min(shape_length, best_s + shape_length / samples);
+    for (int it = 0; it < 100 && hi - lo > 1e-15 * shape_length; ++it) {
       const double m1 = lo + 0.382 * (hi - lo), m2 = hi - 0.382 * (hi - lo);
       if ((parts.curve->point(m1) - point).norm() < (parts.curve->point(m2) - point).norm())
         hi = m2;
       else
         lo = m1;
     }
-    edge.s0 = 0.5 * (lo + hi);
-    best = (parts.curve->point(edge.s0) - point).norm();
+    const double s_shape = 0.5 * (lo + hi);
+    edge.s0 = s_shape * ell / shape_length;
+    best = (parts.curve->point(s_shape) - point).norm();
     if (!(best <= kPlaceTolerance * ell))
       fail_at(spec, key + ".point",
               fmt::format("{}.point = {} is not on the string: the initial shape passes {:.6g} m from it at the "
@@ -364,7 +369,7 @@ std::unique_ptr<StringModel<dim>> build_front_model(const SceneSpec& spec, scene
                           key, text_of(spec, key + ".point"), edge.s0, s_lo, s_hi));
     // The string must bend over the edge (the jump conditions' [t] ≠ 0), and a table needs a face beside
     // the string on its side: none where the string turns back on itself (a peg).
-    if (const std::optional<double> turn = shape_turn<dim>(*parts.curve, edge.s0, ell)) {
+    if (const std::optional<double> turn = shape_turn<dim>(*parts.curve, s_shape, shape_length)) {
       if (!(*turn > kEdgeTurnTolerance))
         fail_at(spec, key + ".point",
                 fmt::format("{}.point = {}: the shape runs straight through it (it turns by {:.3g} deg at s = {:.6g} "

@@ -387,6 +387,15 @@ t_end = 1.0
   CHECK_THAT(error(edit(two_pegs, "table = \"none\"", "table = \"after\"")),
              Contains("s.toml:15:9: effects.edge[0]: the scene has 2 edges and a table (effects.edge[0].table = \"after\")") &&
                  Contains("allowed table = \"none\""));
+  // A table needs the field to press its side onto it: none, or a field along the table, used to be
+  // accepted (a table holding nothing: the side free to leave it with no event).
+  for (const char* field : {"g = [0.0, 0.0]", "g = [-9.81, 0.0]"})
+    CHECK_THAT(error(edit(scene, "g = [0.0, -9.81]", field)),
+               Contains("s.toml:12:1: effects.edge[0]: the table under the string before the edge has its outward "
+                        "normal [") &&
+                   Contains("the field does not press the string onto it (g·n = 0)") &&
+                   Contains("allowed a table the field presses the string onto (g·n < 0), or table = \"none\""));
+  CHECK_THAT(error(edit(scene, "g = [0.0, -9.81]", "g = [0.0, 9.81]")), Contains("the field pulls the string off it"));
   CHECK_THAT(error(edit(peg, "[stop]", "[solver]\nmethod = \"dirk4\"\n\n[stop]")),
              Contains("s.toml:18:10: solver.method = \"dirk4\" is implicit, and implicit methods do not meet an edge") &&
                  Contains("allowed an explicit method"));

@@ -9,6 +9,7 @@
 #include <string>
 
 #include <catch2/catch.hpp>
+#include <fmt/format.h>
 
 #include "cases/canonical/edge_case.hpp"
 #include "cases/reduced/exact_solutions.hpp"
@@ -171,4 +172,30 @@ TEST_CASE("hard edges: 5 nodes over an edge and over a peg lift off at the exact
       require_finite(c.run);
     }
   }
+}
+
+TEST_CASE("hard edges: a shape a little longer or shorter than the string, its corner on a node, runs over the edge",
+          "[edge][hard]") {
+  // cases/scenes/chain_off_table_edge.toml with its hanging part 0.2 (1 + δ) m long, δ inside
+  // shape.length_tolerance (1e-6): the nodes sit on the shape at equal arc length L/N, so the node nearest
+  // the corner (s = 0.8 m, a node on 41 and 101 nodes) lies up to 0.8 δ m from it along the hanging side.
+  // The edge used to take that node as the end of the table's side and the table's normal from it: a
+  // tilted table, "node 0 ... is 0.799984 m off the table" (exit 2) for δ = 5e-7, 0.126 m for δ = 5e-10.
+  // Now the lift-off is the exact one for the scene's chain (x0 = 0.2 m, ℓ = 1 m) to the shape's own
+  // perturbation: x0 and ℓ change by at most 1e-7 m, t* by less than 1e-6 s.
+  const std::string file = std::string(CHAINSIM_SOURCE_DIR) + "/cases/scenes/chain_off_table_edge.toml";
+  const double t_star = exact::edge_time(0.0, exact::edge_lift_off_x(0.0, 0.2, 1.0, kG), 0.2, 1.0, kG);
+  for (const int nodes : {41, 101})
+    for (const double delta : {5e-7, 5e-10, -5e-10, -5e-7}) {
+      const std::string points = fmt::format("shape.points=[[-0.8, 0.0], [0.0, 0.0], [0.0, {:.17g}]]", -0.2 * (1 + delta));
+      SceneRun<2> run(parse_scene(file, {fmt::format("string.nodes={}", nodes), points, "stop.t_end=0.6"}));
+      REQUIRE_FALSE(run.run().has_value());
+      const RunSummary& summary = run.solver().summary();
+      INFO(nodes << " nodes, delta = " << delta << ": " << summary.status << ": " << summary.stop_reason);
+      REQUIRE(summary.status == "stopped");
+      REQUIRE(summary.events.size() == 1);
+      CHECK(summary.events[0].t == Approx(t_star).margin(1e-6));
+      CHECK_THAT(summary.stop_reason, Contains("lifted off the edge at t = "));
+      require_finite(summary);
+    }
 }
