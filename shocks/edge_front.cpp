@@ -392,9 +392,17 @@ void EdgeFront<dim>::checks(const StringModel<dim>& model, const FrontState<dim>
   // it was laid slack), and then this check is negative: the run stops at once (docs/model.md §9).
   if (slack_) {
     g[0] = -1;
+    if constexpr (dim == 3) g[1] = 1;
     return;
   }
-  g[0] = jump::pinned_lift_off_margin<dim>(recorded_reaction(model, s), t_minus_, t_plus_, axis_);
+  const Vec<dim> reaction = recorded_reaction(model, s);
+  g[0] = jump::pinned_lift_off_margin<dim>(reaction, t_minus_, t_plus_, axis_);
+  if constexpr (dim == 3) g[1] = along_line_margin(reaction);
+}
+
+template <int dim>
+double EdgeFront<dim>::along_line_margin(const Vec<dim>& reaction) const {
+  return kAlongLine * reaction.norm() - std::abs(reaction.dot(axis_));
 }
 
 template <int dim>
@@ -403,16 +411,35 @@ std::string EdgeFront<dim>::check_failed(const StringModel<dim>& model, const Fr
     return fmt::format("lifted off the edge at t = {:.9g} s: the link bent over the edge at {} (link {}) has gone slack, "
                        "so the string no longer presses on the edge (s0 = {:.9g} m)",
                        t, show<dim>(point_), link_, s.s0);
+  const Vec<dim> reaction = recorded_reaction(model, s);
+  if (dim == 3 && along_line(model, s))
+    return fmt::format(
+        "the string crosses the edge at {} obliquely at t = {:.9g} s: held there, it would need a force {:.6g} N along "
+        "the edge's line {} (reaction F0 = {} N; allowed at most {:g} of |F0|), which a smooth edge cannot give: the "
+        "crossing point would slide along the line, which the edge front does not model (docs/model.md §8, \"An edge "
+        "in 3D\"); the string must cross the line at right angles (s0 = {:.9g} m)",
+        show<dim>(point_), t, reaction.dot(axis_), show<dim>(axis_), show<dim>(reaction), kAlongLine, s.s0);
   return fmt::format("lifted off the edge at t = {:.9g} s: the edge at {} would have to pull the string (its reaction "
                      "F0 = {} N leaves the edge's normal cone; tensions {:.6g} N before and {:.6g} N after it, "
                      "material speed {:.6g} m/s, s0 = {:.9g} m)",
-                     t, show<dim>(point_), show<dim>(recorded_reaction(model, s)), tension_minus(model),
-                     tension_plus(model), std::abs(s.s0_dot), s.s0);
+                     t, show<dim>(point_), show<dim>(reaction), tension_minus(model), tension_plus(model),
+                     std::abs(s.s0_dot), s.s0);
+}
+
+template <int dim>
+bool EdgeFront<dim>::along_line(const StringModel<dim>& model, const FrontState<dim>& s) const {
+  // The check that stopped the run: the along-line one whenever it fails or is at its root (within a
+  // thousandth of its scale: both roots can fall in one step), since a reaction with a part along the line
+  // is outside what the held crossing point describes, its lift-off cone included.
+  if (dim != 3 || slack_) return false;
+  const Vec<dim> reaction = recorded_reaction(model, s);
+  return along_line_margin(reaction) <= 1e-3 * kAlongLine * reaction.norm();
 }
 
 template <int dim>
 std::optional<RunEvent> EdgeFront<dim>::check_event(const StringModel<dim>& model, const FrontState<dim>& s,
                                                     double t) const {
+  if (along_line(model, s)) return std::nullopt;  // no physical event: the model's limit (check_failed says)
   RunEvent e;
   e.kind = "lift_off";
   e.t = t;

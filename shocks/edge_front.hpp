@@ -84,8 +84,12 @@ class EdgeFront final : public FrontKind<dim> {
   void crossings(const StringModel<dim>& model, const FrontState<dim>& state, double* g) const override;
   int second_direction() const override { return -1; }
   EventAction cross(StringModel<dim>& model, const FrontState<dim>& state, int e0) override;
-  /// One: the lift-off margin (N), positive while the edge pushes.
-  int num_checks() const override { return 1; }
+  /// The lift-off margin (N), positive while the edge pushes; in 3D also the along-line margin
+  /// kAlongLine |F0| − |F0·d| (N), positive while the held crossing point asks no force of the edge along
+  /// its line (a smooth edge has none: an oblique crossing would slide along it, which is not built).
+  int num_checks() const override { return dim == 3 ? 2 : 1; }
+  /// The largest share of |F0| the reaction may have along a 3D edge's line before the run stops.
+  static constexpr double kAlongLine = 1e-6;
   void checks(const StringModel<dim>& model, const FrontState<dim>& state, double* g) const override;
   std::string check_failed(const StringModel<dim>& model, const FrontState<dim>& state, double t) const override;
   bool checks_need_tensions() const override { return true; }
@@ -103,6 +107,10 @@ class EdgeFront final : public FrontKind<dim> {
   double tension_plus(const StringModel<dim>& model) const { return model.link_tension(link_) + jump_; }
 
  private:
+  /// kAlongLine |F0| − |F0·d| (N) for the reaction F0 (3D).
+  double along_line_margin(const Vec<dim>& reaction) const;
+  /// Whether the along-line check is the one that stops the run at this state (3D).
+  bool along_line(const StringModel<dim>& model, const FrontState<dim>& s) const;
   /// Signed distances (m) from node a to x0 and from x0 to node b, along the directions the string
   /// arrives at a and leaves b (StringModel::bend_side_direction): a node passing x0 changes their sign,
   /// and the sign of its partial length l∓ with them (StringModel::bent_sides).
