@@ -85,6 +85,10 @@ def animate(run, out_path, speed=1.0, fps=25, fmt=None):
     clock = fig.text(0.01, 0.97, "", fontsize=11, family="monospace", va="top")
     fig.suptitle(f"{run.name}" + (f"  ({speed:g} x real time)" if speed != 1 else "  (real time)"), fontsize=10)
     fig.tight_layout(rect=(0, 0, 1, 0.95))
+    # Once more after a draw: the equal aspect shrinks each panel's box, its ticks then change, and the first
+    # layout (made for the taller boxes) can leave a wider tick label's axis label outside the figure.
+    fig.canvas.draw()
+    fig.tight_layout(rect=(0, 0, 1, 0.95))
 
     def draw(j):
         t = min(t_first + j * speed / fps, t_last)
