@@ -7,7 +7,7 @@ where RESULTS_DIR/<scene>/ holds the outputs of
 for shaken_chain, travelling_loop, whip_crack, pendulum_release, folded_chain_ends_apart, swinging_u,
 pendulum_whip and thrown_chain (string scenes; the last three with slack = "allow"), spinning_loop_dropped
 (3D, closed, slack = "allow"), chain_off_table_edge and
-chain_over_peg and chain_over_two_pegs (edges), atwood_pulley and atwood_rough_pulley (cylinders), chain_landing_at_angle (a surface),
+chain_over_peg and chain_over_two_pegs (edges), atwood_pulley and atwood_rough_pulley (cylinders), chain_landing_at_angle and chain_landing_on_table (a surface),
 chain_off_real_table (a table bounded by its edge), chain_into_heap_on_table (a heap on a contact surface), streaming_corner (a kink) and
 falling_chain, folded_chain, sliding_chain, swinging_sliding_chain, tilted_falling_chain and
 curved_falling_chain (scenes with fronts), and RESULTS_DIR/<scene>_reduced/ the same canonical scenes run with
@@ -333,6 +333,34 @@ def chain_landing_at_angle(run, ax):
     decorate(ax[1], "t (s)", "J", "each landing takes the node's normal kinetic energy")
 
 
+def chain_landing_on_table(run, ax):
+    snapshots(ax[0], run, [0, 0.04, 0.08, 0.1, 0.2, 0.3], "level chain dropped 5 cm onto a smooth table at 0.5 m/s")
+    g, h, speed = 9.81, 0.05, 0.5
+    frames = run.nodes
+    mass = np.full(len(frames.positions(0)), 1.0 / (len(frames.positions(0)) - 1))  # 1 kg/m over 1 m, lumped
+    mass[[0, -1]] /= 2
+    total = float(np.sum(mass))
+    v = np.array([mass @ frames.velocities(k) / total for k in range(len(frames))])
+    # The closed form (the scene's header): free fall until every node lands at once, at sqrt(2 h/g); the
+    # perfectly inelastic landing takes the normal kinetic energy M g h and keeps the speed along the table.
+    t_land = math.sqrt(2 * h / g)
+    ts = np.linspace(0, frames.times[-1], 400)
+    e = run.energy
+    ax[1].plot(e["t"], e["W_impacts"], "o-", ms=4, lw=2, alpha=0.7, label="W_impacts (J, string solver; each line at the frames)")
+    ax[1].plot(ts, np.where(ts >= t_land, -total * g * h, 0.0), "k:", lw=1.5,
+               label=f"- M g h = -{total * g * h:.4f} J from t = sqrt(2h/g) = {t_land:.5f} s")
+    ax[1].plot(frames.times, v[:, 0], "s-", ms=3, lw=1.5, alpha=0.7, label="centre of mass v_x (m/s)")
+    ax[1].plot(frames.times, v[:, 1], "^-", ms=3, lw=1.5, alpha=0.7, label="centre of mass v_y (m/s)")
+    ax[1].plot(ts, np.full_like(ts, speed), "--", color="0.3", lw=1.2, label="0.5 m/s: kept along the table")
+    ax[1].plot(ts, np.where(ts < t_land, -g * ts, 0.0), "-.", color="0.3", lw=1.2, label="- g t until the landing, then 0")
+    worst = max(float(np.max(np.abs(np.asarray(e["W_impacts"])[np.asarray(e["t"]) > t_land] + total * g * h))),
+                float(np.max(np.abs(v[:, 0] - speed))))
+    decorate(ax[1], "t (s)", "J, m/s",
+             f"the landing takes M g h and keeps the sliding speed (max error {worst:.1e})", legend=False)
+    ax[1].set_ylim(-1.1, 1.75)  # room above the curves for the legend
+    ax[1].legend(fontsize=7, loc="upper right")
+
+
 def chain_into_heap_on_table(run, ax):
     snapshots(ax[0], run, [0, 0.1, 0.15, 0.2, 0.247], "a V of chain falling into its heap on a table, f = 1")
     g = 9.81
@@ -389,7 +417,8 @@ def spinning_loop_dropped(run, ax):
 SCENES = [shaken_chain, travelling_loop, whip_crack, pendulum_release, falling_chain, folded_chain, sliding_chain,
           swinging_sliding_chain, tilted_falling_chain, curved_falling_chain, folded_chain_ends_apart,
           chain_off_table_edge, swinging_u, pendulum_whip, thrown_chain, chain_over_peg, chain_over_two_pegs,
-          atwood_pulley, atwood_rough_pulley, streaming_corner, chain_landing_at_angle, chain_off_real_table, chain_into_heap_on_table,
+          atwood_pulley, atwood_rough_pulley, streaming_corner, chain_landing_at_angle, chain_landing_on_table,
+          chain_off_real_table, chain_into_heap_on_table,
           spinning_loop_dropped]
 
 

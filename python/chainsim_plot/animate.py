@@ -68,18 +68,26 @@ def animate(run, out_path, speed=1.0, fps=25, fmt=None):
     # An even pixel size (the H.264 encoder needs one): 100 dpi, whole inches.
     fig, axes = plt.subplots(1, len(projections), figsize=(8 * len(projections), 6), dpi=100, squeeze=False)
     axes = axes[0]
-    lines, markers, heaps = [], [], []
+    lines, firsts, markers, heaps = [], [], [], []
     for ax, proj in zip(axes, projections):
         layout.limits(ax, proj)
         space_axes(ax, proj, adjustable="box")
         layout.draw_obstacles(ax, proj, label=False)
         heaps.append([ax.plot([], [], "o", color=HEAP_COLOR, alpha=0.6, mew=0)[0] for _ in layout.heaps(t_first)])
         (line,) = ax.plot([], [], "-", lw=1.6, color="tab:blue")
+        # The first point drawn, a small dot as in the snapshots: it tells the ends apart, and shows the
+        # shorter side of a chain over a peg, which hangs along the longer one.
+        (first,) = ax.plot([], [], "o", ms=4, color="tab:blue", linestyle="none")
+        firsts.append(first)
         (mark,) = ax.plot([], [], "o", ms=6, mfc="none", color=FRONT_COLOR, linestyle="none")
         lines.append(line)
         markers.append(mark)
     clock = fig.text(0.01, 0.97, "", fontsize=11, family="monospace", va="top")
     fig.suptitle(f"{run.name}" + (f"  ({speed:g} x real time)" if speed != 1 else "  (real time)"), fontsize=10)
+    fig.tight_layout(rect=(0, 0, 1, 0.95))
+    # Once more after a draw: the equal aspect shrinks each panel's box, its ticks then change, and the first
+    # layout (made for the taller boxes) can leave a wider tick label's axis label outside the figure.
+    fig.canvas.draw()
     fig.tight_layout(rect=(0, 0, 1, 0.95))
 
     def draw(j):
@@ -91,12 +99,13 @@ def animate(run, out_path, speed=1.0, fps=25, fmt=None):
         for q, proj in enumerate(projections):
             a, b = proj
             lines[q].set_data(pts[:, a], pts[:, b])
+            firsts[q].set_data(pts[:1, a], pts[:1, b])
             markers[q].set_data([p[a] for _, p in fronts], [p[b] for _, p in fronts])
             for artist, (_, p, size) in zip(heaps[q], layout.heaps(tk)):
                 artist.set_data([p[a]], [p[b]])
                 artist.set_markersize(size)
         clock.set_text(f"t = {tk:8.4f} s")
-        return lines + markers
+        return lines + firsts + markers
 
     if fmt == "html":
         # Every frame embedded (no limit: the writer would drop the frames beyond animation.embed_limit).

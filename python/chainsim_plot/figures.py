@@ -23,6 +23,9 @@ from .readers import RunError  # noqa: E402
 DPI = 110
 HEAP_COLOR = "tab:brown"
 FRONT_COLOR = "tab:red"
+# An edge whose two arms leave its point within 20 degrees of each other (the string turns back on itself, by
+# 180 degrees over a peg) is drawn as a peg, a disc inside the bend: a wedge between the arms would be a sliver.
+PEG_COS = np.cos(np.radians(20.0))
 
 
 # --- helpers --------------------------------------------------------------------------------------
@@ -197,18 +200,21 @@ class Layout:
         """The obstacles (draw_obstacles): the old name, kept."""
         self.draw_obstacles(ax, proj, extra, label)
 
-    def draw_obstacles(self, ax, proj, extra=0.0, label=True):
+    def draw_obstacles(self, ax, proj, extra=0.0, label=True, shifts=None):
         """The obstacles, drawn once and the same in the snapshots and the animation: the plane (table)
         under each heap on a plane, as its trace on the projection `proj` (only where the projection sees
         it edge-on), and each edge (edge_geometry): a grey wedge at its point between the two arms' initial
-        directions (the obstacle lies inside the bend) and, with `table = "before"|"after"`, the table's
+        directions (the obstacle lies inside the bend; a peg, where the arms turn back on each other, a grey
+        disc inside the bend touching the point) and, with `table = "before"|"after"`, the table's
         face as a thick grey line from the point along that side's initial direction (in 3D only on a
         projection that sees the table edge-on). `extra`: how much
-        further right they must reach (staggered snapshots)."""
+        further right they must reach (staggered snapshots); `shifts`: the staggered snapshots' offsets to the
+        right, each drawn over its own copy of the edges (a chain over a peg)."""
         self._draw_contact_obstacles(ax, proj, extra, label)
         for f in self.run.fronts:
             if f.kind == "edge":
-                self._draw_edge(ax, f, proj, extra, label)
+                for q, shift in enumerate(shifts if shifts else [0.0]):
+                    self._draw_edge(ax, f, proj, extra, label and q == 0, shift)
                 continue
             if f.kind != "heap" or not f.on_plane or f.plane_normal is None or f.point is None:
                 continue
@@ -295,15 +301,25 @@ class Layout:
             return (x[j] - p) / dist[j]
         return p, side(s < s0), side(s > s0)
 
-    def _draw_edge(self, ax, f, proj, extra, label):
+    def _draw_edge(self, ax, f, proj, extra, label, shift=0.0):
+        """Edge f on the projection `proj`, `shift` to the right (a staggered snapshot's copy: without its
+        table, which the unshifted copy draws)."""
         if f.point is None:
             return
         a, b = proj
         p, before, after = self.edge_geometry(f)
-        p2 = p[[a, b]]
+        p2 = p[[a, b]] + np.array([shift, 0.0])
         r = 0.07 * self.size
         arms = [d[[a, b]] for d in (before, after) if d is not None and np.linalg.norm(d[[a, b]]) > 1e-9]
-        if len(arms) == 2:
+        units = [d / np.linalg.norm(d) for d in arms]
+        if len(arms) == 2 and np.dot(units[0], units[1]) > PEG_COS:
+            # A peg: the string turns back on itself (by 180 degrees, or as the projection sees it), so the
+            # wedge between its arms would have no area. A grey disc inside the bend, touching the point.
+            from matplotlib.patches import Circle
+            inside = (units[0] + units[1]) / np.linalg.norm(units[0] + units[1])
+            ax.add_patch(Circle(p2 + 0.5 * r * inside, 0.5 * r, facecolor="0.45", alpha=0.6, lw=0, zorder=0,
+                                gid=f"obstacle {f.name}", label=f"peg ({f.name})" if label else None))
+        elif len(arms) == 2:
             wedge = np.array([p2, p2 + r * arms[0], p2 + r * arms[1]])
             ax.fill(wedge[:, 0], wedge[:, 1], color="0.45", alpha=0.6, lw=0, gid=f"obstacle {f.name}",
                     label=f"edge ({f.name})" if label else None)
@@ -311,7 +327,7 @@ class Layout:
             ax.plot([p2[0]], [p2[1]], "^", ms=9, color="0.45", alpha=0.6, mew=0, gid=f"obstacle {f.name}",
                     label=f"edge ({f.name})" if label else None)
         side = {"before": before, "after": after}.get(f.info.get("table"))
-        if side is None:
+        if side is None or shift:
             return
         if self.dim == 3 and "direction" in f.info:  # the table's plane holds the edge and that side
             n = np.cross(side, np.asarray(f.info["direction"], dtype=float))
@@ -374,7 +390,7 @@ def draw_snapshots(axes, run, picks, layout=None):
     shifts = [q * layout.stagger for q in range(len(picks))]
     for ax, proj in zip(axes, layout.projections):
         a, b = proj
-        layout.draw_obstacles(ax, proj, extra=shifts[-1])
+        layout.draw_obstacles(ax, proj, extra=shifts[-1], shifts=shifts if layout.stagger else None)
         for q, k in enumerate(picks):
             pts = layout.curve(k)
             ax.plot(pts[:, a] + shifts[q], pts[:, b], "-", lw=1.3, color=colors[q],
@@ -411,7 +427,7 @@ def snapshots_figure(run, out_dir, wanted=None):
     if any(f.kind == "heap" for f in run.fronts):
         notes.append("brown discs: the heaps (area grows with their mass)")
     if any(f.kind == "edge" for f in run.fronts):
-        notes.append("grey wedge: the edge, inside the bend; thick grey line: the table")
+        notes.append("grey wedge: the edge, inside the bend (a grey disc: a peg); thick grey line: the table")
     title = f"{run.name}: the string at {len(picks)} times\n" + textwrap.fill("; ".join(notes), 70 * n)
     fig.suptitle(title, fontsize=9)
     fig.tight_layout()

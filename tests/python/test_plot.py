@@ -88,6 +88,8 @@ def run_dir(kind):
             r"\[\[-0.8, 0.0\], \[0.0, 0.0\], \[0.0, -0.2\]\]": "[[-0.8, 0.0, 0.0], [0.0, 0.0, 0.0], [0.0, -0.2, 0.0]]",
             r"g = \[0.0, -9.81\]": "g = [0.0, -9.81, 0.0]",
             r"(?m)^point = \[0.0, 0.0\]": "point = [0.0, 0.0, 0.0]\ndirection = [0.0, 0.0, 1.0]"}), "--out", out]
+    elif kind == "peg":  # 1 m over a peg at the origin, 0.4 m down one side and 0.6 m the other
+        args = ["run", scene("chain_over_peg", 21, {r"(?m)^t_end = .*": "t_end = 0.1"}), "--out", out]
     elif kind == "pulley":
         args = ["run", scene("atwood_pulley", 21, {r"(?m)^t_end = .*": "t_end = 0.1"}), "--out", out]
     elif kind == "landing":
@@ -586,6 +588,33 @@ def test_reader_3d_edge_drawn_where_the_projection_sees_it():
     r = np.linalg.norm(wedge[1])
     assert np.allclose(wedge, [[0, 0], [-r, 0], [0, -r]], atol=1e-9)
     assert np.allclose(np.ravel(xz["obstacle edge0"].get_data()), 0, atol=1e-12)
+    plt.close(fig)
+
+
+def test_reader_peg_drawn_as_a_disc_inside_the_bend():
+    """The chain over a peg (cases/scenes/chain_over_peg.toml: both sides hang straight down from the origin,
+    a 180 degree turn) would have a wedge of no area between its arms: the peg is a disc below the point,
+    touching it, in the snapshots and in the animation's frames; staggered snapshots draw one over each copy,
+    at the same offsets as the string's (where the front markers are)."""
+    import matplotlib.pyplot as plt
+    from chainsim_plot.figures import Layout, choose_times, draw_snapshots
+    from chainsim_plot.readers import load_run
+    for fig in drawn_figures(run_dir("peg")):
+        assert sorted(obstacle_artists(fig)) == ["obstacle edge0"]
+        discs = sorted((p for p in fig.axes[0].patches if p.get_gid() == "obstacle edge0"), key=lambda d: d.center[0])
+        r = discs[0].radius
+        assert r > 0 and np.allclose(discs[0].center, [0, -r], atol=1e-9 * r)
+        assert all(d.radius == r and abs(d.center[1] + r) < 1e-9 * r for d in discs)
+        plt.close(fig)
+    run = load_run(run_dir("peg"))
+    layout = Layout(run)
+    assert layout.stagger > 0
+    fig, ax = plt.subplots()
+    picks = choose_times(run.nodes.times, count=3)
+    draw_snapshots([ax], run, picks, layout)
+    discs = [p for p in ax.patches if p.get_gid() == "obstacle edge0"]
+    assert len(discs) == len(picks)
+    assert np.allclose(sorted(d.center[0] for d in discs), [q * layout.stagger for q in range(len(picks))])
     plt.close(fig)
 
 
