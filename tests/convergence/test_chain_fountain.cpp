@@ -16,8 +16,10 @@
 #include "cases/scene/front_scene.hpp"
 #include "cases/scene/scene.hpp"
 #include "solver/string_solver.hpp"
+#include "tests/convergence/observed_order.hpp"
 
 using namespace chainsim;
+using chainsim::test::fitted_order;
 
 namespace {
 
@@ -135,17 +137,6 @@ std::vector<std::string> laid_on(const Steady& shape, double content, double spe
           fmt::format("effects.heap[1].point=[{:.17g}, -0.5]", px), fmt::format("velocity.speed={:.17g}", speed)};
 }
 
-/// The order fitted by least squares to errors on meshes halved one after the other.
-double fitted_order(const std::vector<double>& errors) {
-  const double n = static_cast<double>(errors.size()), mean_k = (n - 1) / 2;
-  double mean_e = 0, cov = 0, var = 0;
-  for (double e : errors) mean_e += std::log(e) / n;
-  for (std::size_t k = 0; k < errors.size(); ++k) {
-    cov += (k - mean_k) * (std::log(errors[k]) - mean_e);
-    var += (k - mean_k) * (k - mean_k);
-  }
-  return -cov / var / std::log(2.0);
-}
 
 TEST_CASE("the steady chain fountain: speed, rise and shape converge to the closed form", "[fountain]") {
   // Four meshes (h = 4, 2, 1, 0.5 cm; 24 to 196 nodes in the air), 0.4 s each: the chain in the air is replaced

@@ -28,6 +28,7 @@
 #include "solver/contact_module.hpp"
 #include "solver/string_solver.hpp"
 #include "tests/convergence/contact_test_support.hpp"
+#include "tests/convergence/observed_order.hpp"
 
 using namespace chainsim;
 using chainsim::test::contact_options;
@@ -393,6 +394,34 @@ TEST_CASE("contact: compare pulley, the heavy Atwood chain released at rest, aga
     CHECK(std::abs(runs[k]["mean_err_tension_long"].get<double>()) < 3e-7);
     CHECK(runs[k]["max_abs_err_x"].get<double>() < 1e-7);  // measured 5.4e-8, 1.2e-8, 1.3e-8 m (51: 2.6e-6)
   }
+}
+
+TEST_CASE("contact: compare pulley at rtol 1e-12 converges at second order in the lift-off time on four meshes",
+          "[contact][pulley]") {
+  // At the default rtol 1e-9 the lift-off error floors at about 1e-7 s from 101 nodes (the test above),
+  // so its order shows on one pair of meshes only. At rtol 1e-12 (atol 1e-14) the floor is below the
+  // finest mesh's error: measured 5.77e-6, -1.53e-6, 3.01e-7, 3.40e-8 s on 31, 61, 121, 241 nodes (local
+  // orders 1.9, 2.3, 3.1; 7.8e-9 s on 481), a least-squares order of 2.46; x at the lift-off (interpolated
+  // between the steps as t is) 6.5e-7, 2.5e-7, 7.1e-8, 1.8e-8 m, order 1.74.
+  PulleyCaseSetup setup;
+  setup.integrator.rtol = 1e-12;
+  setup.integrator.atol = 1e-14;
+  std::vector<double> errors, x_errors;
+  for (int nodes : {31, 61, 121, 241}) {
+    setup.nodes = nodes;
+    const nlohmann::json s = compare_pulley_with_exact(setup).summary;
+    REQUIRE(s["status"] == "completed");
+    REQUIRE(s["t_lift_off"].is_number());
+    errors.push_back(s["abs_err_t_lift_off"].get<double>());
+    x_errors.push_back(s["abs_err_x_lift_off"].get<double>());
+    std::printf("  compare pulley, rtol 1e-12, %4d nodes: lift-off error %.3g s, x error %.3g m\n", nodes,
+                errors.back(), x_errors.back());
+  }
+  const double order = test::fitted_order(errors), x_order = test::fitted_order(x_errors);
+  std::printf("  least-squares orders: lift-off time %.2f, x at the lift-off %.2f\n", order, x_order);
+  CHECK(order > 1.8);
+  CHECK(x_order > 1.5);
+  CHECK(errors.back() < 1e-7);
 }
 
 TEST_CASE("contact: links along the arc carry a chain running round a pulley at constant speed exactly",
