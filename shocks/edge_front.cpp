@@ -397,12 +397,14 @@ void EdgeFront<dim>::checks(const StringModel<dim>& model, const FrontState<dim>
   }
   const Vec<dim> reaction = recorded_reaction(model, s);
   g[0] = jump::pinned_lift_off_margin<dim>(reaction, t_minus_, t_plus_, axis_);
-  if constexpr (dim == 3) g[1] = along_line_margin(reaction);
+  if constexpr (dim == 3) g[1] = along_line_margin(model, s, reaction);
 }
 
 template <int dim>
-double EdgeFront<dim>::along_line_margin(const Vec<dim>& reaction) const {
-  return kAlongLine * reaction.norm() - std::abs(reaction.dot(axis_));
+double EdgeFront<dim>::along_line_margin(const StringModel<dim>& model, const FrontState<dim>& s,
+                                         const Vec<dim>& reaction) const {
+  const double scale = std::abs(tension_minus(model)) + std::abs(tension_plus(model)) + this->m_.lambda * s.s0_dot * s.s0_dot;
+  return kAlongLine * scale - std::abs(reaction.dot(axis_));
 }
 
 template <int dim>
@@ -415,7 +417,7 @@ std::string EdgeFront<dim>::check_failed(const StringModel<dim>& model, const Fr
   if (dim == 3 && along_line(model, s))
     return fmt::format(
         "the string crosses the edge at {} obliquely at t = {:.9g} s: held there, it would need a force {:.6g} N along "
-        "the edge's line {} (reaction F0 = {} N; allowed at most {:g} of |F0|), which a smooth edge cannot give: the "
+        "the edge's line {} (reaction F0 = {} N; allowed at most {:g} of τ⁻ + τ⁺ + λ ṡ0²), which a smooth edge cannot give: the "
         "crossing point would slide along the line, which the edge front does not model (docs/model.md §8, \"An edge "
         "in 3D\"); the string must cross the line at right angles (s0 = {:.9g} m)",
         show<dim>(point_), t, reaction.dot(axis_), show<dim>(axis_), show<dim>(reaction), kAlongLine, s.s0);
@@ -428,12 +430,14 @@ std::string EdgeFront<dim>::check_failed(const StringModel<dim>& model, const Fr
 
 template <int dim>
 bool EdgeFront<dim>::along_line(const StringModel<dim>& model, const FrontState<dim>& s) const {
-  // The check that stopped the run: the along-line one whenever it fails or is at its root (within a
-  // thousandth of its scale: both roots can fall in one step), since a reaction with a part along the line
-  // is outside what the held crossing point describes, its lift-off cone included.
+  // The check that stopped the run: the along-line one where it is at or past its root (within a
+  // thousandth of its scale: both roots can fall in one step) and the lift-off margin is not.
   if (dim != 3 || slack_) return false;
   const Vec<dim> reaction = recorded_reaction(model, s);
-  return along_line_margin(reaction) <= 1e-3 * kAlongLine * reaction.norm();
+  const double along = along_line_margin(model, s, reaction);
+  const double scale = std::abs(tension_minus(model)) + std::abs(tension_plus(model)) + this->m_.lambda * s.s0_dot * s.s0_dot;
+  return along <= 1e-3 * kAlongLine * scale &&
+         jump::pinned_lift_off_margin<dim>(reaction, t_minus_, t_plus_, axis_) > 0;
 }
 
 template <int dim>

@@ -85,11 +85,14 @@ class EdgeFront final : public FrontKind<dim> {
   int second_direction() const override { return -1; }
   EventAction cross(StringModel<dim>& model, const FrontState<dim>& state, int e0) override;
   /// The lift-off margin (N), positive while the edge pushes; in 3D also the along-line margin
-  /// kAlongLine |F0| − |F0·d| (N), positive while the held crossing point asks no force of the edge along
-  /// its line (a smooth edge has none: an oblique crossing would slide along it, which is not built).
+  /// kAlongLine (τ⁻ + τ⁺ + λ ṡ0²) − |F0·d| (N), positive while the held crossing point asks no force of the
+  /// edge along its line (a smooth edge has none: an oblique crossing would slide along it, not built).
   int num_checks() const override { return dim == 3 ? 2 : 1; }
-  /// The largest share of |F0| the reaction may have along a 3D edge's line before the run stops.
-  static constexpr double kAlongLine = 1e-6;
+  /// The largest force along a 3D edge's line, per the forces the jump conditions balance there
+  /// (τ⁻ + τ⁺ + λ ṡ0²: not |F0|, which falls to zero at a lift-off), before the run stops. Far above the
+  /// round-off of F0·d on a line at right angles to the string (measured up to 2.5e-7 of |F0|, the partial
+  /// links' directions 1e-8 links long carrying the coordinates' round-off); a 45° crossing is at 0.35.
+  static constexpr double kAlongLine = 1e-3;
   void checks(const StringModel<dim>& model, const FrontState<dim>& state, double* g) const override;
   std::string check_failed(const StringModel<dim>& model, const FrontState<dim>& state, double t) const override;
   bool checks_need_tensions() const override { return true; }
@@ -107,8 +110,8 @@ class EdgeFront final : public FrontKind<dim> {
   double tension_plus(const StringModel<dim>& model) const { return model.link_tension(link_) + jump_; }
 
  private:
-  /// kAlongLine |F0| − |F0·d| (N) for the reaction F0 (3D).
-  double along_line_margin(const Vec<dim>& reaction) const;
+  /// kAlongLine (τ⁻ + τ⁺ + λ ṡ0²) − |F0·d| (N) for the reaction F0 (3D).
+  double along_line_margin(const StringModel<dim>& model, const FrontState<dim>& s, const Vec<dim>& reaction) const;
   /// Whether the along-line check is the one that stops the run at this state (3D).
   bool along_line(const StringModel<dim>& model, const FrontState<dim>& s) const;
   /// Signed distances (m) from node a to x0 and from x0 to node b, along the directions the string
