@@ -79,9 +79,15 @@ void EdgeFront<dim>::initialize(StringModel<dim>& model) {
   // back from the edge by 2 kCross h along its tangent there, the side after c towards it, each
   // rigidly (every link keeps its length; the bent link is (c, c + 1)).
   const double l_minus = this->expected_s0 - model.chain().node_coordinate(link_);
-  const double nudge = 2 * kCross * h;
-  const int c = l_minus < nudge ? link_ : h - l_minus < nudge ? link_ + 1 : -1;
+  const int c = l_minus < 2 * kCross * h ? link_ : h - l_minus < 2 * kCross * h ? link_ + 1 : -1;
   if (c >= 0) {
+    // Node c may sit off the point by about as much as its material offset (a shape whose length differs
+    // from the string's within shape.length_tolerance holds its nodes L/N apart in arc length, so the
+    // node at a corner can lie just past it, on the other side). The nudge grows by twice that offset:
+    // node c is put exactly at the nudge's place on its side's line below, which changes its links'
+    // lengths by up to the offset, and the start's projection may move it back by as much; it must
+    // still be more than kCross h from the point, or the crossing's root would start negative.
+    const double nudge = 2 * kCross * h + 2 * (x.col(c) - point_).norm();
     if (c == 0 || c + 1 >= this->m_.n)
       throw InputError("the edge point is on an end node of the string: an edge needs string on both sides");
     // A held node (a fixed or driven end) cannot be moved: its support or path starts where it is.
@@ -95,12 +101,9 @@ void EdgeFront<dim>::initialize(StringModel<dim>& model) {
     const Vec<dim> tm = unit_vector<dim>(point_ - x.col(c - 1), "the string before the edge");
     const Vec<dim> tp = unit_vector<dim>(x.col(c + 1) - point_, "the string after the edge");
     shift_sides(model, 0, c, c + 1, this->m_.n - 1, -nudge, tm, tp);
-    // Node c may have sat off the point by about as much as its material offset (a shape whose length
-    // differs from the string's within shape.length_tolerance holds its nodes L/N apart in arc length, so
-    // the node at a corner can lie just past it, on the other side): it goes exactly to the nudge's
-    // place on its side's line. Left where the shift put it, the bent link's direction, the table's
-    // normal and the lift-off cone would tilt by that offset over the nudge (a table 9° off for an
-    // offset of 8e-11 m). Its links change length by that offset, which the shape's own tolerance allows.
+    // Node c goes exactly to the nudge's place on its side's line: left where the shift put it (off by
+    // its offset), the bent link's direction, the table's normal and the lift-off cone would tilt by the
+    // offset over the nudge (a table 9° off for an offset of 8e-11 m on 2e-10 m).
     Points<dim>& moved = model.x();
     moved.col(c) = point_ - nudge * tm;
     for (int i = 0; i < this->m_.n; ++i) model.move_initial_node(i, Vec<dim>(x.col(i)));

@@ -176,28 +176,52 @@ TEST_CASE("hard edges: 5 nodes over an edge and over a peg lift off at the exact
 
 TEST_CASE("hard edges: a shape a little longer or shorter than the string, its corner on a node, runs over the edge",
           "[edge][hard]") {
-  // cases/scenes/chain_off_table_edge.toml with its hanging part 0.2 (1 + δ) m long, δ inside
+  // cases/scenes/chain_off_table_edge.toml with one of its parts (1 + δ) times as long, δ inside
   // shape.length_tolerance (1e-6): the nodes sit on the shape at equal arc length L/N, so the node nearest
-  // the corner (s = 0.8 m, a node on 41 and 101 nodes) lies up to 0.8 δ m from it along the hanging side.
-  // The edge used to take that node as the end of the table's side and the table's normal from it: a
-  // tilted table, "node 0 ... is 0.799984 m off the table" (exit 2) for δ = 5e-7, 0.126 m for δ = 5e-10.
-  // Now the lift-off is the exact one for the scene's chain (x0 = 0.2 m, ℓ = 1 m) to the shape's own
-  // perturbation: x0 and ℓ change by at most 1e-7 m, t* by less than 1e-6 s.
-  const std::string file = std::string(CHAINSIM_SOURCE_DIR) + "/cases/scenes/chain_off_table_edge.toml";
-  const double t_star = exact::edge_time(0.0, exact::edge_lift_off_x(0.0, 0.2, 1.0, kG), 0.2, 1.0, kG);
+  // the corner (s = 0.8 m, a node on 41 and 101 nodes) lies up to 0.8 δ' m from it (δ' = δ L_part / L),
+  // on either side. The edge used to take that node as the end of the table's side and the table's
+  // normal from it: a tilted table, "node 0 ... is 0.799984 m off the table" (exit 2) for δ = 5e-7 on
+  // the hanging part, 0.126 m for 5e-10; then, with the node put on the nudge's place, a node 1-2e-8 links
+  // past the corner (δ = 7.5e-10 on the hanging part, -5e-10 on the table's) started with its crossing's
+  // root negative and stalled at 0.0032 s ("a node of link 80 has passed the edge"). Now the lift-off is
+  // the exact one for the scene's chain (x0 = 0.2 m, ℓ = 1 m) to the shape's own perturbation (x0 and ℓ
+  // change by at most 1e-7 m, t* by less than 1e-6 s); the same for a peg (chain_over_peg.toml, lift-off
+  // against exact::peg_*).
+  const std::string edge_file = std::string(CHAINSIM_SOURCE_DIR) + "/cases/scenes/chain_off_table_edge.toml";
+  const double t_edge = exact::edge_time(0.0, exact::edge_lift_off_x(0.0, 0.2, 1.0, kG), 0.2, 1.0, kG);
+  auto lifts_off_at = [](const std::string& file, const std::vector<std::string>& overrides, double t_star) {
+    SceneRun<2> run(parse_scene(file, overrides));
+    REQUIRE_FALSE(run.run().has_value());
+    const RunSummary& summary = run.solver().summary();
+    INFO(overrides[0] << ", " << overrides[1] << ": " << summary.status << ": " << summary.stop_reason);
+    REQUIRE(summary.status == "stopped");
+    REQUIRE(summary.events.size() == 1);
+    CHECK(summary.events[0].t == Approx(t_star).margin(1e-6));
+    CHECK_THAT(summary.stop_reason, Contains("lifted off the edge at t = "));
+    require_finite(summary);
+  };
+  for (const int nodes : {41, 101}) {
+    const std::string mesh = fmt::format("string.nodes={}", nodes);
+    for (const double delta : {5e-7, 7.5e-10, 5e-10, -5e-10, -5e-7})
+      lifts_off_at(edge_file,
+                   {mesh, fmt::format("shape.points=[[-0.8, 0.0], [0.0, 0.0], [0.0, {:.17g}]]", -0.2 * (1 + delta)),
+                    "stop.t_end=0.6"},
+                   t_edge);
+    for (const double delta : {5e-7, -5e-10, -2e-9})
+      lifts_off_at(edge_file,
+                   {mesh, fmt::format("shape.points=[[{:.17g}, 0.0], [0.0, 0.0], [0.0, -0.2]]", -0.8 * (1 + delta)),
+                    "stop.t_end=0.6"},
+                   t_edge);
+  }
+  // The peg: 0.4 m on one side and 0.6 m on the other, f = 0.5 (its scene), on 41 and 101 nodes.
+  const std::string peg_file = std::string(CHAINSIM_SOURCE_DIR) + "/cases/scenes/chain_over_peg.toml";
+  const double t_peg = exact::peg_time(0.5, exact::peg_lift_off_x(0.5, 0.6, 1.0, kG), 0.6, 1.0, kG);
   for (const int nodes : {41, 101})
-    for (const double delta : {5e-7, 5e-10, -5e-10, -5e-7}) {
-      const std::string points = fmt::format("shape.points=[[-0.8, 0.0], [0.0, 0.0], [0.0, {:.17g}]]", -0.2 * (1 + delta));
-      SceneRun<2> run(parse_scene(file, {fmt::format("string.nodes={}", nodes), points, "stop.t_end=0.6"}));
-      REQUIRE_FALSE(run.run().has_value());
-      const RunSummary& summary = run.solver().summary();
-      INFO(nodes << " nodes, delta = " << delta << ": " << summary.status << ": " << summary.stop_reason);
-      REQUIRE(summary.status == "stopped");
-      REQUIRE(summary.events.size() == 1);
-      CHECK(summary.events[0].t == Approx(t_star).margin(1e-6));
-      CHECK_THAT(summary.stop_reason, Contains("lifted off the edge at t = "));
-      require_finite(summary);
-    }
+    for (const double delta : {5e-7, 5e-10, -5e-10, -5e-7})
+      lifts_off_at(peg_file,
+                   {fmt::format("string.nodes={}", nodes),
+                    fmt::format("shape.points=[[0.0, -0.4], [0.0, 0.0], [0.0, {:.17g}]]", -0.6 * (1 + delta))},
+                   t_peg);
 }
 
 TEST_CASE("hard edges: a 3D string that meets the edge's line obliquely stops, located, with the force along the line",
