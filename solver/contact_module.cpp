@@ -991,7 +991,7 @@ class ContactModule final : public WrappingModule<dim> {
       if (k < 0) continue;
       const int held = a_on ? chain.link_start(j) : b_on ? chain.link_end(j) : -1;
       if (held >= 0) {
-        lift_off(model, t, held, {{"link", static_cast<double>(j)}});
+        lift_off(model, t, held, {}, j);
         release_on_arc(model, held, j);
         held_[static_cast<std::size_t>(held)] = -1;
         offset_[static_cast<std::size_t>(held)] = kReleaseGap;
@@ -1181,8 +1181,10 @@ class ContactModule final : public WrappingModule<dim> {
   }
   /// Node i, held, is let go at t: counted (lift_offs_, per obstacle), and listed in the summary's `events`
   /// while its obstacle has had fewer than kListedLiftOffs: at its position, with its index, its material
-  /// coordinate s and `values` (the release's cause: the force N that pulls, or the link whose arc ran out).
-  void lift_off(const StringModel<dim>& model, double t, int i, std::vector<std::pair<std::string, double>> values) {
+  /// coordinate s and the release's cause: `values` (the force N that no longer pushes) or `link` (≥ 0: the
+  /// link whose arc ran out).
+  void lift_off(const StringModel<dim>& model, double t, int i, std::vector<std::pair<std::string, double>> values,
+                int link) {
     const std::size_t k = static_cast<std::size_t>(held_[static_cast<std::size_t>(i)]);
     ++lift_offs_;
     if (++lift_off_totals_[k] > kListedLiftOffs) return;
@@ -1191,7 +1193,9 @@ class ContactModule final : public WrappingModule<dim> {
     e.t = t;
     const Vec<dim> x = model.x().col(i);
     e.position.assign(x.data(), x.data() + dim);
-    e.values = {{"node", static_cast<double>(i)}, {"s", model.chain().node_coordinate(i)}};
+    e.indices = {{"node", i}};
+    if (link >= 0) e.indices.emplace_back("link", link);
+    e.values = {{"s", model.chain().node_coordinate(i)}};
     e.values.insert(e.values.end(), values.begin(), values.end());
     e.obstacle = obstacles_[k].name;
     events_.push_back(std::move(e));
@@ -1226,7 +1230,7 @@ class ContactModule final : public WrappingModule<dim> {
         }
       }
       if (worst < 0) break;
-      lift_off(model, t, worst, {{"N", worst_force * model.masses()[worst] * a}});
+      lift_off(model, t, worst, {{"N", worst_force * model.masses()[worst] * a}}, -1);
       if (arc_) release_on_arc(model, worst, -1);
       held_[static_cast<std::size_t>(worst)] = -1;
       offset_[static_cast<std::size_t>(worst)] = kReleaseGap;

@@ -56,7 +56,7 @@ struct FrontRecord {
 };
 
 /// A physical event a module located during the run (the summary's `events`): its kind ("lift_off"),
-/// time (s), front, position (m, dim components) and further named values. An obstacle's event (a node
+/// time (s), front, position (m, dim components), further named values and named indices. An obstacle's event (a node
 /// the contact module let go, solver/contact_module.hpp) names its obstacle instead of a front
 /// (`front` −1, `obstacle` e.g. "effects.cylinder[0]"); a front's event has no obstacle ("").
 struct RunEvent {
@@ -65,7 +65,9 @@ struct RunEvent {
   int front = -1;
   std::vector<double> position;
   std::vector<std::pair<std::string, double>> values;
-  std::string obstacle{};  // a default member initializer: the fronts' aggregate initializers stay complete
+  // Default member initializers: the fronts' aggregate initializers stay complete.
+  std::string obstacle{};
+  std::vector<std::pair<std::string, long>> indices{};  ///< named integers (a node's, a link's index)
 };
 
 /// How many lift-offs an obstacle had in the run, all of them, listed in `events` or not (the contact

@@ -151,6 +151,7 @@ nlohmann::json to_json(const RunSummary& s) {
       event["obstacle"] = e.obstacle;
     }
     for (const auto& [name, value] : e.values) event[name] = value;
+    for (const auto& [name, index] : e.indices) event[name] = index;
     j["events"].push_back(std::move(event));
   }
   if (!s.lift_off_totals.empty()) {
