@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <iterator>
 #include <tuple>
 
 #include <Eigen/Geometry>
@@ -46,6 +47,10 @@ constexpr double kWrapEnter = 3 * kWrapLand;
 /// A sliding node whose tangential speed is within kStopWindow of the speed scale √(a ℓ) at a located
 /// stop has stopped (the state recomputed to the event is within the integration error of the root).
 constexpr double kStopWindow = 1e-5;
+/// The summary's `events` lists the first kListedLiftOffs lift-offs of each obstacle; the rest are counted
+/// (`contact_lift_offs`, LiftOffTotal). A pulley in node contact lets a node go at every link that leaves it,
+/// thousands in a long run (docs/scenes.md, the summary's `events`).
+constexpr long kListedLiftOffs = 100;
 
 /// A closed interval (empty when lo > hi) and a half-plane a x + b y ≤ c: the friction cone of a stuck
 /// node in 2D in the tensions x, y of its two links.
@@ -254,6 +259,7 @@ class ContactModule final : public WrappingModule<dim> {
     stuck_.assign(static_cast<std::size_t>(n), 0);
     dir_.setZero(dim - 1, n);
     length_ = chain.length();
+    lift_off_totals_.assign(obstacles_.size(), 0);
     for (int i = 0; i < n; ++i) {
       if (!free_node(model, i)) continue;
       const auto [k, gap] = nearest(i, model.x().col(i));
@@ -470,6 +476,22 @@ class ContactModule final : public WrappingModule<dim> {
     return {EventAction::Kind::kTransfer, ""};  // the velocities or the held set changed: the integrator restarts
   }
   bool release_contacts(StringModel<dim>& model, double t) override { return settle(model, t, false); }
+  /// The inner module's events (a front's) and the listed lift-offs, merged in time order (the inner
+  /// module's first at equal times).
+  std::vector<RunEvent> run_events() const override {
+    std::vector<RunEvent> inner = inner_ ? inner_->run_events() : std::vector<RunEvent>{};
+    std::vector<RunEvent> all;
+    all.reserve(inner.size() + events_.size());
+    std::merge(inner.begin(), inner.end(), events_.begin(), events_.end(), std::back_inserter(all),
+               [](const RunEvent& a, const RunEvent& b) { return a.t < b.t; });
+    return all;
+  }
+  std::vector<LiftOffTotal> lift_off_totals() const override {
+    std::vector<LiftOffTotal> totals;
+    for (std::size_t k = 0; k < obstacles_.size(); ++k)
+      totals.push_back({obstacles_[k].name, k < lift_off_totals_.size() ? lift_off_totals_[k] : 0});
+    return totals;
+  }
   /// The inner module's drawing (an edge's), then each obstacle sized to the string's initial nodes
   /// plus a tenth of its length.
   ObstacleDrawing obstacles() const override {
@@ -487,6 +509,8 @@ class ContactModule final : public WrappingModule<dim> {
   std::vector<double> let_go_at_;  // per node: when settle() last let it go (s; −∞: never)
   double h_ = 1;
   long impacts_ = 0, lift_offs_ = 0;
+  std::vector<long> lift_off_totals_;  // per obstacle: its lift-offs so far (lift_offs_ is their sum)
+  std::vector<RunEvent> events_;       // the lift-offs listed (at most kListedLiftOffs per obstacle), in time order
   // Friction: whether an obstacle has μ > 0; per node, whether it sticks, and the direction it slides
   // in (its coordinates in the obstacle's tangents(); zero: not yet classified, or no friction).
   static constexpr int kFriction = 2 + dim;  // W_friction's place in the module's own ledger (after the inner's)
@@ -967,11 +991,11 @@ class ContactModule final : public WrappingModule<dim> {
       if (k < 0) continue;
       const int held = a_on ? chain.link_start(j) : b_on ? chain.link_end(j) : -1;
       if (held >= 0) {
+        lift_off(model, t, held, {}, j);
         release_on_arc(model, held, j);
         held_[static_cast<std::size_t>(held)] = -1;
         offset_[static_cast<std::size_t>(held)] = kReleaseGap;
         let_go_at_[static_cast<std::size_t>(held)] = t;
-        ++lift_offs_;
       } else {
         wrap_[static_cast<std::size_t>(j)] = -1;
       }
@@ -1155,6 +1179,27 @@ class ContactModule final : public WrappingModule<dim> {
         if (o.may_hold(static_cast<int>(i))) c[i] = 1;
     return c;
   }
+  /// Node i, held, is let go at t: counted (lift_offs_, per obstacle), and listed in the summary's `events`
+  /// while its obstacle has had fewer than kListedLiftOffs: at its position, with its index, its material
+  /// coordinate s and the release's cause: `values` (the force N that no longer pushes) or `link` (≥ 0: the
+  /// link whose arc ran out).
+  void lift_off(const StringModel<dim>& model, double t, int i, std::vector<std::pair<std::string, double>> values,
+                int link) {
+    const std::size_t k = static_cast<std::size_t>(held_[static_cast<std::size_t>(i)]);
+    ++lift_offs_;
+    if (++lift_off_totals_[k] > kListedLiftOffs) return;
+    RunEvent e;
+    e.kind = "lift_off";
+    e.t = t;
+    const Vec<dim> x = model.x().col(i);
+    e.position.assign(x.data(), x.data() + dim);
+    e.indices = {{"node", i}};
+    if (link >= 0) e.indices.emplace_back("link", link);
+    e.values = {{"s", model.chain().node_coordinate(i)}};
+    e.values.insert(e.values.end(), values.begin(), values.end());
+    e.obstacle = obstacles_[k].name;
+    events_.push_back(std::move(e));
+  }
   /// Lets go of the held nodes whose normal force pulls, one at a time, most negative first (each
   /// release changes the others' forces), until none pulls; at a located lift-off (`located`) the one
   /// whose force has reached zero to the root's accuracy goes first. Returns whether one was let go.
@@ -1185,6 +1230,7 @@ class ContactModule final : public WrappingModule<dim> {
         }
       }
       if (worst < 0) break;
+      lift_off(model, t, worst, {{"N", worst_force * model.masses()[worst] * a}}, -1);
       if (arc_) release_on_arc(model, worst, -1);
       held_[static_cast<std::size_t>(worst)] = -1;
       offset_[static_cast<std::size_t>(worst)] = kReleaseGap;
@@ -1193,7 +1239,6 @@ class ContactModule final : public WrappingModule<dim> {
         stuck_[static_cast<std::size_t>(worst)] = 0;
         dir_.col(worst).setZero();
       }
-      ++lift_offs_;
       released = true;
       refresh(model);
     }

@@ -16,7 +16,10 @@
 ///   - the ledgers W_contact (J: the work of the contact forces, zero on the exact solution; it books
 ///     the drift control's share), W_impacts (J, ≤ 0: the kinetic energy the landings took) and the
 ///     impulse of all external forces (the momentum ledger p − p0 − impulse, closed across impacts);
-///   - the recorded quantities impacts and lift_offs (series.csv): how many landings and lift-offs;
+///   - the recorded quantities impacts and lift_offs (series.csv): how many landings and lift-offs; each
+///     lift-off is also a run event (StringModule::run_events: the summary's `events`, the first 100 of each
+///     obstacle, merged in time order with the inner module's) and counted per obstacle
+///     (StringModule::lift_off_totals: `contact_lift_offs`; docs/model.md §10, "Lift-offs in the summary");
 ///   - its drawing for the ParaView output (Obstacle::draw);
 ///   - Coulomb friction on obstacles with μ > 0 (docs/model.md §10, "Friction"): a held node slides
 ///     (force −μ N t̂, NodeContact::slide) or sticks (held completely, NodeContact::stuck); two more

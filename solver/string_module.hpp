@@ -56,13 +56,25 @@ struct FrontRecord {
 };
 
 /// A physical event a module located during the run (the summary's `events`): its kind ("lift_off"),
-/// time (s), front, position (m, dim components) and further named values.
+/// time (s), front, position (m, dim components), further named values and named indices. An obstacle's event (a node
+/// the contact module let go, solver/contact_module.hpp) names its obstacle instead of a front
+/// (`front` −1, `obstacle` e.g. "effects.cylinder[0]"); a front's event has no obstacle ("").
 struct RunEvent {
   std::string kind;
   double t = 0;
   int front = -1;
   std::vector<double> position;
   std::vector<std::pair<std::string, double>> values;
+  // Default member initializers: the fronts' aggregate initializers stay complete.
+  std::string obstacle{};
+  std::vector<std::pair<std::string, long>> indices{};  ///< named integers (a node's, a link's index)
+};
+
+/// How many lift-offs an obstacle had in the run, all of them, listed in `events` or not (the contact
+/// module lists at most a bound per obstacle: ContactModule, kListedLiftOffs).
+struct LiftOffTotal {
+  std::string obstacle;
+  long total = 0;
 };
 
 /// What a module draws of the obstacles it models (fixed in space), for the ParaView output
@@ -253,8 +265,12 @@ class StringModule {
   /// start is a snap taut, StringModel::make_consistent): the module books it in its ledgers' initial
   /// values `ledger`. Only a module of unilateral links has impulses to book.
   virtual void book_start_dissipation(double /*dissipated*/, Eigen::Ref<Eigen::VectorXd> /*ledger*/) const {}
-  /// The physical events of the run so far (e.g. a chain lifting off an edge), for the run's summary.
+  /// The physical events of the run so far (e.g. a chain lifting off an edge), for the run's summary,
+  /// in time order.
   virtual std::vector<RunEvent> run_events() const { return {}; }
+  /// Per obstacle, the lift-offs of the run so far, listed in run_events() or not (the summary's
+  /// `contact_lift_offs`); empty without a contact module.
+  virtual std::vector<LiftOffTotal> lift_off_totals() const { return {}; }
   /// The root functions `g` (events() at the start of the run) that say the run cannot go on from
   /// its very start: ARKODE finds only sign changes, so a check already negative at t0 (an edge that
   /// would have to pull the string it is given) is acted on as an event at t0. Returns `found` for

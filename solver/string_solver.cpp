@@ -146,8 +146,26 @@ nlohmann::json to_json(const RunSummary& s) {
   j["events"] = nlohmann::json::array();
   for (const RunEvent& e : s.events) {
     nlohmann::json event = {{"kind", e.kind}, {"t", e.t}, {"front", e.front}, {"position", e.position}};
+    if (!e.obstacle.empty()) {  // an obstacle's event: no front
+      event["front"] = nullptr;
+      event["obstacle"] = e.obstacle;
+    }
     for (const auto& [name, value] : e.values) event[name] = value;
+    for (const auto& [name, index] : e.indices) event[name] = index;
     j["events"].push_back(std::move(event));
+  }
+  if (!s.lift_off_totals.empty()) {
+    nlohmann::json totals = nlohmann::json::object();
+    bool truncated = false;
+    for (const LiftOffTotal& total : s.lift_off_totals) {
+      totals[total.obstacle] = total.total;
+      const auto listed = std::count_if(s.events.begin(), s.events.end(), [&](const RunEvent& e) {
+        return e.kind == "lift_off" && e.obstacle == total.obstacle;
+      });
+      truncated = truncated || listed < total.total;
+    }
+    j["contact_lift_offs"] = totals;
+    j["events_truncated"] = truncated;
   }
   j.update(model_json(s));
   nlohmann::json slack = {{"policy", to_string(s.slack_policy)}, {"detected", s.slack.has_value()}};
@@ -481,6 +499,7 @@ const RunSummary& StringSolver<dim>::run() {
     summary_.tension_solves = model_.tension_solves() - solves_before;
     summary_.transfers = (model_.module() ? model_.module()->transfers() : 0) - transfers_before;
     summary_.events = model_.module() ? model_.module()->run_events() : std::vector<RunEvent>{};
+    summary_.lift_off_totals = model_.module() ? model_.module()->lift_off_totals() : std::vector<LiftOffTotal>{};
     if (integrator) {
       summary_.stats = integrator->stats();
       summary_.t_stop = integrator->time();

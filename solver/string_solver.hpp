@@ -182,6 +182,10 @@ struct RunSummary {
   /// The physical events the module located (StringModule::run_events), in the summary's `events`:
   /// one JSON object each, {"kind", "t", "front", "position", and the event's values}; empty without.
   std::vector<RunEvent> events;
+  /// Per obstacle, its lift-offs (StringModule::lift_off_totals), listed in `events` or not: the summary's
+  /// `contact_lift_offs` {obstacle: total} and `events_truncated` (some were not listed); empty (and neither
+  /// key written) without obstacles.
+  std::vector<LiftOffTotal> lift_off_totals;
   /// energy_drift / energy_scale (0 if the scale is 0).
   double relative_energy_drift() const { return energy_scale > 0 ? energy_drift / energy_scale : 0.0; }
   double relative_energy_residual() const { return relative_energy_drift(); }

@@ -44,6 +44,9 @@ class WrappingModule : public StringModule<dim> {
   std::vector<RunEvent> run_events() const override {
     return inner_ ? inner_->run_events() : std::vector<RunEvent>{};
   }
+  std::vector<LiftOffTotal> lift_off_totals() const override {
+    return inner_ ? inner_->lift_off_totals() : std::vector<LiftOffTotal>{};
+  }
   ObstacleDrawing obstacles() const override { return inner_ ? inner_->obstacles() : ObstacleDrawing{}; }
   /// The inner module's checks that failed at the start, its root functions first (the wrapper's own
   /// are not checks).
