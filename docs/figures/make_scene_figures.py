@@ -196,7 +196,7 @@ def edge_slide(run, ax, title, subtitle):
     ax[1].axhline(x_star, color="r", lw=0.8, ls="--",
                   label=f"lift-off length x* = {x_star:.4f} m (t* = {t_star:.4f} s)")
     for e in run.summary.get("events", []):
-        if e.get("kind") == "lift_off":
+        if e.get("kind") == "lift_off" and e.get("front") is not None:  # the edge's (not a contact lift-off)
             ax[1].plot([e["t"]], [ell - e["s0"]], "rx", ms=8, label=f"the run's lift-off event, t = {e['t']:.4f} s")
     decorate(ax[1], "t (s)", "m", subtitle)
 
