@@ -176,6 +176,12 @@ class FrontKind {
   /// tension solve): zero for constraints that only couple nodes (a kink's); the momentum ledger books it.
   virtual Vec<dim> constraint_force(const StringModel<dim>& /*model*/) const { return Vec<dim>::Zero(); }
   virtual bool has_constraint_force() const { return false; }
+  /// Whether the projection onto the links' lengths after this front's crossing changes K + V by
+  /// round-off only (the crossing re-lays the string exactly, as an edge's does on straight sides): the
+  /// tracker then stops the run, located, where a projection changes it by more than
+  /// FrontTracker::kCrossingProjectionTolerance of the energy scale (a crossing that left the string far
+  /// from its constraints), rather than run on with a motion that is not the string's.
+  virtual bool exact_crossing() const { return false; }
   /// Root functions of the front's own that stop the run (positive while it may go on).
   virtual int num_checks() const { return 0; }
   virtual void checks(const StringModel<dim>& /*model*/, const FrontState<dim>& /*state*/, double* /*g*/) const {}

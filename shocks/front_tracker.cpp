@@ -431,8 +431,9 @@ EventAction FrontTracker<dim>::handle_events(StringModel<dim>& model, double t, 
   // allowed (perfectly inelastic otherwise), and the energy it changes is the front's last dissipation,
   // booked in W_shocks (docs/model.md §2.5, "A kink at a held end").
   model.refresh();
-  const double K_moved = record_ ? model.kinetic_energy() : 0.0;
-  const double E_moved = record_ ? K_moved + model.potential_energy(ledger) : 0.0;
+  const bool exact = acted && !forming && !absorbed && fronts_[*acted]->exact_crossing();
+  const double K_moved = record_ || exact ? model.kinetic_energy() : 0.0;
+  const double E_moved = record_ || exact ? K_moved + model.potential_energy(ledger) : 0.0;
   try {
     if (absorbed)
       model.impact(t, model.options().snap_restitution);
@@ -442,6 +443,18 @@ EventAction FrontTracker<dim>::handle_events(StringModel<dim>& model, double t, 
     throw NumericalError(fmt::format("after a front {}: {}", absorbed ? "left the string" : "crossing", e.what()), t);
   }
   model.refresh();
+  if (exact) {
+    const double projected = model.kinetic_energy() + model.potential_energy(ledger) - E_moved;
+    const double scale = model.physical_scales().energy;
+    if (!(std::abs(projected) <= kCrossingProjectionTolerance * scale))
+      throw NumericalError(
+          fmt::format("after the crossing of front {} ({}) at t = {:.9g} s (s0 = {:.9g} m): the projection onto the links' "
+                      "lengths changed K + V by {:.3g} J, more than {:g} of the energy scale {:.3g} J (on straight "
+                      "sides it is round-off): the crossing left the string far from its constraints, and the run "
+                      "past it would not be the string's motion (docs/model.md §8, \"Round-off at a crossing\")",
+                      *acted, fronts_[*acted]->name(), t, fs_[*acted].s0, projected, kCrossingProjectionTolerance, scale),
+          t);
+  }
   // The material a crossing moves between an arc and a heap (the front is re-drawn through the new
   // end node: O(h³) of material) goes with its momentum and is laid at the front; a heap crossing
   // also re-lumps the end's material on the nodes with their own velocities (the lumped momentum
