@@ -24,7 +24,7 @@ using chainsim::test::fitted_order;
 namespace {
 
 // The scene's physics (checked against the scene file below).
-constexpr double kG = 9.81, kH = 0.5, kThetaDeg = 70.0, kFPot = -0.2, kFFloor = 0.6, kLambda = 1.0;
+constexpr double kG = 9.81, kH = 0.5, kThetaDeg = 70.0, kFPot = -0.2, kFFloor = 0.6;
 
 struct Steady {
   double v, yc, a, xc, rise, x_floor;
