@@ -94,7 +94,8 @@ class FrontTracker final : public StringModule<dim> {
  public:
   /// The largest change of K + V, per the energy scale, that the projection after an exact crossing
   /// (FrontKind::exact_crossing) may make before the run stops: its round-off is 1e-11 of the scale and
-  /// less, the failures measured 4.7e-4 and 8.8e-3 (docs/model.md §8, "Round-off at a crossing").
+  /// less; the crossings that broke on rotated or off-origin edges before their cure changed it by 4.7e-4 to
+  /// 1.2e-1 of it (docs/model.md §8, "Round-off at a crossing").
   static constexpr double kCrossingProjectionTolerance = 1e-6;
   /// The fronts, in order of s: fronts()[k] is front k's FrontKind.
   class Fronts {

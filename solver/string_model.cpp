@@ -22,6 +22,9 @@ constexpr double kCollapsedLink = 1e-6;
 /// A bent link's part on either side of its point may be this short (a node crossing an edge passes
 /// within 1e-8 h of it, shocks/edge_front.hpp).
 constexpr double kBentLinkFloor = 1e-10;
+/// A signed side of a link bent over a point is measured along its side's line within this share of the
+/// link of the point (point_bend_sides).
+constexpr double kNearPoint = 1e-4;
 /// A bent link's node has passed its point (point_bend_sides: its partial length negative) where the
 /// node lies past the point within this cosine of the side's direction (60°).
 constexpr double kPassedCone = 0.5;
@@ -488,6 +491,15 @@ typename StringModel<dim>::PointBendSides StringModel<dim>::point_bend_sides(con
   auto side = [&](const Vec<dim>& d, bool at_end, const Vec<dim>& last, double& l, Vec<dim>& e) {
     const double r = d.norm();
     const bool signed_side = at_end ? bend.signed_plus : bend.signed_minus;
+    if (signed_side && r < kNearPoint * chain_.link_length(j)) {
+      // Near the point the side's own line measures it: its node's error across that line (the
+      // integrator's, or round-off) would turn d / |d| by error / |d|, and the row's |v⊥|²/l with it.
+      const Vec<dim> ref = side_reference(bend, at_end, x);
+      l = ref.dot(d);
+      if (directions) e = ref;
+      if (directions && !(std::abs(l) > 0)) e = last.squaredNorm() > 0 ? last : ref;
+      return;
+    }
     l = signed_side && side_reference(bend, at_end, x).dot(d) < -kPassedCone * r ? -r : r;
     if (!directions) return;
     // A node within the floor of the point (a root function's search may pass there) keeps the

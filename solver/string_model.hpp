@@ -345,8 +345,10 @@ class StringModel final : public OdeSystem {
   /// inside its overshoot band) l⁻ < 0 and e⁻ still points along the side, so that for a node moving along
   /// a straight line through the point l⁻ runs on through zero and e⁻ stays; the same at the end node b
   /// (docs/model.md §8, "Past the point"). σ = −1 only within 60° of that line beyond the point, and
-  /// only on a signed side (bend_link). A side within kBentLinkFloor h of the point keeps its direction
-  /// of the last evaluation. RecoverableError if a side has no direction.
+  /// only on a signed side (bend_link). A signed side within kNearPoint h (1e-4 links) of the point is
+  /// measured along its side's line, l = d·(x0 − x_a), e = d (docs/model.md §8, "Round-off at a crossing":
+  /// d / |d| would carry the node's position error over |d|). An unsigned side within kBentLinkFloor h of
+  /// the point keeps its direction of the last evaluation. RecoverableError if a side has no direction.
   struct PointBendSides {
     double l_minus = 0, l_plus = 0;  ///< signed partial lengths (m), l⁻ + l⁺ = h on the constraint
     Vec<dim> e_minus = Vec<dim>::Zero(), e_plus = Vec<dim>::Zero();

@@ -7,6 +7,9 @@
 #include <fstream>
 #include <sstream>
 #include <string>
+#include <tuple>
+
+#include <Eigen/Geometry>
 
 #include <catch2/catch.hpp>
 #include <fmt/format.h>
@@ -262,6 +265,54 @@ TEST_CASE("hard edges: a 3D string that meets the edge's line obliquely stops, l
     CHECK(run.t_stop < 1e-3);  // the lift-off (x0 = 0.2 m) would come at 0.525 s
     CHECK(run.events.empty());
     CHECK_THAT(run.stop_reason, Contains("obliquely at t = "));
+    require_finite(run);
+  }
+}
+
+TEST_CASE("hard edges: an edge far from the origin, and a 3D edge along a general line, lift off at the exact time",
+          "[edge][peg][hard]") {
+  // The crossing node's partial link is 1e-8 links long: measured from the positions, its direction carried
+  // their error over that length (round-off where the coordinates are not exact binary numbers; the
+  // integrator's error across a side that does not run along a coordinate axis), and the node whirled
+  // round the point: on main, the chain off the table with its edge at [3.1, -17.3] lifted off at 0.4895 s
+  // on 100 nodes (exact 0.5251 s), and of 108 rotated copies of the edge and peg problems
+  // (tests/bench/edge_rotation_scan.py) 25 failed or lifted off at a wrong time, every one on 160 nodes.
+  // Near the point a side is now measured along its own line, and a crossing turns the node's velocity
+  // about the edge's line with the sides' directions from their whole links (docs/model.md §8).
+  const std::string file = std::string(CHAINSIM_SOURCE_DIR) + "/cases/scenes/chain_off_table_edge.toml";
+  const double t_edge = exact::edge_time(0.0, exact::edge_lift_off_x(0.0, 0.2, 1.0, kG), 0.2, 1.0, kG);
+  for (const auto& [x, y, nodes] : {std::tuple{3.1, -17.3, 100}, std::tuple{3.1, -17.3, 101}, std::tuple{1000.1, 1000.3, 201}}) {
+    SceneRun<2> run(parse_scene(
+        file, {fmt::format("string.nodes={}", nodes),
+               fmt::format("shape.points=[[{:.17g}, {:.17g}], [{:.17g}, {:.17g}], [{:.17g}, {:.17g}]]", x - 0.8, y, x, y, x, y - 0.2),
+               fmt::format("effects.edge[0].point=[{:.17g}, {:.17g}]", x, y), "stop.t_end=0.6"}));
+    REQUIRE_FALSE(run.run().has_value());
+    const RunSummary& summary = run.solver().summary();
+    INFO("edge at [" << x << ", " << y << "], " << nodes << " nodes: " << summary.status << ": " << summary.stop_reason);
+    REQUIRE(summary.events.size() == 1);
+    CHECK(summary.events[0].t == Approx(t_edge).margin(1e-6));
+  }
+  // 3D: the chain off the table and the chain over a peg (0.4 m and 0.6 m, f = 0) turned by a rotation
+  // about a general axis, on 160 nodes (every rotation of the scan failed there).
+  const Eigen::Matrix3d R = Eigen::AngleAxisd(1.3, Eigen::Vector3d(0.3, -0.7, 0.648).normalized()).toRotationMatrix();
+  auto vec = [&](double a, double b) {
+    const Eigen::Vector3d w = R * Eigen::Vector3d(a, b, 0.0);
+    return fmt::format("[{:.17g}, {:.17g}, {:.17g}]", w[0], w[1], w[2]);
+  };
+  const double t_peg = exact::peg_time(0.0, exact::peg_lift_off_x(0.0, 0.6, 1.0, kG), 0.6, 1.0, kG);
+  for (const bool peg : {false, true}) {
+    const std::string points = peg ? vec(0.0, -0.4) + ", " + vec(0.0, 0.0) + ", " + vec(0.0, -0.6)
+                                   : vec(-0.8, 0.0) + ", " + vec(0.0, 0.0) + ", " + vec(0.0, -0.2);
+    const std::string text =
+        "[string]\nlength = 1.0\nnodes = 160\ndimension = 3\n\n[shape]\nkind = \"polyline\"\npoints = [" + points +
+        "]\n\n[effects.gravity]\ng = " + vec(0.0, -kG) + "\n\n[[effects.edge]]\npoint = [0.0, 0.0, 0.0]\ndirection = " +
+        fmt::format("[{:.17g}, {:.17g}, {:.17g}]", R(0, 2), R(1, 2), R(2, 2)) + "\nf = 0.0\ntable = \"" +
+        (peg ? "none" : "before") + "\"\n\n[solver]\nrtol = 1e-9\natol = 1e-11\n\n[stop]\nt_end = 2.0\n";
+    const RunSummary run = run_front_scene<3>(parse_scene_text(text, peg ? "rotated_peg.toml" : "rotated_edge.toml"));
+    INFO((peg ? "peg" : "edge") << ": " << run.status << ": " << run.stop_reason << run.error);
+    REQUIRE(run.status == "stopped");
+    REQUIRE(run.events.size() == 1);
+    CHECK(run.events[0].t == Approx(peg ? t_peg : t_edge).margin(1e-6));
     require_finite(run);
   }
 }
