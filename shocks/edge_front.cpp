@@ -14,12 +14,12 @@ namespace chainsim {
 
 namespace {
 
-/// v rotated about the edge's line `axis` (in 2D the out-of-plane axis) by the angle that takes the side
-/// direction `from` to `to`, as seen across the line (their parts normal to it): its length kept. The
-/// string turns over the edge about its line (it crosses the line at right angles), so the rotation is
-/// about the line whatever the round-off of the two directions; about their own normal it would take an
-/// axis from that round-off where they are antiparallel (a peg), and turn the node's velocity across
-/// its side about it.
+/// The crossing node's velocity v carried from the side along `from` to the side along `to` (unit
+/// vectors): its part along `from` goes along `to` exactly, and the rest turns about the edge's line `axis`
+/// (in 2D the out-of-plane axis) by the angle between the sides seen across the line; its length kept where
+/// both sides are normal to the line. About the line, not about the sides' own normal: where they are
+/// antiparallel (a peg) that normal is made of their round-off, and it would turn the node's velocity
+/// across its side about it.
 template <int dim>
 Vec<dim> rotate_onto(const Vec<dim>& v, const Vec<dim>& from, const Vec<dim>& to, const Vec<dim>& axis) {
   if constexpr (dim == 2) {
@@ -28,7 +28,9 @@ Vec<dim> rotate_onto(const Vec<dim>& v, const Vec<dim>& from, const Vec<dim>& to
   } else {
     const Vec<dim> f = (from - axis.dot(from) * axis).normalized(), g = (to - axis.dot(to) * axis).normalized();
     const double c = f.dot(g), s = f.cross(g).dot(axis);
-    return c * v + s * axis.cross(v) + (1 - c) * axis.dot(v) * axis;  // Rodrigues about the line
+    const double along = v.dot(from);
+    const Vec<dim> rest = v - along * from;
+    return along * to + c * rest + s * axis.cross(rest) + (1 - c) * axis.dot(rest) * axis;  // Rodrigues about the line
   }
 }
 

@@ -444,6 +444,8 @@ void StringModel<dim>::bend_links() {
     const int j = bend.link;
     bend.l_minus = sides.l_minus;
     bend.l_plus = sides.l_plus;
+    bend.near_minus = sides.near_minus;
+    bend.near_plus = sides.near_plus;
     l_[j] = bend.l_minus + bend.l_plus;
     e_.col(j) = sides.e_minus;
     bend.e_plus = sides.e_plus;
@@ -488,12 +490,14 @@ typename StringModel<dim>::PointBendSides StringModel<dim>::point_bend_sides(con
   // node on a straight line through the point: l = σ |d| runs on through zero, e = d / l stays; a node
   // that passes beside the point, further from it than from that line, keeps σ = 1 and its l = |d|
   // continuous, as before). An unsigned side (bend_link) keeps σ = 1.
-  auto side = [&](const Vec<dim>& d, bool at_end, const Vec<dim>& last, double& l, Vec<dim>& e) {
+  auto side = [&](const Vec<dim>& d, bool at_end, const Vec<dim>& last, double& l, Vec<dim>& e, bool& near) {
     const double r = d.norm();
     const bool signed_side = at_end ? bend.signed_plus : bend.signed_minus;
-    if (signed_side && r < kNearPoint * chain_.link_length(j)) {
+    near = signed_side && r < kNearPoint * chain_.link_length(j);
+    if (near) {
       // Near the point the side's own line measures it: its node's error across that line (the
-      // integrator's, or round-off) would turn d / |d| by error / |d|, and the row's |v⊥|²/l with it.
+      // integrator's, or round-off) would turn d / |d| by error / |d|, and the row's |v⊥|²/l with it
+      // (the row drops that term for such a side: l = ref·d has no 1/l in its second derivative).
       const Vec<dim> ref = side_reference(bend, at_end, x);
       l = ref.dot(d);
       if (directions) e = ref;
@@ -513,8 +517,8 @@ typename StringModel<dim>::PointBendSides StringModel<dim>::point_bend_sides(con
                                          to_a.norm(), from_b.norm()));
     e = d / l;
   };
-  side(to_a, false, bend.e_minus_last, out.l_minus, out.e_minus);
-  side(from_b, true, bend.e_plus_last, out.l_plus, out.e_plus);
+  side(to_a, false, bend.e_minus_last, out.l_minus, out.e_minus, out.near_minus);
+  side(from_b, true, bend.e_plus_last, out.l_plus, out.e_plus, out.near_plus);
   if (directions && !(out.l_minus + out.l_plus > 0 && std::isfinite(out.l_minus + out.l_plus)))
     throw RecoverableError(fmt::format("link {} has passed the point it is bent over (its parts {:g} and {:g} m)", j,
                                        out.l_minus, out.l_plus));
@@ -921,13 +925,14 @@ double StringModel<dim>::evaluate_current(double t) {
       const Vec<dim> va = v_.col(a) - em * em.dot(v_.col(a)), vb = v_.col(b) - ep * ep.dot(v_.col(b));
       const double h = chain_.link_length(j), l = l_[j];
       const double stab = 2 * alpha_ * bend_rate(bend) + beta2_ * 0.5 * (l * l - h * h) / l;
-      // |v⊥|²/l with l signed (point_bend_sides); through zero within the floor, where a node passes the point.
+      // |v⊥|²/l with l signed (point_bend_sides); through zero within the floor, where a node passes the point;
+      // none for a side measured along its line near the point (its l = d·(x0 − x_a) has no such term).
       const double floor = kBentLinkFloor * h;
-      auto turn = [floor](double v2, double part) {
-        return std::abs(part) > floor ? v2 / part : v2 * part / (floor * floor);
+      auto turn = [floor](double v2, double part, bool near) {
+        return near ? 0.0 : std::abs(part) > floor ? v2 / part : v2 * part / (floor * floor);
       };
-      system_->rhs(u) = -turn(va.squaredNorm(), bend.l_minus) - turn(vb.squaredNorm(), bend.l_plus) -
-                        (ep.dot(b_.col(b)) - em.dot(b_.col(a))) - stab;
+      system_->rhs(u) = -turn(va.squaredNorm(), bend.l_minus, bend.near_minus) -
+                        turn(vb.squaredNorm(), bend.l_plus, bend.near_plus) - (ep.dot(b_.col(b)) - em.dot(b_.col(a))) - stab;
     }
     if (contact_stuck_) locked_rhs();
     const Eigen::VectorXd& T = solve_tensions(t);

@@ -352,6 +352,7 @@ class StringModel final : public OdeSystem {
   struct PointBendSides {
     double l_minus = 0, l_plus = 0;  ///< signed partial lengths (m), l⁻ + l⁺ = h on the constraint
     Vec<dim> e_minus = Vec<dim>::Zero(), e_plus = Vec<dim>::Zero();
+    bool near_minus = false, near_plus = false;  ///< measured along the side's line (within kNearPoint h)
   };
   PointBendSides bent_sides(int link) const;
   /// The direction the string arrives at the start node a of bent link `link` (`at_end` false: along the
@@ -554,6 +555,7 @@ class StringModel final : public OdeSystem {
     Vec<dim> bent_minus = Vec<dim>::Zero(), bent_plus = Vec<dim>::Zero();
     bool signed_minus = true, signed_plus = true;  // (bend_link)
     double l_minus = 0, l_plus = 0;  // a point's: signed (point_bend_sides)
+    bool near_minus = false, near_plus = false;  // a point's side measured along its line (point_bend_sides)
     // Bent over a circle (bend_link_on_circle): its centre, radius and sense, which ends are on it; after
     // links() the arc's length, the quadratic term of d²l/dt² at zero accelerations (q), and its angles.
     bool circle = false, a_on = false, b_on = false;
