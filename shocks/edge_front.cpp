@@ -408,10 +408,14 @@ void EdgeFront<dim>::checks(const StringModel<dim>& model, const FrontState<dim>
 }
 
 template <int dim>
+double EdgeFront<dim>::along_line_scale(const StringModel<dim>& model, const FrontState<dim>& s) const {
+  return std::abs(tension_minus(model)) + std::abs(tension_plus(model)) + this->m_.lambda * s.s0_dot * s.s0_dot;
+}
+
+template <int dim>
 double EdgeFront<dim>::along_line_margin(const StringModel<dim>& model, const FrontState<dim>& s,
                                          const Vec<dim>& reaction) const {
-  const double scale = std::abs(tension_minus(model)) + std::abs(tension_plus(model)) + this->m_.lambda * s.s0_dot * s.s0_dot;
-  return kAlongLine * scale - std::abs(reaction.dot(axis_));
+  return kAlongLine * along_line_scale(model, s) - std::abs(reaction.dot(axis_));
 }
 
 template <int dim>
@@ -441,9 +445,7 @@ bool EdgeFront<dim>::along_line(const StringModel<dim>& model, const FrontState<
   // thousandth of its scale: both roots can fall in one step) and the lift-off margin is not.
   if (dim != 3 || slack_) return false;
   const Vec<dim> reaction = recorded_reaction(model, s);
-  const double along = along_line_margin(model, s, reaction);
-  const double scale = std::abs(tension_minus(model)) + std::abs(tension_plus(model)) + this->m_.lambda * s.s0_dot * s.s0_dot;
-  return along <= 1e-3 * kAlongLine * scale &&
+  return along_line_margin(model, s, reaction) <= 1e-3 * kAlongLine * along_line_scale(model, s) &&
          jump::pinned_lift_off_margin<dim>(reaction, t_minus_, t_plus_, axis_) > 0;
 }
 

@@ -113,6 +113,8 @@ class EdgeFront final : public FrontKind<dim> {
   double tension_plus(const StringModel<dim>& model) const { return model.link_tension(link_) + jump_; }
 
  private:
+  /// |τ⁻| + |τ⁺| + λ ṡ0² (N): the forces the jump conditions balance at the point (3D's along-line check).
+  double along_line_scale(const StringModel<dim>& model, const FrontState<dim>& s) const;
   /// kAlongLine (τ⁻ + τ⁺ + λ ṡ0²) − |F0·d| (N) for the reaction F0 (3D).
   double along_line_margin(const StringModel<dim>& model, const FrontState<dim>& s, const Vec<dim>& reaction) const;
   /// Whether the along-line check is the one that stops the run at this state (3D).
