@@ -1,9 +1,9 @@
-"""How a node reaches a peg along a swinging side (docs/model.md §8, "Where the scheme stops").
+"""How a node reaches a peg along a swinging side (docs/model.md §8, "A side that swings").
 
 Runs a chain laid as a V over a peg at the origin (sides at 37° from the vertical, released with a tangential
-speed of 0.5 m/s under gravity, slack allowed: the scene of the `[slack][edge]` test "a tangential start over an
-edge or a peg") on each mesh, frames every --interval, and prints for the node that reaches the peg first, over
-its last frames before the run stops: its distance r to the peg (in links), the turn between its last whole link
+speed of 0.5 m/s under gravity, slack allowed: the scene of the `[edge][convergence]` test "a V over a peg, both
+sides swinging") on each mesh, frames every --interval, and prints for the node that reaches the peg first, over
+its last frames before it crosses: its distance r to the peg (in links), the turn between its last whole link
 and its partial link (deg), and its velocity along and across the partial link (m/s) with r times the latter (its
 angular momentum about the peg per unit mass, m²/s).
 
@@ -58,11 +58,15 @@ def main():
         with open(os.path.join(out, "nodes.csv")) as f:
             for row in csv.DictReader(f):
                 frames[float(row["t"])][int(row["node"])] = tuple(float(row[k]) for k in ("x", "y", "vx", "vy"))
-        times = sorted(frames)
+        with open(os.path.join(out, "series.csv")) as f:
+            series = [(float(row["t"]), float(row["s0_0"])) for row in csv.DictReader(f)]
         h = 1.0 / (n - 1)
-        last = frames[times[-1]]
-        a = min(sorted(last, key=lambda i: math.hypot(last[i][0], last[i][1]))[:2])  # the − side's node
-        print(f"{n} nodes: node {a} reaches the peg; the run ends: "
+        # The first node to reach the peg: the last one before it at the start (the material runs to the + side),
+        # and the frames before the front passes it.
+        a = int(series[0][1] / h)
+        crossed = next((t for t, s0 in series if s0 <= a * h), series[-1][0])
+        times = sorted(t for t in frames if t < crossed)
+        print(f"{n} nodes: node {a} reaches the peg at t = {crossed:.4f} s; the run ends: "
               f"{(run.stderr.strip().splitlines() or ['completed'])[-1][:160]}")
         step = max(1, min(len(times), 40) // args.frames)
         for t in times[-min(len(times), 40)::step]:
