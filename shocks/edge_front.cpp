@@ -132,8 +132,20 @@ void EdgeFront<dim>::evaluate(const StringModel<dim>& model, FrontState<dim>& s,
   // A trial stage that carries node a (or b) past x0 by more than kOvershoot h is refused (the
   // integrator retries a shorter step): a step over a crossing must end within that distance, where
   // the crossing's root is located.
-  if (g_minus(model) < -kOvershoot * h || g_plus(model) < -kOvershoot * h)
-    throw RecoverableError(fmt::format("a node of link {} has passed the edge within a step", a));
+  // Measured along the side's last link, a node also lies "past" x0 where the string folds back at it, more
+  // than 90° next to the edge (a kink, or a free end whipping round, that reaches the edge): the message
+  // says which, by how far the node is from x0.
+  const bool past_minus = g_minus(model) < -kOvershoot * h, past_plus = g_plus(model) < -kOvershoot * h;
+  if (past_minus || past_plus) {
+    const int node = past_minus ? a : b;
+    const double away = std::abs(past_minus ? lm : lp);
+    throw RecoverableError(
+        away > 2 * kOvershoot * h
+            ? fmt::format("node {}, {:.3g} links from the edge, turns the string back by more than 90° there (a kink "
+                          "or a whipping end has reached the edge, which the edge front does not take)",
+                          node, away / h)
+            : fmt::format("a node of link {} has passed the edge within a step", a));
+  }
   slack_ = model.link_slack(a);
   double s0_dot = 0, l_minus = lm, l_plus = lp;
   if (!slack_) {
