@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include <Eigen/Geometry>
 #include <fmt/format.h>
 
 #include "mesh/errors.hpp"
@@ -12,6 +13,26 @@
 namespace chainsim {
 
 namespace {
+
+/// The crossing node's velocity v carried from the side along `from` to the side along `to` (unit
+/// vectors): its part along `from` goes along `to` exactly, and the rest turns about the edge's line `axis`
+/// (in 2D the out-of-plane axis) by the angle between the sides seen across the line; its length kept where
+/// both sides are normal to the line. About the line, not about the sides' own normal: where they are
+/// antiparallel (a peg) that normal is made of their round-off, and it would turn the node's velocity
+/// across its side about it.
+template <int dim>
+Vec<dim> rotate_onto(const Vec<dim>& v, const Vec<dim>& from, const Vec<dim>& to, const Vec<dim>& axis) {
+  if constexpr (dim == 2) {
+    const double c = from.dot(to), s = from[0] * to[1] - from[1] * to[0];
+    return Vec<dim>(c * v[0] - s * v[1], s * v[0] + c * v[1]);
+  } else {
+    const Vec<dim> f = (from - axis.dot(from) * axis).normalized(), g = (to - axis.dot(to) * axis).normalized();
+    const double c = f.dot(g), s = f.cross(g).dot(axis);
+    const double along = v.dot(from);
+    const Vec<dim> rest = v - along * from;
+    return along * to + c * rest + s * axis.cross(rest) + (1 - c) * axis.dot(rest) * axis;  // Rodrigues about the line
+  }
+}
 
 template <int dim>
 std::string show(const Vec<dim>& v) {
@@ -193,20 +214,6 @@ void EdgeFront<dim>::evaluate(const StringModel<dim>& model, FrontState<dim>& s,
       s.reaction += support;
     }
   }
-  if (!slack_) {
-    // The guide on the node coming to the edge (edge_front.hpp): the support's, a dissipative force whose
-    // power is booked with the kink's. Not on a side measured along its line (within kNearPoint h of x0).
-    auto guide = [&](int node, double l, const Vec<dim>& e, bool near) {
-      if (near || !(l > 0 && l < kGuideReach * h)) return;
-      const Vec<dim> across = v.col(node) - v.col(node).dot(e) * e;
-      const Vec<dim> pull = -(kGuideRate * std::abs(s0_dot) / l) * mass[node] * across;
-      force.col(node) += pull;
-      s.reaction += pull;
-      s.power_shock += pull.dot(v.col(node));
-    };
-    if (s0_dot < 0) guide(a, lm, t_minus_, sides.near_minus);  // node a comes to x0
-    if (s0_dot > 0) guide(b, lp, t_plus_, sides.near_plus);    // node b comes to x0
-  }
 }
 
 template <int dim>
@@ -316,27 +323,6 @@ void EdgeFront<dim>::crossings(const StringModel<dim>& model, const FrontState<d
 }
 
 template <int dim>
-bool EdgeFront<dim>::project_before_crossing(const StringModel<dim>& model, int /*e0*/) const {
-  // Every link of the arc (the projection after the crossing fixes them all, and its correction reaches
-  // the crossing node from anywhere: a 9e-8 m drift at a whipping free end, 16 links away, moved it back
-  // across the point by 9e-10 m on 41 nodes). The other bends of an edge scene are edges' (point bends).
-  const double h = this->m_.h, allowed = 0.25 * kMirror * kCross * h;
-  const Points<dim>& x = model.x();
-  const ArcRange& arc = model.arcs()[static_cast<std::size_t>(this->arc_minus)];
-  for (int j = arc.first; j < arc.last; ++j) {
-    double length = 0;
-    if (model.link_bent(j)) {
-      const typename StringModel<dim>::PointBendSides sides = model.bent_sides(j);
-      length = sides.l_minus + sides.l_plus;
-    } else {
-      length = (x.col(j + 1) - x.col(j)).norm();
-    }
-    if (std::abs(length - h) > allowed) return true;
-  }
-  return false;
-}
-
-template <int dim>
 EventAction EdgeFront<dim>::cross(StringModel<dim>& model, const FrontState<dim>& s, int e0) {
   Points<dim>& x = model.x();
   Points<dim>& v = model.v();
@@ -378,13 +364,10 @@ EventAction EdgeFront<dim>::cross(StringModel<dim>& model, const FrontState<dim>
   // The sides' directions: the crossing node's own partial link is kCross h long, and its direction from
   // the positions carries their error over that length (a node 7.5e-14 m off its side's line tilts it by
   // 1.2e-3 rad on 160 nodes, where the integrator's tolerance allows far more; exactly zero only where the
-  // side runs along a coordinate axis), which the velocity carried below would turn into a velocity
+  // side runs along a coordinate axis), which the velocity's rotation below would turn into a velocity
   // across the new partial link (2.4e-4 m/s: the run failed at the crossing). That side's direction is
   // taken from its whole links (bend_side_direction, as the crossing's root measures it); the other
-  // side's partial link is nearly h long (docs/model.md §8, "Round-off at a crossing"). The node's velocity
-  // along the side it leaves goes along the other side; what is left across (the guide's remainder, and
-  // on a side that swings the side's turn at the node) is dropped: it would whirl the node about the
-  // point on its new partial link. The energy it had is the crossing's, booked with it (W_remesh).
+  // side's partial link is nearly h long (docs/model.md §8, "Round-off at a crossing").
   const Vec<dim> side_minus = e0 != 0 ? model.bend_side_direction(link_, false) : t_minus_;
   const Vec<dim> side_plus = e0 != 0 ? t_plus_ : model.bend_side_direction(link_, true);
   // Each side moves on by δ + kMirror kCross h along itself: from this edge along its line on that side,
@@ -394,18 +377,19 @@ EventAction EdgeFront<dim>::cross(StringModel<dim>& model, const FrontState<dim>
   shift_sides(model, arc.first, node - 1, node + 1, arc.last, sign * (delta + past), side_minus, side_plus);
   if (e0 != 0) {
     x.col(a) = point_ + past * side_plus;
-    v.col(a) = v.col(a).dot(side_minus) * side_plus;
+    v.col(a) = rotate_onto<dim>(v.col(a), side_minus, side_plus, axis_);
     link_ = a - 1;
   } else {
     x.col(b) = point_ - past * side_minus;
-    v.col(b) = v.col(b).dot(side_plus) * side_minus;
+    v.col(b) = rotate_onto<dim>(v.col(b), side_plus, side_minus, axis_);
     link_ = b;
   }
   model.unbend_link(a);  // this edge's bend only: another edge's stays
   // The side the crossing node now lies on keeps |x − x0| as its partial length (unsigned): that node
-  // leaves the point, 2e-8 h past it, along its side, and where the side turns (a side that swings) its
-  // partial link turns about the point with it, which a signed length would not let it do. The side it
-  // left, whose node comes next to the edge, is signed.
+  // leaves the point, 2e-8 h past it, with the velocity it crossed with, and where that velocity has a
+  // part across its partial link (a side reaching the edge swinging) the node whirls about the point
+  // as a short rope round a post, which a signed length would not let it do. The side it left, whose
+  // node comes next to the edge, is signed.
   set_link(model, link_, e0 != 0 ? +1 : -1);
   model.rebuild();
   model.refresh();

@@ -22,17 +22,10 @@
 /// impulse P (e⁻ − e⁺)); the lift-off margin reaches zero before its tension does unless ṡ0 = 0, and a
 /// bent link found slack (released at ṡ0 = 0, left slack by a snap, or laid slack) is a lift-off too:
 /// the string no longer presses on the edge (docs/model.md §9 "Slack over an edge").
-///   - a guide on the node coming to the edge, within kGuideReach h of it: a force across its partial
-///     link that damps its velocity there, so that it reaches x0 along its side. On a side that swings,
-///     the lumped node comes with a velocity across its partial link (first order in h), an angular
-///     momentum about x0 that the partial link's tension cannot take away: without the guide the node
-///     whirls about x0 as l → 0 (docs/model.md §8, "A side that swings"). Its work is booked with the
-///     kink's dissipation (W_shocks); it is zero on straight sides.
 /// Crossing: when node a comes within kCross h of x0 (material flowing from the − side to the +
-/// side) it passes to the other side, put just past x0 (x0 + kMirror kCross h t⁺) with its velocity along
-/// t⁻ carried along t⁺ (what is left across the side, the guide's remainder, is dropped and its energy
-/// booked with the crossing's), and the link before it is bent instead; the same the other way; each side
-/// moves on rigidly by as much (cross()), so that every link keeps its length.
+/// side) it passes to the other side, put just past x0 (x0 + kMirror kCross h t⁺) with its velocity rotated from
+/// t⁻ to t⁺ (its speed kept: no energy lost), and the link before it is bent instead; the same the
+/// other way; each side moves on rigidly by as much (cross()), so that every link keeps its length.
 /// A step over a crossing may end up to kOvershoot h past it, before it is handled: there the bent
 /// link's partial lengths are signed (StringModel::bent_sides), so that everything above runs on
 /// continuously through the crossing (docs/model.md §8, "Past the point").
@@ -70,11 +63,6 @@ class EdgeFront final : public FrontKind<dim> {
   static constexpr double kMirror = 2;
   /// How far past x0 (in links) a trial stage may carry the bent link's node before it is refused.
   static constexpr double kOvershoot = 1e-3;
-  /// The guide (evaluate): within kGuideReach h of x0 the node coming to the edge feels
-  /// −kGuideRate |ṡ0| m v⊥ / l, its velocity across its partial link damped at kGuideRate times the rate
-  /// at which it closes on x0 (above 1, the rate at which that velocity would grow as l falls).
-  static constexpr double kGuideReach = 0.25;
-  static constexpr double kGuideRate = 2;
 
   explicit EdgeFront(const EdgeSpec<dim>& spec);
 
@@ -99,11 +87,6 @@ class EdgeFront final : public FrontKind<dim> {
   /// The crossing moves each side along itself: its projection changes K + V by round-off (measured at most
   /// 5e-11 J of 9.81 J on the example and rotated scenes).
   bool exact_crossing() const override { return true; }
-  /// Where a link of the arc is off its length by more than a quarter of kMirror kCross h (the drift on a
-  /// side that swings: 4e-10 m on 192 nodes, where the node is put 1e-10 m past x0): the projection after
-  /// the crossing would take it back and carry the node back across x0. Straight sides drift by round-off,
-  /// and keep their crossings as they are.
-  bool project_before_crossing(const StringModel<dim>& model, int e0) const override;
   /// The lift-off margin (N), positive while the edge pushes; in 3D also the along-line margin
   /// kAlongLine (τ⁻ + τ⁺ + λ ṡ0²) − |F0·d| (N), positive while the held crossing point asks no force of the
   /// edge along its line (a smooth edge has none: an oblique crossing would slide along it, not built).

@@ -182,10 +182,6 @@ class FrontKind {
   /// FrontTracker::kCrossingProjectionTolerance of the energy scale (a crossing that left the string far
   /// from its constraints), rather than run on with a motion that is not the string's.
   virtual bool exact_crossing() const { return false; }
-  /// Whether the string must be projected onto its constraints before the crossing found by root `e0`
-  /// (cross()'s argument): an exact crossing that puts its node just past a point cannot start from the
-  /// integrator's drift when that is larger than how far past it is put.
-  virtual bool project_before_crossing(const StringModel<dim>& /*model*/, int /*e0*/) const { return false; }
   /// Root functions of the front's own that stop the run (positive while it may go on).
   virtual int num_checks() const { return 0; }
   virtual void checks(const StringModel<dim>& /*model*/, const FrontState<dim>& /*state*/, double* /*g*/) const {}

@@ -419,10 +419,6 @@ EventAction FrontTracker<dim>::handle_events(StringModel<dim>& model, double t, 
       absorbed = true;
       break;
     }
-    if (fronts_[k]->project_before_crossing(model, e0)) {
-      model.project(t);
-      model.refresh();
-    }
     const EventAction action = fronts_[k]->cross(model, fs_[k], e0);
     if (action.kind == EventAction::Kind::kStop) return action;
     ++transfers_;

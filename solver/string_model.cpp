@@ -456,23 +456,22 @@ void StringModel<dim>::bend_links() {
 
 template <int dim>
 template <class Position>
-Vec<dim> StringModel<dim>::side_reference(const Bend& bend, bool at_end, const Position& x, bool chord) const {
+Vec<dim> StringModel<dim>::side_reference(const Bend& bend, bool at_end, const Position& x) const {
   // Along the link beyond the node (from or to the point it is bent over, if it is bent over one), as
-  // the string runs there; with `chord`, from that link's far end (or point) to this bend's point, or
-  // from this point to it. At an end of the arc, the bent link's own direction when it was bent.
+  // the string runs there; at an end of the arc, the bent link's own direction when it was bent.
   const int j = bend.link, a = chain_.link_start(j), b = chain_.link_end(j);
   const int arc = arc_of_[static_cast<std::size_t>(at_end ? b : a)];
   if (arc >= 0) {
     const ArcRange& range = arcs_[static_cast<std::size_t>(arc)];
     if (!at_end && a > range.first) {
       const Bend* other = bend_of(a - 1);
-      const Vec<dim> from = other && !other->circle ? Vec<dim>(other->point) : Vec<dim>(x(a - 1));
-      return Vec<dim>(((chord ? bend.point : Vec<dim>(x(a))) - from).normalized());
+      return other && !other->circle ? Vec<dim>((x(a) - other->point).normalized())
+                                     : Vec<dim>((x(a) - x(a - 1)).normalized());
     }
     if (at_end && b < range.last) {
       const Bend* other = bend_of(b);
-      const Vec<dim> to = other && !other->circle ? Vec<dim>(other->point) : Vec<dim>(x(b + 1));
-      return Vec<dim>((to - (chord ? bend.point : Vec<dim>(x(b)))).normalized());
+      return other && !other->circle ? Vec<dim>((other->point - x(b)).normalized())
+                                     : Vec<dim>((x(b + 1) - x(b)).normalized());
     }
   }
   return at_end ? bend.bent_plus : bend.bent_minus;
@@ -499,11 +498,7 @@ typename StringModel<dim>::PointBendSides StringModel<dim>::point_bend_sides(con
       // Near the point the side's own line measures it: its node's error across that line (the
       // integrator's, or round-off) would turn d / |d| by error / |d|, and the row's |v⊥|²/l with it
       // (the row drops that term for such a side: l = ref·d has no 1/l in its second derivative).
-      // The line is the side's chord, from the node beyond to the point: it is |d|/h of the side's turn at
-      // its node off d / |d|, so l and its rate hardly move where the band begins (along the last link, a
-      // side that reaches the point swinging, at an angle θ to its partial link, jumped by kNearPoint h
-      // (1 − cos θ) there, docs/model.md §8), and it tends to the last link's direction at the point.
-      const Vec<dim> ref = side_reference(bend, at_end, x, true);
+      const Vec<dim> ref = side_reference(bend, at_end, x);
       l = ref.dot(d);
       if (directions) e = ref;
       if (directions && !(std::abs(l) > 0)) e = last.squaredNorm() > 0 ? last : ref;

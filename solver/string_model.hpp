@@ -612,11 +612,9 @@ class StringModel final : public OdeSystem {
   void bend_couplings();           // assemble_matrix(): their couplings at the end node
   double bend_rate(const Bend& bend) const;  // d(l⁻ + l⁺)/dt
   /// bend_side_direction and bent_sides at the positions x(i) (a callable: x_, or a state's y); without
-  /// `directions` the lengths only (no error where a side has no direction). With `chord`, the side's chord
-  /// instead: from the node beyond a (or the point link a − 1 is bent over) to this point, from this point to
-  /// the node beyond b; a signed side near the point is measured along it.
+  /// `directions` the lengths only (no error where a side has no direction).
   template <class Position>
-  Vec<dim> side_reference(const Bend& bend, bool at_end, const Position& x, bool chord = false) const;
+  Vec<dim> side_reference(const Bend& bend, bool at_end, const Position& x) const;
   template <class Position>
   PointBendSides point_bend_sides(const Bend& bend, const Position& x, bool directions) const;
   const Bend* bend_of(int link) const;       // the bend of a link, or null

@@ -1,8 +1,8 @@
-"""How a node reaches a peg along a swinging side (docs/model.md §8, "A side that swings").
+"""How a node reaches a peg along a swinging side (docs/model.md §8, "Why a swinging side fails at the point").
 
 Runs a chain laid as a V over a peg at the origin (sides at 37° from the vertical, released with a tangential
-speed of 0.5 m/s under gravity, slack allowed: the scene of the `[edge][convergence]` test "a V over a peg, both
-sides swinging") on each mesh, frames every --interval, and prints for the node that reaches the peg first, over
+speed of 0.5 m/s under gravity, slack allowed: the scene of the `[slack][edge]` test "a tangential start over an
+edge or a peg") on each mesh, frames every --interval, and prints for the node that reaches the peg first, over
 its last frames before it crosses: its distance r to the peg (in links), the turn between its last whole link
 and its partial link (deg), and its velocity along and across the partial link (m/s) with r times the latter (its
 angular momentum about the peg per unit mass, m²/s).

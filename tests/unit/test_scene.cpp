@@ -352,6 +352,30 @@ TEST_CASE("the example scenes parse, run and close their energy ledger", "[unit]
   CHECK(with_fronts >= 5);
 }
 
+TEST_CASE("every example scene is named in docs/scenes.md, and every figure it shows exists", "[unit][scene]") {
+  const std::filesystem::path source(CHAINSIM_SOURCE_DIR);
+  const std::string doc = read(source / "docs" / "scenes.md");
+  int scenes = 0;
+  for (const auto& entry : std::filesystem::directory_iterator(source / "cases" / "scenes")) {
+    if (entry.path().extension() != ".toml") continue;
+    ++scenes;
+    INFO(entry.path().filename().string() << " is not named in docs/scenes.md");
+    CHECK(doc.find(entry.path().filename().string()) != std::string::npos);
+  }
+  CHECK(scenes >= 11);
+  // Each image and link into figures/: "](figures/NAME)".
+  int figures = 0;
+  for (std::size_t at = doc.find("](figures/"); at != std::string::npos; at = doc.find("](figures/", at + 1)) {
+    const std::size_t start = at + 2, end = doc.find(')', start);
+    REQUIRE(end != std::string::npos);
+    const std::string file = doc.substr(start, end - start);
+    INFO("docs/scenes.md shows docs/" << file);
+    CHECK(std::filesystem::exists(source / "docs" / file));
+    ++figures;
+  }
+  CHECK(figures >= 10);
+}
+
 TEST_CASE("chainsim run writes every output and prints the JSON summary", "[unit][scene]") {
   const auto dir = temp_dir("run_scene");
   const auto scene = dir / "hanging.toml";
