@@ -1,8 +1,8 @@
 """How a node reaches a peg along a swinging side (docs/model.md §8, "Why a swinging side fails at the point").
 
 Runs a chain laid as a V over a peg at the origin (sides at 37° from the vertical, released with a tangential
-speed of 0.5 m/s under gravity, slack allowed: the scene of the `[slack][edge]` test "a tangential start over an
-edge or a peg") on each mesh, frames every --interval, and prints for the node that reaches the peg first, over
+speed of 0.5 m/s under gravity, slack allowed: docs/data/v_over_peg.toml, the scene of the `[slack][edge]` test "a
+tangential start over an edge or a peg") on each mesh, frames every --interval, and prints for the node that reaches the peg first, over
 its last frames before it crosses: its distance r to the peg (in links), the turn between its last whole link
 and its partial link (deg), and its velocity along and across the partial link (m/s) with r times the latter (its
 angular momentum about the peg per unit mass, m²/s).
@@ -16,32 +16,12 @@ import math
 import os
 import subprocess
 
-SCENE = """model = "string"
-[string]
-length = 1.0
-nodes = {nodes}
-[shape]
-kind = "polyline"
-points = [[-0.3, -0.4], [0.0, 0.0], [0.3, -0.4]]
-[velocity]
-kind = "tangential"
-speed = 0.5
-[effects.gravity]
-g = [0.0, -9.81]
-[[effects.edge]]
-point = [0.0, 0.0]
-[solver]
-slack = "allow"
-[output]
-interval = {interval}
-[stop]
-t_end = 0.2
-"""
 
 
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--binary", default="build/chainsim")
+    parser.add_argument("--scene", default="docs/data/v_over_peg.toml")
     parser.add_argument("--nodes", type=int, nargs="+", default=[12, 24, 48])
     parser.add_argument("--interval", type=float, default=0.0002)
     parser.add_argument("--frames", type=int, default=12, help="frames printed per mesh")
@@ -50,10 +30,9 @@ def main():
     for n in args.nodes:
         out = os.path.join(args.out, f"n{n}")
         os.makedirs(out, exist_ok=True)
-        scene = os.path.join(out, "v_over_peg.toml")
-        with open(scene, "w") as f:
-            f.write(SCENE.format(nodes=n, interval=args.interval))
-        run = subprocess.run([args.binary, "run", scene, "--out", out], capture_output=True, text=True)
+        run = subprocess.run([args.binary, "run", args.scene, "--set", f"string.nodes={n}", "--set",
+                              f"output.interval={args.interval}", "--set", "stop.t_end=0.2", "--out", out],
+                             capture_output=True, text=True)
         frames = collections.defaultdict(dict)
         with open(os.path.join(out, "nodes.csv")) as f:
             for row in csv.DictReader(f):

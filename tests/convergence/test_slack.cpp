@@ -791,26 +791,8 @@ TEST_CASE("slack: a tangential start over an edge or a peg keeps the bent link a
   // s (1 − cos 45°) = 0.088 m/s: that link went slack at t = 0 and the edge lifted off at once. (A table
   // ending at an edge on a node, in 3D: test_table_edge.cpp, "in 3D with slack allowed and an initial speed".)
   SECTION("2D, a peg inside a link (the corner of the shape half-way along link 5, both sides hanging)") {
-    const std::string text = R"(model = "string"
-[string]
-length = 1.0
-nodes = 12
-[shape]
-kind = "polyline"
-points = [[-0.3, -0.4], [0.0, 0.0], [0.3, -0.4]]
-[velocity]
-kind = "tangential"
-speed = 0.5
-[effects.gravity]
-g = [0.0, -9.81]
-[[effects.edge]]
-point = [0.0, 0.0]
-[solver]
-slack = "allow"
-[stop]
-t_end = 0.08
-)";
-    StringScene<2> scene = build_string_scene<2>(parse_scene_text(text, "peg_speed.toml"));
+    const std::filesystem::path file = std::filesystem::path(CHAINSIM_SOURCE_DIR) / "docs" / "data" / "v_over_peg.toml";
+    StringScene<2> scene = build_string_scene<2>(parse_scene(file));
     REQUIRE(scene.model->bend_point(5) != nullptr);
     const Eigen::VectorXd rate = link_rates_of(*scene.model);
     std::printf("tangential start over a peg inside link 5: its rate %.3g m/s, largest |rate| %.3g m/s\n", rate[5],
@@ -829,7 +811,7 @@ t_end = 0.08
     // the first crossings on 24, 48, 96 nodes), which used to run on with the energy ledger off by 6.1e-3 J
     // (2.4e-3, 4.0e-4 J on 24, 48 nodes). The run now stops there, located
     // (FrontTracker::kCrossingProjectionTolerance).
-    StringScene<2> longer = build_string_scene<2>(parse_scene_text(text, "peg_speed.toml", {"stop.t_end=0.2"}));
+    StringScene<2> longer = build_string_scene<2>(parse_scene(file, {"stop.t_end=0.2"}));
     StringSolver<2> on(*longer.model, longer.solver);
     CHECK_THROWS_WITH(on.run(), Catch::Matchers::Contains("after the crossing of front 0 (edge) at t = 0.0890754") &&
                                     Catch::Matchers::Contains("the projection onto the links' lengths changed K + V by -0.128 J"));
