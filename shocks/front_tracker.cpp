@@ -451,7 +451,10 @@ EventAction FrontTracker<dim>::handle_events(StringModel<dim>& model, double t, 
           fmt::format("after the crossing of front {} ({}) at t = {:.9g} s (s0 = {:.9g} m): the projection onto the links' "
                       "lengths changed K + V by {:.3g} J, more than {:g} of the energy scale {:.3g} J (on straight "
                       "sides it is round-off): the crossing left the string far from its constraints, and the run "
-                      "past it would not be the string's motion (docs/model.md §8, \"Round-off at a crossing\")",
+                      "past it would not be the string's motion. A side that reaches the point swinging or curved "
+                      "does this: an edge takes material that reaches it along a straight side only, and a peg with "
+                      "a radius ([[effects.cylinder]]) takes swinging sides (docs/scenes.md, \"Sides that swing\"; "
+                      "docs/model.md §8, \"Why a swinging side fails at the point\")",
                       *acted, fronts_[*acted]->name(), t, fs_[*acted].s0, projected, kCrossingProjectionTolerance, scale),
           t);
   }

@@ -7,7 +7,7 @@ where RESULTS_DIR/<scene>/ holds the outputs of
 for shaken_chain, travelling_loop, whip_crack, pendulum_release, folded_chain_ends_apart, swinging_u,
 pendulum_whip and thrown_chain (string scenes; the last three with slack = "allow"), spinning_loop_dropped
 (3D, closed, slack = "allow"), chain_off_table_edge and
-chain_over_peg and chain_over_two_pegs (edges), atwood_pulley and atwood_rough_pulley (cylinders), chain_landing_at_angle and chain_landing_on_table (a surface),
+chain_over_peg and chain_over_two_pegs (edges), atwood_pulley, atwood_rough_pulley and chain_over_round_peg (cylinders), chain_landing_at_angle and chain_landing_on_table (a surface),
 chain_off_real_table (a table bounded by its edge), chain_into_heap_on_table (a heap on a contact surface), streaming_corner (a kink) and
 falling_chain, folded_chain, sliding_chain, swinging_sliding_chain, tilted_falling_chain and
 curved_falling_chain (scenes with fronts), and RESULTS_DIR/<scene>_reduced/ the same canonical scenes run with
@@ -310,6 +310,20 @@ def atwood_rough_pulley(run, ax):
     decorate(ax[1], "t (s)", "m", "beyond the capstan bound (x1 = 0.45 m > 0.4161 m) it slides")
 
 
+def chain_over_round_peg(run, ax):
+    snapshots(ax[0], run, [0, 0.1, 0.2, 0.3, 0.4], "a V swinging over a round peg, R = 1 cm")
+    centre = np.array([0.0, -0.016666666666666666])
+    frames = run.nodes
+    for node, label in [(0, "shorter side's end (s = 0)"), (-1, "longer side's end")]:
+        angle = []
+        for k in range(len(frames)):
+            r = frames.positions(k)[node] - centre
+            angle.append(math.degrees(math.atan2(r[0], -r[1])))
+        ax[1].plot(frames.times, np.unwrap(np.radians(angle)) * 180 / math.pi, lw=2, label=label)
+    ax[1].axhline(0, color="k", lw=0.6)
+    decorate(ax[1], "t (s)", "deg", "each end's angle about the peg from the downward vertical")
+
+
 def free_fall_landing_loss(frames, ts, nodes=slice(None), g=9.81):
     """-sum of m g y0 over the chosen nodes (lumped masses: 1 kg/m over 1 m, half a link's mass at each end)
     that have landed on the table y = 0 by each time in ts, each falling freely from rest at its height y0:
@@ -417,7 +431,7 @@ def spinning_loop_dropped(run, ax):
 SCENES = [shaken_chain, travelling_loop, whip_crack, pendulum_release, falling_chain, folded_chain, sliding_chain,
           swinging_sliding_chain, tilted_falling_chain, curved_falling_chain, folded_chain_ends_apart,
           chain_off_table_edge, swinging_u, pendulum_whip, thrown_chain, chain_over_peg, chain_over_two_pegs,
-          atwood_pulley, atwood_rough_pulley, streaming_corner, chain_landing_at_angle, chain_landing_on_table,
+          atwood_pulley, atwood_rough_pulley, chain_over_round_peg, streaming_corner, chain_landing_at_angle, chain_landing_on_table,
           chain_off_real_table, chain_into_heap_on_table,
           spinning_loop_dropped]
 
