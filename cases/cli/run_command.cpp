@@ -98,6 +98,8 @@ int run_string_scene(const SceneSpec& spec, const std::filesystem::path& dir, bo
   // The JSON summary is for a program: the warning also goes to stderr, for the person who ran it
   // (the text report has it on its 'warning' line).
   if (json && !s.tolerance_warning.empty()) std::cerr << "chainsim: warning: " << s.tolerance_warning << '\n';
+  const std::string resolution_warning = summary.value("resolution_warning", std::string());
+  if (json && !resolution_warning.empty()) std::cerr << "chainsim: warning: " << resolution_warning << '\n';
   if (json) {
     print_json(out, summary, spec, dir);
   } else if (!failure) {  // a failure is reported by its message (outputs written up to it)
@@ -158,6 +160,7 @@ int run_string_scene(const SceneSpec& spec, const std::filesystem::path& dir, bo
                            : "none at any accepted step",
                        to_string(s.slack_policy));
     if (!s.tolerance_warning.empty()) out << fmt::format("warning    {}\n", s.tolerance_warning);
+    if (!resolution_warning.empty()) out << fmt::format("warning    {}\n", resolution_warning);
     out << fmt::format("outputs    {}: {}\n", dir.string(), output_files(dir));
   }
   if (failure) throw *failure;

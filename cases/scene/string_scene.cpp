@@ -1,5 +1,8 @@
 // String scenes, step 3: SceneSpec -> StringModel (build_string_scene, scene.hpp), the one builder of
 // scenes with and without fronts (the fronts' part: build_front_model, front_scene.cpp).
+#include <algorithm>
+#include <cmath>
+
 #include "cases/scene/front_scene.hpp"
 #include "cases/scene/scene.hpp"
 #include "cases/scene/scene_build.hpp"
@@ -149,6 +152,29 @@ std::string obstacle_key(const SceneSpec& spec) {
   return spec.effects.cylinders.empty() ? "effects.plane" : "effects.cylinder";
 }
 
+/// The warning for a cylinder in node contact whose radius is shorter than the longest link (empty when every
+/// one is resolved). Its nodes are held on the circle and its links are chords, so a cylinder less than about a
+/// link in radius is touched by one or two nodes, a polygon: the contact forces and the lift-offs are then not
+/// the cylinder's (docs/scenes.md, "[[effects.cylinder]]": the heavy Atwood chain over R = h/2 lifts off 5 % early).
+std::string cylinder_resolution_warning(const SceneSpec& spec, const std::vector<double>& link_lengths) {
+  if (link_lengths.empty()) return {};
+  const double h = *std::max_element(link_lengths.begin(), link_lengths.end());
+  double length = 0;
+  for (double hj : link_lengths) length += hj;
+  std::string warning;
+  for (std::size_t k = 0; k < spec.effects.cylinders.size(); ++k) {
+    const CylinderEntry& c = spec.effects.cylinders[k];
+    if (c.contact != "nodes" || !(h > c.radius)) continue;
+    const long nodes = static_cast<long>(std::ceil(length / c.radius)) + 1;
+    warning += fmt::format("{}effects.cylinder[{}].radius = {:g} m is shorter than the links ({:.3g} m): in node contact "
+                           "its nodes are held on the circle and its links are chords, so it is touched by one or two "
+                           "nodes and its contact forces and lift-offs are not resolved (docs/scenes.md); set "
+                           "string.nodes >= {} (links no longer than the radius)",
+                           warning.empty() ? "" : "; ", k, c.radius, h, nodes);
+  }
+  return warning;
+}
+
 }  // namespace
 
 template <int dim>
@@ -206,6 +232,8 @@ StringScene<dim> build_string_scene(const SceneSpec& spec) {
   RunSummary built;
   describe_model(*scene.model, built);
   scene.description.update(model_json(built));
+  const std::string unresolved = cylinder_resolution_warning(spec, scene.model->chain().link_lengths());
+  if (!unresolved.empty()) scene.description["resolution_warning"] = unresolved;
   return scene;
 }
 

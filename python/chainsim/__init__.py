@@ -35,12 +35,17 @@ from ._results import Comparison, ReducedResult, Result, result_of_run
 __version__: str = _core.__version__
 
 __all__ = ["ChainsimInputError", "NumericalError", "Scene", "Result", "ReducedResult", "Comparison", "reduced",
-           "compare", "sweep", "read_run", "plot", "ToleranceWarning", "__version__"]
+           "compare", "sweep", "read_run", "plot", "ToleranceWarning", "ResolutionWarning", "__version__"]
 
 
 class ToleranceWarning(UserWarning):
     """Scene.run(): atol is coarser than rtol times the motion's size (the summary's
     ``tolerance_warning``, which names the value of ``solver.atol`` that resolves the motion)."""
+
+
+class ResolutionWarning(UserWarning):
+    """Scene.run(): a cylinder in node contact is thinner than the links, so the mesh does not resolve it (the
+    summary's ``resolution_warning``, which names the ``string.nodes`` that does)."""
 
 if TYPE_CHECKING:  # pragma: no cover
     from pandas import DataFrame
@@ -234,6 +239,8 @@ class Scene:
             raise KeyboardInterrupt(result.summary.get("stop_reason", "interrupted"))
         if "tolerance_warning" in result.summary:  # atol coarser than rtol x the motion's size
             warnings.warn(result.summary["tolerance_warning"], ToleranceWarning, stacklevel=2)
+        if "resolution_warning" in result.summary:  # a cylinder thinner than the links
+            warnings.warn(result.summary["resolution_warning"], ResolutionWarning, stacklevel=2)
         if run.error:
             error = NumericalError(run.error)
             error.result = result  # type: ignore[attr-defined]

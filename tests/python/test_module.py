@@ -361,3 +361,17 @@ def test_a_coarse_atol_warns_with_the_value_to_set():
     with warnings.catch_warnings():
         warnings.simplefilter("error", chainsim.ToleranceWarning)
         assert "tolerance_warning" not in scene.set(**{"solver.atol": advised}).run().summary
+
+
+def test_a_cylinder_thinner_than_the_links_warns_with_the_nodes_to_set():
+    # The heavy Atwood chain over a pulley of radius 0.1 m on 5 nodes (links of 0.25 m): the pulley is a polygon
+    # of one or two nodes; the advised mesh does not warn (issue 23).
+    scene = chainsim.Scene.from_file(os.path.join(SOURCE, "cases", "scenes", "atwood_pulley.toml")).set(**{
+        "string.nodes": 5, "stop.t_end": 0.01})
+    with pytest.warns(chainsim.ResolutionWarning, match=r"set string.nodes >= 11 ") as caught:
+        result = scene.run()
+    assert [str(w.message) for w in caught if w.category is chainsim.ResolutionWarning] == \
+        [result.summary["resolution_warning"]]
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", chainsim.ResolutionWarning)
+        assert "resolution_warning" not in scene.set(**{"string.nodes": 11}).run().summary
