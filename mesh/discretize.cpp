@@ -84,14 +84,6 @@ class Polyline final : public Curve<dim> {
   bool closed_;
 };
 
-/// A point as messages show it: "[0.04, -0.3]".
-template <int dim>
-std::string show_point(const Vec<dim>& x) {
-  std::string out = "[";
-  for (int d = 0; d < dim; ++d) out += fmt::format("{}{:g}", d > 0 ? ", " : "", x[d]);
-  return out + "]";
-}
-
 /// An open polyline whose interior vertices are rounded by fillets (rounded_polyline_curve).
 ///
 /// At vertex k with unit directions a (incoming) and b (outgoing), cos θ = a·b and the unit normal

@@ -34,12 +34,6 @@ Vec<dim> rotate_onto(const Vec<dim>& v, const Vec<dim>& from, const Vec<dim>& to
   }
 }
 
-template <int dim>
-std::string show(const Vec<dim>& v) {
-  std::string out = "[";
-  for (int d = 0; d < dim; ++d) out += fmt::format("{}{:.6g}", d ? ", " : "", v[d]);
-  return out + "]";
-}
 
 }  // namespace
 
@@ -92,7 +86,7 @@ void EdgeFront<dim>::initialize(StringModel<dim>& model) {
             "the edge point {} is on node {} (s = {:.9g} m) and node {} of the string is held (a fixed or driven "
             "end): the edge needs its point inside a link there (the string is moved back by {:.3g} m to put it "
             "there, which a held node cannot follow); move the point along the string or change string.nodes",
-            show<dim>(point_), c, model.chain().node_coordinate(c), i, nudge));
+            show_point<dim>(point_), c, model.chain().node_coordinate(c), i, nudge));
     const Vec<dim> tm = unit_vector<dim>(point_ - x.col(c - 1), "the string before the edge");
     const Vec<dim> tp = unit_vector<dim>(x.col(c + 1) - point_, "the string after the edge");
     shift_sides(model, 0, c, c + 1, this->m_.n - 1, -nudge, tm, tp);
@@ -124,7 +118,7 @@ void EdgeFront<dim>::initialize(StringModel<dim>& model) {
     throw InputError(fmt::format("the table under the string {} the edge has its outward normal {} and the uniform "
                                  "field is {}: {}, so no table holds it; allowed a table the field presses the string "
                                  "onto (g·n < 0), or table = \"none\"",
-                                 before ? "before" : "after", show<dim>(table_normal_), show<dim>(g),
+                                 before ? "before" : "after", show_point<dim>(table_normal_), show_point<dim>(g),
                                  g.dot(table_normal_) > 0 ? "the field pulls the string off it"
                                                           : "the field does not press the string onto it (g·n = 0)"));
   const int first = before ? 0 : a + 1, last = before ? a : this->m_.n - 1;
@@ -133,7 +127,7 @@ void EdgeFront<dim>::initialize(StringModel<dim>& model) {
     if (std::abs(off) > 1e-6 * this->m_.ell)
       throw InputError(fmt::format("node {} of the string {} the edge is {:.6g} m off the table (the face through the "
                                    "edge point with outward normal {}): the string there must lie on it",
-                                   i, before ? "before" : "after", off, show<dim>(table_normal_)));
+                                   i, before ? "before" : "after", off, show_point<dim>(table_normal_)));
   }
 }
 
@@ -357,7 +351,7 @@ EventAction EdgeFront<dim>::cross(StringModel<dim>& model, const FrontState<dim>
     return {EventAction::Kind::kStop,
             fmt::format("node {} has reached the edge at {} (s0 = {:.9g} m) and the next link over it, link {}, runs "
                         "over another edge at {}: two edges within one link of each other",
-                        node, show<dim>(point_), s.s0, new_link, show<dim>(*model.bend_point(new_link)))};
+                        node, show_point<dim>(point_), s.s0, new_link, show_point<dim>(*model.bend_point(new_link)))};
   const double h = this->m_.h, past = kMirror * kCross * h;
   const int sign = e0 != 0 ? +1 : -1;
   const double delta = e0 != 0 ? g_minus(model) : g_plus(model);
@@ -435,7 +429,7 @@ std::string EdgeFront<dim>::check_failed(const StringModel<dim>& model, const Fr
   if (slack_)
     return fmt::format("lifted off the edge at t = {:.9g} s: the link bent over the edge at {} (link {}) has gone slack, "
                        "so the string no longer presses on the edge (s0 = {:.9g} m)",
-                       t, show<dim>(point_), link_, s.s0);
+                       t, show_point<dim>(point_), link_, s.s0);
   const Vec<dim> reaction = recorded_reaction(model, s);
   if (dim == 3 && along_line(model, s))
     return fmt::format(
@@ -443,11 +437,11 @@ std::string EdgeFront<dim>::check_failed(const StringModel<dim>& model, const Fr
         "the edge's line {} (reaction F0 = {} N; allowed at most {:g} of τ⁻ + τ⁺ + λ ṡ0²), which a smooth edge cannot give: the "
         "crossing point would slide along the line, which the edge front does not model (docs/model.md §8, \"An edge "
         "in 3D\"); the string must cross the line at right angles (s0 = {:.9g} m)",
-        show<dim>(point_), t, reaction.dot(axis_), show<dim>(axis_), show<dim>(reaction), kAlongLine, s.s0);
+        show_point<dim>(point_), t, reaction.dot(axis_), show_point<dim>(axis_), show_point<dim>(reaction), kAlongLine, s.s0);
   return fmt::format("lifted off the edge at t = {:.9g} s: the edge at {} would have to pull the string (its reaction "
                      "F0 = {} N leaves the edge's normal cone; tensions {:.6g} N before and {:.6g} N after it, "
                      "material speed {:.6g} m/s, s0 = {:.9g} m)",
-                     t, show<dim>(point_), show<dim>(reaction), tension_minus(model), tension_plus(model),
+                     t, show_point<dim>(point_), show_point<dim>(reaction), tension_minus(model), tension_plus(model),
                      std::abs(s.s0_dot), s.s0);
 }
 

@@ -235,6 +235,7 @@ class ContactModule final : public WrappingModule<dim> {
     for (const Obstacle<dim>& o : obstacles_) {
       friction_ = friction_ || o.mu > 0;
       arc_ = arc_ || on_arc(o);
+      side_faces_ = side_faces_ || bounded(o);
     }
   }
 
@@ -270,6 +271,19 @@ class ContactModule final : public WrappingModule<dim> {
                                      i, -gap, obstacles_[static_cast<std::size_t>(k)].name, kInitialContact));
       if (gap <= kInitialContact * h_) held_[static_cast<std::size_t>(i)] = k;
     }
+    if (side_faces_)
+      for (int i = 0; i < n; ++i) {
+        const auto [k, gap] = side_face_gap(model, i);
+        if (k >= 0 && held_[static_cast<std::size_t>(i)] < 0 && gap <= 0)
+          throw InputError(fmt::format("node {} of the string, beyond the table's edge in the material, starts inside "
+                                       "the table {}, {:.6g} m beneath its top and {:.6g} m in from its edge (allowed: "
+                                       "beyond the edge's line, or above the table)",
+                                       i, obstacles_[static_cast<std::size_t>(k)].name,
+                                       -obstacles_[static_cast<std::size_t>(k)].normal.dot(
+                                           model.x().col(i) - obstacles_[static_cast<std::size_t>(k)].point),
+                                       obstacles_[static_cast<std::size_t>(k)].inward.dot(
+                                           model.x().col(i) - obstacles_[static_cast<std::size_t>(k)].point)));
+      }
     if (arc_) {
       // Links along the arc are built for a string that starts wrapped on the circle: a node that reaches
       // it from off the circle lands across a bend, its links chords (an open chain started 3e-5 m off
@@ -416,7 +430,9 @@ class ContactModule final : public WrappingModule<dim> {
                        {ledger[k + kFriction], static_cast<double>(sticks_), static_cast<double>(slips_)});
     out.has_momentum_ledger = true;
   }
-  int num_events() const override { return inner_events() + (friction_ ? 4 : 2) + (arc_ ? 2 : 0); }
+  int num_events() const override {
+    return inner_events() + (friction_ ? 4 : 2) + (arc_ ? 2 : 0) + (side_faces_ ? 1 : 0);
+  }
   bool events_need_tensions() const override { return true; }
   void events(const StringModel<dim>& model, Eigen::Ref<Eigen::VectorXd> g) const override {
     // The inner module's, then: the smallest gap of a free node (landing); the smallest normal force of
@@ -434,13 +450,20 @@ class ContactModule final : public WrappingModule<dim> {
     for (std::size_t c = 0; c < model.contacts().size(); ++c)
       g[k + 1] = std::min(g[k + 1], held_force(model, c, a));
     if (friction_) friction_events(model, g.tail(g.size() - k));
-    if (arc_) wrap_events(model, g.tail(2));
+    if (arc_) wrap_events(model, g.segment(side_face_event() - 2, 2));
+    if (side_faces_) {
+      // The smallest distance of a free node from the body of a table that ends at an edge (per link length).
+      g[side_face_event()] = 1;
+      for (int i = 0; i < static_cast<int>(held_.size()); ++i)
+        g[side_face_event()] = std::min(g[side_face_event()], side_face_gap(model, i).second / h_);
+    }
   }
   std::vector<int> event_directions() const override {
     std::vector<int> directions = inner_ ? inner_->event_directions() : std::vector<int>{};
     directions.insert(directions.end(), {-1, -1});
     if (friction_) directions.insert(directions.end(), {-1, -1});
     if (arc_) directions.insert(directions.end(), {-1, -1});
+    if (side_faces_) directions.push_back(-1);
     return directions;
   }
   EventAction handle_events(StringModel<dim>& model, double t, Eigen::Ref<Eigen::VectorXd> ledger,
@@ -448,6 +471,8 @@ class ContactModule final : public WrappingModule<dim> {
     // The fronts' events first (a crossing moves nodes between arcs, heaps and the sides of an edge),
     // then the held set brought up to the layout they leave, then the landings and lift-offs.
     const int k = inner_events(), kl = inner_ledgers();
+    if (side_faces_ && found.size() > static_cast<std::size_t>(side_face_event()) && found[side_face_event()] != 0)
+      through_side_face(model, t);
     EventAction action = this->handle_inner_events(model, t, ledger, found);
     if (action.kind == EventAction::Kind::kStop) return action;
     bool changed = action.kind == EventAction::Kind::kTransfer;
@@ -515,6 +540,7 @@ class ContactModule final : public WrappingModule<dim> {
   // in (its coordinates in the obstacle's tangents(); zero: not yet classified, or no friction).
   static constexpr int kFriction = 2 + dim;  // W_friction's place in the module's own ledger (after the inner's)
   bool friction_ = false;
+  bool side_faces_ = false;  ///< some obstacle is a table that ends at an edge: the side-face event
   std::vector<char> stuck_;
   Eigen::Matrix<double, dim - 1, Eigen::Dynamic> dir_;
   double length_ = 1;  // the string's length (m)
@@ -1008,6 +1034,53 @@ class ContactModule final : public WrappingModule<dim> {
   }
 
   static bool free_node(const StringModel<dim>& model, int i) { return model.in_arc(i) && !model.is_prescribed(i); }
+  /// A table that ends at an edge: a plane bounded by its edge.
+  static bool bounded(const Obstacle<dim>& o) {
+    return o.kind == Obstacle<dim>::Kind::kPlane && o.inward.squaredNorm() > 0;
+  }
+  /// The index of the side-face event: the last of this module's.
+  int side_face_event() const { return num_events() - (side_faces_ ? 1 : 0); }
+  /// A table's body is the quarter-plane (a quarter-space in 3D) beneath its top and in from its edge. The nodes
+  /// beyond the edge in the material (the edge front's other side) cannot rest on the table, and its side face
+  /// below the edge is not an obstacle (docs/scenes.md, "[[effects.surface]]"): such a node that reaches the body
+  /// stops the run. The bounded table that may not hold free node i and the node's distance from its body,
+  /// max(n·r + δ_top, δ_side − d·r) with r from the edge, n the top's normal and d the direction into the table:
+  /// < 0 inside it. δ_side = kSideFaceMargin h leaves a side hanging flush with the face (the chain off a table,
+  /// d·r at round-off) outside, δ_top = kInitialContact h the node crossing the edge at the top's level.
+  /// (−1, +∞) for a held node, a node every bounded table may hold, or without bounded tables.
+  std::pair<int, double> side_face_gap(const StringModel<dim>& model, int i) const {
+    std::pair<int, double> nearest{-1, INFINITY};
+    if (held_[static_cast<std::size_t>(i)] >= 0 || !free_node(model, i)) return nearest;
+    for (std::size_t k = 0; k < obstacles_.size(); ++k) {
+      const Obstacle<dim>& o = obstacles_[k];
+      if (!bounded(o) || o.may_hold(i)) continue;
+      const Vec<dim> r = model.x().col(i) - o.point;
+      const double gap = std::max(o.normal.dot(r) + kInitialContact * h_, kSideFaceMargin * h_ - o.inward.dot(r));
+      if (gap < nearest.second) nearest = {static_cast<int>(k), gap};
+    }
+    return nearest;
+  }
+  /// A free node has reached a table's body through its side face: the run stops, located (a NumericalError:
+  /// the motion past it would pass through the table, which the model does not hold there).
+  [[noreturn]] void through_side_face(const StringModel<dim>& model, double t) const {
+    int node = -1, table = -1;
+    double deepest = INFINITY;
+    for (int i = 0; i < static_cast<int>(held_.size()); ++i) {
+      const auto [k, gap] = side_face_gap(model, i);
+      if (k >= 0 && gap < deepest) std::tie(node, table, deepest) = std::tie(i, k, gap);
+    }
+    const Obstacle<dim>& o = obstacles_[static_cast<std::size_t>(table)];
+    const Vec<dim> r = model.x().col(node) - o.point;
+    throw NumericalError(
+        fmt::format("node {} (s = {:.6g} m), beyond the edge at {} in the material, has reached the body of the table "
+                    "{} at t = {:.9g} s, {:.6g} m beneath its top and {:.6g} m in from its edge: the table's side face "
+                    "below the edge is not an obstacle, and the string beyond the edge cannot rest on the table, so "
+                    "the string would pass into it (a side that swings back under the table, or over onto it, is not "
+                    "modelled: docs/scenes.md, \"[[effects.surface]]\")",
+                    node, model.chain().node_coordinate(node), show_point<dim>(o.point), o.name, t, -o.normal.dot(r),
+                    o.inward.dot(r)),
+        t);
+  }
   /// Node i is held now: on an obstacle, free (a front may have taken it into a heap), and on the
   /// obstacle's side of its edge (a node that has crossed the edge is the edge front's).
   bool holds(const StringModel<dim>& model, int i) const {

@@ -100,4 +100,9 @@ std::unique_ptr<StringModule<dim>> make_contact_module(std::vector<Obstacle<dim>
 /// a polygon inscribed in a curved one); further inside, the scene is refused.
 inline constexpr double kInitialContact = 1e-3;
 
+/// A free node this share of a link length in from the edge of a table that ends at an edge, beneath its top,
+/// has entered the table through its side face (which is not an obstacle): the run stops, located. The margin
+/// leaves a side hanging flush with the face (its nodes at round-off from it) outside.
+inline constexpr double kSideFaceMargin = 1e-6;
+
 }  // namespace chainsim

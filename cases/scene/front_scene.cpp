@@ -60,12 +60,6 @@ std::optional<double> shape_turn(const Curve<dim>& curve, double s0, double ell)
   return std::acos(std::clamp(t->first.dot(t->second), -1.0, 1.0));
 }
 
-template <int dim>
-std::string show(const Vec<dim>& v) {
-  std::string out = "[";
-  for (int d = 0; d < dim; ++d) out += fmt::format("{}{:.6g}", d ? ", " : "", v[d]);
-  return out + "]";
-}
 
 template <int dim>
 nlohmann::json to_array(const Vec<dim>& v) {
@@ -134,7 +128,7 @@ TableSide<dim> table_side(const SceneSpec& spec, std::size_t k, const EdgeSpec<d
       fail_at(spec, key + ".normal",
               fmt::format("{}.normal = {} is not normal to the line of {} (direction {}): the table's edge lies in "
                           "its plane",
-                          key, text_of(spec, key + ".normal"), edge_key, show<dim>(edge.axis)));
+                          key, text_of(spec, key + ".normal"), edge_key, show_point<dim>(edge.axis)));
   }
   const double d = std::min({kTangentStep * ell, 0.5 * edge.s0, 0.5 * (ell - edge.s0)});
   const Vec<dim> tm = (curve.point(edge.s0) - curve.point(edge.s0 - d)).normalized();
@@ -143,7 +137,7 @@ TableSide<dim> table_side(const SceneSpec& spec, std::size_t k, const EdgeSpec<d
   auto shown = [](Vec<dim> v) {  // the tangents of a polyline, without the round-off of their differences
     for (int c = 0; c < dim; ++c)
       if (std::abs(v[c]) < 1e-9) v[c] = 0;
-    return show<dim>(v);
+    return show_point<dim>(v);
   };
   if (on_before == on_after)
     fail_at(spec, key + ".edge",
@@ -225,7 +219,7 @@ std::unique_ptr<StringModel<dim>> build_front_model(const SceneSpec& spec, scene
   if (fx.plane) {
     plane_point = as_vec<dim>(spec, fx.plane->point, "effects.plane.point");
     const Vec<dim> n = as_vec<dim>(spec, fx.plane->normal, "effects.plane.normal");
-    check_plane_normal(n, show<dim>(n), keys);
+    check_plane_normal(n, show_point<dim>(n), keys);
     plane_normal = n.stableNormalized();  // [0, 1e300] too: its norm overflows, its direction does not
   }
   for (std::size_t k = 0; k < fx.heaps.size(); ++k) {
@@ -240,15 +234,15 @@ std::unique_ptr<StringModel<dim>> build_front_model(const SceneSpec& spec, scene
       fail_at(spec, key + ".point",
               fmt::format("{}.point = {} is {:.6g} m from the string's material point s0 = {:g} m, which the shape puts "
                           "at {}: the shape must pass through the heap point at s0",
-                          key, text_of(spec, key + ".point"), miss, heap.s0, show<dim>(on_shape)));
+                          key, text_of(spec, key + ".point"), miss, heap.s0, show_point<dim>(on_shape)));
     if (heap.on_plane) {
       const double distance = (point - *plane_point).dot(*plane_normal);
       if (std::abs(distance) > kPlaceTolerance * ell)
         fail_at(spec, key + ".point",
                 fmt::format("{}.point = {} is not on its plane: it is {:.6g} m from effects.plane (through {} with "
                             "normal {})",
-                            key, text_of(spec, key + ".point"), std::abs(distance), show<dim>(*plane_point),
-                            show<dim>(*plane_normal)));
+                            key, text_of(spec, key + ".point"), std::abs(distance), show_point<dim>(*plane_point),
+                            show_point<dim>(*plane_normal)));
     }
     (start ? s_lo : s_hi) = heap.s0;
     HeapSpec<dim> hs;
@@ -487,7 +481,7 @@ std::unique_ptr<StringModel<dim>> build_front_model(const SceneSpec& spec, scene
                     fmt::format("{}.direction = {}: the string {} the edge runs along its line (tangent {}), and the "
                                 "edge's lift-off cone lies normal to the line; allowed a direction the string crosses "
                                 "on both sides",
-                                key, text_of(spec, key + ".direction"), side, show<dim>(tangent)));
+                                key, text_of(spec, key + ".direction"), side, show_point<dim>(tangent)));
     }
 
   // 4d. Touchdown fronts ([[effects.surface]] with f): where the initial shape leaves the surface.
