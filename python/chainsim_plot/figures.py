@@ -247,8 +247,9 @@ class Layout:
     def _draw_contact_obstacles(self, ax, proj, extra, label):
         """The obstacles of [[effects.surface]] and [[effects.cylinder]] (the summary's `obstacles`): a
         plane as its trace (where the projection sees it edge-on), a cylinder as a grey disc (2D, or a 3D
-        cylinder whose axis is normal to the projection)."""
-        from matplotlib.patches import Circle
+        cylinder whose axis is normal to the projection), or else as its silhouette, the band of half-width R
+        about its axis's projection, across the picture."""
+        from matplotlib.patches import Circle, Polygon
         a, b = proj
         first = {"surface": True, "cylinder": True}
         count = {"surface": 0, "cylinder": 0}
@@ -265,13 +266,18 @@ class Layout:
                     continue
                 ax.lines[-1].set_gid(gid)
             else:
-                if self.dim == 3:
-                    axis = np.asarray(o.get("axis", [0, 0, 1]), dtype=float)
-                    if abs(axis[a]) + abs(axis[b]) > 1e-9 * np.linalg.norm(axis):
-                        continue
                 c = np.asarray(o["center"], dtype=float)[[a, b]]
-                ax.add_patch(Circle(c, o["radius"], facecolor="0.75", edgecolor="0.45", lw=1.0, zorder=0, label=lab,
-                                    gid=gid))
+                style = dict(facecolor="0.75", edgecolor="0.45", lw=1.0, zorder=0, label=lab, gid=gid)
+                axis = np.asarray(o.get("axis", [0, 0, 1]), dtype=float) if self.dim == 3 else None
+                if axis is not None and abs(axis[a]) + abs(axis[b]) > 1e-9 * np.linalg.norm(axis):
+                    u = axis[[a, b]] / np.linalg.norm(axis[[a, b]])
+                    n = np.array([-u[1], u[0]]) * o["radius"]
+                    mid = c + np.dot(0.5 * (self.lo[[a, b]] + self.hi[[a, b]]) - c, u) * u
+                    half = 0.6 * self.size + extra
+                    ax.add_patch(Polygon([mid - half * u + n, mid + half * u + n, mid + half * u - n,
+                                          mid - half * u - n], closed=True, **style))
+                else:
+                    ax.add_patch(Circle(c, o["radius"], **style))
             first[kind] = False
 
     @staticmethod

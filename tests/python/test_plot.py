@@ -92,6 +92,13 @@ def run_dir(kind):
         args = ["run", scene("chain_over_peg", 21, {r"(?m)^t_end = .*": "t_end = 0.1"}), "--out", out]
     elif kind == "pulley":
         args = ["run", scene("atwood_pulley", 21, {r"(?m)^t_end = .*": "t_end = 0.1"}), "--out", out]
+    elif kind == "pulley3d":  # the same in 3D, the pulley's axis along z
+        args = ["run", scene("atwood_pulley", 21, {
+            r"(?m)^t_end = .*": "t_end = 0.1", r"(?m)^nodes = 21": "nodes = 21\ndimension = 3",
+            r"(?m)^points = .*": "points = [[-0.1, -0.2929203673205103, 0.0], [-0.1, 0.1, 0.0], [0.1, 0.1, 0.0], "
+                                 "[0.1, -0.3929203673205103, 0.0]]",
+            r"g = \[0.0, -9.81\]": "g = [0.0, -9.81, 0.0]",
+            r"(?m)^center = \[0.0, 0.0\]": "center = [0.0, 0.0, 0.0]\naxis = [0.0, 0.0, 1.0]"}), "--out", out]
     elif kind == "landing":
         args = ["run", scene("chain_landing_on_table", 11, {r"(?m)^t_end = .*": "t_end = 0.15"}), "--out", out]
     elif kind == "real_table":
@@ -635,6 +642,27 @@ def test_reader_surface_and_cylinder_drawn_as_obstacles():
         x, y = drawn["obstacle surface0"].get_data()
         assert np.allclose(y, 0, atol=1e-12) and x[0] < 0 and x[1] > 1.0
         plt.close(fig)
+
+
+def test_reader_3d_cylinder_drawn_in_every_view():
+    """The Atwood pulley in 3D, its axis along z: a disc on x-y (the axis normal to the view); on x-z, where the
+    axis lies in the view, its silhouette, the band |x| <= R along z across the picture (it used to be left out)."""
+    import matplotlib.pyplot as plt
+    from chainsim_plot.figures import Layout
+    from chainsim_plot.readers import load_run
+    run = load_run(run_dir("pulley3d"))
+    layout = Layout(run)
+    fig, axes = plt.subplots(1, 2)
+    for ax, proj in zip(axes, layout.projections):
+        layout.draw_obstacles(ax, proj)
+    xy = {a.get_gid(): a for a in axes[0].patches if a.get_gid()}
+    xz = {a.get_gid(): a for a in axes[1].patches if a.get_gid()}
+    assert sorted(xy) == ["obstacle cylinder0"] and sorted(xz) == ["obstacle cylinder0"]
+    assert np.allclose(xy["obstacle cylinder0"].center, [0, 0], atol=1e-12)
+    band = xz["obstacle cylinder0"].get_xy()
+    assert np.allclose(sorted(set(np.round(band[:, 0], 12))), [-0.1, 0.1])
+    assert band[:, 1].min() < -0.2 and band[:, 1].max() > 0.2
+    plt.close(fig)
 
 
 def test_reader_table_ending_at_its_edge_drawn_up_to_the_edge():
