@@ -168,6 +168,9 @@ class FrontKind {
   /// Puts the front into the string where it formed: splits an arc (model.arcs(), then model.rebuild()) and
   /// sets arc_minus, arc_plus; returns false if no place fits (the run then stops).
   virtual bool insert(StringModel<dim>& /*model*/) { return false; }
+  /// Where the front formed, for the message of an insertion that found no place (" at node j (s = … m, at […])");
+  /// empty for a kind that does not say.
+  virtual std::string where_formed(const StringModel<dim>& /*model*/) const { return {}; }
   /// Constraints of the front that couple nodes beyond the links (NodeConstraint, a kink's
   /// compatibility), at the string's current state, after `evaluate`.
   virtual void constraints(const StringModel<dim>& /*model*/, const FrontState<dim>& /*state*/,

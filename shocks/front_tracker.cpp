@@ -406,8 +406,9 @@ EventAction FrontTracker<dim>::handle_events(StringModel<dim>& model, double t, 
       }
   if (forming && !insert_front(model, *forming, t))
     return {EventAction::Kind::kStop,
-            fmt::format("a {} formed at t = {:.9g} s where no link fits it (its arms need a full link on either side)",
-                        fronts_[*forming]->name(), t)};
+            fmt::format("a {} formed at t = {:.9g} s{}, and no link there fits it (its arms need a full link on either "
+                        "side, and the arms' meeting point inside the kinked link)",
+                        fronts_[*forming]->name(), t, fronts_[*forming]->where_formed(model))};
   for (int f = 0; f < nf && !forming; ++f) {
     const int e0 = found[static_cast<std::size_t>(2 * f)], e1 = found[static_cast<std::size_t>(2 * f + 1)];
     if (e0 == 0 && e1 == 0) continue;

@@ -81,6 +81,13 @@ bool KinkFront<dim>::insert(StringModel<dim>& model) {
 }
 
 template <int dim>
+std::string KinkFront<dim>::where_formed(const StringModel<dim>& model) const {
+  if (sharpest_ < 0) return {};
+  return fmt::format(" at node {} (s = {:.6g} m, at {}, where the tangent turns most)", sharpest_,
+                     model.chain().node_coordinate(sharpest_), show_point<dim>(Vec<dim>(model.x().col(sharpest_))));
+}
+
+template <int dim>
 double KinkFront<dim>::turn_margin(const FrontState<dim>& s) const {
   // opening = the angle of the arms from antiparallel, so the arms turn by π − opening.
   return std::cos(s.opening) + std::cos(kMinTurnDeg * kPi / 180);

@@ -42,6 +42,7 @@ class KinkFront final : public SplitLinkFront<dim> {
   /// In the link whose neighbours turn most near the sharpest window (its arms' meeting point l⁻ inside it),
   /// its neighbouring links taken taut.
   bool insert(StringModel<dim>& model) override;
+  std::string where_formed(const StringModel<dim>& model) const override;
   void evaluate(const StringModel<dim>& model, FrontState<dim>& state, Eigen::VectorXd& mass,
                 Points<dim>& force) override;
   /// The rest of the compatibility [v] = −ṡ0 [t] (docs/model.md §2.5): the arms meet at x0,

@@ -693,4 +693,13 @@ t_end = 0.6
     CHECK(std::abs(r.relative_energy_residual()) < 4e-9);
     CHECK(r.relative_momentum_residual() < 6e-10);
   }
+  // On 141 nodes the kink forms two links from the free end, where no link has a full link beyond it: the run
+  // stops saying when and where (it said only when).
+  StringScene<2> scene = build_string_scene<2>(parse_scene_text(text, "coil.toml", {"string.nodes=141"}));
+  StringSolver<2> solver(*scene.model, scene.solver);
+  const RunSummary r = solver.run();
+  CHECK(r.status == "stopped");
+  CHECK_THAT(r.stop_reason, Catch::Matchers::Contains("a kink formed at t = 0.44") &&
+                                Catch::Matchers::Contains("at node 138 (s = 0.8515") &&
+                                Catch::Matchers::Contains("and no link there fits it"));
 }
