@@ -7,7 +7,7 @@ where RESULTS_DIR/<scene>/ holds the outputs of
 for shaken_chain, travelling_loop, whip_crack, pendulum_release, folded_chain_ends_apart, swinging_u,
 pendulum_whip and thrown_chain (string scenes; the last three with slack = "allow"), spinning_loop_dropped
 (3D, closed, slack = "allow"), chain_off_table_edge and
-chain_over_peg and chain_over_two_pegs (edges), atwood_pulley, atwood_rough_pulley and chain_over_round_peg (cylinders), chain_landing_at_angle and chain_landing_on_table (a surface),
+chain_over_peg and chain_over_two_pegs (edges), atwood_pulley, chain_lifting_off_pulley, atwood_rough_pulley and chain_over_round_peg (cylinders), chain_landing_at_angle and chain_landing_on_table (a surface),
 chain_off_real_table (a table bounded by its edge), chain_into_heap_on_table (a heap on a contact surface), streaming_corner (a kink) and
 falling_chain, folded_chain, sliding_chain, swinging_sliding_chain, tilted_falling_chain and
 curved_falling_chain (scenes with fronts), and RESULTS_DIR/<scene>_reduced/ the same canonical scenes run with
@@ -264,17 +264,29 @@ def streaming_corner(run, ax):
     decorate(ax[1], "t (s)", "m", "the kink runs through the material at -v and stays put in space")
 
 
+def atwood_u_panel(ax, run, title):
+    """u = x1 - l_free/2 = (x1 - x2)/2 of the heavy Atwood chain (the sides' lengths read off the end nodes'
+    depths, while they hang) against u0 cosh(sqrt(2g/l) t), which holds up to the shorter side's lift-off."""
+    g, ell, u0, t_lift = 9.81, 1.0, 0.05, 0.525026
+    frames = run.nodes
+    u = [(frames.positions(k)[0, 1] - frames.positions(k)[-1, 1]) / 2 for k in range(len(frames))]
+    ax.plot(frames.times, u, lw=2, alpha=0.7, label="u = (x1 - x2)/2 (string solver)")
+    ts = np.linspace(0, min(frames.times[-1], t_lift), 200)
+    ax.plot(ts, u0 * np.cosh(math.sqrt(2 * g / ell) * ts), "k:", lw=2, label="u0 cosh(sqrt(2g/l) t), exact")
+    ax.axhline(0.2583, color="r", lw=0.8, ls="--", label="lift-off u* = 0.2583 m (t* = 0.525 s)")
+    if frames.times[-1] > t_lift:
+        ax.axvline(t_lift, color="r", lw=0.8, ls=":")
+    decorate(ax, "t (s)", "m", title)
+
+
 def atwood_pulley(run, ax):
     snapshots(ax[0], run, [0, 0.2, 0.3, 0.4, 0.5], "heavy Atwood chain over a smooth pulley, R = 0.1 m")
-    g, ell, u0 = 9.81, 1.0, 0.05
-    frames = run.nodes
-    # u = x1 - l_free/2 = (x1 - x2)/2, with the sides' lengths read off the end nodes' depths.
-    u = [(frames.positions(k)[0, 1] - frames.positions(k)[-1, 1]) / 2 for k in range(len(frames))]
-    ax[1].plot(frames.times, u, lw=2, alpha=0.7, label="u = (x1 - x2)/2 (string solver)")
-    ts = np.linspace(0, frames.times[-1], 200)
-    ax[1].plot(ts, u0 * np.cosh(math.sqrt(2 * g / ell) * ts), "k:", lw=2, label="u0 cosh(sqrt(2g/l) t), exact")
-    ax[1].axhline(0.2583, color="r", lw=0.8, ls="--", label="lift-off u* = 0.2583 m (t* = 0.525 s)")
-    decorate(ax[1], "t (s)", "m", "the wrapped half circle moves with the chain")
+    atwood_u_panel(ax[1], run, "the wrapped half circle moves with the chain")
+
+
+def chain_lifting_off_pulley(run, ax):
+    snapshots(ax[0], run, [0, 0.45, 0.55, 0.6, 0.65, 0.75], "the heavy Atwood chain lifting off its pulley")
+    atwood_u_panel(ax[1], run, "the cosh up to the lift-off at t* = 0.525 s; then the chain leaves the pulley")
 
 
 def atwood_rough_pulley(run, ax):
@@ -431,7 +443,7 @@ def spinning_loop_dropped(run, ax):
 SCENES = [shaken_chain, travelling_loop, whip_crack, pendulum_release, falling_chain, folded_chain, sliding_chain,
           swinging_sliding_chain, tilted_falling_chain, curved_falling_chain, folded_chain_ends_apart,
           chain_off_table_edge, swinging_u, pendulum_whip, thrown_chain, chain_over_peg, chain_over_two_pegs,
-          atwood_pulley, atwood_rough_pulley, chain_over_round_peg, streaming_corner, chain_landing_at_angle, chain_landing_on_table,
+          atwood_pulley, chain_lifting_off_pulley, atwood_rough_pulley, chain_over_round_peg, streaming_corner, chain_landing_at_angle, chain_landing_on_table,
           chain_off_real_table, chain_into_heap_on_table,
           spinning_loop_dropped]
 
