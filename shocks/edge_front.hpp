@@ -128,6 +128,11 @@ class EdgeFront final : public FrontKind<dim> {
   Vec<dim> point_ = Vec<dim>::Zero();
   Vec<dim> axis_ = Vec<dim>::Zero();
   typename EdgeSpec<dim>::Table table_ = EdgeSpec<dim>::Table::kNone;
+  /// The side a contact surface that ends at this edge holds (edge_table): kNone without one.
+  typename EdgeSpec<dim>::Table surface_side_ = EdgeSpec<dim>::Table::kNone;
+  template <int d>
+  friend Obstacle<d> edge_table(EdgeFront<d>& edge, const Vec<d>& normal, const Vec<d>& inward, bool before,
+                                const Vec<d>& edge_axis, std::string name);
   Vec<dim> table_normal_ = Vec<dim>::Zero();  ///< the table's outward unit normal (set at initialize)
   int link_ = -1;
   /// The sides' tangents at the edge at the start (the faces drawn along them).
@@ -158,7 +163,7 @@ class EdgeFront final : public FrontKind<dim> {
 /// edge front's bent link leaves them on. The contact module holds them (make_contact_module, with the
 /// edge's front tracker as its inner module); the edge keeps its table = kNone. `edge` must outlive it.
 template <int dim>
-Obstacle<dim> edge_table(const EdgeFront<dim>& edge, const Vec<dim>& normal, const Vec<dim>& inward, bool before,
+Obstacle<dim> edge_table(EdgeFront<dim>& edge, const Vec<dim>& normal, const Vec<dim>& inward, bool before,
                          const Vec<dim>& edge_axis, std::string name);
 
 }  // namespace chainsim

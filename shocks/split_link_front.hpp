@@ -30,6 +30,15 @@ class SplitLinkFront : public FrontKind<dim> {
   /// The split link becomes a full link again: arcs A and B merge, its material re-lumped ½–½ with its
   /// momentum (mass parcels, as at a crossing).
   void remove(StringModel<dim>& model, const FrontState<dim>& state) override;
+  /// The weight of a partial link of material length l that continues the full link (q, p) straight beyond its
+  /// node p (its material runs from x_p along u = (x_p − x_q)/|x_p − x_q| to the front) acting at the partial
+  /// link's midpoint x_p + ½ l u, where potential_moment counts its potential: the node masses put the weight
+  /// W = λ l g on p (g the model's uniform field), and this adds its moment about p as the couple ±(l / 2|x_p − x_q|)
+  /// W⊥ on p and q (W⊥ the part of W across the link), whose power ½ l W·u̇ is the weight's work on the partial
+  /// link as it turns with the link (docs/model.md §10, "The partial links' weight"; the edge front uses it too).
+  /// Nothing without a uniform field.
+  static void add_partial_weight(const StringModel<dim>& model, int p, int q, double l, double lambda,
+                                 Points<dim>& force);
 
  protected:
   /// The unit tangent of the link i → j and its rate (the part of (v_j − v_i) across it over its length).
@@ -38,15 +47,6 @@ class SplitLinkFront : public FrontKind<dim> {
   /// velocity of the node it leaves; `mass` and `mom` hold the nodes lo, lo + 1, … (momentum exact).
   static void move_parcel(const StringModel<dim>& model, int lo, int j, double delta, Eigen::Ref<Eigen::VectorXd> mass,
                           Points<dim>& mom);
-  /// The weight of a partial link of material length l that continues the full link (q, p) straight beyond its
-  /// node p (its material runs from x_p along u = (x_p − x_q)/|x_p − x_q| to the front) acting at the partial
-  /// link's midpoint x_p + ½ l u, where potential_moment counts its potential: the node masses put the weight
-  /// W = λ l g on p (g the model's uniform field), and this adds its moment about p as the couple ±(l / 2|x_p − x_q|)
-  /// W⊥ on p and q (W⊥ the part of W across the link), whose power ½ l W·u̇ is the weight's work on the partial
-  /// link as it turns with the link (docs/model.md §10, "The partial links' weight"). Nothing
-  /// without a uniform field.
-  static void add_partial_weight(const StringModel<dim>& model, int p, int q, double l, double lambda,
-                                 Points<dim>& force);
   /// The velocities of the free nodes lo, lo + 1, … in an arc from their parcels' mass and momentum.
   static void set_velocities(StringModel<dim>& model, int lo, const Eigen::Ref<const Eigen::VectorXd>& mass,
                              const Points<dim>& mom);

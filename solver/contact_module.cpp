@@ -471,7 +471,10 @@ class ContactModule final : public WrappingModule<dim> {
     // The fronts' events first (a crossing moves nodes between arcs, heaps and the sides of an edge),
     // then the held set brought up to the layout they leave, then the landings and lift-offs.
     const int k = inner_events(), kl = inner_ledgers();
-    if (side_faces_ && found.size() > static_cast<std::size_t>(side_face_event()) && found[side_face_event()] != 0)
+    // The side face: at its root, and at any event where a node is already inside (its root function would
+    // restart below zero, where ARKODE finds no root: a projection or an impact that carried it in).
+    if (side_faces_ && ((found.size() > static_cast<std::size_t>(side_face_event()) && found[side_face_event()] != 0) ||
+                        inside_a_table(model)))
       through_side_face(model, t);
     EventAction action = this->handle_inner_events(model, t, ledger, found);
     if (action.kind == EventAction::Kind::kStop) return action;
@@ -497,6 +500,7 @@ class ContactModule final : public WrappingModule<dim> {
     // restart its function would start below zero, where ARKODE finds no root, and the node would fall
     // through. It lands here, at this event (docs/string_solver.md, "Events at loose tolerances").
     changed = hold(model, t, own, passed_through(model)) || changed;
+    if (side_faces_ && inside_a_table(model)) through_side_face(model, t);
     if (!changed) return {};
     return {EventAction::Kind::kTransfer, ""};  // the velocities or the held set changed: the integrator restarts
   }
@@ -1044,9 +1048,9 @@ class ContactModule final : public WrappingModule<dim> {
   /// beyond the edge in the material (the edge front's other side) cannot rest on the table, and its side face
   /// below the edge is not an obstacle (docs/scenes.md, "[[effects.surface]]"): such a node that reaches the body
   /// stops the run. The bounded table that may not hold free node i and the node's distance from its body,
-  /// max(n·r + δ_top, δ_side − d·r) with r from the edge, n the top's normal and d the direction into the table:
-  /// < 0 inside it. δ_side = kSideFaceMargin h leaves a side hanging flush with the face (the chain off a table,
-  /// d·r at round-off) outside, δ_top = kInitialContact h the node crossing the edge at the top's level.
+  /// max(n·r + δ, δ − d·r) with r from the edge, n the top's normal and d the direction into the table:
+  /// < 0 inside it. The margins δ = kSideFaceMargin h leave a side hanging flush with the face (the chain off a
+  /// table, d·r at the integration error) and the node crossing the edge at the top's level outside.
   /// (−1, +∞) for a held node, a node every bounded table may hold, or without bounded tables.
   std::pair<int, double> side_face_gap(const StringModel<dim>& model, int i) const {
     std::pair<int, double> nearest{-1, INFINITY};
@@ -1055,10 +1059,16 @@ class ContactModule final : public WrappingModule<dim> {
       const Obstacle<dim>& o = obstacles_[k];
       if (!bounded(o) || o.may_hold(i)) continue;
       const Vec<dim> r = model.x().col(i) - o.point;
-      const double gap = std::max(o.normal.dot(r) + kInitialContact * h_, kSideFaceMargin * h_ - o.inward.dot(r));
+      const double gap = std::max(o.normal.dot(r) + kSideFaceMargin * h_, kSideFaceMargin * h_ - o.inward.dot(r));
       if (gap < nearest.second) nearest = {static_cast<int>(k), gap};
     }
     return nearest;
+  }
+  /// Some free node that a table may not hold is inside that table's body.
+  bool inside_a_table(const StringModel<dim>& model) const {
+    for (int i = 0; i < static_cast<int>(held_.size()); ++i)
+      if (side_face_gap(model, i).second < 0) return true;
+    return false;
   }
   /// A free node has reached a table's body through its side face: the run stops, located (a NumericalError:
   /// the motion past it would pass through the table, which the model does not hold there).

@@ -1826,25 +1826,6 @@ typename StringModel<dim>::SnapResult StringModel<dim>::snap(double t) {
   result.dissipated = impulses.dissipated;
   result.support_work = impulses.support_work;
   result.support_impulse = impulses.support_impulse;
-  // 3. The module's constraints (an inserted kink's arms meeting, §2.5): the links' impulses alone leave their rates
-  //    Ċ ≠ 0, which the drift control then took out over the following steps with work no ledger booked (a coil
-  //    with an inserted kink whose tip link snapped: energy residual 3.2e-6, the same at every rtol; review of
-  //    #27). Their impulses are part of the snap: the mass-weighted projection onto Ċ = 0 with the taut links'
-  //    rates kept. Its change of kinetic energy is booked with the links' dissipation, and the momentum it gives
-  //    the string is the supports' impulse (the constraints' own impulses sum to zero; the links' at a prescribed
-  //    node are the support's). A driven support's share of that energy is booked in W_snap, not W_snap_supports:
-  //    the ledger closes either way.
-  if (module_) {
-    constraints_.clear();
-    module_->node_constraints(*this, constraints_);
-    if (!constraints_.empty()) {
-      const double before = kinetic_energy();
-      const Vec<dim> p_before = momentum();
-      project_velocities(t);
-      result.dissipated += before - kinetic_energy();
-      result.support_impulse += momentum() - p_before;
-    }
-  }
   return result;
 }
 
@@ -1955,6 +1936,25 @@ typename StringModel<dim>::SnapResult StringModel<dim>::link_impulses(double t, 
       }
     }
   });
+  // 5. The module's constraints (an inserted kink's arms meeting, §2.5): the links' impulses alone leave their
+  //    rates Ċ ≠ 0, which the drift control then took out over the following steps with work no ledger booked (a
+  //    coil with an inserted kink whose tip link snapped: energy residual 3.2e-6, the same at every rtol; review of
+  //    #27). Their impulses are part of every impulse problem (a snap, a landing, the start): the mass-weighted
+  //    projection onto Ċ = 0 with the rates of the links that stay taut kept (the separated ones are slack by now).
+  //    Its change of kinetic energy is booked with the links' dissipation (with a driven support it includes the
+  //    support's work, which is then in W_snap rather than W_snap_supports: the ledger closes either way), and the
+  //    momentum it gives the string is the supports' impulse (the constraints' own impulses sum to zero).
+  if (module_) {
+    constraints_.clear();
+    module_->node_constraints(*this, constraints_);
+    if (!constraints_.empty()) {
+      const double before = kinetic_energy();
+      const Vec<dim> p_before = momentum();
+      project_velocities(t);
+      result.dissipated += before - kinetic_energy();
+      result.support_impulse += momentum() - p_before;
+    }
+  }
   return result;
 }
 

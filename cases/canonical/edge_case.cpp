@@ -72,8 +72,8 @@ EdgeComparison compare_over_point(const EdgeCaseSetup& setup, const PointProblem
   // The table y = 0, x < 0 as a surface that ends at the edge: the contact module around the fronts.
   std::unique_ptr<StringModule<2>> module;
   if (table_surface) {
-    const FrontKind<2>& edge_front = *fronts.front();
-    std::vector<Obstacle<2>> table{edge_table<2>(dynamic_cast<const EdgeFront<2>&>(edge_front), Vec<2>(0.0, 1.0),
+    FrontKind<2>& edge_front = *fronts.front();
+    std::vector<Obstacle<2>> table{edge_table<2>(dynamic_cast<EdgeFront<2>&>(edge_front), Vec<2>(0.0, 1.0),
                                                  Vec<2>(-1.0, 0.0), true, Vec<2>::Zero(), "table")};
     module = make_contact_module<2>(std::move(table), std::make_unique<FrontTracker<2>>(std::move(fronts), FrontOptions{}));
   } else {

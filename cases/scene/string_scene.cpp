@@ -165,7 +165,8 @@ std::string cylinder_resolution_warning(const SceneSpec& spec, const std::vector
   for (std::size_t k = 0; k < spec.effects.cylinders.size(); ++k) {
     const CylinderEntry& c = spec.effects.cylinders[k];
     if (c.contact != "nodes" || !(h > c.radius)) continue;
-    const long nodes = static_cast<long>(std::ceil(length / c.radius)) + 1;
+    // Links no longer than R: ceil(ℓ/R) links, one node more on an open string.
+    const long nodes = static_cast<long>(std::ceil(length / c.radius)) + (spec.closed.value_or(spec.shape.kind == "circle") ? 0 : 1);
     warning += fmt::format("{}effects.cylinder[{}].radius = {:g} m is shorter than the links ({:.3g} m): in node contact "
                            "its nodes are held on the circle and its links are chords, so it is touched by one or two "
                            "nodes and its contact forces and lift-offs are not resolved (docs/scenes.md); set "

@@ -2,6 +2,7 @@
 // through both by the same length. References: a chain over two corners (two pegs, or a peg and an edge)
 // without gravity, pulled at its ends by constant loads along its straight parts (the closed form
 // below), and a chain hanging over two pegs in static equilibrium (the catenary between them).
+#include <cstdio>
 #include <catch2/catch.hpp>
 
 #include <algorithm>
@@ -250,8 +251,9 @@ t_end = 0.05
 TEST_CASE("two pegs: a chain at rest over two pegs has the static reactions at t = 0, at second order",
           "[edge][peg][two_edges]") {
   // The initial shape samples the continuous equilibrium, so the tensions at t = 0 differ from it by the
-  // discretisation only. Measured: |ΔR_x| 3.6e-2 and 1.1e-2 N, |ΔR_y| 9.8e-3 and 2.3e-3 N on 81 and 161
-  // nodes (the closed form −2.943 and 5.732 N).
+  // discretisation only. Measured: |ΔR_x| 3.2e-2 and 1.04e-2 N, |ΔR_y| 1.74e-2 and 3.3e-3 N on 81 and 161
+  // nodes (the closed form −2.943 and 5.732 N); before the partial links' weight acted at their midpoints (a couple
+  // on the sagging span's last links, docs/model.md §8) |ΔR_x| 3.6e-2 and 1.1e-2 N, |ΔR_y| 9.8e-3 and 2.3e-3 N.
   const TwoPegsAtRest rest;
   std::array<double, 2> ex{}, ey{};
   const std::array<int, 2> meshes = {81, 161};
@@ -270,8 +272,10 @@ TEST_CASE("two pegs: a chain at rest over two pegs has the static reactions at t
     CHECK(s0.forces[2] == Approx(-Rx).epsilon(1e-9));
     CHECK(s0.forces[3] == Approx(Ry).epsilon(1e-9));
   }
+  std::printf("\ntwo pegs at rest, reactions at t = 0 against the closed form: |dR_x| %.3e, %.3e N, |dR_y| %.3e, %.3e N\n",
+              ex[0], ex[1], ey[0], ey[1]);
   CHECK(ex[1] < 0.012);
-  CHECK(ey[1] < 0.003);
+  CHECK(ey[1] < 0.005);
   CHECK(ex[0] / ex[1] > 3.0);  // second order, with the kink's O(h^1.5)-like start
   CHECK(ey[0] / ey[1] > 3.8);
 }
