@@ -1940,7 +1940,8 @@ typename StringModel<dim>::SnapResult StringModel<dim>::link_impulses(double t, 
   //    rates Ċ ≠ 0, which the drift control then took out over the following steps with work no ledger booked (a
   //    coil with an inserted kink whose tip link snapped: energy residual 3.2e-6, the same at every rtol; review of
   //    #27). Their impulses are part of every impulse problem (a snap, a landing, the start): the mass-weighted
-  //    projection onto Ċ = 0 with the rates of the links that stay taut kept (the separated ones are slack by now).
+  //    projection onto Ċ = 0 with the links that stay taut held at zero rate (a bilateral projection; the links that
+  //    separated above are slack by now and free, so a separation is kept, and their rebound speed is read again).
   //    Its change of kinetic energy is booked with the links' dissipation (with a driven support it includes the
   //    support's work, which is then in W_snap rather than W_snap_supports: the ledger closes either way), and the
   //    momentum it gives the string is the supports' impulse (the constraints' own impulses sum to zero).
@@ -1953,6 +1954,9 @@ typename StringModel<dim>::SnapResult StringModel<dim>::link_impulses(double t, 
       project_velocities(t);
       result.dissipated += before - kinetic_energy();
       result.support_impulse += momentum() - p_before;
+      links();
+      for (std::size_t j = 0; j < rebound_time_.size(); ++j)
+        if (link_slack(static_cast<int>(j)) && rebound_time_[j] == t) rebound_speed_[j] = -link_rate(static_cast<int>(j));
     }
   }
   return result;

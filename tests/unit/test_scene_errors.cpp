@@ -338,7 +338,7 @@ TEST_CASE("bad scenes with fronts, and scenes the reduced model does not fit, ar
        "s.toml:21:6: effects.kink[1].s0 = 0.5 is less than two links from effects.kink[0]"},
       {"an inserted kink with an obstacle",
        edit(kBase, "[stop]", "[[effects.surface]]\npoint = [0.0, -2.0]\nnormal = [0.0, 1.0]\n\n[solver]\nslack = \"allow\"\nkinks = \"insert\"\n\n[stop]"),
-       "s.toml:22:9: solver.kinks = \"insert\" with an obstacle ([[effects.surface]]): an inserted kink and node contact are not built together (their impulses are not shared, and the ledgers would not close); allowed: \"off\", or no [[effects.surface]], [[effects.cylinder]] or [effects.plane] surface"},
+       "s.toml:22:9: solver.kinks = \"insert\" with an obstacle ([[effects.surface]]): a kink front and node contact are not built together (their impulses are not shared, and the ledgers would not close); allowed: no kink front (solver.kinks = \"off\", no [[effects.kink]]), or no [[effects.surface]], [[effects.cylinder]] or [effects.plane] surface"},
       {"reduced: a kink", reduced(D) + "[[effects.kink]]\ns0 = 0.5\n", "s.toml:1:9: model = \"reduced\" has no kink: remove [[effects.kink]] (the string solver runs it: model = \"string\")"},
       {"a stop on a front the scene lacks", edit(F, "front = \"heap_end\"", "front = \"fold\""),
        "s.toml:28:9: stop.front[0].front = \"fold\" but the scene has no fold ([effects.fold]); its fronts: heap_end"},
