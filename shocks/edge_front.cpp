@@ -35,7 +35,6 @@ Vec<dim> rotate_onto(const Vec<dim>& v, const Vec<dim>& from, const Vec<dim>& to
   }
 }
 
-
 }  // namespace
 
 void check_edge_dissipation(double f, const std::string& name) {

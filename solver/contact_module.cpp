@@ -273,16 +273,14 @@ class ContactModule final : public WrappingModule<dim> {
     }
     if (side_faces_)
       for (int i = 0; i < n; ++i) {
-        const auto [k, gap] = side_face_gap(model, i);
-        if (k >= 0 && held_[static_cast<std::size_t>(i)] < 0 && gap <= 0)
-          throw InputError(fmt::format("node {} of the string, beyond the table's edge in the material, starts inside "
-                                       "the table {}, {:.6g} m beneath its top and {:.6g} m in from its edge (allowed: "
-                                       "beyond the edge's line, or above the table)",
-                                       i, obstacles_[static_cast<std::size_t>(k)].name,
-                                       -obstacles_[static_cast<std::size_t>(k)].normal.dot(
-                                           model.x().col(i) - obstacles_[static_cast<std::size_t>(k)].point),
-                                       obstacles_[static_cast<std::size_t>(k)].inward.dot(
-                                           model.x().col(i) - obstacles_[static_cast<std::size_t>(k)].point)));
+        const auto [k, gap] = side_face_gap(model, i);  // (−1, +∞) for a held node
+        if (k < 0 || gap > 0) continue;
+        const Obstacle<dim>& o = obstacles_[static_cast<std::size_t>(k)];
+        const Vec<dim> r = model.x().col(i) - o.point;
+        throw InputError(fmt::format("node {} of the string, beyond the table's edge in the material, starts inside the "
+                                     "table {}, {:.6g} m beneath its top and {:.6g} m in from its edge (allowed: beyond "
+                                     "the edge's line, or above the table)",
+                                     i, o.name, -o.normal.dot(r), o.inward.dot(r)));
       }
     if (arc_) {
       // Links along the arc are built for a string that starts wrapped on the circle: a node that reaches
