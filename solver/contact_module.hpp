@@ -32,6 +32,7 @@
 /// adds the held nodes, its ledgers and root functions after the tracker's (docs/model.md §10, "Contact
 /// with fronts"). A plane may end at an edge front (a table and its edge): it then holds only the nodes
 /// on the table's side of the edge in the material (Obstacle::carries), and only where it exists.
+#include <cmath>
 #include <functional>
 #include <memory>
 #include <string>
@@ -95,6 +96,16 @@ struct Obstacle {
 template <int dim>
 std::unique_ptr<StringModule<dim>> make_contact_module(std::vector<Obstacle<dim>> obstacles,
                                                        std::unique_ptr<StringModule<dim>> inner = nullptr);
+
+/// A cylinder of radius R is resolved by links no longer than R: with thinner links in node contact it is a
+/// polygon of one or two nodes, and with links along the arc it is wrapped exactly but its lift-off, where the
+/// tension falls to λ v² over a curvature 1/R, is read on a link that spans the whole contact (measured with
+/// `chainsim compare pulley`, links along the arc: the lift-off 4-7 % early at R = h/2, 0.3-0.5 % late at R = h,
+/// 2e-5 to 2.5e-3 at R = 2h, 4e-6 at R = 4h; docs/model.md §10). The fewest nodes of a string of `length` m whose links are no longer than
+/// R: ceil(length / R) links, one node more on an open string.
+inline long nodes_resolving_radius(double radius, double length, bool closed) {
+  return static_cast<long>(std::ceil(length / radius)) + (closed ? 0 : 1);
+}
 
 /// A node this share of a link length from a surface at the start is on it (the discretized shape is
 /// a polygon inscribed in a curved one); further inside, the scene is refused.

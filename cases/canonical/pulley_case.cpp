@@ -150,6 +150,14 @@ PulleyComparison compare_pulley_with_exact(const PulleyCaseSetup& setup) {
   c.summary["mean_err_tension_long"] = signed_long / steps;
   c.summary["max_rel_err_tension"] = std::max(err_short, err_long) / setup.chain.P0();
   c.summary["tension_steps"] = tension_steps;
+  // A pulley thinner than the links: the lift-off is not resolved (nodes_resolving_radius), as a scene warns.
+  const double h = ell / links;
+  if (h > R)
+    c.summary["resolution_warning"] = fmt::format(
+        "--R = {:g} m is shorter than the links ({:.3g} m): the wrapped part is exact, but the lift-off, read on links "
+        "longer than the radius, is not resolved (docs/model.md section 10); set --nodes >= {} (links no longer than "
+        "the radius)",
+        R, h, nodes_resolving_radius(R, ell, false));
   return c;
 }
 

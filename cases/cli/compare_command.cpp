@@ -1,6 +1,7 @@
 // `chainsim compare`: the string solver against the reduced ODE, or (edge, peg, pulley) against the
 // exact solution (see commands.hpp).
 #include <filesystem>
+#include <iostream>
 #include <optional>
 #include <ostream>
 
@@ -168,7 +169,11 @@ int run_compare_command(CompareCommandOptions options, std::ostream& out) {
   write_json(dir / "summary.json", s);  // written last: its presence means the set is complete
   const bool failed = run.status == "failed";
   const std::string error = fmt::format("the string solver failed: {}", run.error);
+  // compare pulley's warning (a pulley thinner than the links), as `chainsim run` gives a scene's: on stderr
+  // beside the JSON, on the report's warning line otherwise.
+  const std::string warning = s.value("resolution_warning", std::string());
   if (options.json) {
+    if (!warning.empty()) std::cerr << "chainsim: warning: " << warning << '\n';
     nlohmann::json j = s;
     if (failed) {
       j["error"] = error;
@@ -192,6 +197,7 @@ int run_compare_command(CompareCommandOptions options, std::ostream& out) {
     }
     out << fmt::format("  energy ledger    {:.3g} (relative)   momentum ledger {:.3g}\n",
                        s["energy_residual"].get<double>(), s["momentum_residual"].get<double>());
+    if (!warning.empty()) out << fmt::format("  warning          {}\n", warning);
     out << fmt::format("  stop: {} ({} crossings, {} steps, {:.3g} s)\n", s["stop_reason"].get<std::string>(),
                        s["transfers"].get<long>(), s["steps"].get<long>(), s["wall_s"].get<double>());
     out << fmt::format("  outputs in {}\n", dir.string());

@@ -152,26 +152,30 @@ std::string obstacle_key(const SceneSpec& spec) {
   return spec.effects.cylinders.empty() ? "effects.plane" : "effects.cylinder";
 }
 
-/// The warning for a cylinder in node contact whose radius is shorter than the longest link (empty when every
-/// one is resolved). Its nodes are held on the circle and its links are chords, so a cylinder less than about a
-/// link in radius is touched by one or two nodes, a polygon: the contact forces and the lift-offs are then not
-/// the cylinder's (docs/scenes.md, "[[effects.cylinder]]": the heavy Atwood chain over R = h/2 lifts off 5 % early).
+/// The warning for a cylinder whose radius is shorter than the longest link (empty when every one is resolved,
+/// nodes_resolving_radius): in node contact a polygon of one or two nodes, whose contact forces and lift-offs are
+/// not the cylinder's (docs/scenes.md, "[[effects.cylinder]]": the heavy Atwood chain over R = h/2 lifts off 5 %
+/// early); with links along the arc, a lift-off read on links longer than the radius (compare pulley: 4-7 % early
+/// at R = h/2).
 std::string cylinder_resolution_warning(const SceneSpec& spec, const std::vector<double>& link_lengths) {
   if (link_lengths.empty()) return {};
   const double h = *std::max_element(link_lengths.begin(), link_lengths.end());
   double length = 0;
   for (double hj : link_lengths) length += hj;
+  const bool closed = spec.closed.value_or(spec.shape.kind == "circle");
   std::string warning;
   for (std::size_t k = 0; k < spec.effects.cylinders.size(); ++k) {
     const CylinderEntry& c = spec.effects.cylinders[k];
-    if (c.contact != "nodes" || !(h > c.radius)) continue;
-    // Links no longer than R: ceil(ℓ/R) links, one node more on an open string.
-    const long nodes = static_cast<long>(std::ceil(length / c.radius)) + (spec.closed.value_or(spec.shape.kind == "circle") ? 0 : 1);
-    warning += fmt::format("{}effects.cylinder[{}].radius = {:g} m is shorter than the links ({:.3g} m): in node contact "
-                           "its nodes are held on the circle and its links are chords, so it is touched by one or two "
-                           "nodes and its contact forces and lift-offs are not resolved (docs/scenes.md); set "
-                           "string.nodes >= {} (links no longer than the radius)",
-                           warning.empty() ? "" : "; ", k, c.radius, h, nodes);
+    if (!(h > c.radius)) continue;
+    const std::string why = c.contact == "nodes"
+                                ? "in node contact its nodes are held on the circle and its links are chords, so it is "
+                                  "touched by one or two nodes and its contact forces and lift-offs are not resolved"
+                                : "with links along the arc the wrapped part is exact, but its lift-off, read on links "
+                                  "longer than the radius, is not resolved";
+    warning += fmt::format("{}effects.cylinder[{}].radius = {:g} m is shorter than the links ({:.3g} m): {} "
+                           "(docs/scenes.md); set string.nodes >= {} (links no longer than the radius)",
+                           warning.empty() ? "" : "; ", k, c.radius, h, why,
+                           nodes_resolving_radius(c.radius, length, closed));
   }
   return warning;
 }
