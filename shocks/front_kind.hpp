@@ -195,10 +195,10 @@ class FrontKind {
   /// Whether `checks` read the string's tensions (then the string solves for them before the root
   /// functions are evaluated).
   virtual bool checks_need_tensions() const { return false; }
-  /// Whether a check already negative right after an event's handling (a crossing's re-layout, a snap)
-  /// stops the run there (StringModule::events_failed_after_event): ARKODE restarts from that state and
-  /// finds only sign changes, so such a check would otherwise go unseen.
-  virtual bool checks_after_events() const { return true; }
+  /// Whether check `check` (0 … num_checks() − 1), already negative right after an event's handling (a crossing's
+  /// re-layout, a snap), stops the run there (StringModule::events_failed_after_event): ARKODE restarts from that
+  /// state and finds only sign changes, so such a check would otherwise go unseen.
+  virtual bool check_after_events(int /*check*/) const { return true; }
   /// The physical event a failed check is (the run's summary lists it in `events`), if any.
   virtual std::optional<RunEvent> check_event(const StringModel<dim>& /*model*/, const FrontState<dim>& /*state*/,
                                               double /*t*/) const {

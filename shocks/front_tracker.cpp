@@ -234,9 +234,9 @@ std::vector<int> FrontTracker<dim>::failed_checks(const Eigen::Ref<const Eigen::
   std::vector<int> found(static_cast<std::size_t>(g.size()), 0);
   bool any = false;
   for (const auto& front : fronts_) {
-    const bool watched = front->active && (!after_event || front->checks_after_events());
     for (int c = 0; c < front->num_checks(); ++c, ++q)
-      if (watched && g[q] < 0) found[static_cast<std::size_t>(q)] = -1, any = true;
+      if (front->active && (!after_event || front->check_after_events(c)) && g[q] < 0)
+        found[static_cast<std::size_t>(q)] = -1, any = true;
   }
   return any ? found : std::vector<int>{};
 }

@@ -230,8 +230,9 @@ EventAction KinkFront<dim>::cross(StringModel<dim>& model, const FrontState<dim>
   // Across node n (b, or a) the kinked link becomes an arm and the arc's next link the other arm. The new arms
   // meet at l⁻ from the new kinked link's start, usually inside it (a partial link of −10⁻² h is routine and
   // harmless: the front moves on into the link); where the string turns sharply one link beyond n (a free
-  // end's tip curling), they meet more than h/2 outside it, and the re-lumped node there, λ (h/2 + l⁻) or
-  // λ (h/2 + l⁺), would have no mass: the discrete kink cannot pass that corner (docs/model.md §9).
+  // end's tip curling), they meet outside it, and the re-lumped node there, λ (h/2 + l⁻) or λ (h/2 + l⁺), keeps
+  // less than half its material beyond kMaxRelaidOutside h (none at h/2): the discrete kink cannot pass that
+  // corner (docs/model.md §9).
   const Points<dim>& x = model.x();
   const double h = this->m_.h;
   const int n = to_A ? B.first : A.last;
@@ -240,29 +241,49 @@ EventAction KinkFront<dim>::cross(StringModel<dim>& model, const FrontState<dim>
   const Vec<dim> d = tA - tB;
   const double dd = d.squaredNorm();
   const double lA = dd > 0 ? meeting_point(d, dd, Vec<dim>(x.col(p + 1) - x.col(p) - h * tB)) : 0.5 * h;
-  if (!(lA > -0.5 * h && lA < 1.5 * h)) {
+  if (!(lA > -kMaxRelaidOutside * h && lA < (1 + kMaxRelaidOutside) * h)) {
     const int corner = to_A ? n + 1 : n - 1;
     const Vec<dim> t_in = (x.col(to_A ? n + 1 : n) - x.col(to_A ? n : n - 1)).normalized(), t_out = to_A ? tB : tA;
     const double corner_deg = std::acos(std::clamp(t_in.dot(t_out), -1.0, 1.0)) * 180 / kPi;
+    const double outside = lA < 0 ? -lA / h : lA / h - 1;
     return {EventAction::Kind::kStop,
             fmt::format("the kink at s0 = {:.6g} m (its arms turning by {:.3g} degrees) has reached node {} with a second "
                         "corner one link beyond it: the string turns by {:.3g} degrees at node {}, so that across node "
-                        "{} the kink's arms would meet {:.3g} h outside the next link and node {} would keep no mass "
+                        "{} the kink's arms would meet {:.3g} h outside the next link and node {} would keep {} "
                         "(the discrete kink's arms need a straight link on either side; docs/model.md §9)",
-                        state.s0, 180 - state.opening * 180 / kPi, n, corner_deg, corner, n,
-                        lA < 0 ? -lA / h : lA / h - 1, lA < 0 ? p : p + 1)};
+                        state.s0, 180 - state.opening * 180 / kPi, n, corner_deg, corner, n, outside, lA < 0 ? p : p + 1,
+                        outside < 0.5 ? fmt::format("{:.0f} % of its mass", 100 * (1 - 2 * outside)) : "no mass")};
   }
-  return SplitLinkFront<dim>::cross(model, state, e0);
+  EventAction action = SplitLinkFront<dim>::cross(model, state, e0);
+  if (action.kind != EventAction::Kind::kStop) this->watch_outside();  // the arms may meet outside the new link
+  return action;
 }
 
 template <int dim>
 void KinkFront<dim>::checks(const StringModel<dim>& /*model*/, const FrontState<dim>& s, double* g) const {
   g[0] = std::min(turn_margin(s), kMaxChord - chord_);
+  g[1] = this->outside_margin(s);
 }
 
 template <int dim>
 std::string KinkFront<dim>::check_failed(const StringModel<dim>& model, const FrontState<dim>& s, double t) const {
   const int a = this->node_a(model), b = this->node_b(model);
+  const double outside = this->outside_margin(s);
+  if (outside < 0) {
+    // Moving out on A's side (towards the start) or on B's (towards the end), with the links left on that side.
+    const bool start = s.l_minus < s.l_plus;
+    const int links = model.arcs()[static_cast<std::size_t>(start ? this->arc_minus : this->arc_plus)].num_links();
+    return fmt::format(
+        "the kink at s0 = {:.6g} m lies {:.4g} h outside its kinked link, beyond node {}, and moves on away from it at "
+        "t = {:.9g} s (ds0/dt = {:.4g} m/s): its last crossing re-laid it where its arms meet, beyond the new node "
+        "because the string turns sharply next to the kinked link, and it then turned back, past the crossing's root{} "
+        "(docs/model.md §9)",
+        s.s0, -std::min(s.l_minus, s.l_plus) / this->m_.h, start ? a : b, t, s.s0_dot,
+        links < 2 ? fmt::format(": it has in effect reached the {} of the string (its arms need a full link on either "
+                                "side, and {} has {} left)",
+                                start ? "start" : "end", start ? "the arm before it" : "the arm after it", links == 1 ? "one" : "none")
+                  : std::string());
+  }
   if (kMaxChord - chord_ < turn_margin(s))
     return fmt::format(
         "the kink at s0 = {:.6g} m has come apart at t = {:.9g} s: the ends of its kinked link, nodes {} and {}, are "

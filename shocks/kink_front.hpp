@@ -29,6 +29,12 @@ class KinkFront final : public SplitLinkFront<dim> {
   /// The kinked link's chord |x_b − x_a| is at most h for arms that meet at x0; the run stops when it
   /// passes this (in units of h): the link's material no longer reaches across.
   static constexpr double kMaxChord = 1.02;
+  /// A crossing re-lays the kink where its new arms meet; where the string turns sharply one link beyond the node
+  /// crossed, they meet outside the new kinked link, and the node there keeps λ (h/2 − outside) of material. The
+  /// run stops at a crossing that would put the kink more than this (per h) outside: half the node's material
+  /// (at half a link it would keep none, and the projection after the crossing moved a kink re-laid 0.44 h
+  /// outside past that: a shaken U on 401 nodes "degenerated", node 62 without mass; docs/model.md §9).
+  static constexpr double kMaxRelaidOutside = 0.25;
 
   const char* name() const override { return "kink"; }
   const char* placed() const override { return "kink"; }
@@ -59,14 +65,17 @@ class KinkFront final : public SplitLinkFront<dim> {
   bool absorbed(const StringModel<dim>& model, const FrontState<dim>& state, int e0) const override;
   /// Stops where an arc would be left without a full link (its direction t∓ is that link's).
   EventAction cross(StringModel<dim>& model, const FrontState<dim>& state, int e0) override;
-  /// One: positive while the arms turn by more than kMinTurnDeg and the chord is within kMaxChord h.
-  int num_checks() const override { return 1; }
+  /// Two: (0) positive while the arms turn by more than kMinTurnDeg and the chord is within kMaxChord h; (1) the
+  /// front inside its kinked link or moving back into it after a crossing (SplitLinkFront::outside_margin: where
+  /// the string turns sharply next to the new kinked link its arms meet beyond the node just crossed, and a kink
+  /// that then turns back would run on past the crossing's root until a node lost its mass).
+  int num_checks() const override { return 2; }
   void checks(const StringModel<dim>& model, const FrontState<dim>& state, double* g) const override;
-  /// No: a crossing re-lays the kinked link with its arms not meeting (the least squares of §2.5; on the
+  /// Check 0 no: a crossing re-lays the kinked link with its arms not meeting (the least squares of §2.5; on the
   /// swinging U, 201 nodes, its chord is 1.035 h right after the crossing at t = 0.4285 s), and the drift
   /// control brings the chord back within kMaxChord h; the check is watched from the next sign change
-  /// (docs/model.md §9, "The crossing breaks the jump conditions").
-  bool checks_after_events() const override { return false; }
+  /// (docs/model.md §9, "The crossing breaks the jump conditions"). Check 1 yes.
+  bool check_after_events(int check) const override { return check != 0; }
   std::string check_failed(const StringModel<dim>& model, const FrontState<dim>& state, double t) const override;
 
  private:

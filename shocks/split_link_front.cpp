@@ -68,6 +68,14 @@ void SplitLinkFront<dim>::crossings(const StringModel<dim>& /*model*/, const Fro
 }
 
 template <int dim>
+double SplitLinkFront<dim>::outside_margin(const FrontState<dim>& s) const {
+  if (!relaid_) return 1.0;
+  const double out_minus = s.l_minus / this->m_.h + kMaxOutside, out_plus = s.l_plus / this->m_.h + kMaxOutside;
+  if (out_minus >= 0 && out_plus >= 0) relaid_ = false;
+  return std::min({1.0, out_minus < 0 && s.s0_dot < 0 ? out_minus : 1.0, out_plus < 0 && s.s0_dot > 0 ? out_plus : 1.0});
+}
+
+template <int dim>
 EventAction SplitLinkFront<dim>::cross(StringModel<dim>& model, const FrontState<dim>& state, int e0) {
   Points<dim>& v = model.v();
   const double h = this->m_.h, lambda = this->m_.lambda;

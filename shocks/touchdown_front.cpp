@@ -400,7 +400,7 @@ EventAction TouchdownFront<dim>::cross(StringModel<dim>& model, const FrontState
   }
   EventAction action = SplitLinkFront<dim>::cross(model, state, e0);
   if (action.kind == EventAction::Kind::kStop) return action;
-  relaid_ = true;
+  this->watch_outside();
   if (e0 != 0) {
     // Node b has joined the lying arc with its velocity: it lies on the plane, where the contact module
     // holds it.
@@ -457,16 +457,8 @@ typename TouchdownFront<dim>::Margins TouchdownFront<dim>::margins(const StringM
 
   }
   // The front outside its split link after a crossing (a landing's re-layout can leave it behind the new node a,
-  // docs/model.md §10, "A falling arc"): harmless while it moves back in (the landing goes on), fatal if it moves
-  // further out, past a crossing's root that ARKODE no longer sees (until the node beyond loses its mass). Negative
-  // where the front lies more than kMaxBehind h out on a side and moves away from the link on that side; watched from
-  // a crossing until the front is first seen inside (not before a crossing, where a step past its root would meet
-  // this one too and be taken again: the 3D drawn string took 1,880 right-hand sides instead of 1,009).
-  if (relaid_) {
-    const double out_minus = s.l_minus / this->m_.h + kMaxBehind, out_plus = s.l_plus / this->m_.h + kMaxBehind;
-    if (out_minus >= 0 && out_plus >= 0) relaid_ = false;
-    m.inside = std::min({1.0, out_minus < 0 && s.s0_dot < 0 ? out_minus : 1.0, out_plus < 0 && s.s0_dot > 0 ? out_plus : 1.0});
-  }
+  // docs/model.md §10, "A falling arc"): SplitLinkFront::outside_margin.
+  m.inside = this->outside_margin(s);
   // 3D, f > 0: the sideways pull the front puts on the lying end, f λ ṡ0² |t·b|, beyond f λ ṡ0² sin 1°, per
   // f λ ṡ0², with the take-off check's round-off floor: the arc's angle to the plane of e and n where the front
   // moves, nothing where it is at rest (ṡ0 = 0: the balance across holds at any angle).

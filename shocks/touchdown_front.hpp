@@ -99,7 +99,7 @@ class TouchdownFront final : public SplitLinkFront<dim> {
   /// node on either side: the crossing left it past its own root (l⁻ or l⁺ < −kHysteresis h), where ARKODE, which sees
   /// sign changes only, would no longer find the next crossing and the front would run past a node until the node
   /// lost its mass (docs/model.md §10, "A falling arc"). Well below one link and well above the crossing's kHysteresis.
-  static constexpr double kMaxBehind = 1e-6;
+  static constexpr double kMaxBehind = SplitLinkFront<dim>::kMaxOutside;
 
   explicit TouchdownFront(const TouchdownSpec<dim>& spec);
 
@@ -184,8 +184,6 @@ class TouchdownFront final : public SplitLinkFront<dim> {
   /// The index of this front's constraint in the model's list (constraints() appends it to the list the model
   /// rebuilds from every front), for constraint_force; in 3D the lateral one follows it.
   mutable std::size_t constraint_index_ = static_cast<std::size_t>(-1);
-  /// Set by a crossing, cleared where the checks first see the front inside its split link (Margins::inside).
-  mutable bool relaid_ = false;
 };
 
 /// The surface's obstacle holding the lying arc of `front` only (its nodes up to front.lying_last()).

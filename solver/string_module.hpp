@@ -279,7 +279,7 @@ class StringModule {
   /// Whether events_failed_at_start can find anything (else the runner does not evaluate events() at t0).
   virtual bool checks_at_start() const { return false; }
   /// The same after an event's handling, at the state the integrator restarts from (e.g. a front's crossing),
-  /// without the checks that a kind of front lets go negative there (FrontKind::checks_after_events).
+  /// without the checks that a kind of front lets go negative there (FrontKind::check_after_events).
   virtual std::vector<int> events_failed_after_event(const Eigen::Ref<const Eigen::VectorXd>& g) const {
     return events_failed_at_start(g);
   }

@@ -682,16 +682,33 @@ interval = 0.05
 [stop]
 t_end = 0.6
 )";
-  for (const int nodes : {151, 201}) {
+  for (const int nodes : {151, 161}) {
     const SceneSpec spec = parse_scene_text(text, "coil.toml", {"string.nodes=" + std::to_string(nodes)});
     StringScene<2> scene = build_string_scene<2>(spec);
     StringSolver<2> solver(*scene.model, scene.solver);
     const RunSummary r = solver.run();
     CAPTURE(nodes, r.stop_reason, r.error);
+    std::printf("coil on %d nodes: %s at %.9g s, %g snaps, energy residual %.3g, momentum residual %.3g\n", nodes,
+                r.status.c_str(), r.t_stop, solver.frames().back().terms["snaps"], r.relative_energy_residual(),
+                r.relative_momentum_residual());
     REQUIRE(r.status == "stopped");
     REQUIRE(solver.frames().back().terms["snaps"] >= 1);
     CHECK(std::abs(r.relative_energy_residual()) < 4e-9);
     CHECK(r.relative_momentum_residual() < 6e-10);
+  }
+  // On 201 nodes the kink, turning by only 1.7 degrees there, reaches node 195 at
+  // 0.4206 s with a corner of 0.54 degrees one link beyond: its new arms would meet 0.456 h outside the next link,
+  // leaving node 195 9 % of its mass, and the run stops there, located (KinkFront::kMaxRelaidOutside; it used to go on
+  // to the end of the string at 0.4608 s, its snap after 0.4206 s).
+  {
+    StringScene<2> scene = build_string_scene<2>(parse_scene_text(text, "coil.toml", {"string.nodes=201"}));
+    StringSolver<2> solver(*scene.model, scene.solver);
+    const RunSummary r = solver.run();
+    CHECK(r.status == "stopped");
+    CHECK_THAT(r.stop_reason, Catch::Matchers::Contains("has reached node 195 with a second corner one link beyond it") &&
+                                  Catch::Matchers::Contains("would meet 0.456 h outside the next link and node 195 "
+                                                            "would keep 9 % of its mass"));
+    CHECK(std::abs(r.relative_energy_residual()) < 2e-9);  // measured 5.4e-10
   }
   // On 141 nodes the kink forms two links from the free end, where no link has a full link beyond it: the run
   // stops saying when and where (it said only when).
@@ -702,4 +719,81 @@ t_end = 0.6
   CHECK_THAT(r.stop_reason, Catch::Matchers::Contains("a kink formed at t = 0.44") &&
                                 Catch::Matchers::Contains("at node 138 (s = 0.8515") &&
                                 Catch::Matchers::Contains("and no link there fits it"));
+}
+
+TEST_CASE("a kink re-laid outside its kinked link that turns back stops, located", "[kink][slack]") {
+  // A free Z spun about its middle (a user's slack motion, issue 27): on 321 nodes the inserted kink runs to the
+  // free start; its crossing at 0.42157 s re-lays it where its arms meet, 0.08 h behind the new node 1 because the
+  // end link whips round (96.8 degrees at node 1), and the kink then turns back. Its crossing's root, already
+  // negative, was never found again: the run stalled at 0.4241 s, "node 1 has lost its mass (a front overshot it)".
+  // The kink's outside check (SplitLinkFront::outside_margin) stops it where it turns back, with one link left.
+  const std::string text = R"([string]
+density = 0.1
+nodes = 321
+[shape]
+kind = "polyline"
+points = [[-0.3, 0.1], [0.3, 0.1], [-0.3, -0.1], [0.3, -0.1]]
+corner_radius = 0.05
+[velocity]
+kind = "rotation"
+omega = 6.0
+center = [0.0, 0.0]
+[effects.gravity]
+g = [0.0, -9.81]
+[solver]
+slack = "allow"
+kinks = "insert"
+[output]
+interval = 0.05
+[stop]
+t_end = 1.0
+)";
+  StringScene<2> scene = build_string_scene<2>(parse_scene_text(text, "z_spin.toml"));
+  StringSolver<2> solver(*scene.model, scene.solver);
+  const RunSummary r = solver.run();
+  CAPTURE(r.stop_reason, r.error);
+  CHECK(r.status == "stopped");
+  CHECK(std::abs(r.t_stop - 0.4227) < 1e-3);  // measured 0.422698 s
+  CHECK_THAT(r.stop_reason, Catch::Matchers::Contains("outside its kinked link, beyond node 1, and moves on away") &&
+                                Catch::Matchers::Contains("it has in effect reached the start of the string"));
+  CHECK(std::abs(r.relative_energy_residual()) < 3e-9);  // measured 9.4e-10
+  CHECK(r.relative_momentum_residual() < 5e-10);         // measured 1.4e-10
+}
+
+TEST_CASE("a kink whose crossing would leave a node less than half its mass stops there", "[kink][slack]") {
+  // The swinging U with its second support shaken (A = [0.1, 0.05] m, 10 rad/s), kinks inserted, 401 nodes (a
+  // user's run, issue 27): the kink runs up arm A into a sharper bend; its crossings re-laid it 0.14, 0.25, then
+  // 0.44 h outside the new kinked link, and the projection after that crossing took node 62 past zero mass: "the
+  // string degenerated at t = 0.581 s". The crossing now stops where the re-lumped node would keep less than half
+  // its material (KinkFront::kMaxRelaidOutside = 0.25 h outside).
+  const std::string text = R"([string]
+density = 0.1
+nodes = 401
+[shape]
+kind = "polyline"
+points = [[0.0, 0.0], [0.3, -0.4], [0.6, -0.4], [0.3, 0.0]]
+corner_radius = 0.12
+[ends]
+start = "fixed"
+end = { kind = "driven", path = "shake", amplitude = [0.1, 0.05], omega = 10.0 }
+[effects.gravity]
+g = [0.0, -9.81]
+[solver]
+slack = "allow"
+kinks = "insert"
+[output]
+interval = 0.01
+[stop]
+t_end = 0.8
+)";
+  StringScene<2> scene = build_string_scene<2>(parse_scene_text(text, "shaken_u.toml"));
+  StringSolver<2> solver(*scene.model, scene.solver);
+  const RunSummary r = solver.run();
+  CAPTURE(r.stop_reason, r.error);
+  CHECK(r.status == "stopped");
+  CHECK(std::abs(r.t_stop - 0.58006) < 1e-3);  // measured 0.580057 s
+  CHECK_THAT(r.stop_reason, Catch::Matchers::Contains("has reached node 64 with a second corner one link beyond it") &&
+                                Catch::Matchers::Contains("and node 64 would keep 49 % of its mass"));
+  CHECK(std::abs(r.relative_energy_residual()) < 3e-11);  // measured 1.0e-11
+  CHECK(r.relative_momentum_residual() < 3e-11);          // measured 7.4e-12
 }

@@ -156,7 +156,7 @@ TEST_CASE("a fold whose crossing opens it past 20 degrees stops at that crossing
   // (the old folded link) its arm, and the arms leave the fold 20.4° from antiparallel at once. ARKODE restarts from
   // that state and finds only sign changes, so the opening check, negative from the restart, went unseen: the run
   // went on through 7 more crossings and stopped at t = 0.4035 s on the chord. A check already failed after an
-  // event's handling now stops the run there (StringSolver::failed_checks, FrontKind::checks_after_events).
+  // event's handling now stops the run there (StringSolver::failed_checks, FrontKind::check_after_events).
   StringCaseSetup s = setup_for(Problem::kFolded, 0.0, 81);
   s.tilt_deg = 1.0;
   s.frame_interval = 1.0;
