@@ -45,13 +45,15 @@ def main():
     parser.add_argument("--nodes", type=int, nargs="+", default=[101, 201, 401, 801])
     parser.add_argument("--interval", type=float, default=0.25)
     parser.add_argument("--out", default="results/slack_u_error")
+    parser.add_argument("--t-end", type=float, help="replaces the scene's [stop] t_end (s)")
     args = parser.parse_args()
     runs = []
     for n in args.nodes:
         directory = os.path.join(args.out, f"n{n}")
         if not os.path.exists(os.path.join(directory, "stats.json")):
+            t_end = ["--t-end", str(args.t_end)] if args.t_end else []
             subprocess.run([args.binary, "run", args.scene, "--set", f"string.nodes={n}", "--set",
-                            f"output.interval={args.interval}", "--out", directory], check=True,
+                            f"output.interval={args.interval}", "--out", directory] + t_end, check=True,
                            stdout=subprocess.DEVNULL)
         runs.append(load(directory))
     print("t (s) | meshes | max (m) | at s (m) | RMS (m) | kink at s (m), turn | max > 5 cm from the kink (m) | share > max/2")
