@@ -297,8 +297,10 @@ void StringModel<dim>::links() {
       l_of[j] = l;
       if (!(l > kCollapsedLink * h[j]) || !std::isfinite(l)) {
         // A slack link may be as short as anything, its ends may pass each other (it carries no tension,
-        // its row is out of the system): no direction. A taut one that collapses is a degenerate state.
-        if (!(std::isfinite(l) && link_slack(j)))
+        // its row is out of the system): no direction. A taut one that collapses is a degenerate state;
+        // not a link bent over a point, whose length and directions are its sides' (bend_links, below):
+        // over a peg (sides antiparallel) its chord passes through zero where the peg is at its midpoint.
+        if (!(std::isfinite(l) && (link_slack(j) || (!bends_.empty() && bend_of(j)))))
           throw RecoverableError(fmt::format("link {} has collapsed to length {:g}", j, l));
         Map(e + dim * j).setZero();
       } else {

@@ -364,3 +364,45 @@ TEST_CASE("hard edges: a hanging side drawn inside the table is refused before t
   CHECK_THROWS_WITH(SceneRun<2>(parse_scene(file, {"shape.points=[[-0.8, 0.0], [0.0, 0.0], [-0.1, -0.17320508075688773]]"})),
                     Contains("starts inside the table effects.surface[0]"));
 }
+
+TEST_CASE("hard edges: a peg at the midpoint of its bent link (sides antiparallel) is passed, at an output time too",
+          "[edge][peg][hard]") {
+  // A chain over a sharp peg, pulled by 3 N at its long side's end and 1 N at its short side's (1 m, 1 kg/m, no
+  // gravity, f = 0): it slides at 2 m/s², the short side x = 0.1 − t² m, and its end reaches the peg at √0.1 s
+  // (tester's run, issue 23). Over a peg the bent link's nodes lie on one line, so where the peg is at the link's
+  // midpoint its chord is zero: the collapse test read the chord, not the sides, and refused that state, an output
+  // time at t = 0.25 s on 41 nodes ("time integration stalled … link 38 has collapsed to length 2.5e-08"), the
+  // initial state on 6 nodes (refused before the run).
+  const std::string text = R"([string]
+length = 1.0
+density = 1.0
+nodes = 41
+[shape]
+kind = "polyline"
+points = [[0.0, -0.9], [0.0, 0.0], [0.0, -0.1]]
+[ends]
+start = { kind = "loaded", force = [0.0, -3.0] }
+end = { kind = "loaded", force = [0.0, -1.0] }
+[[effects.edge]]
+point = [0.0, 0.0]
+f = 0.0
+[solver]
+method = "erk5"
+rtol = 1e-9
+atol = 1e-11
+[output]
+interval = 0.01
+[stop]
+t_end = 1.0
+)";
+  for (const int nodes : {6, 21, 41, 81}) {
+    const RunSummary run =
+        run_front_scene<2>(parse_scene_text(text, "peg_midpoint.toml", {fmt::format("string.nodes={}", nodes)}));
+    INFO(nodes << " nodes: " << run.status << ": " << run.stop_reason << run.error);
+    REQUIRE(run.status == "stopped");
+    CHECK_THAT(run.stop_reason, Contains("has reached the edge"));
+    CHECK(std::abs(run.t_stop - std::sqrt(0.1)) < 1.5e-8);  // measured −3.2e-9 (6 nodes), −4.7e-9 s (21-81), at rtol 1e-9
+    CHECK(std::abs(run.relative_energy_residual()) < 2e-15);  // measured 1.4e-16 to 4.0e-16
+    require_finite(run);
+  }
+}
