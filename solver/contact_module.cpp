@@ -271,6 +271,7 @@ class ContactModule final : public WrappingModule<dim> {
                                      i, -gap, obstacles_[static_cast<std::size_t>(k)].name, kInitialContact));
       if (gap <= kInitialContact * h_) held_[static_cast<std::size_t>(i)] = k;
     }
+    refuse_locked_loop(model);
     if (side_faces_)
       for (int i = 0; i < n; ++i) {
         const auto [k, gap] = side_face_gap(model, i);  // (−1, +∞) for a held node
@@ -1036,6 +1037,45 @@ class ContactModule final : public WrappingModule<dim> {
   }
 
   static bool free_node(const StringModel<dim>& model, int i) { return model.in_arc(i) && !model.is_prescribed(i); }
+  /// A closed string that starts with every node held on one cylinder, wrapping its axis, is locked there: no
+  /// motion but a rigid turn keeps it on the cylinder and its links at their lengths, and its tension has a
+  /// uniform part that nothing determines (any uniform tension is balanced by the cylinder's push; the tension
+  /// system is singular). Refused before the run (InputError) with that cause, rather than the singular solve's
+  /// pivot.
+  void refuse_locked_loop(const StringModel<dim>& model) const {
+    const Chain<dim>& chain = model.chain();
+    if (!chain.closed() || held_.empty()) return;
+    const int k = held_[0];
+    if (k < 0 || obstacles_[static_cast<std::size_t>(k)].kind != Obstacle<dim>::Kind::kCylinder) return;
+    for (std::size_t i = 0; i < held_.size(); ++i)
+      if (held_[i] != k && free_node(model, static_cast<int>(i))) return;
+    // The winding about the axis: the angles between consecutive nodes seen from it, summed round the loop.
+    const Obstacle<dim>& o = obstacles_[static_cast<std::size_t>(k)];
+    const Eigen::Matrix<double, dim, 2> basis = [&] {
+      Eigen::Matrix<double, dim, 2> b = Eigen::Matrix<double, dim, 2>::Zero();
+      if constexpr (dim == 2) {
+        b(0, 0) = b(1, 1) = 1;
+      } else {
+        b.col(0) = o.axis.unitOrthogonal();
+        b.col(1) = o.axis.cross(Vec<3>(b.col(0)));
+      }
+      return b;
+    }();
+    const int n = chain.num_nodes();
+    double winding = 0;
+    for (int i = 0; i < n; ++i) {
+      const Eigen::Vector2d p = basis.transpose() * (model.x().col(i) - o.point);
+      const Eigen::Vector2d q = basis.transpose() * (model.x().col((i + 1) % n) - o.point);
+      winding += std::atan2(p[0] * q[1] - p[1] * q[0], p.dot(q));
+    }
+    if (!(std::abs(winding) > kPi)) return;
+    throw InputError(fmt::format(
+        "the closed string starts with all its {} nodes held on {} (within {:g} of a link length of its surface), "
+        "wrapped round it: it is locked there, and its tension is indeterminate (any uniform tension is balanced by "
+        "the cylinder's push), which an inextensible string does not resolve; allowed: a closed string that does not "
+        "lie all round the cylinder (longer than its circumference, or round a smaller cylinder)",
+        n, o.name, kInitialContact));
+  }
   /// A table that ends at an edge: a plane bounded by its edge.
   static bool bounded(const Obstacle<dim>& o) {
     return o.kind == Obstacle<dim>::Kind::kPlane && o.inward.squaredNorm() > 0;
