@@ -685,14 +685,18 @@ std::unique_ptr<StringModel<dim>> build_front_model(const SceneSpec& spec, scene
       if (!(margin < 0)) continue;
       const double turn =
           std::acos(std::clamp(margin + std::cos(spec.solver.kink_turn * kPi / 180), -1.0, 1.0)) * 180 / kPi;
+      // The window as measured on this mesh: 2m links, m = kink_window / 2h rounded and at least 1.
+      const double h = model->chain().link_length(0);
+      const int window_links = 2 * std::max(1, static_cast<int>(std::lround(kinks.back().window / (2 * h))));
       fail_at(spec, "solver.kinks",
-              fmt::format("solver.kinks = {}: the initial shape already turns by {:.4g} deg over kink_window = {:g} m, "
-                          "past kink_turn = {:g} deg: a corner present at t = 0 (a sharp polyline vertex, the turn "
+              fmt::format("solver.kinks = {}: the initial shape already turns by {:.4g} deg over kink_window = {:g} m "
+                          "({} links of {:g} m on this mesh), past kink_turn = {:g} deg: a corner present at t = 0 (a sharp polyline vertex, the turn "
                           "over an edge or a peg, or a bend that turns this much within a window this wide), which "
                           "insertion cannot take (it inserts the kinks that form during the run); allowed: a shape "
                           "that turns by less than kink_turn over kink_window at t = 0 (round a corner with "
                           "shape.corner_radius or declare it with [[effects.kink]], narrow kink_window{})",
-                          text_of(spec, "solver.kinks"), turn, kinks.back().window, spec.solver.kink_turn,
+                          text_of(spec, "solver.kinks"), turn, kinks.back().window, window_links, h,
+                          spec.solver.kink_turn,
                           turn < 179 ? fmt::format(", or raise solver.kink_turn above {:.4g} deg", turn) : ""));
     }
   for (const TableSide<dim>& table : tables) {  // where each table ends (the plot tool draws it up to there)

@@ -537,10 +537,11 @@ TEST_CASE("kinks = \"insert\" on a shape that already has a corner at t = 0 is r
   // over one peg or off a table's edge stopped at t = 0 ("a kink formed at t = 0 s where no link fits it").
   const std::string sharp = edit(kBase, "points = [[0.0, 0.0], [0.0, -1.0]]", "points = [[0.0, 0.0], [0.0, -0.5], [0.3, -0.1]]");
   const std::string insert = "\n[solver]\nkinks = \"insert\"\n";
-  // The L turns by 143.13 deg at its vertex (cos = -0.8), over the default window (ℓ/50 = 0.02 m, one link each side).
+  // The L turns by 143.13 deg at its vertex (cos = -0.8), over the default window (ℓ/50 = 0.02 m, one link each side:
+  // the message says how wide the window measured on this mesh is).
   CHECK(error_of(sharp + insert) ==
-        "s.toml:20:9: solver.kinks = \"insert\": the initial shape already turns by 143.1 deg over kink_window = 0.02 m, "
-        "past kink_turn = 90 deg: a corner present at t = 0 (a sharp polyline vertex, the turn over an edge or a peg, "
+        "s.toml:20:9: solver.kinks = \"insert\": the initial shape already turns by 143.1 deg over kink_window = 0.02 m "
+        "(2 links of 0.1 m on this mesh), past kink_turn = 90 deg: a corner present at t = 0 (a sharp polyline vertex, the turn over an edge or a peg, "
         "or a bend that turns this much within a window this wide), which insertion cannot take (it inserts the kinks "
         "that form during the run); allowed: a shape that turns by less than kink_turn over kink_window at t = 0 (round "
         "a corner with shape.corner_radius or declare it with [[effects.kink]], narrow kink_window, or raise "
