@@ -747,3 +747,51 @@ TEST_CASE("touchdown front: a falling arc pulled back below the threshold stops 
     CHECK(run.energy_drift < 1.5e-12 * run.energy_scale);
   }
 }
+
+TEST_CASE("touchdown front: a tangential start slides exactly through the front, whatever the slack mode",
+          "[touchdown]") {
+  // The drawn string at 7 degrees (tester's scene, issue 23) started with [velocity] kind = "tangential" at 1 m/s:
+  // with slack = "stop" the nodes used to move along their neighbours' chord, which at the front's corner mixes the
+  // lying side with the arc, and the start's projection made the front start at 0.64, 0.69, 0.73 m/s on 10, 40, 80
+  // nodes (an impulsive start booked in W_applied). The tangential kind is now the exact sliding with a touchdown
+  // front, as over an edge (docs/scenes.md, "The tangential kind"): the front runs at 1 m/s from the start.
+  const std::string text = R"([string]
+density = 1.0
+nodes = 40
+[shape]
+kind = "polyline"
+points = [[-0.5, 0.0], [0.0, 0.0], [0.496273075820661, 0.06093467170257374]]
+[velocity]
+kind = "tangential"
+speed = -1.0
+[ends]
+start = { kind = "loaded", force = [-0.503726924179339, 0.0] }
+end = { kind = "driven", path = "linear", velocity = [-0.992546151641322, -0.12186934340514748] }
+[[effects.surface]]
+point = [0.0, 0.0]
+normal = [0.0, 1.0]
+f = 0.5
+[solver]
+method = "erk5"
+rtol = 1e-10
+atol = 1e-13
+[stop]
+t_end = 0.3
+)";
+  for (const int nodes : {10, 40, 80}) {
+    CAPTURE(nodes);
+    StringScene<2> scene = build_string_scene<2>(parse_scene_text(text, "tangential.toml", {fmt::format("string.nodes={}", nodes)}));
+    StringSolver<2> solver(*scene.model, scene.solver);
+    const RunSummary run = solver.run();
+    REQUIRE(run.status == "completed");
+    CHECK_FALSE(run.impulsive_start);
+    REQUIRE(run.samples.size() > 10);
+    double err_s0 = 0, err_speed = 0;
+    for (const StepSample& r : run.samples) {
+      err_s0 = std::max(err_s0, std::abs(r.fronts[0].s0 - (0.5 + r.t)));
+      err_speed = std::max(err_speed, std::abs(r.fronts[0].s0_dot - 1.0));
+    }
+    CHECK(err_s0 < 1e-13);     // measured 7e-16 m on 80 nodes
+    CHECK(err_speed < 1e-11);  // measured 1.8e-13 m/s on 80 nodes
+  }
+}
