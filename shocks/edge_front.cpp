@@ -129,6 +129,37 @@ void EdgeFront<dim>::initialize(StringModel<dim>& model) {
                                    "edge point with outward normal {}): the string there must lie on it",
                                    i, before ? "before" : "after", off, show_point<dim>(table_normal_)));
   }
+  // Into the table along its top, normal to the edge's line: back along the side that lies on it.
+  Vec<dim> inward = before ? Vec<dim>(-tm) : tp;
+  inward -= inward.dot(table_normal_) * table_normal_;
+  if constexpr (dim == 3) inward -= inward.dot(axis_) * axis_;
+  table_inward_ = inward.normalized();
+  const auto [node, gap] = table_body(model);
+  if (node >= 0 && gap < 0) {
+    const Vec<dim> r = x.col(node) - point_;
+    throw InputError(fmt::format("node {} of the string {} the edge, beyond it in the material, starts inside the table "
+                                 "under the string {} it, {:.6g} m beneath its top and {:.6g} m in from its edge "
+                                 "(allowed: beyond the edge's line, or above the table)",
+                                 node, before ? "after" : "before", before ? "before" : "after",
+                                 -table_normal_.dot(r), table_inward_.dot(r)));
+  }
+}
+
+template <int dim>
+std::pair<int, double> EdgeFront<dim>::table_body(const StringModel<dim>& model) const {
+  std::pair<int, double> deepest{-1, INFINITY};
+  if (table_ == EdgeSpec<dim>::Table::kNone) return deepest;
+  // The nodes beyond the edge: after the bent link for a table before it, before the bent link otherwise.
+  const bool before = table_ == EdgeSpec<dim>::Table::kBefore;
+  const int first = before ? link_ + 1 : 0, last = before ? this->m_.n - 1 : link_;
+  const double margin = kSideFaceMargin * this->m_.h;
+  const Points<dim>& x = model.x();
+  for (int i = first; i <= last; ++i) {
+    if (!model.in_arc(i)) continue;
+    const double gap = table_body_gap<dim>(x.col(i) - point_, table_normal_, table_inward_, margin);
+    if (gap < deepest.second) deepest = {i, gap};
+  }
+  return deepest;
 }
 
 template <int dim>
@@ -428,6 +459,7 @@ void EdgeFront<dim>::checks(const StringModel<dim>& model, const FrontState<dim>
   // τ (1 − cos θ) − λ ṡ0² |[t]|²/2 for f = 0, reaches zero as the link's tension falls and the lift-off is
   // located there; the link goes slack first only where ṡ0 = 0 exactly (or when a snap leaves it slack, or
   // it was laid slack), and then this check is negative: the run stops at once (docs/model.md §9).
+  if (table_ != EdgeSpec<dim>::Table::kNone) g[kTableCheck] = std::min(1.0, table_body(model).second / this->m_.h);
   if (slack_) {
     g[0] = -1;
     if constexpr (dim == 3) g[1] = 1;
@@ -450,7 +482,18 @@ double EdgeFront<dim>::along_line_margin(const StringModel<dim>& model, const Fr
 }
 
 template <int dim>
-std::string EdgeFront<dim>::check_failed(const StringModel<dim>& model, const FrontState<dim>& s, double t) const {
+std::string EdgeFront<dim>::check_failed(const StringModel<dim>& model, const FrontState<dim>& s, double t, int check) const {
+  if (table_ != EdgeSpec<dim>::Table::kNone && check == kTableCheck) {
+    const int node = table_body(model).first;
+    const Vec<dim> r = model.x().col(node) - point_;
+    return fmt::format(
+        "node {} (s = {:.6g} m), beyond the edge at {} in the material, has reached the body of the table under the "
+        "string {} the edge at t = {:.9g} s, {:.6g} m beneath its top and {:.6g} m in from its edge: the table's side "
+        "face below the edge is not an obstacle, so the string would pass into it (a side that swings back under the "
+        "table is not modelled: docs/model.md §8)",
+        node, model.chain().node_coordinate(node), show_point<dim>(point_),
+        table_ == EdgeSpec<dim>::Table::kBefore ? "before" : "after", t, -table_normal_.dot(r), table_inward_.dot(r));
+  }
   if (slack_)
     return fmt::format("lifted off the edge at t = {:.9g} s: the link bent over the edge at {} (link {}) has gone slack, "
                        "so the string no longer presses on the edge (s0 = {:.9g} m)",
@@ -482,8 +525,9 @@ bool EdgeFront<dim>::along_line(const StringModel<dim>& model, const FrontState<
 
 template <int dim>
 std::optional<RunEvent> EdgeFront<dim>::check_event(const StringModel<dim>& model, const FrontState<dim>& s,
-                                                    double t) const {
+                                                    double t, int check) const {
   if (along_line(model, s)) return std::nullopt;  // no physical event: the model's limit (check_failed says)
+  if (check == kTableCheck) return std::nullopt;  // the same (a table's body)
   RunEvent e;
   e.kind = "lift_off";
   e.t = t;

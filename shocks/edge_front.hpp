@@ -89,18 +89,23 @@ class EdgeFront final : public FrontKind<dim> {
   bool exact_crossing() const override { return true; }
   /// The lift-off margin (N), positive while the edge pushes; in 3D also the along-line margin
   /// kAlongLine (τ⁻ + τ⁺ + λ ṡ0²) − |F0·d| (N), positive while the held crossing point asks no force of the
-  /// edge along its line (a smooth edge has none: an oblique crossing would slide along it, not built).
-  int num_checks() const override { return dim == 3 ? 2 : 1; }
+  /// edge along its line (a smooth edge has none: an oblique crossing would slide along it, not built); with a
+  /// table, the string beyond the edge outside the table's body (table_body_gap, per h: its side face beneath the
+  /// edge is not an obstacle, so a side that swings back under the table would pass into it).
+  int num_checks() const override { return kTableCheck + (table_ != EdgeSpec<dim>::Table::kNone ? 1 : 0); }
+  /// The table's check comes after the lift-off's (and in 3D the along-line one).
+  static constexpr int kTableCheck = dim == 3 ? 2 : 1;
   /// The largest force along a 3D edge's line, per the forces the jump conditions balance there
   /// (τ⁻ + τ⁺ + λ ṡ0²: not |F0|, which falls to zero at a lift-off), before the run stops. Far above the
   /// round-off of F0·d on a line at right angles to the string (measured up to 2.5e-7 of |F0|, the partial
   /// links' directions 1e-8 links long carrying the coordinates' round-off); a 45° crossing is at 0.35.
   static constexpr double kAlongLine = 1e-3;
   void checks(const StringModel<dim>& model, const FrontState<dim>& state, double* g) const override;
-  std::string check_failed(const StringModel<dim>& model, const FrontState<dim>& state, double t) const override;
+  std::string check_failed(const StringModel<dim>& model, const FrontState<dim>& state, double t,
+                           int check) const override;
   bool checks_need_tensions() const override { return true; }
-  std::optional<RunEvent> check_event(const StringModel<dim>& model, const FrontState<dim>& state,
-                                      double t) const override;
+  std::optional<RunEvent> check_event(const StringModel<dim>& model, const FrontState<dim>& state, double t,
+                                      int check) const override;
   /// F0 of the jump conditions at the current tension (without the table's support).
   Vec<dim> recorded_reaction(const StringModel<dim>& model, const FrontState<dim>& state) const override;
 
@@ -134,6 +139,10 @@ class EdgeFront final : public FrontKind<dim> {
   friend Obstacle<d> edge_table(EdgeFront<d>& edge, const Vec<d>& normal, const Vec<d>& inward, bool before,
                                 const Vec<d>& edge_axis, std::string name);
   Vec<dim> table_normal_ = Vec<dim>::Zero();  ///< the table's outward unit normal (set at initialize)
+  /// The table's top from the edge into the table, normal to the edge's line (set at initialize).
+  Vec<dim> table_inward_ = Vec<dim>::Zero();
+  /// The node beyond the edge deepest in the table's body and its gap (table_body_gap, m): (−1, +∞) without a table.
+  std::pair<int, double> table_body(const StringModel<dim>& model) const;
   int link_ = -1;
   /// The sides' tangents at the edge at the start (the faces drawn along them).
   Vec<dim> start_minus_ = Vec<dim>::Zero(), start_plus_ = Vec<dim>::Zero();

@@ -85,7 +85,7 @@ void FoldFront<dim>::checks(const StringModel<dim>& /*model*/, const FrontState<
 }
 
 template <int dim>
-std::string FoldFront<dim>::check_failed(const StringModel<dim>& model, const FrontState<dim>& s, double t) const {
+std::string FoldFront<dim>::check_failed(const StringModel<dim>& model, const FrontState<dim>& s, double t, int /*check*/) const {
   const bool apart = max_chord() - chord_ <= std::cos(s.opening) - std::cos(kMaxOpeningDeg * kPi / 180);
   return apart ? apart_message(model, s, t) : opened_message(s, t);
 }

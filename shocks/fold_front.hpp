@@ -46,7 +46,8 @@ class FoldFront final : public SplitLinkFront<dim> {
   /// material spans its chord.
   int num_checks() const override { return 1; }
   void checks(const StringModel<dim>& model, const FrontState<dim>& state, double* g) const override;
-  std::string check_failed(const StringModel<dim>& model, const FrontState<dim>& state, double t) const override;
+  std::string check_failed(const StringModel<dim>& model, const FrontState<dim>& state, double t,
+                           int check) const override;
 
  private:
   /// `t`: the time of a run's stop (none at the start's refusal).

@@ -188,8 +188,9 @@ class FrontKind {
   /// Root functions of the front's own that stop the run (positive while it may go on).
   virtual int num_checks() const { return 0; }
   virtual void checks(const StringModel<dim>& /*model*/, const FrontState<dim>& /*state*/, double* /*g*/) const {}
+  /// What stopped the run where check `check` (0 … num_checks() − 1) reached zero at t (the reason).
   virtual std::string check_failed(const StringModel<dim>& /*model*/, const FrontState<dim>& /*state*/,
-                                   double /*t*/) const {
+                                   double /*t*/, int /*check*/) const {
     return {};
   }
   /// Whether `checks` read the string's tensions (then the string solves for them before the root
@@ -199,9 +200,9 @@ class FrontKind {
   /// re-layout, a snap), stops the run there (StringModule::events_failed_after_event): ARKODE restarts from that
   /// state and finds only sign changes, so such a check would otherwise go unseen.
   virtual bool check_after_events(int /*check*/) const { return true; }
-  /// The physical event a failed check is (the run's summary lists it in `events`), if any.
+  /// The physical event that check `check` reaching zero is (the run's summary lists it in `events`), if any.
   virtual std::optional<RunEvent> check_event(const StringModel<dim>& /*model*/, const FrontState<dim>& /*state*/,
-                                              double /*t*/) const {
+                                              double /*t*/, int /*check*/) const {
     return std::nullopt;
   }
   /// The force of the front's obstacle or support on the string that the outputs show (R_front<k>

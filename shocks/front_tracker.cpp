@@ -377,11 +377,11 @@ EventAction FrontTracker<dim>::handle_events(StringModel<dim>& model, double t, 
           forming = k;
           continue;
         }
-        if (std::optional<RunEvent> event = fronts_[k]->check_event(model, fs_[k], t)) {
+        if (std::optional<RunEvent> event = fronts_[k]->check_event(model, fs_[k], t, c)) {
           event->front = static_cast<int>(k);
           events_.push_back(std::move(*event));
         }
-        return {EventAction::Kind::kStop, fronts_[k]->check_failed(model, fs_[k], t)};
+        return {EventAction::Kind::kStop, fronts_[k]->check_failed(model, fs_[k], t, c)};
       }
   // Energy, momentum and held masses before, to book what the crossing changes.
   const double K_before = model.kinetic_energy();

@@ -29,7 +29,7 @@ template <int dim>
 double KinkFront<dim>::formation_margin(const StringModel<dim>& model) const {
   // The turn between the links at either end of a window of 2m links (m ≥ 1), centred on link j, inside one arc.
   const Points<dim>& x = model.x();
-  const int m = std::max(1, static_cast<int>(std::lround(spec_.window / (2 * this->m_.h))));
+  const int m = window_half_links(spec_.window, this->m_.h);
   double lowest = 2;
   sharpest_ = -1;
   for (const ArcRange& arc : model.arcs())
@@ -49,7 +49,7 @@ bool KinkFront<dim>::insert(StringModel<dim>& model) {
   if (sharpest_ < 0) return false;
   const Points<dim>& x = model.x();
   const double h = this->m_.h;
-  const int m = std::max(1, static_cast<int>(std::lround(spec_.window / (2 * h))));
+  const int m = window_half_links(spec_.window, h);
   std::vector<ArcRange>& arcs = model.arcs();
   const int k = model.arc_of(sharpest_);
   const ArcRange arc = arcs[static_cast<std::size_t>(k)];
@@ -266,18 +266,17 @@ void KinkFront<dim>::checks(const StringModel<dim>& /*model*/, const FrontState<
 }
 
 template <int dim>
-std::string KinkFront<dim>::check_failed(const StringModel<dim>& model, const FrontState<dim>& s, double t) const {
+std::string KinkFront<dim>::check_failed(const StringModel<dim>& model, const FrontState<dim>& s, double t, int check) const {
   const int a = this->node_a(model), b = this->node_b(model);
-  const double outside = this->outside_margin(s);
-  if (outside < 0) {
+  if (check == 1) {
     // Moving out on A's side (towards the start) or on B's (towards the end), with the links left on that side.
     const bool start = s.l_minus < s.l_plus;
     const int links = model.arcs()[static_cast<std::size_t>(start ? this->arc_minus : this->arc_plus)].num_links();
     return fmt::format(
         "the kink at s0 = {:.6g} m lies {:.4g} h outside its kinked link, beyond node {}, and moves on away from it at "
-        "t = {:.9g} s (ds0/dt = {:.4g} m/s): its last crossing re-laid it where its arms meet, beyond the new node "
-        "because the string turns sharply next to the kinked link, and it then turned back, past the crossing's root{} "
-        "(docs/model.md §9)",
+        "t = {:.9g} s (ds0/dt = {:.4g} m/s): its last crossing re-laid it where its arms meet, outside the new kinked "
+        "link because the string turns sharply next to it, and it moves away from the link past a crossing's root "
+        "that the integrator no longer sees{} (docs/model.md §9)",
         s.s0, -std::min(s.l_minus, s.l_plus) / this->m_.h, start ? a : b, t, s.s0_dot,
         links < 2 ? fmt::format(": it has in effect reached the {} of the string (its arms need a full link on either "
                                 "side, and {} has {} left)",

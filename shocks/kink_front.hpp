@@ -3,6 +3,9 @@
 /// A kink front (front_kind.hpp): a conservative internal shock (f = 0) at a corner of the string between
 /// the arc before and the arc after it, its arms at any angle (docs/model.md §2.5, docs/shocks.md). The
 /// split link's bookkeeping (layout, crossings, mass parcels) is SplitLinkFront's.
+#include <algorithm>
+#include <cmath>
+
 #include "shocks/split_link_front.hpp"
 
 namespace chainsim {
@@ -45,6 +48,11 @@ class KinkFront final : public SplitLinkFront<dim> {
   /// cos(turn_deg) subtracted from the smallest cosine of the turn between the links at either end of a
   /// window of material (KinkSpec::window) in one arc: negative once a window turns by more than turn_deg.
   double formation_margin(const StringModel<dim>& model) const override;
+  /// The formation window's half width in links on links of h: m = kink_window / 2h rounded, at least 1 (the window is
+  /// 2m links, centred on a link, and the links at its ends are compared).
+  static int window_half_links(double window, double h) {
+    return std::max(1, static_cast<int>(std::lround(window / (2 * h))));
+  }
   /// In the link whose neighbours turn most near the sharpest window (its arms' meeting point l⁻ inside it),
   /// its neighbouring links taken taut.
   bool insert(StringModel<dim>& model) override;
@@ -76,7 +84,8 @@ class KinkFront final : public SplitLinkFront<dim> {
   /// control brings the chord back within kMaxChord h; the check is watched from the next sign change
   /// (docs/model.md §9, "The crossing breaks the jump conditions"). Check 1 yes.
   bool check_after_events(int check) const override { return check != 0; }
-  std::string check_failed(const StringModel<dim>& model, const FrontState<dim>& state, double t) const override;
+  std::string check_failed(const StringModel<dim>& model, const FrontState<dim>& state, double t,
+                           int check) const override;
 
  private:
   double turn_margin(const FrontState<dim>& state) const;

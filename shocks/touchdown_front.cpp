@@ -477,7 +477,7 @@ void TouchdownFront<dim>::checks(const StringModel<dim>& model, const FrontState
 }
 
 template <int dim>
-std::string TouchdownFront<dim>::check_failed(const StringModel<dim>& model, const FrontState<dim>& s, double t) const {
+std::string TouchdownFront<dim>::check_failed(const StringModel<dim>& model, const FrontState<dim>& s, double t, int /*check*/) const {
   const Margins m = margins(model, s);
   const double least = TouchdownFront::least(m);
   const double angle = dim == 3 ? std::asin(std::clamp(elevation_, -1.0, 1.0)) : theta_;  // 3D: the elevation
@@ -534,7 +534,7 @@ std::string TouchdownFront<dim>::check_failed(const StringModel<dim>& model, con
 
 template <int dim>
 std::optional<RunEvent> TouchdownFront<dim>::check_event(const StringModel<dim>& model, const FrontState<dim>& s,
-                                                         double t) const {
+                                                         double t, int /*check*/) const {
   const Margins m = margins(model, s);
   if (least(m) != m.take_off || m.take_off >= std::min(m.pushed, m.inside)) return std::nullopt;
   RunEvent e;

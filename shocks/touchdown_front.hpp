@@ -125,9 +125,10 @@ class TouchdownFront final : public SplitLinkFront<dim> {
   bool checks_need_tensions() const override { return true; }
   int num_checks() const override { return 1; }
   void checks(const StringModel<dim>& model, const FrontState<dim>& state, double* g) const override;
-  std::string check_failed(const StringModel<dim>& model, const FrontState<dim>& state, double t) const override;
-  std::optional<RunEvent> check_event(const StringModel<dim>& model, const FrontState<dim>& state,
-                                      double t) const override;
+  std::string check_failed(const StringModel<dim>& model, const FrontState<dim>& state, double t,
+                           int check) const override;
+  std::optional<RunEvent> check_event(const StringModel<dim>& model, const FrontState<dim>& state, double t,
+                                      int check) const override;
 
   void constraints(const StringModel<dim>& model, const FrontState<dim>& state,
                    std::vector<NodeConstraint<dim>>& out) const override;

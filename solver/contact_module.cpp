@@ -1037,18 +1037,22 @@ class ContactModule final : public WrappingModule<dim> {
   }
 
   static bool free_node(const StringModel<dim>& model, int i) { return model.in_arc(i) && !model.is_prescribed(i); }
-  /// A closed string that starts with every node held on one cylinder, wrapping its axis, is locked there: no
-  /// motion but a rigid turn keeps it on the cylinder and its links at their lengths, and its tension has a
-  /// uniform part that nothing determines (any uniform tension is balanced by the cylinder's push; the tension
-  /// system is singular). Refused before the run (InputError) with that cause, rather than the singular solve's
-  /// pivot.
+  /// A closed string that starts with every node held on one cylinder, wrapping it in a circle (in 3D at right
+  /// angles to the axis: every node at one axial coordinate), is locked there: no motion but a rigid turn keeps it
+  /// on the cylinder and its links at their lengths, and its tension has a uniform part that nothing determines
+  /// (any uniform tension is balanced by the cylinder's push; the tension system is singular). Refused before the
+  /// run (InputError) with that cause, rather than the singular solve's pivot. A loop round a 3D cylinder at an
+  /// angle to its axis is not locked (a uniform tension would push it along the cylinder: it may deform) and runs.
   void refuse_locked_loop(const StringModel<dim>& model) const {
     const Chain<dim>& chain = model.chain();
-    if (!chain.closed() || held_.empty()) return;
-    const int k = held_[0];
+    if (!chain.closed()) return;
+    int k = -1;
+    for (std::size_t i = 0; i < held_.size(); ++i) {
+      if (!free_node(model, static_cast<int>(i))) continue;
+      if (k < 0) k = held_[i];
+      if (held_[i] < 0 || held_[i] != k) return;
+    }
     if (k < 0 || obstacles_[static_cast<std::size_t>(k)].kind != Obstacle<dim>::Kind::kCylinder) return;
-    for (std::size_t i = 0; i < held_.size(); ++i)
-      if (held_[i] != k && free_node(model, static_cast<int>(i))) return;
     // The winding about the axis: the angles between consecutive nodes seen from it, summed round the loop.
     const Obstacle<dim>& o = obstacles_[static_cast<std::size_t>(k)];
     const Eigen::Matrix<double, dim, 2> basis = [&] {
@@ -1069,11 +1073,17 @@ class ContactModule final : public WrappingModule<dim> {
       winding += std::atan2(p[0] * q[1] - p[1] * q[0], p.dot(q));
     }
     if (!(std::abs(winding) > kPi)) return;
+    if constexpr (dim == 3) {
+      const auto axial = [&](int i) { return o.axis.dot(model.x().col(i) - o.point); };
+      for (int i = 1; i < n; ++i)
+        if (std::abs(axial(i) - axial(0)) > kInitialContact * h_) return;
+    }
     throw InputError(fmt::format(
         "the closed string starts with all its {} nodes held on {} (within {:g} of a link length of its surface), "
         "wrapped round it: it is locked there, and its tension is indeterminate (any uniform tension is balanced by "
         "the cylinder's push), which an inextensible string does not resolve; allowed: a closed string that does not "
-        "lie all round the cylinder (longer than its circumference, or round a smaller cylinder)",
+        "lie all round the cylinder (longer than its circumference, in 3D at an angle to its axis, or round a smaller "
+        "cylinder)",
         n, o.name, kInitialContact));
   }
   /// A table that ends at an edge: a plane bounded by its edge.
@@ -1096,8 +1106,7 @@ class ContactModule final : public WrappingModule<dim> {
     for (std::size_t k = 0; k < obstacles_.size(); ++k) {
       const Obstacle<dim>& o = obstacles_[k];
       if (!bounded(o) || o.may_hold(i)) continue;
-      const Vec<dim> r = model.x().col(i) - o.point;
-      const double gap = std::max(o.normal.dot(r) + kSideFaceMargin * h_, kSideFaceMargin * h_ - o.inward.dot(r));
+      const double gap = table_body_gap<dim>(model.x().col(i) - o.point, o.normal, o.inward, kSideFaceMargin * h_);
       if (gap < nearest.second) nearest = {static_cast<int>(k), gap};
     }
     return nearest;

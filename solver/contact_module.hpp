@@ -32,6 +32,7 @@
 /// adds the held nodes, its ledgers and root functions after the tracker's (docs/model.md §10, "Contact
 /// with fronts"). A plane may end at an edge front (a table and its edge): it then holds only the nodes
 /// on the table's side of the edge in the material (Obstacle::carries), and only where it exists.
+#include <algorithm>
 #include <cmath>
 #include <functional>
 #include <memory>
@@ -110,6 +111,16 @@ inline long nodes_resolving_radius(double radius, double length, bool closed) {
 /// A node this share of a link length from a surface at the start is on it (the discretized shape is
 /// a polygon inscribed in a curved one); further inside, the scene is refused.
 inline constexpr double kInitialContact = 1e-3;
+
+/// How far a point is outside the body of a table (m, < 0 inside): the table's top is the plane through its edge's
+/// point with outward unit normal `normal`, and its body lies beneath the top on the side of the edge that `inward`
+/// (the top's unit direction from the edge into the table, normal to the edge's line) points to; `r` is the point
+/// from the edge's point. The body's side face, beneath the edge, is not an obstacle: a node there has come through
+/// it. `margin` (m) moves both faces into the body.
+template <int dim>
+double table_body_gap(const Vec<dim>& r, const Vec<dim>& normal, const Vec<dim>& inward, double margin) {
+  return std::max(normal.dot(r) + margin, margin - inward.dot(r));
+}
 
 /// A free node this share of a link length in from the edge of a table that ends at an edge, and as far beneath
 /// its top, has entered the table through its side face (which is not an obstacle): the run stops, located. The

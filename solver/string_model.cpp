@@ -312,7 +312,13 @@ void StringModel<dim>::links() {
     }
   }
   x_max_ = x_max;
-  if (!bends_.empty()) bend_links();
+  if (bends_.empty()) return;
+  bend_links();
+  // A bent link's length is its sides' (its chord may pass through zero, above): the collapse test on that.
+  for (const Bend& bend : bends_)
+    if (!(l_[bend.link] > kCollapsedLink * h[bend.link]) && !link_slack(bend.link))
+      throw RecoverableError(fmt::format("link {} (bent over {}) has collapsed to length {:g}", bend.link,
+                                         bend.circle ? "a cylinder" : "a point", l_[bend.link]));
 }
 
 template <int dim>

@@ -687,7 +687,7 @@ std::unique_ptr<StringModel<dim>> build_front_model(const SceneSpec& spec, scene
           std::acos(std::clamp(margin + std::cos(spec.solver.kink_turn * kPi / 180), -1.0, 1.0)) * 180 / kPi;
       // The window as measured on this mesh: 2m links, m = kink_window / 2h rounded and at least 1.
       const double h = model->chain().link_length(0);
-      const int window_links = 2 * std::max(1, static_cast<int>(std::lround(kinks.back().window / (2 * h))));
+      const int window_links = 2 * KinkFront<dim>::window_half_links(kinks.back().window, h);
       fail_at(spec, "solver.kinks",
               fmt::format("solver.kinks = {}: the initial shape already turns by {:.4g} deg over kink_window = {:g} m "
                           "({} links of {:g} m on this mesh), past kink_turn = {:g} deg: a corner present at t = 0 (a sharp polyline vertex, the turn "

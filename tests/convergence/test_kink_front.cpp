@@ -659,8 +659,9 @@ TEST_CASE("a coil with an inserted kink closes its ledgers across a snap", "[kin
   // (kinks = "insert"), and the tip link snaps taut while the kink runs along the chain (found by review of issue
   // 27). The snap's impulses were the links' alone and left the kink's constraint with a rate, which the drift
   // control took out with unbooked work: energy residual 3.2e-6, 9.0e-7, 2.1e-7 of the scale on 151, 161, 201
-  // nodes at every rtol. With the snap projecting onto the constraint too (docs/model.md §9): 6.0e-10, 6.4e-10,
-  // 1.3e-9; momentum 1.1e-10, 4.2e-11, 1.9e-10. The run ends where the kink meets a second corner (located).
+  // nodes at every rtol. With the snap projecting onto the constraint too (docs/model.md §9): 6.0e-10, 6.4e-10 on 151,
+  // 161 nodes (201 nodes, 1.3e-9, now stops before its snap: below); momentum 1.1e-10, 4.2e-11. The run ends where
+  // the kink meets a second corner (located).
   const std::string text = R"([string]
 density = 0.1
 nodes = 151

@@ -365,6 +365,34 @@ TEST_CASE("hard edges: a hanging side drawn inside the table is refused before t
                     Contains("starts inside the table effects.surface[0]"));
 }
 
+TEST_CASE("hard edges: a hanging side that swings back under the edge's own table stops there too, located",
+          "[edge][hard]") {
+  // cases/scenes/chain_off_table_edge.toml (the table as the edge's `table = "before"`, not a contact surface) with
+  // its hanging part started 30° out: it passed silently into the table's body after about 0.2 s (its lift-off at
+  // 0.5224 s reported clean). The edge front's table check stops it where the first node of the hanging side reaches
+  // the body, at the same time as the contact surface's side face does (the test above, 0.2068 s); a side drawn
+  // inside the table is refused before the run.
+  const std::filesystem::path file =
+      std::filesystem::path(CHAINSIM_SOURCE_DIR) / "cases" / "scenes" / "chain_off_table_edge.toml";
+  SceneRun<2> run(parse_scene(file, {"shape.points=[[-0.8, 0.0], [0.0, 0.0], [0.1, -0.17320508075688773]]",
+                                     "stop.t_end=1.0", "output.interval=0.01"}));
+  REQUIRE_FALSE(run.run().has_value());
+  const RunSummary& summary = run.solver().summary();
+  INFO(summary.stop_reason);
+  CHECK(summary.status == "stopped");
+  CHECK(summary.events.empty());  // not a lift-off
+  CHECK(std::abs(summary.t_stop - 0.2068) < 1e-4);  // measured 0.206803 s
+  CHECK_THAT(summary.stop_reason, Contains("has reached the body of the table under the string before the edge"));
+  const double h = 0.01, depth = 2e-3 * h, in_from_edge = 2e-3 * h;  // located at 1e-3 h (kSideFaceMargin)
+  for (const Frame<2>& frame : run.solver().frames())
+    for (Eigen::Index i = 0; i < frame.x.cols(); ++i) {
+      INFO("t = " << frame.t << " node " << i << " at (" << frame.x(0, i) << ", " << frame.x(1, i) << ")");
+      CHECK_FALSE((frame.x(1, i) < -depth && frame.x(0, i) < -in_from_edge));  // the table: y < 0, x < 0
+    }
+  CHECK_THROWS_WITH(SceneRun<2>(parse_scene(file, {"shape.points=[[-0.8, 0.0], [0.0, 0.0], [-0.1, -0.17320508075688773]]"})),
+                    Contains("starts inside the table under the string before it"));
+}
+
 TEST_CASE("hard edges: a peg at the midpoint of its bent link (sides antiparallel) is passed, at an output time too",
           "[edge][peg][hard]") {
   // A chain over a sharp peg, pulled by 3 N at its long side's end and 1 N at its short side's (1 m, 1 kg/m, no
