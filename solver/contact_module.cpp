@@ -800,17 +800,18 @@ class ContactModule final : public WrappingModule<dim> {
     }
     return o.tangents(model.x().col(i)).col(0);
   }
-  /// 3D: the onset of slip from rest as Coulomb's law has it in the tangent plane (docs/model.md §10,
-  /// *The onset of slip in 3D*). At rest node i of the run carries G_i = F_i + T_i e_i − T_{i−1} e_{i−1}
-  /// (F_i its applied force); its friction is −G_t,i while |G_t,i| ≤ μ N_i (it stays), else −μ N_i d_i
-  /// with d_i = G_t,i/|G_t,i|, its acceleration (|G_t,i| − μ N_i)⁺ d_i / m_i. The link conditions at
-  /// rest, e_j·(a_{j+1} − a_j) = 0, are the gradient of the convex Φ(T) = Σ ½ (|G_t,i| − μ N_i)⁺² / m_i in
-  /// the run's link tensions (the links leaving the run keep their tensions): its minimum, found by
-  /// Newton's method with a line search, gives the nodes that slip and their directions. The run is
-  /// `first`..`last`, every node stuck, no link bent, the chain open; otherwise, or if Newton's method
-  /// does not converge, false (slip_block then tries the chain's two directions, as in 2D). True: the
-  /// nodes with (|G_t| − μ N)⁺ > 0 slide along d_i, the others stay stuck with their links locked at
-  /// the minimiser's tensions.
+  /// 3D: the onset of slip as Coulomb's law has it in the tangent plane (docs/model.md §10, *The onset
+  /// of slip in 3D*). Node i of the run `first`..`last` carries G_i = F_i + T_i e_i − T_{i−1} e_{i−1} (F_i
+  /// its applied force): a stuck one keeps a_i = 0 while |G_t,i| ≤ μ N_i, else it slips with
+  /// a_i = (|G_t,i| − μ N_i)⁺ d_i / m_i, d_i = G_t,i/|G_t,i|; a sliding one (direction t̂_i) has
+  /// a_i = (G_t,i + μ (n·G_i) t̂_i)/m_i. The link conditions e_j·(a_{j+1} − a_j) = −|v_{j+1} − v_j|²/ℓ_j are
+  /// the gradient of the convex Φ(T) = Σ_i φ_i(G_i) − Σ_j c_j T_j (φ_i = ½ (|G_t| − μ N)⁺²/m_i stuck,
+  /// ½ |G_t + μ (n·G) t̂|²/m_i sliding): its minimum over T ≥ 0 (a string cannot push), by a damped,
+  /// projected Newton method on the tridiagonal Hessian, gives the nodes that slip and their directions.
+  /// The links leaving the run keep their tensions. False (slip_block then tries the chain's two
+  /// directions, as in 2D) if a link is bent, the chain closed or Newton's method does not converge;
+  /// true: the stuck nodes with (|G_t| − μ N)⁺ > 0 slide along d_i, the others stay stuck with their
+  /// links locked at the minimiser's tensions.
   bool slip_onset(StringModel<dim>& model, const std::vector<int>& block, int first, int last) {
     const Chain<dim>& chain = model.chain();
     if (chain.closed() || block.empty()) return false;
@@ -981,10 +982,11 @@ class ContactModule final : public WrappingModule<dim> {
       if (model.link_locked(first + j)) model.set_locked_tension(first + j, T[j]);
     return true;
   }
-  /// Node `node` cannot be held (its cone is left; F_t the force that held it): its block, the stuck
-  /// nodes of its run of held rough nodes, slides along the chain, in the direction the force pushed
-  /// the node first, and if the block's accelerations along it come out negative (inconsistent) the
-  /// other way. If neither is consistent (Coulomb's law has no sliding solution there) the run stops.
+  /// Node `node` cannot be held (its cone is left; F_t the force that held it): in 3D its run slips as
+  /// slip_onset() finds; in 2D (or where that does not apply) its block, the stuck nodes of its run of
+  /// held rough nodes, slides along the chain, in the direction the force pushed the node first, and if
+  /// the block's accelerations along it come out negative (inconsistent) the other way. If neither is
+  /// consistent (Coulomb's law has no sliding solution there) the run stops.
   void slip_block(StringModel<dim>& model, double t, int node, const Vec<dim>& ft) {
     const int n = static_cast<int>(held_.size());
     auto rough = [&](int i) { return i >= 0 && i < n && held_[static_cast<std::size_t>(i)] >= 0 && obstacle_of(static_cast<std::size_t>(i)).mu > 0; };

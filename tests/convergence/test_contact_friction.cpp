@@ -13,6 +13,9 @@
 //    ODE says; launched towards the lighter side it stops at the ODE's time and holds;
 //  - a chain landing flat on a rough table: Coulomb's impulse at the landing, then the stick at the
 //    exact place; a 3D chain launched up a rough slope: the stop and the slide back;
+//  - the onset of slip in 3D (the minimum of Φ, docs/model.md §10): a straight chain at 45° to 90° to the
+//    line of steepest slope slides rigidly straight downhill at g (sin α − μ cos α) with no tension, and a
+//    half circle pulled at an end slips, closes its ledgers and converges on refinement;
 //  - the energy ledger with W_friction, and the momentum ledger with the friction's impulse, closed.
 #include <cmath>
 #include <cstdio>
