@@ -801,10 +801,193 @@ class ContactModule final : public WrappingModule<dim> {
     }
     return o.tangents(model.x().col(i)).col(0);
   }
-  /// Node `node` cannot be held (its cone is left; F_t the force that held it): its block, the stuck
-  /// nodes of its run of held rough nodes, slides along the chain, in the direction the force pushed
-  /// the node first, and if the block's accelerations along it come out negative (inconsistent) the
-  /// other way. If neither is consistent (Coulomb's law has no sliding solution there) the run stops.
+  /// 3D: the onset of slip as Coulomb's law has it in the tangent plane (docs/model.md §10, *The onset
+  /// of slip in 3D*). Node i of the run `first`..`last` carries G_i = F_i + T_i e_i − T_{i−1} e_{i−1} (F_i
+  /// its applied force): a stuck one keeps a_i = 0 while |G_t,i| ≤ μ N_i, else it slips with
+  /// a_i = (|G_t,i| − μ N_i)⁺ d_i / m_i, d_i = G_t,i/|G_t,i|; a sliding one (direction t̂_i) has
+  /// a_i = (G_t,i + μ (n·G_i) t̂_i)/m_i. The link conditions e_j·(a_{j+1} − a_j) = −|v_{j+1} − v_j|²/ℓ_j are
+  /// the gradient of the convex Φ(T) = Σ_i φ_i(G_i) − Σ_j c_j T_j (φ_i = ½ (|G_t| − μ N)⁺²/m_i stuck,
+  /// ½ |G_t + μ (n·G) t̂|²/m_i sliding): its minimum over T ≥ 0 (a string cannot push), by a damped,
+  /// projected Newton method on the tridiagonal Hessian, gives the nodes that slip and their directions.
+  /// The links leaving the run keep their tensions. False (slip_block then tries the chain's two
+  /// directions, as in 2D) if a link is bent, the chain closed or Newton's method does not converge;
+  /// true: the stuck nodes with (|G_t| − μ N)⁺ > 0 slide along d_i, the others stay stuck with their
+  /// links locked at the minimiser's tensions.
+  bool slip_onset(StringModel<dim>& model, const std::vector<int>& block, int first, int last) {
+    const Chain<dim>& chain = model.chain();
+    if (chain.closed() || block.empty()) return false;
+    const int L = chain.num_links(), n = last - first;  // unknowns: links first..last−1
+    for (int j = std::max(first - 1, 0); j <= std::min(last, L - 1); ++j)
+      if (model.link_bent(j)) return false;
+    std::vector<int> contact_of(held_.size(), -1);
+    for (std::size_t k = 0; k < model.contacts().size(); ++k) contact_of[static_cast<std::size_t>(model.contacts()[k].node)] = static_cast<int>(k);
+    const int count = last - first + 1;
+    std::vector<Vec<dim>> F(static_cast<std::size_t>(count)), normal(static_cast<std::size_t>(count)), slide(static_cast<std::size_t>(count));
+    std::vector<double> mass(static_cast<std::size_t>(count)), mu(static_cast<std::size_t>(count));
+    std::vector<char> moving(static_cast<std::size_t>(count), 0);
+    for (int i = first; i <= last; ++i) {
+      const int k = contact_of[static_cast<std::size_t>(i)];
+      if (k < 0) return false;
+      const std::size_t b = static_cast<std::size_t>(i - first);
+      F[b] = model.contact_applied(static_cast<std::size_t>(k));
+      normal[b] = model.contacts()[static_cast<std::size_t>(k)].normal;
+      mass[b] = model.masses()[i];
+      mu[b] = model.contacts()[static_cast<std::size_t>(k)].mu;
+      moving[b] = stuck_[static_cast<std::size_t>(i)] ? 0 : 1;
+      slide[b] = model.contacts()[static_cast<std::size_t>(k)].slide;
+    }
+    auto e = [&](int j) -> Vec<dim> { return (model.x().col(chain.link_end(j)) - model.x().col(chain.link_start(j))).normalized(); };
+    std::vector<Vec<dim>> dir(static_cast<std::size_t>(std::max(n, 0)));
+    for (int j = 0; j < n; ++j) dir[static_cast<std::size_t>(j)] = e(first + j);
+    const double T_before = first > 0 ? model.link_tension(first - 1) : 0.0, T_after = last < L ? model.link_tension(last) : 0.0;
+    const Vec<dim> e_before = first > 0 ? e(first - 1) : Vec<dim>::Zero(), e_after = last < L ? e(last) : Vec<dim>::Zero();
+    Eigen::VectorXd T(n), c(n);  // c_j = |v_{j+1} − v_j|²/ℓ_j: e_j·(a_{j+1} − a_j) = −c_j
+    for (int j = 0; j < n; ++j) {
+      T[j] = model.link_tension(first + j);
+      const Vec<dim> dx = model.x().col(first + j + 1) - model.x().col(first + j), dv = model.v().col(first + j + 1) - model.v().col(first + j);
+      c[j] = dv.squaredNorm() / dx.norm();
+    }
+    // Node b's load G_b(T), its excess s_b = (|G_t| − μ N)⁺ and its gradient q_b = ∂(|G_t| − μN)/∂G.
+    auto load = [&](const Eigen::VectorXd& tension, int b) -> Vec<dim> {
+      Vec<dim> G = F[static_cast<std::size_t>(b)];
+      if (b < n) G += tension[b] * dir[static_cast<std::size_t>(b)];
+      else G += T_after * e_after;
+      if (b > 0) G -= tension[b - 1] * dir[static_cast<std::size_t>(b - 1)];
+      else G -= T_before * e_before;
+      return G;
+    };
+    auto excess = [&](const Vec<dim>& G, int b, Vec<dim>* q) {
+      const Vec<dim>& nb = normal[static_cast<std::size_t>(b)];
+      const Vec<dim> Gt = G - nb.dot(G) * nb;
+      const double s = Gt.norm() - mu[static_cast<std::size_t>(b)] * (-nb.dot(G));
+      if (q) *q = (Gt.norm() > 0 ? Vec<dim>(Gt.normalized()) : Vec<dim>::Zero()) + mu[static_cast<std::size_t>(b)] * nb;
+      return std::max(s, 0.0);
+    };
+    // A node of the run already sliding along d: its acceleration w/m, w = G_t + μ (n·G) d = J G (linear).
+    auto sliding_force = [&](const Vec<dim>& G, int b) -> Vec<dim> {
+      const Vec<dim>& nb = normal[static_cast<std::size_t>(b)];
+      return G - nb.dot(G) * nb + mu[static_cast<std::size_t>(b)] * nb.dot(G) * slide[static_cast<std::size_t>(b)];
+    };
+    auto phi = [&](const Eigen::VectorXd& tension) {
+      double sum = -c.dot(tension);
+      for (int b = 0; b < count; ++b) {
+        const Vec<dim> G = load(tension, b);
+        sum += 0.5 * (moving[static_cast<std::size_t>(b)] ? sliding_force(G, b).squaredNorm() : std::pow(excess(G, b, nullptr), 2)) /
+               mass[static_cast<std::size_t>(b)];
+      }
+      return sum;
+    };
+    // The link conditions r_j = −e_j·(a_{j+1} − a_j) − c_j = ∂Φ/∂T_j and, with `hessian`, the tridiagonal
+    // Hessian (diagonal, off-diagonal).
+    Eigen::VectorXd diag(n), off(std::max(n - 1, 0));
+    double load_scale = acceleration_scale(model);  // the largest |G_b|/m_b (m/s²): the link conditions' round-off
+    auto residuals = [&](const Eigen::VectorXd& tension, bool hessian) {
+      std::vector<Vec<dim>> grad(static_cast<std::size_t>(count));
+      std::vector<Eigen::Matrix<double, dim, dim>> hess(static_cast<std::size_t>(count));
+      for (int b = 0; b < count; ++b) {
+        const Vec<dim> G = load(tension, b);
+        Vec<dim> q;
+        const double s = excess(G, b, &q), m = mass[static_cast<std::size_t>(b)];
+        if (hessian) load_scale = std::max(load_scale, G.norm() / m);
+        const Vec<dim>& nb = normal[static_cast<std::size_t>(b)];
+        const Vec<dim> Gt = G - nb.dot(G) * nb;
+        grad[static_cast<std::size_t>(b)] = s * q / m;
+        hess[static_cast<std::size_t>(b)].setZero();
+        if (moving[static_cast<std::size_t>(b)]) {
+          const Eigen::Matrix<double, dim, dim> J = Eigen::Matrix<double, dim, dim>::Identity() - nb * nb.transpose() +
+                                                    mu[static_cast<std::size_t>(b)] * slide[static_cast<std::size_t>(b)] * nb.transpose();
+          grad[static_cast<std::size_t>(b)] = J.transpose() * sliding_force(G, b) / m;
+          hess[static_cast<std::size_t>(b)] = J.transpose() * J / m;
+        } else if (s > 0) {
+          const Vec<dim> g = Gt.normalized();
+          const Eigen::Matrix<double, dim, dim> P = Eigen::Matrix<double, dim, dim>::Identity() - nb * nb.transpose();
+          hess[static_cast<std::size_t>(b)] = (q * q.transpose() + s / Gt.norm() * (P - g * g.transpose())) / m;
+        }
+      }
+      Eigen::VectorXd r(n);
+      for (int j = 0; j < n; ++j) {
+        const Vec<dim>& ej = dir[static_cast<std::size_t>(j)];
+        r[j] = ej.dot(grad[static_cast<std::size_t>(j)] - grad[static_cast<std::size_t>(j + 1)]) - c[j];
+        if (!hessian) continue;
+        diag[j] = ej.dot((hess[static_cast<std::size_t>(j)] + hess[static_cast<std::size_t>(j + 1)]) * ej);
+        if (j + 1 < n) off[j] = -ej.dot(hess[static_cast<std::size_t>(j + 1)] * dir[static_cast<std::size_t>(j + 1)]);
+      }
+      return r;
+    };
+    const double a = acceleration_scale(model);
+    constexpr double kOnsetTolerance = 1e-10, kStallTolerance = 1e-8;  // of the link conditions, per the largest |G|/m
+    T = T.cwiseMax(0.0);
+    bool converged = n == 0;
+    double damping = 1e-12;  // Levenberg–Marquardt's shift of the Hessian, per its largest entry
+    for (int iteration = 0; iteration < 200 && !converged; ++iteration) {
+      // A string cannot push: T ≥ 0, and a link at T = 0 whose condition asks for less (r_j > 0, its ends
+      // approaching) is held there (it would go slack, which the model's own solve then reports).
+      auto worst = [&](const Eigen::VectorXd& tension, const Eigen::VectorXd& rj) {
+        double w = 0;
+        for (int j = 0; j < n; ++j) w = std::max(w, tension[j] > 0 ? std::abs(rj[j]) : std::max(-rj[j], 0.0));
+        return w;
+      };
+      Eigen::VectorXd r = residuals(T, true);
+      const double residual = worst(T, r);
+      std::vector<char> held(static_cast<std::size_t>(n), 0);
+      for (int j = 0; j < n; ++j) {
+        if (!(T[j] <= 0 && r[j] > 0)) continue;
+        held[static_cast<std::size_t>(j)] = 1;
+        r[j] = 0;
+        diag[j] = 1;
+        if (j > 0) off[j - 1] = 0;
+        if (j + 1 < n) off[j] = 0;
+      }
+      if (residual <= kOnsetTolerance * load_scale) {
+        converged = true;
+        break;
+      }
+      // Newton's step on the tridiagonal Hessian (regularised where a stuck node leaves it singular),
+      // by Thomas' elimination, then halved until Φ decreases (Armijo) or, where Φ's round-off hides
+      // its decrease near the minimum, the largest link condition halves.
+      const double shift = damping * std::max(diag.cwiseAbs().maxCoeff(), 1e-300);
+      Eigen::VectorXd dT = -r, dd = diag.array() + shift;
+      for (int j = 1; j < n; ++j) {
+        const double f = off[j - 1] / dd[j - 1];
+        dd[j] -= f * off[j - 1];
+        dT[j] -= f * dT[j - 1];
+      }
+      for (int j = n - 1; j >= 0; --j) dT[j] = (dT[j] - (j + 1 < n ? off[j] * dT[j + 1] : 0.0)) / dd[j];
+      const double phi0 = phi(T), slope = r.dot(dT);
+      double step = 1;
+      for (; step > 1e-12; step *= 0.5) {
+        const Eigen::VectorXd trial = (T + step * dT).cwiseMax(0.0);
+        if (phi(trial) <= phi0 + 1e-4 * step * slope || worst(trial, residuals(trial, false)) <= 0.5 * residual) break;
+      }
+      // Stalled (a node at its cone's edge, where Φ has a kink, and Φ's round-off): accepted if the link
+      // conditions hold to kStallTolerance.
+      if (!(step > 1e-12) || (!(step > 1e-3) && residual <= kStallTolerance * load_scale)) {
+        converged = residual <= kStallTolerance * load_scale;
+        break;
+      }
+      T = (T + step * dT).cwiseMax(0.0);
+      damping = step == 1 ? std::max(damping * 0.1, 1e-12) : std::min(damping * 10, 1.0);
+    }
+    if (!converged) return false;
+    for (int b = 0; b < count; ++b) {
+      const int i = first + b;
+      const Vec<dim> G = load(T, b);
+      const Vec<dim>& nb = normal[static_cast<std::size_t>(b)];
+      if (!moving[static_cast<std::size_t>(b)] && excess(G, b, nullptr) > kPull * mass[static_cast<std::size_t>(b)] * a) {
+        stuck_[static_cast<std::size_t>(i)] = 0;
+        dir_.col(i) = obstacle_of(static_cast<std::size_t>(i)).tangents(model.x().col(i)).transpose() * (G - nb.dot(G) * nb).normalized();
+      }
+    }
+    refresh(model);
+    for (int j = 0; j < n; ++j)
+      if (model.link_locked(first + j)) model.set_locked_tension(first + j, T[j]);
+    return true;
+  }
+  /// Node `node` cannot be held (its cone is left; F_t the force that held it): in 3D its run slips as
+  /// slip_onset() finds; in 2D (or where that does not apply) its block, the stuck nodes of its run of
+  /// held rough nodes, slides along the chain, in the direction the force pushed the node first, and if
+  /// the block's accelerations along it come out negative (inconsistent) the other way. If neither is
+  /// consistent (Coulomb's law has no sliding solution there) the run stops.
   void slip_block(StringModel<dim>& model, double t, int node, const Vec<dim>& ft) {
     const int n = static_cast<int>(held_.size());
     auto rough = [&](int i) { return i >= 0 && i < n && held_[static_cast<std::size_t>(i)] >= 0 && obstacle_of(static_cast<std::size_t>(i)).mu > 0; };
@@ -815,6 +998,12 @@ class ContactModule final : public WrappingModule<dim> {
     for (int i = first; i <= last; ++i)
       if (stuck_[static_cast<std::size_t>(i)]) block.push_back(i);
     const double preferred = -ft.dot(chain_direction(model, node, -ft)) >= 0 ? 1.0 : -1.0;
+    if constexpr (dim == 3) {
+      if (slip_onset(model, block, first, last)) {
+        for (int i : block) slips_ += stuck_[static_cast<std::size_t>(i)] ? 0 : 1;
+        return;
+      }
+    }
     const double a = acceleration_scale(model);
     for (const double sign : {preferred, -preferred}) {
       for (int i : block) {

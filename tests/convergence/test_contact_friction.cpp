@@ -13,6 +13,9 @@
 //    ODE says; launched towards the lighter side it stops at the ODE's time and holds;
 //  - a chain landing flat on a rough table: Coulomb's impulse at the landing, then the stick at the
 //    exact place; a 3D chain launched up a rough slope: the stop and the slide back;
+//  - the onset of slip in 3D (the minimum of Φ, docs/model.md §10): a straight chain at 45° to 90° to the
+//    line of steepest slope slides rigidly straight downhill at g (sin α − μ cos α) with no tension, and a
+//    half circle pulled at an end slips, closes its ledgers and converges on refinement;
 //  - the energy ledger with W_friction, and the momentum ledger with the friction's impulse, closed.
 #include <cmath>
 #include <cstdio>
@@ -478,4 +481,108 @@ TEST_CASE("friction: a chain landing flat on a rough table takes Coulomb's impul
   CHECK(last.terms["sticks"] == links + 1);
   CHECK(s.relative_energy_drift() < 1e-12);
   CHECK(s.relative_momentum_residual() < 1e-12);
+}
+
+TEST_CASE("friction: in 3D a straight chain at any angle to a rough slope slips from rest straight downhill",
+          "[contact][friction]") {
+  // docs/model.md §10, *The onset of slip in 3D*. A straight chain at angle φ to the line of steepest
+  // slope of a plane (angle α, normal (0, cos α, sin α), gravity −g y): every node carries the same
+  // tangential load m g sin α downhill, so at rest with tan α > μ the chain slides rigidly straight
+  // downhill (across itself unless φ = 0) at g (sin α − μ cos α), its tension zero; W_friction =
+  // −μ M g cos α × (distance slid). Independent of φ: 90° is the chain lying across the slope.
+  const double alpha = kPi / 6, mu = 0.2, ell = 0.8, lambda = 1.0, T = 0.5, M = lambda * ell;
+  const Vec<3> n(0.0, std::cos(alpha), std::sin(alpha)), down = Vec<3>(0.0, -std::sin(alpha), std::cos(alpha)).normalized();
+  const Vec<3> level = n.cross(down);  // horizontal, in the plane
+  const double acc = kG * (std::sin(alpha) - mu * std::cos(alpha)), path = 0.5 * acc * T * T;
+  for (const double phi_deg : {90.0, 89.99, 80.0, 45.0}) {
+    for (const int links : {5, 20, 40}) {
+      const double phi = phi_deg * kPi / 180;
+      const Vec<3> along = std::cos(phi) * down + std::sin(phi) * level;
+      Chain<3> chain = Chain<3>::uniform(lambda, ell, links, false);
+      for (int i = 0; i <= links; ++i) chain.positions().col(i) = (i * ell / links) * along;
+      std::vector<std::unique_ptr<Force<3>>> forces;
+      forces.push_back(std::make_unique<Gravity<3>>(Vec<3>(0.0, -kG, 0.0)));
+      Obstacle<3> plane;
+      plane.kind = Obstacle<3>::Kind::kPlane;
+      plane.point = Vec<3>::Zero();
+      plane.normal = n;
+      plane.mu = mu;
+      plane.name = "slope";
+      StringModel<3> model(std::move(chain), std::move(forces), {}, test::contact_options(), make_contact_module<3>({plane}));
+      StringSolver<3> solver(model, test::contact_run(T, T / 5));
+      const RunSummary& s = solver.run();
+      REQUIRE(s.status == "completed");
+      double position_error = 0, tension = 0;
+      for (const auto& frame : solver.frames()) {
+        for (int i = 0; i <= links; ++i)
+          position_error = std::max(position_error, (frame.x.col(i) - ((i * ell / links) * along + 0.5 * acc * frame.t * frame.t * down)).norm());
+        tension = std::max(tension, frame.tension.cwiseAbs().maxCoeff());
+      }
+      const auto& last = solver.frames().back();
+      const double W = -mu * M * kG * std::cos(alpha) * path;
+      std::printf("\n3D chain at %.2f deg to a rough slope, %d links: position error %.3g m, max |T| %.3g N, "
+                  "W_friction %.12g J (relative error %.3g), slips %g, energy %.3g, momentum %.3g\n",
+                  phi_deg, links, position_error, tension, last.terms["W_friction"], std::abs(last.terms["W_friction"] / W - 1), last.terms["slips"],
+                  s.relative_energy_drift(), s.relative_momentum_residual());
+      CHECK(position_error < 5e-14);
+      CHECK(tension < 4e-12);
+      CHECK(std::abs(last.terms["W_friction"] - W) < 5e-14 * std::abs(W));
+      CHECK(last.terms["slips"] == links + 1);
+      CHECK(s.relative_energy_drift() < 5e-14);
+      CHECK(s.relative_momentum_residual() < 2.5e-13);
+    }
+  }
+}
+
+TEST_CASE("friction: in 3D a half circle on a rough table pulled at an end slips and converges on refinement",
+          "[contact][friction]") {
+  // docs/model.md §10, *The onset of slip in 3D*: a half circle (radius about 0.2 m, length 0.2π m,
+  // λ = 1) at rest on a rough table (μ = 0.3, gravity −g z), its last node pulled by 5 N (> μ M g =
+  // 1.85 N) along the chain's tangent, away from it. At t = 0 the pulled end slips with the nodes
+  // whose cones the tension leaves, each in the direction of its own unheld load (not along the
+  // chain: the tension's curvature pulls the arc inwards); no closed form: the energy ledger with
+  // W_friction and the momentum ledger close, and the node positions at 0.5 s converge on refinement.
+  const double ell = 0.2 * kPi, lambda = 1.0, mu = 0.3, T = 0.5;
+  std::vector<Points<3>> x;
+  for (const int links : {10, 20, 40, 80}) {
+    const double dtheta = kPi / links, R = (ell / links) / (2 * std::sin(dtheta / 2));
+    Chain<3> chain = Chain<3>::uniform(lambda, ell, links, false);
+    for (int i = 0; i <= links; ++i) {
+      const double theta = -kPi / 2 + i * dtheta;
+      chain.positions().col(i) = Vec<3>(R * std::cos(theta), R * std::sin(theta), 0.0);
+    }
+    std::vector<std::unique_ptr<Force<3>>> forces;
+    forces.push_back(std::make_unique<Gravity<3>>(Vec<3>(0.0, 0.0, -kG)));
+    forces.push_back(std::make_unique<EndLoad<3>>(links, Vec<3>(-5.0, 0.0, 0.0)));
+    Obstacle<3> table;
+    table.kind = Obstacle<3>::Kind::kPlane;
+    table.point = Vec<3>::Zero();
+    table.normal = Vec<3>(0.0, 0.0, 1.0);
+    table.mu = mu;
+    table.name = "table";
+    StringModel<3> model(std::move(chain), std::move(forces), {}, test::contact_options(), make_contact_module<3>({table}));
+    StringSolver<3> solver(model, test::contact_run(T, T / 5, 1e-9));
+    const RunSummary& s = solver.run();
+    REQUIRE(s.status == "completed");
+    const auto& last = solver.frames().back();
+    std::printf("\nhalf circle pulled on a rough table, %d links: W_friction %.9g J, slips %g, sticks %g, energy %.3g, "
+                "momentum %.3g\n",
+                links, last.terms["W_friction"], last.terms["slips"], last.terms["sticks"], s.relative_energy_drift(),
+                s.relative_momentum_residual());
+    CHECK(last.terms["slips"] > 0);
+    CHECK(s.relative_energy_drift() < 8e-11);
+    CHECK(s.relative_momentum_residual() < 5e-15);
+    x.push_back(last.x);
+  }
+  std::vector<double> difference;
+  for (std::size_t k = 0; k + 1 < x.size(); ++k) {
+    double d = 0;
+    for (int i = 0; i < x[k].cols(); ++i) d = std::max(d, (x[k].col(i) - x[k + 1].col(2 * i)).norm());
+    difference.push_back(d);
+  }
+  for (std::size_t k = 0; k + 1 < difference.size(); ++k) {
+    const double order = std::log2(difference[k] / difference[k + 1]);
+    std::printf("half circle: max node difference %.3g m -> %.3g m on refinement: order %.2f\n", difference[k], difference[k + 1], order);
+    CHECK(order > 1.2);
+  }
 }
