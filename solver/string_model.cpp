@@ -298,9 +298,11 @@ void StringModel<dim>::links() {
       if (!(l > kCollapsedLink * h[j]) || !std::isfinite(l)) {
         // A slack link may be as short as anything, its ends may pass each other (it carries no tension,
         // its row is out of the system): no direction. A taut one that collapses is a degenerate state;
-        // not a link bent over a point, whose length and directions are its sides' (bend_links, below):
-        // over a peg (sides antiparallel) its chord passes through zero where the peg is at its midpoint.
-        if (!(std::isfinite(l) && (link_slack(j) || (!bends_.empty() && bend_of(j)))))
+        // not a link bent over a point, whose length and directions are its sides' (bend_links, below;
+        // point_bend_sides refuses sides that collapse): over a peg (sides antiparallel) its chord passes
+        // through zero where the peg is at its midpoint. A link over a cylinder keeps the chord's test (its
+        // arc length may go negative in a trial state at loose tolerances, which the drift control takes back).
+        if (!(std::isfinite(l) && (link_slack(j) || point_bent(j))))
           throw RecoverableError(fmt::format("link {} has collapsed to length {:g}", j, l));
         Map(e + dim * j).setZero();
       } else {
@@ -312,13 +314,7 @@ void StringModel<dim>::links() {
     }
   }
   x_max_ = x_max;
-  if (bends_.empty()) return;
-  bend_links();
-  // A bent link's length is its sides' (its chord may pass through zero, above): the collapse test on that.
-  for (const Bend& bend : bends_)
-    if (!(l_[bend.link] > kCollapsedLink * h[bend.link]) && !link_slack(bend.link))
-      throw RecoverableError(fmt::format("link {} (bent over {}) has collapsed to length {:g}", bend.link,
-                                         bend.circle ? "a cylinder" : "a point", l_[bend.link]));
+  if (!bends_.empty()) bend_links();
 }
 
 template <int dim>

@@ -618,6 +618,11 @@ class StringModel final : public OdeSystem {
   template <class Position>
   PointBendSides point_bend_sides(const Bend& bend, const Position& x, bool directions) const;
   const Bend* bend_of(int link) const;       // the bend of a link, or null
+  /// Whether a link is bent over a point (an edge or a peg; not over a cylinder).
+  bool point_bent(int link) const {
+    const Bend* bend = bends_.empty() ? nullptr : bend_of(link);
+    return bend && !bend->circle;
+  }
   /// Link j's length at x_ (a bent link's runs over its point: l⁻ + l⁺), without links().
   double current_length(int j) const;
   Eigen::VectorXd base_mass_;    // lumped masses of the arcs' links
