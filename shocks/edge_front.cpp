@@ -135,14 +135,8 @@ void EdgeFront<dim>::initialize(StringModel<dim>& model) {
   if constexpr (dim == 3) inward -= inward.dot(axis_) * axis_;
   table_inward_ = inward.normalized();
   const auto [node, gap] = table_body(model);
-  if (node >= 0 && gap < 0) {
-    const Vec<dim> r = x.col(node) - point_;
-    throw InputError(fmt::format("node {} of the string {} the edge, beyond it in the material, starts inside the table "
-                                 "under the string {} it, {:.6g} m beneath its top and {:.6g} m in from its edge "
-                                 "(allowed: beyond the edge's line, or above the table)",
-                                 node, before ? "after" : "before", before ? "before" : "after",
-                                 -table_normal_.dot(r), table_inward_.dot(r)));
-  }
+  if (node >= 0 && gap < 0)
+    throw InputError(table_body_start<dim>(node, table_name(), Vec<dim>(x.col(node) - point_), table_normal_, table_inward_));
 }
 
 template <int dim>
@@ -485,14 +479,9 @@ template <int dim>
 std::string EdgeFront<dim>::check_failed(const StringModel<dim>& model, const FrontState<dim>& s, double t, int check) const {
   if (table_ != EdgeSpec<dim>::Table::kNone && check == kTableCheck) {
     const int node = table_body(model).first;
-    const Vec<dim> r = model.x().col(node) - point_;
-    return fmt::format(
-        "node {} (s = {:.6g} m), beyond the edge at {} in the material, has reached the body of the table under the "
-        "string {} the edge at t = {:.9g} s, {:.6g} m beneath its top and {:.6g} m in from its edge: the table's side "
-        "face below the edge is not an obstacle, so the string would pass into it (a side that swings back under the "
-        "table is not modelled: docs/model.md §8)",
-        node, model.chain().node_coordinate(node), show_point<dim>(point_),
-        table_ == EdgeSpec<dim>::Table::kBefore ? "before" : "after", t, -table_normal_.dot(r), table_inward_.dot(r));
+    return table_body_reached<dim>(node, model.chain().node_coordinate(node), point_, table_name(), t,
+                                   Vec<dim>(model.x().col(node) - point_), table_normal_, table_inward_,
+                                   "docs/model.md §8");
   }
   if (slack_)
     return fmt::format("lifted off the edge at t = {:.9g} s: the link bent over the edge at {} (link {}) has gone slack, "

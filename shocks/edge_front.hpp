@@ -143,6 +143,10 @@ class EdgeFront final : public FrontKind<dim> {
   Vec<dim> table_inward_ = Vec<dim>::Zero();
   /// The node beyond the edge deepest in the table's body and its gap (table_body_gap, m): (−1, +∞) without a table.
   std::pair<int, double> table_body(const StringModel<dim>& model) const;
+  /// The table in messages: "under the string before the edge" (or after).
+  std::string table_name() const {
+    return table_ == EdgeSpec<dim>::Table::kBefore ? "under the string before the edge" : "under the string after the edge";
+  }
   int link_ = -1;
   /// The sides' tangents at the edge at the start (the faces drawn along them).
   Vec<dim> start_minus_ = Vec<dim>::Zero(), start_plus_ = Vec<dim>::Zero();

@@ -4,11 +4,13 @@
 #include <algorithm>
 #include <cmath>
 #include <iterator>
+#include <numeric>
 #include <tuple>
 
 #include <Eigen/Geometry>
 #include <fmt/format.h>
 
+#include "banded_lu.hpp"
 #include "mesh/errors.hpp"
 #include "string_model.hpp"
 #include "wrapping_module.hpp"
@@ -118,6 +120,26 @@ Vec<dim> from_edge(const Obstacle<dim>& o, const Vec<dim>& x) {
   return r;
 }
 }  // namespace
+
+template <int dim>
+std::string table_body_reached(int node, double s, const Vec<dim>& edge_point, const std::string& table, double t,
+                               const Vec<dim>& r, const Vec<dim>& normal, const Vec<dim>& inward, const std::string& see) {
+  return fmt::format("node {} (s = {:.6g} m), beyond the edge at {} in the material, has reached the body of the table "
+                     "{} at t = {:.9g} s, {:.6g} m beneath its top and {:.6g} m in from its edge: the table's side face "
+                     "below the edge is not an obstacle, and the string beyond the edge cannot rest on the table, so the "
+                     "string would pass into it (a side that swings back under the table, or over onto it, is not "
+                     "modelled: {})",
+                     node, s, show_point<dim>(edge_point), table, t, -normal.dot(r), inward.dot(r), see);
+}
+
+template <int dim>
+std::string table_body_start(int node, const std::string& table, const Vec<dim>& r, const Vec<dim>& normal,
+                             const Vec<dim>& inward) {
+  return fmt::format("node {} of the string, beyond the table's edge in the material, starts inside the table {}, "
+                     "{:.6g} m beneath its top and {:.6g} m in from its edge (allowed: beyond the edge's line, or above "
+                     "the table)",
+                     node, table, -normal.dot(r), inward.dot(r));
+}
 
 template <int dim>
 double Obstacle<dim>::gap(const Vec<dim>& x, bool held) const {
@@ -277,11 +299,7 @@ class ContactModule final : public WrappingModule<dim> {
         const auto [k, gap] = side_face_gap(model, i);  // (−1, +∞) for a held node
         if (k < 0 || gap > 0) continue;
         const Obstacle<dim>& o = obstacles_[static_cast<std::size_t>(k)];
-        const Vec<dim> r = model.x().col(i) - o.point;
-        throw InputError(fmt::format("node {} of the string, beyond the table's edge in the material, starts inside the "
-                                     "table {}, {:.6g} m beneath its top and {:.6g} m in from its edge (allowed: beyond "
-                                     "the edge's line, or above the table)",
-                                     i, o.name, -o.normal.dot(r), o.inward.dot(r)));
+        throw InputError(table_body_start<dim>(i, o.name, model.x().col(i) - o.point, o.normal, o.inward));
       }
     if (arc_) {
       // Links along the arc are built for a string that starts wrapped on the circle: a node that reaches
@@ -919,6 +937,12 @@ class ContactModule final : public WrappingModule<dim> {
     T = T.cwiseMax(0.0);
     bool converged = n == 0;
     double damping = 1e-12;  // Levenberg–Marquardt's shift of the Hessian, per its largest entry
+    BandedLU hessian;
+    if (n > 0) {
+      std::vector<int> order(static_cast<std::size_t>(n));
+      std::iota(order.begin(), order.end(), 0);
+      hessian.reset(std::move(order), 1, 1);
+    }
     for (int iteration = 0; iteration < 200 && !converged; ++iteration) {
       // A string cannot push: T ≥ 0, and a link at T = 0 whose condition asks for less (r_j > 0, its ends
       // approaching) is held there (it would go slack, which the model's own solve then reports).
@@ -942,17 +966,18 @@ class ContactModule final : public WrappingModule<dim> {
         converged = true;
         break;
       }
-      // Newton's step on the tridiagonal Hessian (regularised where a stuck node leaves it singular),
-      // by Thomas' elimination, then halved until Φ decreases (Armijo) or, where Φ's round-off hides
-      // its decrease near the minimum, the largest link condition halves.
+      // Newton's step on the tridiagonal Hessian (regularised where a stuck node leaves it singular), by
+      // the band LU of the Newton systems (banded_lu.hpp), then halved until Φ decreases (Armijo) or, where
+      // Φ's round-off hides its decrease near the minimum, the largest link condition halves.
       const double shift = damping * std::max(diag.cwiseAbs().maxCoeff(), 1e-300);
-      Eigen::VectorXd dT = -r, dd = diag.array() + shift;
-      for (int j = 1; j < n; ++j) {
-        const double f = off[j - 1] / dd[j - 1];
-        dd[j] -= f * off[j - 1];
-        dT[j] -= f * dT[j - 1];
+      hessian.zero();
+      for (int j = 0; j < n; ++j) {
+        hessian.add(j, j, diag[j] + shift);
+        if (j + 1 < n) hessian.add(j, j + 1, off[j]), hessian.add(j + 1, j, off[j]);
       }
-      for (int j = n - 1; j >= 0; --j) dT[j] = (dT[j] - (j + 1 < n ? off[j] * dT[j + 1] : 0.0)) / dd[j];
+      if (!hessian.factor()) break;  // not converged: slip_block's two directions instead
+      Eigen::VectorXd dT = -r;
+      hessian.solve(dT.data());
       const double phi0 = phi(T), slope = r.dot(dT);
       double step = 1;
       for (; step > 1e-12; step *= 0.5) {
@@ -1316,16 +1341,10 @@ class ContactModule final : public WrappingModule<dim> {
       if (k >= 0 && gap < deepest) std::tie(node, table, deepest) = std::tie(i, k, gap);
     }
     const Obstacle<dim>& o = obstacles_[static_cast<std::size_t>(table)];
-    const Vec<dim> r = model.x().col(node) - o.point;
-    throw NumericalError(
-        fmt::format("node {} (s = {:.6g} m), beyond the edge at {} in the material, has reached the body of the table "
-                    "{} at t = {:.9g} s, {:.6g} m beneath its top and {:.6g} m in from its edge: the table's side face "
-                    "below the edge is not an obstacle, and the string beyond the edge cannot rest on the table, so "
-                    "the string would pass into it (a side that swings back under the table, or over onto it, is not "
-                    "modelled: docs/scenes.md, \"[[effects.surface]]\")",
-                    node, model.chain().node_coordinate(node), show_point<dim>(o.point), o.name, t, -o.normal.dot(r),
-                    o.inward.dot(r)),
-        t);
+    throw NumericalError(table_body_reached<dim>(node, model.chain().node_coordinate(node), o.point, o.name, t,
+                                                 model.x().col(node) - o.point, o.normal, o.inward,
+                                                 "docs/scenes.md, \"[[effects.surface]]\""),
+                         t);
   }
   /// Node i is held now: on an obstacle, free (a front may have taken it into a heap), and on the
   /// obstacle's side of its edge (a node that has crossed the edge is the edge front's).
@@ -1576,6 +1595,12 @@ std::unique_ptr<StringModule<dim>> make_contact_module(std::vector<Obstacle<dim>
 
 template struct Obstacle<2>;
 template struct Obstacle<3>;
+template std::string table_body_reached<2>(int, double, const Vec<2>&, const std::string&, double, const Vec<2>&,
+                                           const Vec<2>&, const Vec<2>&, const std::string&);
+template std::string table_body_reached<3>(int, double, const Vec<3>&, const std::string&, double, const Vec<3>&,
+                                           const Vec<3>&, const Vec<3>&, const std::string&);
+template std::string table_body_start<2>(int, const std::string&, const Vec<2>&, const Vec<2>&, const Vec<2>&);
+template std::string table_body_start<3>(int, const std::string&, const Vec<3>&, const Vec<3>&, const Vec<3>&);
 template std::unique_ptr<StringModule<2>> make_contact_module<2>(std::vector<Obstacle<2>>,
                                                                  std::unique_ptr<StringModule<2>>);
 template std::unique_ptr<StringModule<3>> make_contact_module<3>(std::vector<Obstacle<3>>,

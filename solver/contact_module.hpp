@@ -122,6 +122,16 @@ double table_body_gap(const Vec<dim>& r, const Vec<dim>& normal, const Vec<dim>&
   return std::max(normal.dot(r) + margin, margin - inward.dot(r));
 }
 
+/// The messages of a node beyond a table's edge that has reached the table's body at t (the run stops) or starts
+/// inside it (refused), `r` from the edge's point: one wording for a `[[effects.surface]]` table (the contact module)
+/// and an edge's own table (EdgeFront); `table` names it, `see` is the page that says why.
+template <int dim>
+std::string table_body_reached(int node, double s, const Vec<dim>& edge_point, const std::string& table, double t,
+                               const Vec<dim>& r, const Vec<dim>& normal, const Vec<dim>& inward, const std::string& see);
+template <int dim>
+std::string table_body_start(int node, const std::string& table, const Vec<dim>& r, const Vec<dim>& normal,
+                             const Vec<dim>& inward);
+
 /// A free node this share of a link length in from the edge of a table that ends at an edge, and as far beneath
 /// its top, has entered the table through its side face (which is not an obstacle): the run stops, located. The
 /// margin, kInitialContact's, leaves outside a side hanging flush with the face, whose nodes lie off it by the

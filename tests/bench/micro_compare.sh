@@ -34,7 +34,8 @@ for ((r = 0; r < rounds; ++r)); do
       --benchmark_out="$out/$which.$r.json" >/dev/null
   done
 done
-/usr/bin/python3 - "$out" "$rounds" "$old_rev" "$(git rev-parse --short HEAD)" <<'PY'
+new_rev=$(git rev-parse --short HEAD 2>/dev/null || echo "working tree")  # a tree without git (a source copy) has no revision
+/usr/bin/python3 - "$out" "$rounds" "$old_rev" "$new_rev" <<'PY'
 import json, statistics, sys, collections
 out, rounds, old_rev, new_rev = sys.argv[1], int(sys.argv[2]), sys.argv[3], sys.argv[4]
 t = collections.defaultdict(list)  # (which, name, "cpu" | "real") -> microseconds per iteration

@@ -390,7 +390,7 @@ TEST_CASE("hard edges: a hanging side that swings back under the edge's own tabl
       CHECK_FALSE((frame.x(1, i) < -depth && frame.x(0, i) < -in_from_edge));  // the table: y < 0, x < 0
     }
   CHECK_THROWS_WITH(SceneRun<2>(parse_scene(file, {"shape.points=[[-0.8, 0.0], [0.0, 0.0], [-0.1, -0.17320508075688773]]"})),
-                    Contains("starts inside the table under the string before it"));
+                    Contains("starts inside the table under the string before the edge"));
 }
 
 TEST_CASE("hard edges: a peg at the midpoint of its bent link (sides antiparallel) is passed, at an output time too",
