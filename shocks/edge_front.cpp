@@ -66,7 +66,10 @@ void EdgeFront<dim>::initialize(StringModel<dim>& model) {
   // The material point s0 on a node c: that node sits on the edge, where the bent link has no
   // direction. The string is taken as it was just before c reached the edge: the side up to c moves
   // back from the edge by 2 kCross h along its tangent there, the side after c towards it, each
-  // rigidly (every link keeps its length; the bent link is (c, c + 1)).
+  // rigidly (every link keeps its length; the bent link is (c, c + 1)). With a table after the edge
+  // (its own, or a surface that ends at it) the string moves on along itself instead, node c onto the
+  // table (the bent link is (c − 1, c)): c goes to the table's side either way, so that a layout and its
+  // mirror in the material (the table before the edge or after it) start as each other's mirror.
   const double l_minus = this->expected_s0 - model.chain().node_coordinate(link_);
   const int c = l_minus < 2 * kCross * h ? link_ : h - l_minus < 2 * kCross * h ? link_ + 1 : -1;
   if (c >= 0) {
@@ -84,19 +87,24 @@ void EdgeFront<dim>::initialize(StringModel<dim>& model) {
       if (model.is_prescribed(i))
         throw InputError(fmt::format(
             "the edge point {} is on node {} (s = {:.9g} m) and node {} of the string is held (a fixed or driven "
-            "end): the edge needs its point inside a link there (the string is moved back by {:.3g} m to put it "
+            "end): the edge needs its point inside a link there (the string is moved along itself by {:.3g} m to put it "
             "there, which a held node cannot follow); move the point along the string or change string.nodes",
             show_point<dim>(point_), c, model.chain().node_coordinate(c), i, nudge));
     const Vec<dim> tm = unit_vector<dim>(point_ - x.col(c - 1), "the string before the edge");
     const Vec<dim> tp = unit_vector<dim>(x.col(c + 1) - point_, "the string after the edge");
-    shift_sides(model, 0, c, c + 1, this->m_.n - 1, -nudge, tm, tp);
+    using Table = typename EdgeSpec<dim>::Table;
+    const bool on = table_ == Table::kAfter || surface_side_ == Table::kAfter;
+    if (on)
+      shift_sides(model, 0, c - 1, c, this->m_.n - 1, nudge, tm, tp);
+    else
+      shift_sides(model, 0, c, c + 1, this->m_.n - 1, -nudge, tm, tp);
     // Node c goes exactly to the nudge's place on its side's line: left where the shift put it (off by
     // its offset), the bent link's direction, the table's normal and the lift-off cone would tilt by the
     // offset over the nudge (a table 9° off for an offset of 8e-11 m on 2e-10 m).
     Points<dim>& moved = model.x();
-    moved.col(c) = point_ - nudge * tm;
+    moved.col(c) = on ? Vec<dim>(point_ + nudge * tp) : Vec<dim>(point_ - nudge * tm);
     for (int i = 0; i < this->m_.n; ++i) model.move_initial_node(i, Vec<dim>(x.col(i)));
-    link_ = c;
+    link_ = on ? c - 1 : c;
   }
   const int a = link_;
   set_link(model, a);

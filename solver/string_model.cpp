@@ -426,7 +426,7 @@ typename StringModel<dim>::CircleBend StringModel<dim>::circle_bend(const Bend& 
 template <int dim>
 Vec<dim> StringModel<dim>::end_direction_at_contact(int j) const {
   if (!bends_.empty())
-    if (const Bend* bend = bend_of(j); bend && bend->circle) return bend->e_plus;
+    if (const Bend* bend = bend_of(j)) return bend->e_plus;
   return e_.col(j);
 }
 
@@ -685,11 +685,12 @@ void StringModel<dim>::friction_couplings() {
     const int um = jm >= 0 ? link_unknown_[static_cast<std::size_t>(jm)] : -1;
     const int up = jp >= 0 ? link_unknown_[static_cast<std::size_t>(jp)] : -1;
     const double wmu = w_[i] * c.mu;
-    if (um >= 0) system_->add_diagonal(um, -wmu * e_.col(jm).dot(c.slide) * c.normal.dot(e_.col(jm)));
+    const Vec<dim> em = um >= 0 ? end_direction_at_contact(jm) : Vec<dim>::Zero();  // e⁺ for a bent link
+    if (um >= 0) system_->add_diagonal(um, -wmu * em.dot(c.slide) * c.normal.dot(em));
     if (up >= 0) system_->add_diagonal(up, -wmu * e_.col(jp).dot(c.slide) * c.normal.dot(e_.col(jp)));
     if (um >= 0 && up >= 0)
-      system_->add_couplings(um, wmu * e_.col(jm).dot(c.slide) * c.normal.dot(e_.col(jp)),
-                             wmu * e_.col(jp).dot(c.slide) * c.normal.dot(e_.col(jm)));
+      system_->add_couplings(um, wmu * em.dot(c.slide) * c.normal.dot(e_.col(jp)),
+                             wmu * e_.col(jp).dot(c.slide) * c.normal.dot(em));
   }
 }
 

@@ -606,8 +606,10 @@ class StringModel final : public OdeSystem {
   /// The same at the positions x(i) (a callable: x_, or a state's y) and the velocities v_ (for q only).
   template <class Position>
   CircleBend circle_bend(const Bend& bend, const Position& x) const;
-  /// Link j's direction at its end node: e⁺ for a link bent over a circle, e_j otherwise (a link bent
-  /// over a point keeps e_j there in the held nodes' rows, as before circles).
+  /// Link j's direction at its end node, in the rows of a node held there: e⁺ for a bent link (over a circle
+  /// or a point), e_j otherwise. (A link bent over a point once kept e_j here: a table after its edge in the
+  /// material, whose first node b is held at the end of the bent link, then saw that link run along its
+  /// hanging side, uncoupled from the table's links, and its tension there fell to zero: issue #23.)
   Vec<dim> end_direction_at_contact(int j) const;
   void bend_couplings();           // assemble_matrix(): their couplings at the end node
   double bend_rate(const Bend& bend) const;  // d(l⁻ + l⁺)/dt
