@@ -814,3 +814,123 @@ TEST_CASE("table and edge: a chain drawn back over the edge onto the table lands
       CHECK(run.transfers >= static_cast<long>((x0 + x_star - 2 * x_m) / h) - 2);
     }
 }
+
+namespace {
+
+/// A scene of real_table_scene or rough_table_scene (hanging length x0) with the string's material order
+/// reversed: s = 0 at the free hanging end, the table after the edge in the material (and on the other side
+/// of it in space, x > 0: the mirror of the scene in x, the nodes numbered from the other end).
+std::string mirrored(std::string text, double x0) {
+  const std::size_t from = text.find("points = ["), to = text.find('\n', from);
+  return text.replace(from, to - from, fmt::format("points = [[0.0, {:.17g}], [0.0, 0.0], [{:.17g}, 0.0]]", -x0, 1.0 - x0));
+}
+
+struct EdgeRun {
+  RunSummary run;
+  double max_err_x = 0;  ///< max over the samples of |x − x_ref(t)|, x the hanging length
+};
+
+/// Runs `text`, the hanging length x = s0 (mirrored) or ℓ − s0 against x_ref(t).
+template <class Reference>
+EdgeRun run_edge(const std::string& text, bool mirrored_order, const Reference& x_ref) {
+  SceneSpec spec = parse_scene_text(text, mirrored_order ? "mirrored_table" : "real_table");
+  StringScene<2> scene = build_string_scene<2>(spec);
+  StringSolver<2> solver(*scene.model, scene.solver);
+  solver.run();
+  EdgeRun r{solver.summary()};
+  for (const StepSample& s : r.run.samples) {
+    const double x = mirrored_order ? s.fronts[0].s0 : 1.0 - s.fronts[0].s0;
+    r.max_err_x = std::max(r.max_err_x, std::abs(x - x_ref(s.t)));
+  }
+  return r;
+}
+
+double event_value(const RunEvent& e, const std::string& name) {
+  for (const auto& [key, value] : e.values)
+    if (key == name) return value;
+  return NAN;
+}
+
+}  // namespace
+
+TEST_CASE("table and edge: a real table after its edge in the material (the mirror) slides off as the table before it",
+          "[contact][edge][convergence]") {
+  // Issue #23: with s = 0 at the free hanging end and the table after the edge, the table's first node, held at the
+  // end of the link bent over the edge, took that link's direction before the edge (along the hanging side) in the
+  // tension system: the table's links carried no tension, ẍ(0) was 52 m/s² instead of g x0/ℓ = 1.96, and every mesh
+  // failed within 0.16 s ("link 9 has passed the point it is bent over"). The mirror must run as the original:
+  // against the closed form (exact::edge_*, the rough table's cosh) and against the original run on the same mesh,
+  // with the tensions at the lift-off swapped (the table's side is after the edge). 21 nodes put the edge on a node
+  // (the string is moved along itself, towards the table's side in both), 42 inside a link.
+  const double ell = 1.0, x0 = 0.2;
+  for (double f : {0.0, 0.5}) {
+    const double t_star = exact::edge_time(f, exact::edge_lift_off_x(f, x0, ell, kG), x0, ell, kG);
+    auto x_exact = [&](double t) { return exact::edge_x(f, t, x0, ell, kG); };
+    for (int nodes : {21, 42}) {
+      CAPTURE(f, nodes);
+      std::string text = real_table_scene(nodes, "");
+      text.replace(text.find("[[effects.edge]]\npoint = [0.0, 0.0]\n"), 35,
+                   fmt::format("[[effects.edge]]\npoint = [0.0, 0.0]\nf = {}\n", f));
+      const EdgeRun a = run_edge(text, false, x_exact), c = run_edge(mirrored(text, x0), true, x_exact);
+      REQUIRE(a.run.status == "stopped");
+      REQUIRE(c.run.status == "stopped");
+      REQUIRE(c.run.events.size() == 1);
+      const RunEvent &ea = a.run.events.back(), &ec = c.run.events.back();
+      CHECK(ec.kind == "lift_off");
+      CHECK(c.run.stop_reason.rfind("lifted off the edge at t = ", 0) == 0);
+      // Measured (rtol 1e-9): the lift-off 3.2e-9 .. 3.65e-9 s before t* and x within 1.1e-8 .. 1.2e-8 m of the closed
+      // form (the crossings' floor, docs/model.md §8), as the original's; the two lift-offs 3.5e-13 .. 1.5e-12 s
+      // apart; the event's tensions (read at the located root) 2e-10 .. 3.9e-8 N apart; the ledgers 2.1e-12, 6.5e-12.
+      CHECK(std::abs(ec.t - t_star) < 1.1e-8);
+      CHECK(c.max_err_x < 3.6e-8);
+      CHECK(std::abs(ec.t - ea.t) < 5e-12);
+      CHECK(std::abs(event_value(ec, "tension_minus") - event_value(ea, "tension_plus")) < 1.2e-7);
+      CHECK(std::abs(event_value(ec, "tension_plus") - event_value(ea, "tension_minus")) < 1.2e-7);
+      CHECK(c.run.relative_energy_drift() < 6e-12);
+      CHECK(c.run.relative_momentum_residual() < 2e-11);
+      const StepSample& last = c.run.samples.back();
+      CHECK(last.terms["lift_offs"] == 0);  // the table part stays on the table
+      CHECK(std::abs(last.terms["W_contact"]) < 1e-9);
+    }
+  }
+  // The edge's own table (table = "after", no surface) and its original (table = "before"), the edge on a node
+  // (21 nodes): the string moves along itself towards the table's side in both.
+  {
+    std::string text = real_table_scene(21, "");
+    text.replace(text.find("[[effects.surface]]"), std::string("[[effects.surface]]\npoint = [0.0, 0.0]\nnormal = [0.0, 1.0]\nedge = 0\n").size(), "");
+    text.replace(text.find("[[effects.edge]]\npoint = [0.0, 0.0]\n"), 35, "[[effects.edge]]\npoint = [0.0, 0.0]\ntable = \"before\"\n");
+    std::string after = mirrored(text, x0);
+    after.replace(after.find("table = \"before\""), 16, "table = \"after\"");
+    auto x_exact = [&](double t) { return exact::edge_x(0.0, t, x0, ell, kG); };
+    const EdgeRun a = run_edge(text, false, x_exact), c = run_edge(after, true, x_exact);
+    REQUIRE(a.run.status == "stopped");
+    REQUIRE(c.run.status == "stopped");
+    // Measured: the lift-offs 4.1e-13 s apart (3.8e-10 s when the string moved back along itself for either table,
+    // the node on the edge going off the table after it: twice 2e-8 links of hanging length apart), x within
+    // 1.2e-8 m of the closed form.
+    CHECK(c.run.events.back().kind == "lift_off");
+    CHECK(std::abs(c.run.events.back().t - a.run.events.back().t) < 1.5e-12);
+    CHECK(c.max_err_x < 3.6e-8);
+  }
+  const RoughEdge ref{1.0, 0.2, 0.3};
+  auto x_rough = [&](double t) { return ref.x(t); };
+  for (int nodes : {21, 42}) {
+    CAPTURE(nodes);
+    const std::string text = rough_table_scene(nodes, ref.mu, ref.x0, 2.0);
+    const EdgeRun a = run_edge(text, false, x_rough), c = run_edge(mirrored(text, ref.x0), true, x_rough);
+    REQUIRE(c.run.status == "stopped");
+    const RunEvent &ea = a.run.events.back(), &ec = c.run.events.back();
+    const StepSample &la = a.run.samples.back(), &lc = c.run.samples.back();
+    // Measured: the lift-off 5.3e-9, 5.5e-9 s before t*, x within 1.4e-8, 1.45e-8 m of the cosh, W_friction 3.0e-8
+    // of the closed form, as the original's; the two lift-offs 3.6e-13, 5.0e-12 s apart; the ledgers 3.3e-13, 1.4e-11.
+    CHECK(ec.kind == "lift_off");
+    CHECK(std::abs(ec.t - ref.t_star()) < 1.7e-8);
+    CHECK(c.max_err_x < 4.5e-8);
+    CHECK(std::abs(ec.t - ea.t) < 1.5e-11);
+    CHECK(lc.terms["W_friction"] == Approx(ref.w_friction(lc.fronts[0].s0)).epsilon(1e-7));
+    CHECK(la.terms["W_friction"] == Approx(ref.w_friction(1 - la.fronts[0].s0)).epsilon(1e-7));
+    CHECK(lc.terms["lift_offs"] == 0);
+    CHECK(c.run.relative_energy_drift() < 1e-12);
+    CHECK(c.run.relative_momentum_residual() < 4e-11);
+  }
+}
