@@ -483,7 +483,7 @@ TEST_CASE("slack: the swinging U on 51 to 401 nodes: the differences of the stat
   // only to 6.0e-3 m and the RMS rises (2.1e-3 -> 2.3e-3 m), the error spread over the chain rather than
   // at the kink (docs/model.md §9 "Where the U's error sits"). Measured (max over the
   // coarse mesh's nodes of the distance to the same material point on the next mesh):
-  // 1.29e-2, 9.8e-3, 6.5e-3 m for 51 -> 101 -> 201 -> 401 nodes: observed order 0.39, then 0.59
+  // 1.29e-2, 9.4e-3, 6.4e-3 m for 51 -> 101 -> 201 -> 401 nodes: observed order 0.46, then 0.57
   // (about first order at best: each snap is an O(h) event of the discrete chain). W_snap falls with
   // the mesh (-3.8e-3, -2.7e-3, -1.6e-3, -1.1e-3 J).
   const std::vector<int> meshes = {51, 101, 201, 401};
