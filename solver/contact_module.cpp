@@ -522,6 +522,12 @@ class ContactModule final : public WrappingModule<dim> {
     return {EventAction::Kind::kTransfer, ""};  // the velocities or the held set changed: the integrator restarts
   }
   bool release_contacts(StringModel<dim>& model, double t) override { return settle(model, t, false); }
+  bool land_passed(StringModel<dim>& model, double t, Eigen::Ref<Eigen::VectorXd> ledger) override {
+    const std::vector<std::pair<int, int>> through = passed_through(model);
+    if (through.empty()) return false;
+    Eigen::Ref<Eigen::VectorXd> own = ledger.tail(ledger.size() - inner_ledgers());
+    return hold(model, t, own, through);
+  }
   /// The inner module's events (a front's) and the listed lift-offs, merged in time order (the inner
   /// module's first at equal times).
   std::vector<RunEvent> run_events() const override {

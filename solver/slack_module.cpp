@@ -112,8 +112,13 @@ class SlackModule final : public WrappingModule<dim> {
     const int k = inner_events(), kl = inner_ledgers();
     // The fronts' events first (a crossing rebuilds the arcs; a slack link that leaves them is taut
     // again, StringModel::rebuild), then the snap on the layout they leave.
-    const EventAction action = this->handle_inner_events(model, t, ledger, found);
+    EventAction action = this->handle_inner_events(model, t, ledger, found);
     if (action.kind == EventAction::Kind::kStop) return action;
+    // A node that has passed a surface inside the step of a snap lands now, before the snap (its landing
+    // function would restart below zero, where ARKODE finds no root: a loop dropped onto a pulley, a node
+    // 10⁻⁵ h inside at a snap then fell through it). The inner module acts so at its own events.
+    if (inner_ && found[static_cast<std::size_t>(k)] != 0 && inner_->land_passed(model, t, ledger.head(kl)))
+      action = {EventAction::Kind::kTransfer, ""};
     if (action.kind == EventAction::Kind::kTransfer) model.refresh();
     // A transfer of the inner module (a landing's impact projects the positions) may carry a slack link
     // past its length: its snap is now, with the root function below zero at the restart, where ARKODE

@@ -1835,6 +1835,37 @@ typename StringModel<dim>::SnapResult StringModel<dim>::snap(double t) {
 }
 
 template <int dim>
+bool StringModel<dim>::hold_unresolved_flights(double t, std::vector<int>& separating) {
+  if (separating.empty()) return false;
+  // The accelerations after the jump with the separating links out of the tension solve: each one's free
+  // closing acceleration d²l/dt² = (Δx·Δa + |Δv|² − l̇²)/l. Its flight from its length at l̇ = −u under that
+  // acceleration a > 0 reaches u²/(2a) below it: within kSlackGap h_j, the gap at which accept_step declares a
+  // released link slack, it is not a flight the model resolves, and the link is held taut.
+  for (const int j : separating) set_slack(j, true);
+  evaluate_current(t);
+  bool held = false;
+  std::vector<int> flying;
+  for (const int j : separating) {
+    bool hold = false;
+    if (bends_.empty() || bend_of(j) == nullptr) {  // a bent link's length runs over its point: it flies
+      const int a = chain_.link_start(j), b = chain_.link_end(j);
+      const Vec<dim> dx = x_.col(b) - x_.col(a), dv = v_.col(b) - v_.col(a), da = a_.col(b) - a_.col(a);
+      const double l = dx.norm(), rate = dx.dot(dv) / l;
+      const double closing = (dx.dot(da) + dv.squaredNorm() - rate * rate) / l;
+      hold = closing > 0 && rate * rate < 2 * closing * kSlackGap * chain_.link_length(j);
+    }
+    if (hold) {
+      set_slack(j, false);
+      held = true;
+    } else {
+      flying.push_back(j);
+    }
+  }
+  separating.swap(flying);
+  return held;
+}
+
+template <int dim>
 bool StringModel<dim>::rebounds_accumulate(int j, double t, double e) const {
   // Link j separated at its previous snap, at t_s with speed u_s, flew for τ = t − t_s and is back at
   // approach speed u. Its ends' closing acceleration over the flight is a = (u_s + u)/τ; held at that a, the
@@ -1924,23 +1955,29 @@ typename StringModel<dim>::SnapResult StringModel<dim>::link_impulses(double t, 
     result.support_impulse += m_[c.node] * (v_.col(c.node) - v_before.col(c.node)) - link_impulse.col(c.node);
   // 4. The energy dissipated, Σ P_j (u⁻_j + u⁺_j)/2, and the links that separate go slack.
   links();
+  std::vector<int> separating;
   for_each_link([&](int j, int u, int) {
     const double u_after = link_rate(j);
     result.dissipated += 0.5 * P[u] * (u_before[j] + u_after);
-    if (!link_slack(j) && u_after < -kSeparation * u_scale) {
-      set_slack(j, true);
-      // Its root function starts at +kSlackGap, never at zero: ARKODE deactivates a root function that
-      // is zero at a restart, and would miss the link's return to its length if it came at once.
-      slack_offset_[static_cast<std::size_t>(j)] =
-          std::max(0.0, (l_[j] - chain_.link_length(j)) / chain_.link_length(j)) + kSlackGap;
-      // A rebound of snap() is recorded for the accumulation rule; a link that separates at the start or
-      // at a landing begins a flight, not a rebound.
-      if (static_cast<std::size_t>(j) < rebound_time_.size()) {
-        rebound_time_[static_cast<std::size_t>(j)] = rebounds ? t : NAN;
-        rebound_speed_[static_cast<std::size_t>(j)] = -u_after;
-      }
-    }
+    if (!link_slack(j) && u_after < -kSeparation * u_scale) separating.push_back(j);
   });
+  // 4a. At a snap, a separation whose flight would not open the link beyond kSlackGap of its length is held
+  //     taut (hold_unresolved_flights): the velocities are then projected onto the taut links' lengths below.
+  const bool held = rebounds && hold_unresolved_flights(t, separating);
+  for (const int j : separating) {
+    const double u_after = link_rate(j);
+    set_slack(j, true);
+    // Its root function starts at +kSlackGap, never at zero: ARKODE deactivates a root function that
+    // is zero at a restart, and would miss the link's return to its length if it came at once.
+    slack_offset_[static_cast<std::size_t>(j)] =
+        std::max(0.0, (l_[j] - chain_.link_length(j)) / chain_.link_length(j)) + kSlackGap;
+    // A rebound of snap() is recorded for the accumulation rule; a link that separates at the start or
+    // at a landing begins a flight, not a rebound.
+    if (static_cast<std::size_t>(j) < rebound_time_.size()) {
+      rebound_time_[static_cast<std::size_t>(j)] = rebounds ? t : NAN;
+      rebound_speed_[static_cast<std::size_t>(j)] = -u_after;
+    }
+  }
   // 5. The module's constraints (an inserted kink's arms meeting, §2.5): the links' impulses alone leave their
   //    rates Ċ ≠ 0, which the drift control then took out over the following steps with work no ledger booked (a
   //    coil with an inserted kink whose tip link snapped: energy residual 3.2e-6, the same at every rtol; review of
@@ -1953,16 +1990,16 @@ typename StringModel<dim>::SnapResult StringModel<dim>::link_impulses(double t, 
   if (module_) {
     constraints_.clear();
     module_->node_constraints(*this, constraints_);
-    if (!constraints_.empty()) {
-      const double before = kinetic_energy();
-      const Vec<dim> p_before = momentum();
-      project_velocities(t);
-      result.dissipated += before - kinetic_energy();
-      result.support_impulse += momentum() - p_before;
-      links();
-      for (std::size_t j = 0; j < rebound_time_.size(); ++j)
-        if (link_slack(static_cast<int>(j)) && rebound_time_[j] == t) rebound_speed_[j] = -link_rate(static_cast<int>(j));
-    }
+  }
+  if (held || (module_ && !constraints_.empty())) {
+    const double before = kinetic_energy();
+    const Vec<dim> p_before = momentum();
+    project_velocities(t);
+    result.dissipated += before - kinetic_energy();
+    result.support_impulse += momentum() - p_before;
+    links();
+    for (std::size_t j = 0; j < rebound_time_.size(); ++j)
+      if (link_slack(static_cast<int>(j)) && rebound_time_[j] == t) rebound_speed_[j] = -link_rate(static_cast<int>(j));
   }
   return result;
 }

@@ -512,6 +512,11 @@ class StringModel final : public OdeSystem {
   /// `inelastic`: per link, 1 where the snap takes e = 0 for that link (the accumulation rule, snap()).
   SnapResult link_impulses(double t, double e, double u_floor = 0, const std::vector<char>* inelastic = nullptr,
                            bool rebounds = false);
+  /// At a snap (link_impulses with `rebounds`): of the links about to separate, holds taut those whose flight
+  /// would not take them more than kSlackGap h_j below their length before their closing acceleration brought
+  /// them back (u²/(2a) ≤ kSlackGap h_j, a from the state after the jump, one evaluation): `separating` keeps
+  /// the others. True if one was held (the velocities are then projected onto the taut links).
+  bool hold_unresolved_flights(double t, std::vector<int>& separating);
   /// The accumulation rule of snap() (docs/model.md §9, "Accumulating rebounds"): link j's snap is perfectly
   /// inelastic if it rebounded at its previous snap and the rebounds that would follow end within
   /// kAccumulation · h_j / U (U: speed_scale(), the motion's scale at the start). Only snap() records

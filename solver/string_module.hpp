@@ -261,6 +261,10 @@ class StringModule {
   /// After an impulse the module did not make (a snap of the slack module around it): lets go of the
   /// held nodes whose contact force would now pull; returns whether one was let go.
   virtual bool release_contacts(StringModel<dim>&, double) { return false; }
+  /// At an event the module did not locate (a snap of the slack module around it): lands the free nodes that have
+  /// passed a surface unseen (their landing function below zero at the event's state, where ARKODE, restarting,
+  /// would find no root), with the impact booked in `ledger` (the module's ledgers); returns whether one landed.
+  virtual bool land_passed(StringModel<dim>&, double, Eigen::Ref<Eigen::VectorXd>) { return false; }
   /// The energy (J, ≥ 0) that the links' impulses dissipated at the start of the run (slack = allow: the
   /// start is a snap taut, StringModel::make_consistent): the module books it in its ledgers' initial
   /// values `ledger`. Only a module of unilateral links has impulses to book.

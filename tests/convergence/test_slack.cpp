@@ -324,6 +324,63 @@ TEST_CASE("slack: two halves snap taut: momentum conserved, energy lost as the t
   }
 }
 
+TEST_CASE("slack: a snap holds a neighbour taut whose flight would stay within kSlackGap of its length, "
+          "and lets a longer one fly",
+          "[slack]") {
+  // Three nodes, two links of h = 0.1 m, no force. Link 0 lies slack along x (node 0 at (−l0, 0), node 1 at the
+  // origin) and node 0 moves away at V: it snaps taut at t = (h − l0)/V. Link 1 (node 1 to node 2, at rest) leans
+  // from the normal towards node 0, along e1 = (−cos α, sin α). The perfectly inelastic snap gives node 1 the
+  // velocity (−Δ, 0), Δ = w1 V/(w0 + w1) = V/3, so link 1 separates at u = Δ cos α, and its ends' relative motion
+  // across it brings it back at d²l/dt² = a = Δ² sin²α / h: its flight reaches u²/(2a) = h cot²α / 2 below its
+  // length. Below kSlackGap h (cot²α < 2 kSlackGap) that flight is not resolved, and the link is held taut: both
+  // links end at zero rate, the bilateral impulse, whose loss is ½ V² (w1 + w2)/D, D = (w0 + w1)(w1 + w2) −
+  // w1² cos²α. Above it the link flies (slack), and the loss is the two-body ½ V²/(w0 + w1). The two losses differ
+  // by cos²α/9 of themselves (3e-9 at α = 89.99°): the ledger tells them apart at round-off.
+  const double h = 0.1, lambda = 0.2, l0 = 0.09, V = 1.0;
+  const double w0 = 2 / (lambda * h), w1 = 1 / (lambda * h), w2 = 2 / (lambda * h);
+  for (const double alpha_deg : {89.99, 89.9}) {
+    const double alpha = alpha_deg * 3.141592653589793 / 180, c = std::cos(alpha);
+    const double apex = 0.5 * h * (c / std::sin(alpha)) * (c / std::sin(alpha));  // u²/(2a)
+    const bool held = apex < StringModel<2>::kSlackGap * h;
+    Chain<2> chain = Chain<2>::uniform(lambda, 2 * h, 2, false);
+    chain.positions().col(0) = Vec<2>(-l0, 0.0);
+    chain.positions().col(1) = Vec<2>(0.0, 0.0);
+    chain.positions().col(2) = h * Vec<2>(-c, std::sin(alpha));
+    chain.velocities().col(0) = Vec<2>(-V, 0.0);
+    StringModel<2> model(std::move(chain), {}, {}, allow_options<2>());
+    model.set_slack(0, true);
+    const double t_snap = (h - l0) / V;
+    StringSolver<2> solver(model, run_options<2>(1.02 * t_snap, 0.51 * t_snap));
+    const RunSummary& s = solver.run();
+    REQUIRE(s.status == "completed");
+    const auto& first = solver.frames().front();
+    const auto& last = solver.frames().back();
+    const double K0 = kinetic_of(model, first.v), K1 = kinetic_of(model, last.v);
+    const double lost = held ? 0.5 * V * V * (w1 + w2) / ((w0 + w1) * (w1 + w2) - w1 * w1 * c * c) : 0.5 * V * V / (w0 + w1);
+    const Vec<2> e1 = (last.x.col(2) - last.x.col(1)).normalized();
+    const double rate1 = e1.dot(last.v.col(2) - last.v.col(1));
+    std::printf("\nsnap beside a link leaning %.2f deg from the normal: apex %.3g h, held %d, slack links %d, K lost "
+                "%.15g J (closed form %.15g J), W_snap %.15g J, link 1 rate %.9e m/s\n",
+                90 - alpha_deg, apex / h, held ? 1 : 0, model.num_slack_links(), K0 - K1, lost, last.terms["W_snap"], rate1);
+    INFO("alpha = " << alpha_deg << " deg");
+    CHECK(held == (alpha_deg == 89.99));  // cot²α / 2 = 1.5e-8 and 1.5e-6 against kSlackGap = 2e-7
+    CHECK(last.terms["snaps"] == 1);
+    CHECK(model.num_slack_links() == (held ? 0 : 1));
+    CHECK(std::abs((K0 - K1) - lost) < 1e-12 * K0);
+    CHECK(std::abs(-last.terms["W_snap"] - lost) < 1e-12 * K0);
+    CHECK(s.relative_energy_drift() < 1e-12);
+    CHECK(s.relative_momentum_residual() < 1e-13);
+    if (held) {
+      CHECK(std::abs(rate1) < 1e-12 * V);
+    } else {
+      // Still flying: shortening at Δ cos α less a (t − t_snap), to the change of the geometry over the flight
+      // (its ends have moved 7e-4 h; measured 5.8e-7 of Δ cos α).
+      const double Delta = V / 3, a = Delta * Delta * std::sin(alpha) * std::sin(alpha) / h;
+      CHECK(std::abs(rate1 - (-Delta * c + a * (last.t - t_snap))) < 2e-6 * Delta * c);
+    }
+  }
+}
+
 namespace {
 
 struct PickUp {
@@ -426,7 +483,7 @@ TEST_CASE("slack: the swinging U on 51 to 401 nodes: the differences of the stat
   // only to 6.0e-3 m and the RMS rises (2.1e-3 -> 2.3e-3 m), the error spread over the chain rather than
   // at the kink (docs/model.md §9 "Where the U's error sits"). Measured (max over the
   // coarse mesh's nodes of the distance to the same material point on the next mesh):
-  // 1.29e-2, 9.8e-3, 6.5e-3 m for 51 -> 101 -> 201 -> 401 nodes: observed order 0.39, then 0.59
+  // 1.29e-2, 9.4e-3, 6.4e-3 m for 51 -> 101 -> 201 -> 401 nodes: observed order 0.46, then 0.57
   // (about first order at best: each snap is an O(h) event of the discrete chain). W_snap falls with
   // the mesh (-3.8e-3, -2.7e-3, -1.6e-3, -1.1e-3 J).
   const std::vector<int> meshes = {51, 101, 201, 401};
@@ -471,7 +528,12 @@ TEST_CASE("slack: the swinging U and the whip close their energy ledgers to roun
   // tensions' work on the links' change of length, −∫ Σ T_j dl_j/dt, is W_links (booked). Measured:
   // without it the ledgers closed to 4.3e-8 (U, 101 nodes) and 6.6e-6 (whip) of their energy scale;
   // with it to 8.7e-11 and 1.2e-10, the integration error of a first integral at the scenes' rtol.
-  // (The whip's W_links, 1.9e-7 J, is half its located snaps' W_snap, −3.5e-7 J: few links snap there.)
+  // (The whip's W_links, 1.9e-7 J, was half its located snaps' W_snap, −3.5e-7 J.) Since a link that a snap
+  // would throw off its length by less than kSlackGap h is held taut at that snap (StringModel::
+  // hold_unresolved_flights), most of those pull-backs, the neighbours of links chattering at their length, are
+  // gone: W_links 2.6e-9 J (U) and 1.2e-9 J (whip), 10 and 8 times the ledgers' residual with it booked (2.5e-10
+  // and 1.6e-10 J; relative 2.2e-10 and 1.6e-10).
+  // The check: without W_links the ledger would be off by several times its residual.
   const std::filesystem::path scenes = std::filesystem::path(CHAINSIM_SOURCE_DIR) / "cases" / "scenes";
   for (const char* name : {"swinging_u.toml", "pendulum_whip.toml"}) {
     const SceneSpec spec = parse_scene(scenes / name, {"output.interval=0.1"});
@@ -484,7 +546,7 @@ TEST_CASE("slack: the swinging U and the whip close their energy ledgers to roun
     std::printf("\n%s: drift %.3e (relative %.3e), W_links %.3e J, W_snap %.3e J, momentum %.3e\n", name, s.energy_drift,
                 s.relative_energy_drift(), w_links, w_snap, s.relative_momentum_residual());
     CHECK(s.relative_energy_drift() < 1e-9);
-    CHECK(std::abs(w_links) > 100 * s.energy_drift);  // the work booked is what the ledger missed
+    CHECK(std::abs(w_links) > 3 * s.energy_drift);  // the work booked is what the ledger missed
     CHECK(s.relative_momentum_residual() < 1e-12);
   }
 }
@@ -493,8 +555,12 @@ TEST_CASE("slack: the swinging U on 201 to 1601 nodes: the largest differences a
           "[slack][convergence][.long]") {
   // The study behind docs/model.md §9 "Does the U converge?" (CHAINSIM_LONG_TESTS; about 3 minutes):
   // the largest distance between the same material point on successive meshes keeps falling, but
-  // slowly after the kink forms (measured 6.5e-3, 6.0e-3, 4.5e-3 m: orders 0.12 and 0.41), and W_snap,
-  // the energy the snaps dissipate, falls overall. The measured figures are printed.
+  // slowly after the kink forms (measured 6.4e-3, 6.0e-3, 4.8e-3 m: orders 0.09 and 0.31), and W_snap,
+  // the energy the snaps dissipate, falls overall. The measured figures are printed. The energy ledger closes to
+  // the integration tolerance (rtol = 1e-8, the scene's default): measured relative residuals 1.0e-10, 6.2e-11,
+  // 1.8e-10, 2.9e-9 (it was below 1e-9 on 1601 nodes while links chattering at their length, 2385 snaps then
+  // against 38 now, cut the steps short; the 1601-node residual ranges over 2e-10 .. 3e-9 with the output
+  // interval, which moves the steps).
   const std::vector<int> meshes = {201, 401, 801, 1601};
   std::vector<Points<2>> x;
   std::vector<double> w_snaps, differences;
@@ -513,7 +579,7 @@ TEST_CASE("slack: the swinging U on 201 to 1601 nodes: the largest differences a
       differences.push_back(diff);
     }
     std::printf("  %6d  %10ld  %12.4e  %12.3e  %12.3e\n", n, s.stats.steps, w_snap, s.relative_energy_drift(), diff);
-    CHECK(s.relative_energy_drift() < 1e-9);
+    CHECK(s.relative_energy_drift() < 1e-8);
   }
   for (std::size_t k = 1; k < differences.size(); ++k) {
     std::printf("  observed order %d -> %d nodes: %.2f\n", meshes[k - 1], meshes[k + 1],
