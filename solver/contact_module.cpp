@@ -359,7 +359,7 @@ class ContactModule final : public WrappingModule<dim> {
     // their links by h³/24R²: the forces are judged on the state projected onto the links and the
     // gaps, or the drift control's pull towards the links' lengths reads as a pull off the cylinder
     // and coarse meshes start by letting go of it (docs/model.md §10). A plane's straight nodes need
-    // no projection here (the run's own makes them consistent, as before).
+    // no projection here (the run's own makes them consistent, and start() judges the forces again there).
     bool curved = false;
     for (std::size_t i = 0; i < held_.size(); ++i)
       curved = curved || (held_[i] >= 0 && obstacle_of(i).kind == Obstacle<dim>::Kind::kCylinder);
@@ -380,6 +380,10 @@ class ContactModule final : public WrappingModule<dim> {
       }
       refresh(model);
     }
+    // The held nodes whose force pulls on the state as given are let go (a node given a velocity off the surface
+    // among them: the drift control's pull back onto it is a pull); start() judges the forces again once the
+    // start's projection has made the state consistent, and lands a node let go here that the projection, which
+    // did not hold it, carried into the surface (docs/model.md §10, "At the start").
     settle(model, 0.0, false);
     if (friction_) {
       // A stuck node cannot be moved by the projection of the initial state (make_consistent): the
@@ -389,6 +393,22 @@ class ContactModule final : public WrappingModule<dim> {
       model.chain().velocities() = model.v();
       if (classify(model, 0.0, nullptr)) settle(model, 0.0, false);
     }
+  }
+  /// The start on the consistent initial state (docs/model.md §10, "At the start"). initialize() let go of the
+  /// held nodes whose force pulled on the state as given; the start's projection (StringModel::make_consistent)
+  /// then held the others on their surfaces and moved the nodes let go freely, and may have carried one into a
+  /// surface (a corner of the shape: the chord across it is short of its link, and lengthening it pushes the
+  /// node beside the corner into the table). Here the held nodes whose force pulls on the consistent state are
+  /// let go (settle), and the free nodes inside a surface land at t0 with their impacts (hold: the impact's
+  /// projection, booked in W_impacts and the impulse), as after an impact's projection: a landing root function
+  /// below zero at the start would never find its root, and as the minimum over the free nodes it would hide
+  /// every later landing behind it. A lift-off root function below zero would likewise never find its root.
+  bool start(StringModel<dim>& model, double t0, Eigen::Ref<Eigen::VectorXd> ledger) override {
+    const bool inner_changed = WrappingModule<dim>::start(model, t0, ledger);
+    if (inner_changed) refresh(model);
+    settle(model, t0, false);
+    Eigen::Ref<Eigen::VectorXd> own = ledger.tail(ledger.size() - inner_ledgers());
+    return hold(model, t0, own, passed_through(model)) || inner_changed;
   }
   void node_contacts(const StringModel<dim>& model, std::vector<NodeContact<dim>>& out) const override {
     for (std::size_t i = 0; i < held_.size(); ++i) {

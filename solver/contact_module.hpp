@@ -15,7 +15,8 @@
 ///     whose force would then pull, one at a time, most negative first);
 ///   - the ledgers W_contact (J: the work of the contact forces, zero on the exact solution; it books
 ///     the drift control's share), W_impacts (J, ≤ 0: the kinetic energy the landings took) and the
-///     impulse of all external forces (the momentum ledger p − p0 − impulse, closed across impacts);
+///     impulse of all external forces (the momentum ledger p − p0 − impulse, closed across impacts); with a
+///     driven end W_impacts also holds its support's work in the impacts, and may be positive (docs/model.md §10);
 ///   - the recorded quantities impacts and lift_offs (series.csv): how many landings and lift-offs; each
 ///     lift-off is also a run event (StringModule::run_events: the summary's `events`, the first 100 of each
 ///     obstacle, merged in time order with the inner module's) and counted per obstacle
@@ -93,7 +94,9 @@ struct Obstacle {
 
 /// The contact module of `obstacles` (non-empty) around `inner`, the fronts' module (nullptr: a string
 /// without fronts). A node that starts within kInitialContact of its length h from a surface is held
-/// on it; one further inside is refused (InputError).
+/// on it; one further inside is refused (InputError). On the consistent initial state (StringModule::start)
+/// the held nodes whose force pulls are let go and a node that the start's projection carried into a surface
+/// lands at t = 0 (docs/model.md §10, "At the start").
 template <int dim>
 std::unique_ptr<StringModule<dim>> make_contact_module(std::vector<Obstacle<dim>> obstacles,
                                                        std::unique_ptr<StringModule<dim>> inner = nullptr);

@@ -1488,6 +1488,14 @@ double StringModel<dim>::make_consistent(double t0) {
 }
 
 template <int dim>
+bool StringModel<dim>::start_module(double t0, Eigen::Ref<Eigen::VectorXd> ledger) {
+  if (!module_ || !module_->start(*this, t0, ledger)) return false;
+  chain_.positions() = x_;
+  chain_.velocities() = v_;
+  return true;
+}
+
+template <int dim>
 Eigen::VectorXd StringModel<dim>::pack(const Eigen::Ref<const Eigen::VectorXd>& ledgers) const {
   Eigen::VectorXd y = Eigen::VectorXd::Zero(size());
   const int voff = dim * num_free_;

@@ -152,6 +152,10 @@ class StringModel final : public OdeSystem {
     static constexpr double kImpulsiveSpeed = 1e-9;
   };
   const ImpulsiveStart& impulsive_start() const { return impulsive_start_; }
+  /// After make_consistent: the module's start on the consistent state at t0 (StringModule::start: the
+  /// contact module's lift-offs and landings there), booked in `ledger`, the module's ledgers' initial
+  /// values. The chain's positions and velocities follow the state. Returns whether the state changed.
+  bool start_module(double t0, Eigen::Ref<Eigen::VectorXd> ledger);
   /// The ODE state of the chain's current positions and velocities, with every ledger zero.
   Eigen::VectorXd state_from_chain() const;
 

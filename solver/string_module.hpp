@@ -201,6 +201,14 @@ class StringModule {
   /// Checks that need the built string (its state, masses and arcs); called once, after the string
   /// is built. Throws InputError.
   virtual void initialize(StringModel<dim>& model) = 0;
+  /// The start, after the initial state's projection onto the constraints (StringModel::make_consistent)
+  /// and before the run: the module acts on the consistent state at t0 (the contact module lets go of the
+  /// held nodes whose force would pull there and lands the free nodes that the projection carried into a
+  /// surface, docs/model.md §10), booking what it does in its ledgers' initial values `ledger`. Returns
+  /// whether it changed the state (model.x(), model.v()).
+  virtual bool start(StringModel<dim>& /*model*/, double /*t0*/, Eigen::Ref<Eigen::VectorXd> /*ledger*/) {
+    return false;
+  }
 
   // --- every evaluation ---------------------------------------------------------------------------
   /// At the string's current positions and velocities: adds the mass (kg) and the force (N) the

@@ -322,7 +322,7 @@ void StringSolver<dim>::book(double t, const typename StringModel<dim>::Snapshot
     for (std::size_t k = 0; k < summary_.ledger_terms.size(); ++k)
       if (summary_.ledger_terms[k].energy() && snap.terms[k] != 0) e0_ -= snap.terms[k];
     v0_ = snap.potential;
-    p0_ = snap.momentum;
+    p0_ = snap.momentum - snap.impulse;  // before the impulses a module booked at t0 (its impacts at the start)
     have_start_ = true;
   }
   // The ledger K + V − (K0 + V0) − W_applied − the module's energy terms, and its physical scale.
@@ -531,6 +531,10 @@ const RunSummary& StringSolver<dim>::run() {
                                                   y0.tail(y0.size() - model_.work_index() - 1));
         }
       }
+      // The module's start on the consistent state (the contact module's lift-offs and landings at t0), which
+      // books what it does in the ledgers' initial values.
+      if (model_.start_module(t0, y0.tail(y0.size() - model_.work_index() - 1)))
+        y0.head(model_.work_index()) = model_.state_from_chain().head(model_.work_index());
       integrator = std::make_unique<Integrator>(model_, t0, y0, options_.integrator);
       record_frame(t0, y0);
       if (options_.record_steps) record_sample(t0, y0);

@@ -26,6 +26,9 @@ class WrappingModule : public StringModule<dim> {
     if (inner_) return inner_->initial_arcs(chain);
     return {ArcRange{0, chain.num_nodes() - 1, chain.closed()}};
   }
+  bool start(StringModel<dim>& model, double t0, Eigen::Ref<Eigen::VectorXd> ledger) override {
+    return inner_ && inner_->start(model, t0, ledger.head(inner_ledgers()));
+  }
   void add_mass_and_forces(const StringModel<dim>& model, Eigen::VectorXd& mass, Points<dim>& force) override {
     if (inner_) inner_->add_mass_and_forces(model, mass, force);
   }
