@@ -35,11 +35,11 @@ inline constexpr double kPi = 3.14159265358979323846;
 template <int dim>
 using Vec = Eigen::Matrix<double, dim, 1>;
 
-/// A point or vector as messages show it, six significant digits: "[0.04, -0.3]".
+/// A point or vector as messages show it, six significant digits: "[0.04, -0.3]" (a zero as 0, never -0).
 template <int dim>
 std::string show_point(const Vec<dim>& x) {
   std::string out = "[";
-  for (int d = 0; d < dim; ++d) out += fmt::format("{}{:g}", d > 0 ? ", " : "", x[d]);
+  for (int d = 0; d < dim; ++d) out += fmt::format("{}{:g}", d > 0 ? ", " : "", x[d] == 0 ? 0.0 : x[d]);
   return out + "]";
 }
 

@@ -25,15 +25,30 @@ void KinkFront<dim>::cut(FrontLayout& layout) {
   if (this->active) SplitLinkFront<dim>::cut(layout);
 }
 
+namespace {
+/// A link of first … last (links by their first node) is slack.
+template <int dim>
+bool any_slack(const StringModel<dim>& model, int first, int last) {
+  if (!model.allows_slack()) return false;
+  for (int j = first; j <= last; ++j)
+    if (model.link_slack(j)) return true;
+  return false;
+}
+}  // namespace
+
 template <int dim>
 double KinkFront<dim>::formation_margin(const StringModel<dim>& model) const {
   // The turn between the links at either end of a window of 2m links (m ≥ 1), centred on link j, inside one arc.
+  // Only a taut window: a slack link's direction is not the string's tangent (a pendulum released above the
+  // horizontal falls freely with its first link slack, at any angle to the next), and a kink forms in a taut
+  // string (docs/model.md §9).
   const Points<dim>& x = model.x();
   const int m = window_half_links(spec_.window, this->m_.h);
   double lowest = 2;
   sharpest_ = -1;
   for (const ArcRange& arc : model.arcs())
     for (int j = arc.first + m; j + m + 1 <= arc.last; ++j) {
+      if (any_slack(model, j - m, j + m)) continue;
       const Vec<dim> t1 = x.col(j - m + 1) - x.col(j - m), t2 = x.col(j + m + 1) - x.col(j + m);
       const double n = t1.norm() * t2.norm();
       if (!(n > 0)) continue;
@@ -58,6 +73,7 @@ bool KinkFront<dim>::insert(StringModel<dim>& model) {
   int best = -1;
   double best_cos = 2, best_l = 0;
   for (int j = std::max(arc.first + 1, sharpest_ - m); j <= std::min(arc.last - 2, sharpest_ + m); ++j) {
+    if (any_slack(model, j - 1, j + 1)) continue;  // the arms and the kinked link are taut
     const Vec<dim> tA = (x.col(j) - x.col(j - 1)).normalized(), tB = (x.col(j + 2) - x.col(j + 1)).normalized();
     const Vec<dim> d = tA - tB;
     if (!(d.squaredNorm() > 0)) continue;

@@ -106,10 +106,14 @@ std::unique_ptr<StringModule<dim>> make_contact_module(std::vector<Obstacle<dim>
 /// tension falls to λ v² over a curvature 1/R, is read on a link that spans the whole contact (measured with
 /// `chainsim compare pulley`, links along the arc: the lift-off 4-7 % early at R = h/2, 0.3-0.5 % late at R = h,
 /// 2e-5 to 2.5e-3 at R = 2h, 4e-6 at R = 4h; docs/model.md §10). The fewest nodes of a string of `length` m whose links are no longer than
-/// R: ceil(length / R) links, one node more on an open string.
-inline long nodes_resolving_radius(double radius, double length, bool closed) {
-  return static_cast<long>(std::ceil(length / radius)) + (closed ? 0 : 1);
+/// R / `per_radius`: ceil(per_radius · length / R) links, one node more on an open string.
+inline long nodes_resolving_radius(double radius, double length, bool closed, double per_radius = 1) {
+  return static_cast<long>(std::ceil(per_radius * length / radius)) + (closed ? 0 : 1);
 }
+/// Links along the arc resolve a cylinder's lift-off with links no longer than R / kArcLinksPerRadius: at R = 2h the
+/// heavy Atwood chain's lift-off was 2.5e-3 off on 201 nodes (u0 = 0.05 m), and with u0 = 0.1 m it was 1.2e-3 s late
+/// on 201 nodes and not found on 401; at R = 4h, within 4e-6 (docs/model.md §10, "A pulley thinner than the links").
+inline constexpr double kArcLinksPerRadius = 4;
 
 /// A node this share of a link length from a surface at the start is on it (the discretized shape is
 /// a polygon inscribed in a curved one); further inside, the scene is refused.

@@ -109,10 +109,11 @@ InputError unknown_method(const std::string& method) {
 
 std::vector<std::pair<std::string, std::string>> method_aliases() {
   std::vector<std::pair<std::string, std::string>> out;
-  out.emplace_back("auto", fmt::format("{} for a system as stiff as a string of {:g} links or more and without "
-                                       "root functions (fronts), else {} at rtol >= {:g} and {} below",
-                                       kAutoImplicit, Integrator::kAutoImplicitStiffness, kAutoExplicitLoose,
-                                       kAutoLooseRtol, kAutoExplicit));
+  out.emplace_back("auto", fmt::format("at rtol >= {1:g}: {2} for a system as stiff as a string of {0:g} links or "
+                                       "more and without root functions (fronts), else {3}; below: {4} for such a "
+                                       "stiff system, else {5}",
+                                       Integrator::kAutoImplicitStiffness, kAutoLooseRtol, kAutoImplicit,
+                                       kAutoExplicitLoose, kAutoExplicitStiff, kAutoExplicit));
   for (const auto& [alias, entry] : aliases())
     out.emplace_back(alias, fmt::format("{} ({})", entry.description, entry.table));
   return out;
@@ -597,9 +598,12 @@ Integrator::~Integrator() = default;
 
 std::string Integrator::resolve_method(const std::string& method, const OdeSystem& system, double rtol) {
   if (method != "auto") return method;
-  const bool stiff = system.explicit_stiffness() >= kAutoImplicitStiffness && system.num_events() == 0;
-  if (stiff) return kAutoImplicit;
-  return rtol >= kAutoLooseRtol ? kAutoExplicitLoose : kAutoExplicit;
+  const bool loose = rtol >= kAutoLooseRtol;
+  // A stiff system without root functions: implicit steps follow the motion at a loose tolerance, but at a
+  // tight one they follow the tolerance, and an explicit method's cheap stability-bound steps win.
+  if (system.explicit_stiffness() >= kAutoImplicitStiffness && system.num_events() == 0)
+    return loose ? kAutoImplicit : kAutoExplicitStiff;
+  return loose ? kAutoExplicitLoose : kAutoExplicit;
 }
 
 // The method, tolerance and last step, for the watchdog's messages.
@@ -618,10 +622,12 @@ int Integrator::evolve(double t_target, bool one_step) {
   if (d.steps_total >= d.max_steps)
     throw NumericalError(fmt::format("time integration stopped at t = {:.12g} s with ARK_TOO_MUCH_WORK: the step "
                                      "budget max_steps = {} of the run is used up ({}). Raise max_steps if the steps "
-                                     "are merely many (a low-order method at a tight rtol needs very many: loosen "
-                                     "rtol or pick a higher-order method such as erk8); if they are tiny the "
-                                     "solution may be singular near this time",
-                                     t_, d.max_steps, diagnosis()),
+                                     "are merely many ({}); if they are tiny the solution may be singular near this "
+                                     "time",
+                                     t_, d.max_steps, diagnosis(),
+                                     d.order < 8 ? "a low-order method at a tight rtol needs very many: loosen rtol or "
+                                                   "pick a higher-order method such as erk8"
+                                                 : "a tight rtol needs very many: loosen rtol"),
                          t_);
   if (d.max_wall_s > 0) {
     const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - d.wall_start).count();

@@ -155,6 +155,7 @@ class SlackModule final : public WrappingModule<dim> {
   }
   void book_start_dissipation(double dissipated, Eigen::Ref<Eigen::VectorXd> ledger) const override {
     ledger[inner_ledgers()] -= dissipated;  // W_snap: the start's impulses are a snap at t0
+    ++snaps_;                               // and count as one
   }
   bool events_need_tensions() const override { return inner_ && inner_->events_need_tensions(); }
   void node_contacts(const StringModel<dim>& model, std::vector<NodeContact<dim>>& out) const override {
@@ -164,7 +165,7 @@ class SlackModule final : public WrappingModule<dim> {
     return inner_ && inner_->release_contacts(model, t);
   }
  private:
-  long snaps_ = 0;
+  mutable long snaps_ = 0;  // mutable: the start's snap is booked by the const book_start_dissipation
   mutable bool counting_ = false;  // W_links: a link has been released
 };
 

@@ -377,6 +377,10 @@ void StringSolver<dim>::check_tolerance() {
   const double extent = x0.size() > 0 ? x0.cwiseAbs().maxCoeff() : 0.0;
   if (!(size > kRestMotion * std::numeric_limits<double>::epsilon() * std::max(extent, position_scale))) return;
   if (atol <= rtol * size) return;
+  // An atol below the round-off of the coordinates cannot be set: a motion that small against the string's extent
+  // (a chain balanced over a peg drifting off by 1e-8 m) is not resolved to rtol by any tolerance, and the advice
+  // would be a number the run cannot honour.
+  if (rtol * size < kRestMotion * std::numeric_limits<double>::epsilon() * extent) return;
   // The advice, rounded down to two significant digits so that a run given it does not warn again
   // (rtol × 1.9998e-5 m printed as 2e-9 did).
   const double advice = rtol * size / position_scale;
@@ -508,6 +512,7 @@ const RunSummary& StringSolver<dim>::run() {
     }
     check_tolerance();
   };
+  long events_handled = 0;  // events handled by the model (after the start)
   try {
     // 1. A consistent initial state.
     model_.make_consistent(t0);
@@ -622,6 +627,7 @@ const RunSummary& StringSolver<dim>::run() {
               t);
         }
         const EventAction action = model_.handle_events(t, state, integrator->events_found());
+        ++events_handled;
         if (action.kind == EventAction::Kind::kStop) {
           if (options_.record_steps) record_sample(t, state);
           record_frame(t, state);
@@ -674,6 +680,18 @@ const RunSummary& StringSolver<dim>::run() {
     const double t = summary_.t_stop;  // the integrator's time (t0 if it was never made), set by finish()
     summary_.error = fmt::format("the string degenerated at t = {:.9g} s: {}", t, e.what());
     throw NumericalError(summary_.error, t);
+  } catch (const NumericalError& e) {
+    finish("failed");
+    summary_.error = e.what();
+    // A step budget used up by events (a crumpling chain's snaps, a front's crossings) says so: the advice on
+    // the method and tolerance does not help there.
+    if (events_handled == 0 || summary_.error.find("ARK_TOO_MUCH_WORK") == std::string::npos) throw;
+    summary_.error += fmt::format(
+        ". {} of the steps ended at events, each a restart of the integrator ({})", events_handled,
+        model_.allows_slack() ? "slack = \"allow\": the snaps taut among them; a chain that crumples snaps link by "
+                                "link, docs/model.md §9, \"Limits\""
+                              : "the fronts' crossings and the obstacles' landings and lift-offs");
+    throw NumericalError(summary_.error, e.time());
   } catch (const Error& e) {
     finish("failed");
     summary_.error = e.what();

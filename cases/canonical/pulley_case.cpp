@@ -152,12 +152,12 @@ PulleyComparison compare_pulley_with_exact(const PulleyCaseSetup& setup) {
   c.summary["tension_steps"] = tension_steps;
   // A pulley thinner than the links: the lift-off is not resolved (nodes_resolving_radius), as a scene warns.
   const double h = ell / links;
-  if (h > R)
+  if (h * kArcLinksPerRadius > R)
     c.summary["resolution_warning"] = fmt::format(
-        "--R = {:g} m is shorter than the links ({:.3g} m): the wrapped part is exact, but the lift-off, read on links "
-        "longer than the radius, is not resolved (docs/model.md section 10); set --nodes >= {} (links no longer than "
-        "the radius)",
-        R, h, nodes_resolving_radius(R, ell, false));
+        "--R = {:g} m is shorter than 4 links ({:.3g} m): the wrapped part is exact, but the lift-off, read on links "
+        "longer than a quarter of the radius, is not resolved (docs/model.md section 10); set --nodes >= {} (links "
+        "no longer than a quarter of the radius)",
+        R, h * kArcLinksPerRadius, nodes_resolving_radius(R, ell, false, kArcLinksPerRadius));
   return c;
 }
 

@@ -331,12 +331,7 @@ std::unique_ptr<StringModel<dim>> build_front_model(const SceneSpec& spec, scene
       if (!entry.direction)
         fail_at(spec, key,
                 fmt::format("{} has no direction: a 3D edge needs its line, direction = [dx, dy, dz] (nonzero)", key));
-      const Vec<dim> dir = as_vec<dim>(spec, *entry.direction, key + ".direction");
-      if (!(dir.norm() > 0) || !std::isfinite(dir.norm()))
-        fail_at(spec, key + ".direction",
-                fmt::format("{}.direction = {} is not a direction: allowed a finite nonzero vector [dx, dy, dz]", key,
-                            text_of(spec, key + ".direction")));
-      edge.axis = dir.normalized();
+      edge.axis = scene_build::as_unit_vec<dim>(spec, *entry.direction, key + ".direction", "a direction");
     } else if (entry.direction) {
       const std::vector<double>& dir = *entry.direction;
       if (dir.size() != 3 || dir[0] != 0 || dir[1] != 0 || dir[2] == 0)

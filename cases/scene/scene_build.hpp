@@ -62,9 +62,11 @@ template <int dim>
 Vec<dim> as_unit_vec(const SceneSpec& spec, const std::vector<double>& v, const std::string& key,
                      const std::string& what) {
   const Vec<dim> u = as_vec<dim>(spec, v, key);
-  if (!(u.norm() > 0) || !u.allFinite())
+  // Scaled before the norm (Eigen's stable norm): [0, 1e300] and [0, 1e-300] are directions too, whose plain norm
+  // overflows or underflows.
+  if (!u.allFinite() || !(u.cwiseAbs().maxCoeff() > 0))
     fail_at(spec, key, fmt::format("{} = {} is not {}: allowed a finite nonzero vector", key, text_of(spec, key), what));
-  return Vec<dim>(u.normalized());
+  return Vec<dim>(u.stableNormalized());
 }
 
 /// The string of a scene before a model is made of it.

@@ -24,11 +24,18 @@ namespace {
 /// `f` -> the dotted key of the scene's only front's dissipation.
 std::string front_f_key(const SceneSpec& spec) {
   const auto& fx = spec.effects;
-  const std::size_t fronts = fx.heaps.size() + (fx.fold ? 1 : 0) + fx.edges.size();
+  // The fronts with an f: heaps, a fold, edges and the touchdown fronts of surfaces that declare f (a kink's is 0).
+  std::optional<std::size_t> touchdown;
+  std::size_t touchdowns = 0;
+  for (std::size_t k = 0; k < fx.surfaces.size(); ++k)
+    if (fx.surfaces[k].f) touchdown = k, ++touchdowns;
+  const std::size_t fronts = fx.heaps.size() + (fx.fold ? 1 : 0) + fx.edges.size() + touchdowns;
   if (fronts != 1)
-    throw InputError(fmt::format("{}: the sweep key f names the dissipation of the scene's only front, but the "
-                                 "scene has {} fronts: write effects.heap[K].f, effects.fold.f or effects.edge[K].f",
-                                 spec.source, fronts));
+    throw InputError(fmt::format("{}: the sweep key f names the dissipation of the scene's only front with an f, but "
+                                 "the scene has {}: write effects.heap[K].f, effects.fold.f, effects.edge[K].f or "
+                                 "effects.surface[K].f",
+                                 spec.source, fronts == 0 ? "none" : fmt::format("{}", fronts)));
+  if (touchdown) return fmt::format("effects.surface[{}].f", *touchdown);
   return fx.fold ? "effects.fold.f" : !fx.edges.empty() ? "effects.edge[0].f" : "effects.heap[0].f";
 }
 

@@ -155,8 +155,8 @@ std::string obstacle_key(const SceneSpec& spec) {
 /// The warning for a cylinder whose radius is shorter than the longest link (empty when every one is resolved,
 /// nodes_resolving_radius): in node contact a polygon of one or two nodes, whose contact forces and lift-offs are
 /// not the cylinder's (docs/scenes.md, "[[effects.cylinder]]": the heavy Atwood chain over R = h/2 lifts off 5 %
-/// early); with links along the arc, a lift-off read on links longer than the radius (compare pulley: 4-7 % early
-/// at R = h/2).
+/// early); with links along the arc, a lift-off read on links longer than R / kArcLinksPerRadius (compare pulley:
+/// 4-7 % early at R = h/2, up to 2.5e-3 off or not found at R = 2h).
 std::string cylinder_resolution_warning(const SceneSpec& spec, const std::vector<double>& link_lengths) {
   if (link_lengths.empty()) return {};
   const double h = *std::max_element(link_lengths.begin(), link_lengths.end());
@@ -166,16 +166,18 @@ std::string cylinder_resolution_warning(const SceneSpec& spec, const std::vector
   std::string warning;
   for (std::size_t k = 0; k < spec.effects.cylinders.size(); ++k) {
     const CylinderEntry& c = spec.effects.cylinders[k];
-    if (!(h > c.radius)) continue;
-    const std::string why = c.contact == "nodes"
-                                ? "in node contact its nodes are held on the circle and its links are chords, so it is "
-                                  "touched by one or two nodes and its contact forces and lift-offs are not resolved"
-                                : "with links along the arc the wrapped part is exact, but its lift-off, read on links "
-                                  "longer than the radius, is not resolved";
-    warning += fmt::format("{}effects.cylinder[{}].radius = {:g} m is shorter than the links ({:.3g} m): {} "
-                           "(docs/scenes.md); set string.nodes >= {} (links no longer than the radius)",
-                           warning.empty() ? "" : "; ", k, c.radius, h, why,
-                           nodes_resolving_radius(c.radius, length, closed));
+    const bool nodes = c.contact == "nodes";
+    const double per_radius = nodes ? 1 : kArcLinksPerRadius;
+    if (!(h * per_radius > c.radius)) continue;
+    const std::string why = nodes ? "in node contact its nodes are held on the circle and its links are chords, so it "
+                                    "is touched by one or two nodes and its contact forces and lift-offs are not resolved"
+                                  : "with links along the arc the wrapped part is exact, but its lift-off, read on links "
+                                    "longer than a quarter of the radius, is not resolved";
+    warning += fmt::format("{}effects.cylinder[{}].radius = {:g} m is shorter than {} ({:.3g} m): {} "
+                           "(docs/scenes.md); set string.nodes >= {} (links no longer than {})",
+                           warning.empty() ? "" : "; ", k, c.radius, nodes ? "the links" : "4 links", h * per_radius,
+                           why, nodes_resolving_radius(c.radius, length, closed, per_radius),
+                           nodes ? "the radius" : "a quarter of the radius");
   }
   return warning;
 }

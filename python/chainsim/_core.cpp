@@ -524,6 +524,11 @@ PYBIND11_MODULE(_core, m) {
         },
         py::arg("text"), py::arg("source"), py::arg("overrides"), py::arg("t_end"), py::arg("points"),
         "refuses (ChainsimInputError) points that set one scene key twice, before any runs");
+  m.def("sweep_key",
+        [](const std::string& text, const std::string& source, const std::vector<std::string>& overrides,
+           const std::string& key) { return canonical_sweep_key(sweep_scene(text, source, overrides, {}), key); },
+        py::arg("text"), py::arg("source"), py::arg("overrides"), py::arg("key"),
+        "the scene key a grid or fit key stands for (`f`: the dissipation of the scene's only front with an f)");
   m.def("run_sweep_point",
         [](const std::string& text, const std::string& source, const std::vector<std::string>& overrides,
            std::optional<double> t_end, const std::vector<std::string>& point) {

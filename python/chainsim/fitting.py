@@ -236,17 +236,11 @@ class Data:
 # The model: one run of chainsim per run label and parameter vector
 
 def _scene_key(scene, key):
-    """`f` -> the dotted key of the scene's only front's dissipation (as `chainsim sweep` resolves it)."""
+    """`f` -> the dotted key of the scene's only front's dissipation, as `chainsim sweep` resolves it (the same
+    code: chainsim._core.sweep_key)."""
     if key != "f":
         return key
-    effects = scene.effective.get("effects", {})
-    fronts = len(effects.get("heap", [])) + (1 if "fold" in effects else 0) + len(effects.get("edge", []))
-    if fronts != 1:
-        raise _error(f"{scene.source}: the fit parameter f names the dissipation of the scene's only front, but the "
-                     f"scene has {fronts} fronts: write effects.heap[K].f, effects.fold.f or effects.edge[K].f")
-    if "fold" in effects:
-        return "effects.fold.f"
-    return "effects.edge[0].f" if effects.get("edge") else "effects.heap[0].f"
+    return _core.sweep_key(scene.text, scene.source, scene.overrides, key)
 
 
 def _allowed_range(target, name):

@@ -648,11 +648,22 @@ def main():
     ap.add_argument("--smoke", action="store_true", help="a < 30 s check (CTest)")
     ap.add_argument("--cases", default="", help="comma-separated subset of falling,folded,sliding,tilted,curved,"
                     "hanging,hanging4 (default: all)")
+    ap.add_argument("--string-rtols", default="1e-5,1e-9", help="comma-separated rtols of the strings without "
+                    "fronts (hanging, hanging4), where `auto` may pick an implicit method (default 1e-5,1e-9)")
+    ap.add_argument("--hanging-nodes", default="11,21,41,81,161,321", help="comma-separated meshes of the "
+                    "hanging case (default 11,21,41,81,161,321)")
     opts = ap.parse_args()
     if not opts.chainsim.exists():
         sys.exit(f"work_precision.py: {opts.chainsim} not found: build it first (cmake --build build --target chainsim)")
     if opts.repeats < 1 or opts.budget <= 0:
         sys.exit("work_precision.py: --repeats must be >= 1 and --budget > 0")
+    try:
+        string_rtols = sorted({float(r) for r in opts.string_rtols.split(",") if r.strip()}, reverse=True)
+        hanging_nodes = sorted({int(n) for n in opts.hanging_nodes.split(",") if n.strip()})
+    except ValueError as e:
+        sys.exit(f"work_precision.py: --string-rtols / --hanging-nodes: {e}")
+    if not string_rtols or not all(0 < r < 1 for r in string_rtols) or not hanging_nodes or min(hanging_nodes) < 3:
+        sys.exit("work_precision.py: --string-rtols needs rtols in (0, 1), --hanging-nodes meshes of 3 nodes or more")
     opts.out = opts.out.resolve()
     opts.chainsim = opts.chainsim.resolve()
     opts.out.mkdir(parents=True, exist_ok=True)
@@ -746,10 +757,10 @@ def main():
             study.sweep(curved, methods, [1e-4, 1e-8], [21, 41, 81, 161, 321])
         if wanted("hanging"):
             study.log(f"hanging: {hanging.title}")
-            study.sweep(hanging, methods, [1e-5, 1e-9], [11, 21, 41, 81, 161, 321], hanging.overrides())
+            study.sweep(hanging, methods, string_rtols, hanging_nodes, hanging.overrides())
         if wanted("hanging4"):
             study.log(f"hanging4: {hanging4.title}")
-            study.sweep(hanging4, methods, [1e-5, 1e-9], [5, 7, 9, 13, 17, 21], hanging4.overrides())
+            study.sweep(hanging4, methods, string_rtols, [5, 7, 9, 13, 17, 21], hanging4.overrides())
         cases = canonical + [c for c in (tilted, curved, hanging, hanging4) if wanted(c.name)]
 
     fields = ["case", "model", "method", "explicit", "kind", "rtol", "atol", "nodes", "error", "error_eta", "error_P",

@@ -2,6 +2,7 @@
 // The sweep's threads run here under the sanitizers too (the Python tests do not).
 #include <atomic>
 #include <cmath>
+#include <filesystem>
 
 #include <catch2/catch.hpp>
 #include <fmt/format.h>
@@ -79,7 +80,7 @@ TEST_CASE("a sweep point that fails numerically is a row with its error", "[unit
   CHECK(row["t_end"] == 1.0);
   const nlohmann::json bad = run_sweep_point(hanging, {"f=0.5"});  // no front: f names nothing
   CHECK(bad["status"] == "error");
-  CHECK_THAT(bad["error"].get<std::string>(), Catch::Contains("has 0 fronts"));
+  CHECK_THAT(bad["error"].get<std::string>(), Catch::Contains("the scene has none: write effects.heap[K].f"));
 }
 
 TEST_CASE("the sweep key f names an edge's dissipation when the edge is the scene's only front", "[unit][sweep][edge]") {
@@ -191,4 +192,19 @@ TEST_CASE("a sweep point run by another runner (the Python module's that keeps t
     run_sweep(falling, points, workers, &done);
     CHECK(done.load() == points.size());
   }
+}
+
+TEST_CASE("the sweep key f names a touchdown front's dissipation when it is the scene's only front",
+          "[unit][sweep][touchdown]") {
+  // chainsim sweep chain_drawn_onto_table.toml --grid f=0,0.5,1 said "the scene has 0 fronts": the touchdown front
+  // of a surface with f (docs/model.md §10) was not counted (a tester, issue 23). The key is the surface's f; a
+  // scene with a heap besides it has two fronts with an f, and f names none of them.
+  SweepScene scene;
+  scene.text = read_scene_file(std::filesystem::path(CHAINSIM_SOURCE_DIR) / "cases" / "scenes" /
+                             "chain_drawn_onto_table.toml");
+  scene.source = "chain_drawn_onto_table.toml";
+  CHECK(canonical_sweep_key(scene, "f") == "effects.surface[0].f");
+  const nlohmann::json row = run_sweep_point(scene, {"f=0.5", "stop.t_end=0.01"});
+  CHECK(row["status"] == "completed");
+  CHECK(row["fronts[0].f"] == 0.5);
 }
