@@ -647,6 +647,9 @@ class StringModel final : public OdeSystem {
   std::vector<char> slack_;            // per link: slack (slack = allow)
   std::vector<double> slack_offset_;   // per link: its root function's offset
   std::vector<double> rebound_time_, rebound_speed_;  // per link: when and how fast it separated at its last snap (NaN: it did not)
+  // per link: released by the complementarity problem at some evaluation since the last accepted step (accept_step)
+  std::vector<char> released_;
+  bool any_released_ = false;
   int num_slack_ = 0;
 };
 
