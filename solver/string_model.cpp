@@ -1614,17 +1614,24 @@ typename StringModel<dim>::Snapshot StringModel<dim>::snapshot(double t, const E
 
 template <int dim>
 double StringModel<dim>::max_constraint_violation(double t, const Eigen::Ref<const Eigen::VectorXd>& y) const {
+  return worst_constraint_violation(t, y).relative;
+}
+
+template <int dim>
+typename StringModel<dim>::ConstraintViolation StringModel<dim>::worst_constraint_violation(
+    double t, const Eigen::Ref<const Eigen::VectorXd>& y) const {
+  ConstraintViolation worst;
   if (quadratic_) {
     Points<dim> x, v;
     unpack(t, y, x, v);
-    return quadratic_->max_constraint_violation(x);
+    worst.relative = quadratic_->max_constraint_violation(x);
+    return worst;
   }
   auto position = [&](int i) -> Vec<dim> {
     const int k = slot_[i];
     if (k >= 0) return y.template segment<dim>(dim * k);
     return prescribed_[static_cast<std::size_t>(path_of_[i])].path->position(t);
   };
-  double worst = 0;
   for_each_link([&](int j, int, int) {
     if (link_slack(j)) return;
     const double h = chain_.link_length(j);
@@ -1639,7 +1646,7 @@ double StringModel<dim>::max_constraint_violation(double t, const Eigen::Ref<con
         l = sides.l_minus + sides.l_plus;
       }
     }
-    worst = std::max(worst, std::abs(l - h) / h);
+    if (std::abs(l - h) / h > worst.relative) worst = {std::abs(l - h) / h, j, l};
   });
   return worst;
 }
