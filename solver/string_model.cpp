@@ -95,6 +95,7 @@ StringModel<dim>::StringModel(Chain<dim> chain, std::vector<std::unique_ptr<Forc
     slack_offset_.assign(static_cast<std::size_t>(L), 0.0);
     rebound_time_.assign(static_cast<std::size_t>(L), NAN);
     rebound_speed_.assign(static_cast<std::size_t>(L), NAN);
+    released_.assign(static_cast<std::size_t>(L), 0);
   }
   // 1. The arcs: the whole string, or the module's layout.
   if (module_) {
@@ -1622,17 +1623,24 @@ typename StringModel<dim>::Snapshot StringModel<dim>::snapshot(double t, const E
 
 template <int dim>
 double StringModel<dim>::max_constraint_violation(double t, const Eigen::Ref<const Eigen::VectorXd>& y) const {
+  return worst_constraint_violation(t, y).relative;
+}
+
+template <int dim>
+typename StringModel<dim>::ConstraintViolation StringModel<dim>::worst_constraint_violation(
+    double t, const Eigen::Ref<const Eigen::VectorXd>& y) const {
+  ConstraintViolation worst;
   if (quadratic_) {
     Points<dim> x, v;
     unpack(t, y, x, v);
-    return quadratic_->max_constraint_violation(x);
+    worst.relative = quadratic_->max_constraint_violation(x);
+    return worst;
   }
   auto position = [&](int i) -> Vec<dim> {
     const int k = slot_[i];
     if (k >= 0) return y.template segment<dim>(dim * k);
     return prescribed_[static_cast<std::size_t>(path_of_[i])].path->position(t);
   };
-  double worst = 0;
   for_each_link([&](int j, int, int) {
     if (link_slack(j)) return;
     const double h = chain_.link_length(j);
@@ -1647,7 +1655,7 @@ double StringModel<dim>::max_constraint_violation(double t, const Eigen::Ref<con
         l = sides.l_minus + sides.l_plus;
       }
     }
-    worst = std::max(worst, std::abs(l - h) / h);
+    if (std::abs(l - h) / h > worst.relative) worst = {std::abs(l - h) / h, j, l};
   });
   return worst;
 }
@@ -1738,9 +1746,19 @@ const Eigen::VectorXd& StringModel<dim>::solve_tensions(double t) {
   exclude_slack_links();
   // Round-off is not a release: a tension counts as negative below −slack_tolerance times the larger
   // of max |T| and the physical tension scale (as find_slack judges slack).
-  return system_->solve_complementarity(t, [&](double max_abs) {
+  const long releases = system_->complementarity_stats().calls_with_release;
+  const Eigen::VectorXd& T = system_->solve_complementarity(t, [&](double max_abs) {
     return options_.slack_tolerance * std::max(max_abs, physical_scales().tension);
   });
+  // The taut links this solve released: accept_step judges them (a release that the next evaluations take
+  // back within one step is still a release). O(N), only on a solve that released a link.
+  if (system_->complementarity_stats().calls_with_release != releases) {
+    for_each_link([&](int j, int u, int) {
+      if (!link_slack(j) && system_->excluded(u)) released_[static_cast<std::size_t>(j)] = 1;
+    });
+    any_released_ = true;
+  }
+  return T;
 }
 
 template <int dim>
@@ -1780,7 +1798,7 @@ void StringModel<dim>::accept_step(double t, const Eigen::Ref<const Eigen::Vecto
     if (!link_slack(j)) {
       // (Released: no tension at the step's last evaluation. A link short only by the drift of the
       // constraints, which at loose tolerances is far above kSlackGap, keeps its tension: it is taut.)
-      if (gap > kSlackGap && !(link_tension(j) > 0)) {
+      if (gap > kSlackGap && (!(link_tension(j) > 0) || (any_released_ && released_[static_cast<std::size_t>(j)]))) {
         set_slack(j, true);
         rebound_time_[static_cast<std::size_t>(j)] = NAN;  // released by the tensions: a flight, not a rebound
       }
@@ -1790,6 +1808,10 @@ void StringModel<dim>::accept_step(double t, const Eigen::Ref<const Eigen::Vecto
                                        t, j, chain_.link_midpoint(j), -(gap + slack_offset_[static_cast<std::size_t>(j)])),
                            t);
     }
+  }
+  if (any_released_) {
+    std::fill(released_.begin(), released_.end(), 0);
+    any_released_ = false;
   }
 }
 

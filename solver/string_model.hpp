@@ -190,6 +190,14 @@ class StringModel final : public OdeSystem {
 
   /// max_j | |Δx_j| − h_j | / h_j at (t, y) over the links of the arcs, without a tension solve.
   double max_constraint_violation(double t, const Eigen::Ref<const Eigen::VectorXd>& y) const;
+  /// The same, with the taut link where it is reached and that link's length (link −1 with quadratic
+  /// elements, whose violation is not a link's).
+  struct ConstraintViolation {
+    double relative = 0;
+    int link = -1;
+    double length = 0;
+  };
+  ConstraintViolation worst_constraint_violation(double t, const Eigen::Ref<const Eigen::VectorXd>& y) const;
   /// The physical scales of the current state (never the round-off of a solve), from its velocities,
   /// forces and the drivers' accelerations (valid once evaluate_current has set the forces):
   ///   tension  λ (|g| ℓ + max |v|² + ℓ max |a_driven|) + Σ |F_i − m_i g|: the weight, the centripetal
@@ -658,6 +666,9 @@ class StringModel final : public OdeSystem {
   std::vector<char> slack_;            // per link: slack (slack = allow)
   std::vector<double> slack_offset_;   // per link: its root function's offset
   std::vector<double> rebound_time_, rebound_speed_;  // per link: when and how fast it separated at its last snap (NaN: it did not)
+  // per link: released by the complementarity problem at some evaluation since the last accepted step (accept_step)
+  std::vector<char> released_;
+  bool any_released_ = false;
   int num_slack_ = 0;
 };
 

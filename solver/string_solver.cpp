@@ -30,6 +30,11 @@ constexpr double kStepOfFrames = 1 - 1e-9;
 /// A node that moves by less than this many units of round-off of the coordinates has not moved
 /// (check_tolerance: a string at rest moves by about one, 1e-16 m on a 1 m chain).
 constexpr double kRestMotion = 1e3;
+/// A taut link whose length is off by more than this share of it (or kMaxViolationPerRtol × rtol, if larger)
+/// at an accepted step stops the run (exit 3). Measured: 5.5e-3 on the driven catenary of the slack tests
+/// (321 nodes, rtol 1e-8, the drift control's overshoot after releases), 0.025 and 0.14 on the swinging U at
+/// rtol = atol = 1e-3 and 1e-2; a release taken back within a step had reached 0.155 (docs/model.md §9).
+constexpr double kMaxViolation = 0.05, kMaxViolationPerRtol = 100;
 }  // namespace
 
 void StringSolverOptions::validate() const {
@@ -560,8 +565,26 @@ const RunSummary& StringSolver<dim>::run() {
     // At every accepted step: the constraints, slack, the caller's hook and the step record.
     auto after_step = [&](double t, const Eigen::VectorXd& y) {
       model_.accept_step(t, y);  // slack = allow: the links released at this step go slack
-      summary_.max_constraint_violation =
-          std::max(summary_.max_constraint_violation, model_.max_constraint_violation(t, y));
+      const auto violation = model_.worst_constraint_violation(t, y);
+      summary_.max_constraint_violation = std::max(summary_.max_constraint_violation, violation.relative);
+      // A taut link far off its length is no drift of the integration: stop, located (docs/model.md §9,
+      // "A release taken back within a step"). The bound grows with the tolerances (the U at rtol = atol = 1e-3
+      // drifts 0.025 h): rtol, and atol on positions over the link's length.
+      const auto bound_of = [&](int j) {
+        const Eigen::VectorXd scale = model_.state_scale();
+        const double atol = options_.integrator.atol * (scale.size() > 0 ? scale[0] : 1.0);
+        return std::max(kMaxViolation, kMaxViolationPerRtol * std::max(options_.integrator.rtol,
+                                                                       atol / model_.chain().link_length(j)));
+      };
+      double bound = kMaxViolation;
+      if (violation.link >= 0 && violation.relative > kMaxViolation && violation.relative > (bound = bound_of(violation.link)))
+        throw NumericalError(fmt::format("at t = {:.9g} s taut link {} (s = {:.6g} m) has length {:.6g} m, {:.3g} of its "
+                                         "length {:.6g} m off it (the bound is {:.3g}): the constraints have drifted "
+                                         "far beyond the integration tolerance",
+                                         t, violation.link, model_.chain().link_midpoint(violation.link),
+                                         violation.length, violation.relative,
+                                         model_.chain().link_length(violation.link), bound),
+                             t);
       check_slack(t, y);
       if (on_step) on_step(t, y);
       if (options_.record_steps) record_sample(t, y);
