@@ -407,8 +407,7 @@ class ContactModule final : public WrappingModule<dim> {
     const bool inner_changed = WrappingModule<dim>::start(model, t0, ledger);
     if (inner_changed) refresh(model);
     settle(model, t0, false);
-    Eigen::Ref<Eigen::VectorXd> own = ledger.tail(ledger.size() - inner_ledgers());
-    return hold(model, t0, own, passed_through(model)) || inner_changed;
+    return land_passed(model, t0, ledger) || inner_changed;
   }
   void node_contacts(const StringModel<dim>& model, std::vector<NodeContact<dim>>& out) const override {
     for (std::size_t i = 0; i < held_.size(); ++i) {

@@ -111,9 +111,9 @@ std::vector<std::pair<std::string, std::string>> method_aliases() {
   std::vector<std::pair<std::string, std::string>> out;
   out.emplace_back("auto", fmt::format("at rtol >= {1:g}: {2} for a system as stiff as a string of {0:g} links or "
                                        "more and without root functions (fronts), else {3}; below: {4} for such a "
-                                       "stiff system, else {5}",
+                                       "stiff system up to {6:g} links ({2} beyond), else {5}",
                                        Integrator::kAutoImplicitStiffness, kAutoLooseRtol, kAutoImplicit,
-                                       kAutoExplicitLoose, kAutoExplicitStiff, kAutoExplicit));
+                                       kAutoExplicitLoose, kAutoExplicitStiff, kAutoExplicit, kAutoExplicitStiffMax));
   for (const auto& [alias, entry] : aliases())
     out.emplace_back(alias, fmt::format("{} ({})", entry.description, entry.table));
   return out;
@@ -601,8 +601,9 @@ std::string Integrator::resolve_method(const std::string& method, const OdeSyste
   const bool loose = rtol >= kAutoLooseRtol;
   // A stiff system without root functions: implicit steps follow the motion at a loose tolerance, but at a
   // tight one they follow the tolerance, and an explicit method's cheap stability-bound steps win.
-  if (system.explicit_stiffness() >= kAutoImplicitStiffness && system.num_events() == 0)
-    return loose ? kAutoImplicit : kAutoExplicitStiff;
+  const double stiffness = system.explicit_stiffness();
+  if (stiffness >= kAutoImplicitStiffness && system.num_events() == 0)
+    return loose || stiffness > kAutoExplicitStiffMax ? kAutoImplicit : kAutoExplicitStiff;
   return loose ? kAutoExplicitLoose : kAutoExplicit;
 }
 

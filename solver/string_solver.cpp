@@ -30,6 +30,8 @@ constexpr double kStepOfFrames = 1 - 1e-9;
 /// A node that moves by less than this many units of round-off of the coordinates has not moved
 /// (check_tolerance: a string at rest moves by about one, 1e-16 m on a 1 m chain).
 constexpr double kRestMotion = 1e3;
+/// An atol below this many units of round-off of the coordinates cannot be honoured (check_tolerance).
+constexpr double kRoundoffUnits = 4;
 /// A taut link whose length is off by more than this share of it (or kMaxViolationPerRtol × rtol, if larger)
 /// at an accepted step stops the run (exit 3). Measured: 5.5e-3 on the driven catenary of the slack tests
 /// (321 nodes, rtol 1e-8, the drift control's overshoot after releases), 0.025 and 0.14 on the swinging U at
@@ -385,7 +387,7 @@ void StringSolver<dim>::check_tolerance() {
   // An atol below the round-off of the coordinates cannot be set: a motion that small against the string's extent
   // (a chain balanced over a peg drifting off by 1e-8 m) is not resolved to rtol by any tolerance, and the advice
   // would be a number the run cannot honour.
-  if (rtol * size < kRestMotion * std::numeric_limits<double>::epsilon() * extent) return;
+  if (rtol * size < kRoundoffUnits * std::numeric_limits<double>::epsilon() * extent) return;
   // The advice, rounded down to two significant digits so that a run given it does not warn again
   // (rtol × 1.9998e-5 m printed as 2e-9 did).
   const double advice = rtol * size / position_scale;

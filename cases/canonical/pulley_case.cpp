@@ -154,10 +154,10 @@ PulleyComparison compare_pulley_with_exact(const PulleyCaseSetup& setup) {
   const double h = ell / links;
   if (h * kArcLinksPerRadius > R)
     c.summary["resolution_warning"] = fmt::format(
-        "--R = {:g} m is shorter than 4 links ({:.3g} m): the wrapped part is exact, but the lift-off, read on links "
-        "longer than a quarter of the radius, is not resolved (docs/model.md section 10); set --nodes >= {} (links "
-        "no longer than a quarter of the radius)",
-        R, h * kArcLinksPerRadius, nodes_resolving_radius(R, ell, false, kArcLinksPerRadius));
+        "--R = {0:g} m is shorter than {1:g} links ({2:.3g} m): the wrapped part is exact, but the lift-off, read on "
+        "links longer than 1/{1:g} of the radius, is not resolved (docs/model.md section 10); set --nodes >= {3} "
+        "(links no longer than 1/{1:g} of the radius)",
+        R, kArcLinksPerRadius, h * kArcLinksPerRadius, nodes_resolving_radius(R, ell, false, kArcLinksPerRadius));
   return c;
 }
 

@@ -169,15 +169,17 @@ std::string cylinder_resolution_warning(const SceneSpec& spec, const std::vector
     const bool nodes = c.contact == "nodes";
     const double per_radius = nodes ? 1 : kArcLinksPerRadius;
     if (!(h * per_radius > c.radius)) continue;
-    const std::string why = nodes ? "in node contact its nodes are held on the circle and its links are chords, so it "
-                                    "is touched by one or two nodes and its contact forces and lift-offs are not resolved"
-                                  : "with links along the arc the wrapped part is exact, but its lift-off, read on links "
-                                    "longer than a quarter of the radius, is not resolved";
+    const std::string why =
+        nodes ? "in node contact its nodes are held on the circle and its links are chords, so it is touched by one "
+                "or two nodes and its contact forces and lift-offs are not resolved"
+              : fmt::format("with links along the arc the wrapped part is exact, but its lift-off, read on links "
+                            "longer than 1/{:g} of the radius, is not resolved", per_radius);
     warning += fmt::format("{}effects.cylinder[{}].radius = {:g} m is shorter than {} ({:.3g} m): {} "
                            "(docs/scenes.md); set string.nodes >= {} (links no longer than {})",
-                           warning.empty() ? "" : "; ", k, c.radius, nodes ? "the links" : "4 links", h * per_radius,
-                           why, nodes_resolving_radius(c.radius, length, closed, per_radius),
-                           nodes ? "the radius" : "a quarter of the radius");
+                           warning.empty() ? "" : "; ", k, c.radius,
+                           nodes ? "the links" : fmt::format("{:g} links", per_radius), h * per_radius, why,
+                           nodes_resolving_radius(c.radius, length, closed, per_radius),
+                           nodes ? "the radius" : fmt::format("1/{:g} of the radius", per_radius));
   }
   return warning;
 }

@@ -44,8 +44,9 @@ class ToleranceWarning(UserWarning):
 
 
 class ResolutionWarning(UserWarning):
-    """Scene.run(): a cylinder in node contact is thinner than the links, so the mesh does not resolve it (the
-    summary's ``resolution_warning``, which names the ``string.nodes`` that does)."""
+    """Scene.run(): a cylinder is thinner than the links in node contact, or than 4 links with contact = "arc", so
+    the mesh does not resolve it (the summary's ``resolution_warning``, which names the ``string.nodes`` that
+    does)."""
 
 if TYPE_CHECKING:  # pragma: no cover
     from pandas import DataFrame

@@ -109,6 +109,10 @@ TEST_CASE("method = auto looks at the tolerance and the fronts: erk3 at loose rt
   // hanging chain at rtol 1e-9, 0.35 s) and erk3's stability-bound ones are cheaper (11,514, 0.13 s).
   CHECK(Integrator::resolve_method("auto", stiff, 1e-7) == "erk3");
   CHECK(Integrator::resolve_method("auto", stiff, 1e-9) == "erk3");
+  // ... up to the finest string measured (641 nodes): beyond it dirk4 at every rtol.
+  const StubSystem finer(640, 0), finest(641, 0);
+  CHECK(Integrator::resolve_method("auto", finer, 1e-8) == "erk3");
+  CHECK(Integrator::resolve_method("auto", finest, 1e-8) == "dirk4");
   CHECK(Integrator::resolve_method("erk8", fronts, 1e-3) == "erk8");
   // The Integrator resolves it with its own rtol: a front scene at rtol 1e-4 runs Bogacki-Shampine.
   auto chain = hanging_chain(10, 1.0, [](double) { return 0.0; }, 0.03);

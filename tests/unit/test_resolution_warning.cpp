@@ -44,7 +44,7 @@ TEST_CASE("a cylinder thinner than the links warns with the nodes that resolve i
   CHECK_THAT(arc["resolution_warning"].get<std::string>(),
              Catch::Matchers::Contains("effects.cylinder[0].radius = 0.1 m is shorter than 4 links (0.4 m)") &&
                  Catch::Matchers::Contains("with links along the arc the wrapped part is exact, but its lift-off") &&
-                 Catch::Matchers::EndsWith("set string.nodes >= 41 (links no longer than a quarter of the radius)"));
+                 Catch::Matchers::EndsWith("set string.nodes >= 41 (links no longer than 1/4 of the radius)"));
   CHECK(atwood_summary({"string.nodes=40", "effects.cylinder[0].contact=\"arc\""}).contains("resolution_warning"));
   CHECK_FALSE(atwood_summary({"string.nodes=41", "effects.cylinder[0].contact=\"arc\""}).contains("resolution_warning"));
 }
@@ -62,7 +62,7 @@ TEST_CASE("compare pulley warns where the pulley is thinner than the links, wher
   REQUIRE(thin.contains("resolution_warning"));
   CHECK_THAT(thin["resolution_warning"].get<std::string>(),
              Catch::Matchers::Contains("--R = 0.005 m is shorter than 4 links (0.04 m)") &&
-                 Catch::Matchers::EndsWith("set --nodes >= 801 (links no longer than a quarter of the radius)"));
+                 Catch::Matchers::EndsWith("set --nodes >= 801 (links no longer than 1/4 of the radius)"));
   REQUIRE(thin["t_lift_off"].is_number());
   const double thin_error = std::abs(thin["t_lift_off"].get<double>() / thin["t_lift_off_exact"].get<double>() - 1);
   CHECK(thin_error > 0.02);  // measured 0.054

@@ -197,8 +197,7 @@ TEST_CASE("a sweep point run by another runner (the Python module's that keeps t
 TEST_CASE("the sweep key f names a touchdown front's dissipation when it is the scene's only front",
           "[unit][sweep][touchdown]") {
   // chainsim sweep chain_drawn_onto_table.toml --grid f=0,0.5,1 said "the scene has 0 fronts": the touchdown front
-  // of a surface with f (docs/model.md §10) was not counted (a tester, issue 23). The key is the surface's f; a
-  // scene with a heap besides it has two fronts with an f, and f names none of them.
+  // of a surface with f (docs/model.md §10) was not counted (a tester, issue 23). The key is the surface's f.
   SweepScene scene;
   scene.text = read_scene_file(std::filesystem::path(CHAINSIM_SOURCE_DIR) / "cases" / "scenes" /
                              "chain_drawn_onto_table.toml");

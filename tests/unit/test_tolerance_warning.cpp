@@ -68,7 +68,7 @@ TEST_CASE("a string at rest does not warn about its tolerance", "[scene][toleran
 
 TEST_CASE("a motion too small for any atol does not ask for one below round-off", "[scene][tolerance][edge]") {
   // A chain balanced over a sharp peg (two 0.5 m sides) at rest: the equilibrium is unstable, and the round-off of
-  // its start grows as cosh(sqrt(2g/l) t), to about 1e-8 m in 1 s (a tester, issue 23). The warning asked for
+  // its start grows as cosh(sqrt(2g/l) t), to about 4e-8 m in 1 s (a tester, issue 23). The warning asked for
   // solver.atol <= 8.1e-18, below the round-off of the coordinates (1e-16 m), which no run can honour.
   const std::string text = "[string]\nlength = 1.0\nnodes = 21\n[shape]\nkind = \"polyline\"\npoints = [[0.0, -0.5], "
                            "[0.0, 0.0], [0.0, -0.5]]\n[effects.gravity]\ng = [0.0, -9.81]\n[[effects.edge]]\n"
@@ -80,6 +80,6 @@ TEST_CASE("a motion too small for any atol does not ask for one below round-off"
   double drift = 0;
   for (const auto& frame : frames) drift = std::max(drift, (frame.x - frames.front().x).cwiseAbs().maxCoeff());
   INFO("drift " << drift << " m; " << run.solver().summary().tolerance_warning);
-  CHECK(drift < 1e-6);  // at rest but for round-off grown by the instability
+  CHECK(drift < 1.2e-7);  // at rest but for round-off grown by the instability: measured 4.1e-8 m
   CHECK(run.solver().summary().tolerance_warning.empty());
 }
