@@ -186,6 +186,18 @@ HeapGeometry<dim> heap_geometry(const Points<dim>& x, const Points<dim>& v, bool
   g.position = c.position(t);
   return g;
 }
+/// The full links the curve to the front may use (heap_geometry's `links`) at the end node `node` of arc `arc`
+/// (the heap after it when `after`): the arc's links from the end node inwards up to the first slack one (slack =
+/// "allow", docs/model.md §9 "Slack next to a front"): a slack link's nodes are not h apart along the string, and a
+/// curve through them at material spacing h is not the string.
+template <int dim>
+int curve_links(const StringModel<dim>& model, int arc, int node, bool after) {
+  const int links = model.arcs()[static_cast<std::size_t>(arc)].num_links();
+  const int step = after ? -1 : 1;
+  for (int taut = 0; taut < std::min(links, 2); ++taut)  // heap_geometry reads at most two
+    if (model.link_slack(std::min(node + taut * step, node + (taut + 1) * step))) return taut;
+  return links;
+}
 }  // namespace
 
 template <int dim>
@@ -317,7 +329,7 @@ void HeapFront<dim>::evaluate(const StringModel<dim>& model, FrontState<dim>& s,
   // The string from the end node to the front (docs/shocks.md): its material length l, the tangent e
   // at the front (from the arc into the heap), the front point and w = dl/dt, the rate at which the
   // arc gains material (w < 0: it runs into the heap).
-  const int links = model.arcs()[static_cast<std::size_t>(e_.arc)].num_links();
+  const int links = curve_links(model, e_.arc, node, after_);
   const HeapGeometry<dim> geo =
       heap_geometry<dim>(x, v, on_plane_, point_, normal_, last_direction_, last_curvature_, node, after_, links, h);
   const double l = geo.l, w = geo.w;
@@ -446,7 +458,7 @@ EventAction HeapFront<dim>::cross(StringModel<dim>& model, const FrontState<dim>
     // interpolant through the end nodes and the front), with the velocity there.
     const double h = this->m_.h;
     const HeapGeometry<dim> geo = heap_geometry<dim>(x, v, on_plane_, point_, normal_, last_direction_,
-                                                     last_curvature_, e.node, after_, arc.num_links(), h);
+                                                     last_curvature_, e.node, after_, curve_links(model, e.arc, e.node, after_), h);
     // A pinned pot's node comes out through its mouth instead: on the line from the pot point along the mouth,
     // (l − h) from it, moving along it at w (docs/shocks.md, "A pot": the string leaving a pot that pushes
     // needs its direction there as well as its point).

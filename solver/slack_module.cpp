@@ -52,6 +52,55 @@ class SlackModule final : public WrappingModule<dim> {
   void initialize(StringModel<dim>& model) override {
     if (inner_) inner_->initialize(model);
   }
+  /// The start (docs/model.md §9, "The start" and "A landing at the start"). The start's own snap
+  /// (StringModel::make_consistent, the velocities by the snap's law) is booked here: what it dissipated is W_snap
+  /// at t0 (the runner holds it in W_applied with the rest of the jump, at an impulsive start), and it counts as
+  /// one snap. Then the inner module's start (the contact module's lift-offs and landings at t0), whose landings
+  /// project the positions onto the taut links and the surfaces and may carry a slack link to or past its length:
+  /// its root function would start at or below zero, where ARKODE never finds the snap, and the link would go on
+  /// stretching unseen. Such links are taut again and the start's law acts once more (StringModel::impact with the
+  /// scene's restitution: the positions onto the taut links' lengths and the surfaces, the velocities by the snap's
+  /// problem, the links it leaves shortening slack again), its change of K booked in W_snap and of momentum in the
+  /// supports' impulse, counted as a snap; the held nodes it would pull off are let go and the free nodes its
+  /// projection carried into a surface land, which may stretch another slack link (at most one round per link).
+  bool start(StringModel<dim>& model, double t0, Eigen::Ref<Eigen::VectorXd> ledger) override {
+    const int kl = inner_ledgers();
+    const auto& impulsive = model.impulsive_start();
+    if (impulsive.detected() && impulsive.dissipated > 0) {
+      ledger[kl] -= impulsive.dissipated;
+      ++snaps_;
+    }
+    bool changed = WrappingModule<dim>::start(model, t0, ledger);
+    const Chain<dim>& chain = model.chain();
+    for (int round = 0; changed && round <= chain.num_links(); ++round) {
+      model.refresh();
+      if (!(model.slack_gap() <= 0)) break;
+      bool caught = false;
+      for (int j = 0; j < chain.num_links(); ++j) {
+        if (!model.link_slack(j) || model.link_bent(j)) continue;
+        const double h = chain.link_length(j);
+        if ((model.x().col(chain.link_end(j)) - model.x().col(chain.link_start(j))).norm() >=
+            (1 - StringModel<dim>::kSnapWindow) * h) {
+          model.set_slack(j, false);
+          caught = true;
+        }
+      }
+      if (!caught) break;
+      const double K_before = model.kinetic_energy();
+      const Vec<dim> p_before = model.momentum();
+      model.refresh();
+      model.impact(t0, model.options().snap_restitution);
+      model.refresh();
+      typename StringModel<dim>::SnapResult snap;
+      snap.dissipated = K_before - model.kinetic_energy();  // with a driven end, its support's work too
+      snap.support_impulse = model.momentum() - p_before;
+      book(snap, ledger);
+      if (!inner_) break;
+      inner_->release_contacts(model, t0);
+      if (!inner_->land_passed(model, t0, ledger.head(kl))) break;
+    }
+    return changed;
+  }
   int num_ledgers() const override { return inner_ledgers() + 3 + dim; }
   void ledger_rates(const StringModel<dim>& model, Eigen::Ref<Eigen::VectorXd> rates) const override {
     const int k = inner_ledgers();
@@ -127,10 +176,7 @@ class SlackModule final : public WrappingModule<dim> {
     if (found[static_cast<std::size_t>(k)] == 0 && !stretched) return action;
     const typename StringModel<dim>::SnapResult snap = model.snap(t);
     if (snap.caught == 0) return action;
-    ledger[kl] -= snap.dissipated;
-    ledger[kl + 1] += snap.support_work;
-    ledger.template segment<dim>(kl + 3) += snap.support_impulse;
-    ++snaps_;
+    book(snap, ledger);
     if (inner_) {
       inner_->release_contacts(model, t);  // held nodes the snap would pull off a surface
       // ARKODE restarts from the state after the snap and finds only sign changes from there: a check of
@@ -153,10 +199,6 @@ class SlackModule final : public WrappingModule<dim> {
     }
     return {EventAction::Kind::kTransfer, ""};  // the velocities changed: the integrator restarts
   }
-  void book_start_dissipation(double dissipated, Eigen::Ref<Eigen::VectorXd> ledger) const override {
-    ledger[inner_ledgers()] -= dissipated;  // W_snap: the start's impulses are a snap at t0
-    ++snaps_;                               // and count as one
-  }
   bool events_need_tensions() const override { return inner_ && inner_->events_need_tensions(); }
   void node_contacts(const StringModel<dim>& model, std::vector<NodeContact<dim>>& out) const override {
     if (inner_) inner_->node_contacts(model, out);
@@ -165,8 +207,17 @@ class SlackModule final : public WrappingModule<dim> {
     return inner_ && inner_->release_contacts(model, t);
   }
  private:
-  mutable long snaps_ = 0;  // mutable: the start's snap is booked by the const book_start_dissipation
-  mutable bool counting_ = false;  // W_links: a link has been released
+  long snaps_ = 0;
+  mutable bool counting_ = false;  // W_links: a link has been released (found by the const ledger_rates)
+
+  /// A snap's terms in the ledgers (the whole module's `ledger`), counted.
+  void book(const typename StringModel<dim>::SnapResult& snap, Eigen::Ref<Eigen::VectorXd> ledger) {
+    const int kl = inner_ledgers();
+    ledger[kl] -= snap.dissipated;
+    ledger[kl + 1] += snap.support_work;
+    ledger.template segment<dim>(kl + 3) += snap.support_impulse;
+    ++snaps_;
+  }
 };
 
 }  // namespace

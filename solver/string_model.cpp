@@ -40,6 +40,12 @@ constexpr double kRoundoffUlps = 64;
 /// may take (evaluate_current).
 constexpr double kDriftRoundoff = 1e-6;
 constexpr int kProjectionIterations = 60;
+/// slack = allow: whether a taut link goes slack at a state where it is `gap` (of h) short of its length (accept_step,
+/// and the frames interpolated inside a step, projected_state): short by more than `slack_gap` (kSlackGap) and
+/// released, by the last evaluation (no tension) or by any since the last accepted step (`released`).
+bool goes_slack(double gap, double slack_gap, double tension, bool released) {
+  return gap > slack_gap && (!(tension > 0) || released);
+}
 }  // namespace
 
 const char* to_string(SlackPolicy policy) {
@@ -1436,8 +1442,26 @@ void StringModel<dim>::set_sliding_velocities(double speed) {
 template <int dim>
 Eigen::VectorXd StringModel<dim>::projected_state(double t, const Eigen::Ref<const Eigen::VectorXd>& y) {
   unpack_state(t, y);
+  // slack = allow: a frame inside a step comes before the step's end, where accept_step declares slack the taut
+  // links the tensions released and that have shortened. At the frame such a link is still flagged taut, and
+  // projecting onto its length put it back there: a node flying free drawn back along the released link, the
+  // frame's K + V off by the work that takes (a chain's top driven down, the node below it flying after a snap:
+  // −0.069 J in a frame at 0.16 s, docs/model.md §9 "Frames inside a step"). The frame leaves such links free,
+  // as the step's end will; their flags are restored for the run.
+  std::vector<int> freed;
+  if (allows_slack() && system_ && !quadratic_)
+    for (int j = 0; j < chain_.num_links(); ++j) {
+      if (link_slack(j) || link_unknown_[static_cast<std::size_t>(j)] < 0) continue;
+      const double h = chain_.link_length(j);
+      if (goes_slack((h - current_length(j)) / h, kSlackGap, link_tension(j),
+                     any_released_ && released_[static_cast<std::size_t>(j)])) {
+        set_slack(j, true);
+        freed.push_back(j);
+      }
+    }
   refresh();
   project(t);
+  for (const int j : freed) set_slack(j, false);
   return pack(y.tail(1 + num_ledgers_));
 }
 
@@ -1798,7 +1822,7 @@ void StringModel<dim>::accept_step(double t, const Eigen::Ref<const Eigen::Vecto
     if (!link_slack(j)) {
       // (Released: no tension at the step's last evaluation. A link short only by the drift of the
       // constraints, which at loose tolerances is far above kSlackGap, keeps its tension: it is taut.)
-      if (gap > kSlackGap && (!(link_tension(j) > 0) || (any_released_ && released_[static_cast<std::size_t>(j)]))) {
+      if (goes_slack(gap, kSlackGap, link_tension(j), any_released_ && released_[static_cast<std::size_t>(j)])) {
         set_slack(j, true);
         rebound_time_[static_cast<std::size_t>(j)] = NAN;  // released by the tensions: a flight, not a rebound
       }

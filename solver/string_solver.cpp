@@ -534,13 +534,12 @@ const RunSummary& StringSolver<dim>::run() {
       if (summary_.impulsive_start) {
         summary_.impulsive_energy = impulsive.kinetic_energy;
         y0[model_.work_index()] = impulsive.kinetic_energy;
-        // slack = allow: the start is a snap taut; what its impulses dissipated is W_snap, and W_applied
-        // holds the rest of the jump, the drivers' (supports') work.
-        if (impulsive.dissipated > 0 && model_.module() != nullptr) {
+        // slack = allow: the start is a snap taut; what its impulses dissipated is W_snap (booked by the
+        // slack module's start, SlackModule::start), and W_applied holds the rest of the jump, the drivers'
+        // (supports') work.
+        if (impulsive.dissipated > 0) {
           summary_.impulsive_dissipated = impulsive.dissipated;
           y0[model_.work_index()] += impulsive.dissipated;
-          model_.module()->book_start_dissipation(impulsive.dissipated,
-                                                  y0.tail(y0.size() - model_.work_index() - 1));
         }
       }
       // The module's start on the consistent state (the contact module's lift-offs and landings at t0), which

@@ -9,9 +9,11 @@
 //    otherwise), no NaN;
 //  - the heavy Atwood chain over a pulley run past the lift-off of its shorter side until its free end is
 //    whipped over the pulley (where slack = "stop" ends the run): the energy and momentum ledgers closed.
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <string>
 #include <vector>
 
 #include <fmt/format.h>
@@ -153,4 +155,66 @@ TEST_CASE("contact with slack: the Atwood chain with links along the arc runs pa
   CHECK(last.terms["snaps"] > 0);
   CHECK(s.relative_energy_drift() < 1e-8);
   CHECK(s.relative_momentum_residual() < 1e-10);
+}
+
+TEST_CASE("contact with slack: a landing at the start that lengthens a slack link snaps it taut at t = 0",
+          "[contact][slack]") {
+  // docs/data/zigzag_landing_at_start.toml: a zig-zag of two links (h = 0.5 m, λ = 1 kg/m, 3 nodes), no gravity, over
+  // a smooth table y = 0: node C (the last) 0.8·10⁻³ h inside the table, B above it (link BC at 60° to the table), A
+  // below-left of B (link AB at 45°). A moves at (2, 0) m/s towards B, B and C at (0, 1): link AB shortens (it goes
+  // slack at the start) and BC keeps its length. C, held at first (within 10⁻³ h), is let go (its velocity leaves the
+  // table), and the start lands it at t = 0 (ContactModule::start): the impact's projection puts C on the table and
+  // BC back to its length, which moves B up and left, along CB, and lengthens the slack link AB.
+  // Before the slack module had a start (docs/model.md §9, "A landing at the start"), the landing's projection
+  // left the slack link AB 1.19·10⁻⁴ of its length past it at t = 0: its root function started below zero, where
+  // ARKODE finds no root, and the run stopped at its first step (t = 1.6·10⁻¹⁴ s, "slack link 0 ... is 0.000119 of
+  // its length past it: its snap taut was not located", exit 3). Now AB snaps taut at t = 0. Checked against what
+  // the solver does not make:
+  //  - the given state's momentum along the smooth table, Σ m_i v_x,i = m_A · 2 m/s = 0.5 N s (lumped masses
+  //    λh/2, λh, λh/2), kept at every frame (the table's impulses are normal to it, the links' internal);
+  //  - the given state's K = ½ (0.25 · 4 + 0.5 · 1 + 0.25 · 1) = 0.875 J: the start's jumps of K are the booked
+  //    terms at t = 0 (W_applied + W_impacts + W_snap), and with no force and no driven end K never rises;
+  //  - every link at most its length at t = 0 (the start's state is on the constraints); no node below the table
+  //    after t = 0. At t = 0 the projection onto AB's length carries C, let go after its landing (BC pulls it up),
+  //    6·10⁻⁶ h into the table: within the contact module's window for a node let go at its landing (kPassGap,
+  //    10⁻⁵ h), and C lifts off at once (5.5·10⁻⁵ m above the table at 0.01 s).
+  const double h = 0.5, px0 = 0.25 * 2.0, K_given = 0.875;
+  const Eigen::Vector3d m(0.25, 0.5, 0.25);
+  for (const double e : {0.0, 0.5}) {
+    StringScene<2> scene = build_string_scene<2>(
+        parse_scene(std::filesystem::path(CHAINSIM_SOURCE_DIR) / "docs" / "data" / "zigzag_landing_at_start.toml",
+                    {fmt::format("solver.snap_restitution={}", e)}));
+    StringSolver<2> solver(*scene.model, scene.solver);
+    const RunSummary& s = solver.run();
+    INFO("restitution " << e << ": " << s.status << " " << s.error);
+    REQUIRE(s.status == "completed");
+    const Frame<2>& first = solver.frames().front();
+    double longest = 0, lowest = 0, px_error = 0, K_rise = 0, K_previous = INFINITY;
+    for (int j = 0; j < 2; ++j) longest = std::max(longest, (first.x.col(j + 1) - first.x.col(j)).norm() / h - 1);
+    const double lowest_at_start = first.x.row(1).minCoeff();
+    for (const Frame<2>& f : solver.frames()) {
+      if (f.t > 0) lowest = std::min(lowest, f.x.row(1).minCoeff());
+      px_error = std::max(px_error, std::abs(m.dot(f.v.row(0).transpose()) - px0));
+      K_rise = std::max(K_rise, f.kinetic - K_previous);
+      K_previous = f.kinetic;
+    }
+    const double booked = first.work + first.terms["W_impacts"] + first.terms["W_snap"] + first.terms["W_snap_supports"];
+    std::printf("\nzig-zag landing at the start (e = %g): snaps at t = 0: %g, W_snap(0) %.9g J, W_impacts(0) %.9g J, "
+                "K(0) - K_given %.9g J (booked %.9g J), longest link at t = 0: %.3g of h past it, lowest node %.3g m "
+                "at t = 0, %.3g m after, p_x error %.3g N s, largest rise of K %.3g J, energy ledger %.3g, momentum "
+                "ledger %.3g\n",
+                e, first.terms["snaps"], first.terms["W_snap"], first.terms["W_impacts"], first.kinetic - K_given, booked,
+                longest, lowest_at_start, lowest, px_error, K_rise, s.relative_energy_drift(),
+                s.relative_momentum_residual());
+    CHECK(first.terms["snaps"] == 1);  // AB's snap at t = 0 (its approach: none, it goes slack again at its length)
+    CHECK(first.terms["W_snap"] <= 0);
+    CHECK(longest < 1e-12);
+    CHECK(std::abs(first.kinetic - K_given - booked) < 1e-14);
+    CHECK(lowest_at_start > -1e-5 * h);
+    CHECK(lowest > -1e-14);
+    CHECK(px_error < 1e-14);
+    CHECK(K_rise <= 1e-14);
+    CHECK(s.relative_energy_drift() < 1e-12);
+    CHECK(s.relative_momentum_residual() < 1e-14);
+  }
 }
