@@ -204,8 +204,9 @@ class StringModule {
   /// The start, after the initial state's projection onto the constraints (StringModel::make_consistent)
   /// and before the run: the module acts on the consistent state at t0 (the contact module lets go of the
   /// held nodes whose force would pull there and lands the free nodes that the projection carried into a
-  /// surface, docs/model.md §10), booking what it does in its ledgers' initial values `ledger`. Returns
-  /// whether it changed the state (model.x(), model.v()).
+  /// surface, docs/model.md §10; the module of unilateral links books the start's snap and snaps the slack
+  /// links a landing there carried to their length, §9), booking what it does in its ledgers' initial values
+  /// `ledger`. Returns whether it changed the state (model.x(), model.v()).
   virtual bool start(StringModel<dim>& /*model*/, double /*t0*/, Eigen::Ref<Eigen::VectorXd> /*ledger*/) {
     return false;
   }
@@ -273,10 +274,6 @@ class StringModule {
   /// passed a surface unseen (their landing function below zero at the event's state, where ARKODE, restarting,
   /// would find no root), with the impact booked in `ledger` (the module's ledgers); returns whether one landed.
   virtual bool land_passed(StringModel<dim>&, double, Eigen::Ref<Eigen::VectorXd>) { return false; }
-  /// The energy (J, ≥ 0) that the links' impulses dissipated at the start of the run (slack = allow: the
-  /// start is a snap taut, StringModel::make_consistent): the module books it in its ledgers' initial
-  /// values `ledger`. Only a module of unilateral links has impulses to book.
-  virtual void book_start_dissipation(double /*dissipated*/, Eigen::Ref<Eigen::VectorXd> /*ledger*/) const {}
   /// The physical events of the run so far (e.g. a chain lifting off an edge), for the run's summary,
   /// in time order.
   virtual std::vector<RunEvent> run_events() const { return {}; }

@@ -173,7 +173,8 @@ TEST_CASE("contact with slack: a landing at the start that lengthens a slack lin
   //  - the given state's momentum along the smooth table, Σ m_i v_x,i = m_A · 2 m/s = 0.5 N s (lumped masses
   //    λh/2, λh, λh/2), kept at every frame (the table's impulses are normal to it, the links' internal);
   //  - the given state's K = ½ (0.25 · 4 + 0.5 · 1 + 0.25 · 1) = 0.875 J: the start's jumps of K are the booked
-  //    terms at t = 0 (W_applied + W_impacts + W_snap), and with no force and no driven end K never rises;
+  //    terms at t = 0 (W_applied + W_impacts + W_snap), and with no force and no driven end K never rises but by
+  //    the drift control's work (booked in W_links and W_contact: measured 2.4·10⁻⁹ J; the ledger closes);
   //  - every link at most its length at t = 0 (the start's state is on the constraints); no node below the table
   //    after t = 0. At t = 0 the projection onto AB's length carries C, let go after its landing (BC pulls it up),
   //    6·10⁻⁶ h into the table: within the contact module's window for a node let go at its landing (kPassGap,
@@ -213,7 +214,7 @@ TEST_CASE("contact with slack: a landing at the start that lengthens a slack lin
     CHECK(lowest_at_start > -1e-5 * h);
     CHECK(lowest > -1e-14);
     CHECK(px_error < 1e-14);
-    CHECK(K_rise <= 1e-14);
+    CHECK(K_rise <= 1e-8);
     CHECK(s.relative_energy_drift() < 1e-12);
     CHECK(s.relative_momentum_residual() < 1e-14);
   }
