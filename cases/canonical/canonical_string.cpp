@@ -43,7 +43,7 @@ void StringCaseSetup::validate() const {
     throw InputError(fmt::format("--tilt + --bend = {:g} degrees: the top of the falling chain must stay within 80 "
                                  "degrees of the vertical (its height must grow along the string)",
                                  tilt_deg + bend_deg));
-  require_in_range("t_max_over_t0", t_max_over_t0, 0.0, INFINITY, Bound::kOpen);
+  require_in_range("--t-max", t_max_over_t0, 0.0, INFINITY, Bound::kOpen);
   require_in_range("frame_interval", frame_interval, 0.0, INFINITY);
   integrator.validate();
 }

@@ -2,8 +2,28 @@
 #include "cases/canonical/contact_compare.hpp"
 
 #include <cmath>
+#include <limits>
+
+#include <fmt/format.h>
 
 namespace chainsim {
+
+void require_safety_stop(double t_max_over_t0, double t0) {
+  require_in_range("--t-max", t_max_over_t0, 0.0, INFINITY, Bound::kOpen);
+  const double t_end = t_max_over_t0 * t0;
+  if (!(t_end > 0) || !std::isfinite(t_end))
+    throw InputError(fmt::format("--t-max = {} is out of range: the safety stop t_max t0 = {} s (t0 = {} s) must be a "
+                                 "positive, finite time",
+                                 t_max_over_t0, t_end, t0));
+}
+
+void require_shape_length(const char* option, double value, double length, const char* what, double shape_length) {
+  const double shortest = std::sqrt(std::numeric_limits<double>::min());
+  if (!(shape_length >= shortest))
+    throw InputError(fmt::format("{} = {} is out of range with --length = {}: {} = {} m is below {:.3g} m, the "
+                                 "shortest length whose square a double holds (the shape's geometry squares it)",
+                                 option, value, length, what, shape_length, shortest));
+}
 
 StringSolverOptions exact_comparison_run(const IntegratorOptions& integrator, double t_end) {
   StringSolverOptions options;

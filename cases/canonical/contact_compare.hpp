@@ -21,6 +21,15 @@ struct ExactComparison {
   nlohmann::json summary;  ///< summary.json and `--json`
 };
 
+/// The safety stop t_max t0 (s) of a comparison: InputError naming --t-max unless t_max > 0 and t_max t0 is a
+/// positive, finite time (a t_max of 5e-324 made t_end 0, which the run refused as "stop.t_end = 0").
+void require_safety_stop(double t_max_over_t0, double t0);
+
+/// InputError naming `option` = `value` and the chain's `length` unless `shape_length` (m), a length of the initial
+/// shape that they set (`what`), is at least sqrt(DBL_MIN) ≈ 1.5e-154 m: the shape's geometry squares its lengths,
+/// and a shorter one's square underflows (x0 = 5e-324 made "the polyline's points 1 and 2 coincide").
+void require_shape_length(const char* option, double value, double length, const char* what, double shape_length);
+
 /// The options of a comparison's run: `integrator`, to `t_end` (s, the safety stop), one frame at the
 /// start and one at the stop, a record of every step (string_series.csv).
 StringSolverOptions exact_comparison_run(const IntegratorOptions& integrator, double t_end);

@@ -23,7 +23,20 @@ void EdgeCaseSetup::validate() const {
     require_in_range("--x0", x0, 0.5, 1.0, Bound::kOpen, Bound::kOpen);  // x0 = 0.5: at rest (unstable)
   else
     require_in_range("--x0", x0, 0.0, 1.0, Bound::kOpen, Bound::kOpen);
-  require_in_range("t_max_over_t0", t_max_over_t0, 0.0, INFINITY, Bound::kOpen);
+  // The edge front needs string on both sides: the point more than 2 kCross h from either end node
+  // (EdgeFront::initialize). x0 = 1e-100 put it on the end node (s0 = l - x0 l = l in doubles).
+  const double h = chain.length / (nodes - 1), closest = 2 * EdgeFront<2>::kCross * h;
+  const double sides[] = {x0 * chain.length, chain.length - x0 * chain.length};
+  for (int k = 0; k < 2; ++k)
+    if (!(sides[k] > closest))
+      throw InputError(fmt::format(
+          "--x0 = {} is out of range with --length = {} and --nodes = {}: {} = {} m puts the {} within {:.3g} m "
+          "(2e-8 of a link) of the string's end, and it needs string on both sides",
+          x0, chain.length, nodes,
+          problem == PointContactProblem::kPeg ? (k == 0 ? "the longer side x0 l" : "the shorter side (1 - x0) l")
+                                               : (k == 0 ? "the hanging length x0 l" : "the table's part (1 - x0) l"),
+          sides[k], problem == PointContactProblem::kPeg ? "peg" : "edge", closest));
+  require_safety_stop(t_max_over_t0, chain.t0());
   integrator.validate();
 }
 

@@ -21,7 +21,10 @@ void PulleyCaseSetup::validate() const {
   require_in_range("--R", radius, 0.0, chain.length / kPi, Bound::kOpen, Bound::kOpen);  // πR < ℓ
   // u0 = 0: at rest (unstable); u0 = ℓ_free/2: no shorter side.
   require_in_range("--u0", u0, 0.0, 0.5 * (chain.length - kPi * radius), Bound::kOpen, Bound::kOpen);
-  require_in_range("t_max_over_t0", t_max_over_t0, 0.0, INFINITY, Bound::kOpen);
+  require_shape_length("--R", radius, chain.length, "the pulley's radius R", radius);
+  require_shape_length("--u0", u0, chain.length, "the shorter side (l - pi R)/2 - u0",
+                       0.5 * (chain.length - kPi * radius) - u0);
+  require_safety_stop(t_max_over_t0, chain.t0());
   integrator.validate();
 }
 

@@ -51,7 +51,7 @@ struct CompareCommandOptions {
   std::string out;        ///< output directory; "" = results/compare/<problem>
   bool json = false;
 };
-int run_compare_command(CompareCommandOptions options, std::ostream& out);
+int run_compare_command(const CompareCommandOptions& options, std::ostream& out);
 
 /// `chainsim plot RUN_DIR ...`: draws a run directory with the Python package python/chainsim_plot
 /// (docs/plotting.md). The option values are passed on as written (the package checks them);

@@ -1,5 +1,6 @@
 // `chainsim compare`: the string solver against the reduced ODE, or (edge, peg, pulley) against the
-// exact solution (see commands.hpp).
+// exact solution (see commands.hpp); compare_problem and run_compare_problem (compare_problem.hpp) are the
+// command without its files and report, which the Python module calls too.
 #include <filesystem>
 #include <iostream>
 #include <optional>
@@ -8,9 +9,7 @@
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
-#include "cases/canonical/edge_case.hpp"
-#include "cases/canonical/pulley_case.hpp"
-#include "cases/cli/commands.hpp"
+#include "cases/cli/compare_problem.hpp"
 #include "mesh/errors.hpp"
 #include "solver/output.hpp"
 
@@ -133,15 +132,13 @@ void print_pulley(const nlohmann::json& s, std::ostream& out) {
 
 }  // namespace
 
-int run_compare_command(CompareCommandOptions options, std::ostream& out) {
-  const bool pulley = options.problem == "pulley";
-  const bool edge = options.problem == "edge" || options.problem == "peg" || pulley;  // against an exact solution
-  std::optional<EdgeCaseSetup> edge_case;
-  std::optional<PulleyCaseSetup> pulley_case;
-  if (pulley) {
-    pulley_case = pulley_setup(options);
-  } else if (edge) {
-    edge_case = edge_setup(options, options.problem == "peg" ? PointContactProblem::kPeg : PointContactProblem::kEdge);
+CompareProblem compare_problem(const CompareCommandOptions& options) {
+  CompareProblem p;
+  p.name = options.problem;
+  if (options.problem == "pulley") {
+    p.pulley = pulley_setup(options);
+  } else if (options.problem == "edge" || options.problem == "peg") {
+    p.edge = edge_setup(options, options.problem == "peg" ? PointContactProblem::kPeg : PointContactProblem::kEdge);
   } else {
     if (options.problem != "falling" && options.problem != "folded" && options.problem != "sliding")
       throw InputError(fmt::format(
@@ -150,29 +147,42 @@ int run_compare_command(CompareCommandOptions options, std::ostream& out) {
       throw InputError(fmt::format("--x0 = {}: only compare edge takes --x0, and compare peg ({} starts from --eta0)",
                                    *options.x0, options.problem));
     refuse_pulley_options(options);
-    options.setup.problem = parse_problem(options.problem);
-    options.setup.validate();
+    p.reduced = options.setup;
+    p.reduced->problem = parse_problem(options.problem);
+    p.reduced->validate();
   }
+  return p;
+}
+
+CompareOutcome run_compare_problem(const CompareProblem& p) {
+  CompareOutcome o;
+  if (p.pulley)
+    o.exact = compare_pulley_with_exact(*p.pulley);
+  else if (p.edge)
+    o.exact = p.edge->problem == PointContactProblem::kPeg ? compare_peg_with_exact(*p.edge)
+                                                           : compare_edge_with_exact(*p.edge);
+  else
+    o.reduced = compare_with_reduced(*p.reduced);
+  return o;
+}
+
+int run_compare_command(const CompareCommandOptions& options, std::ostream& out) {
+  const CompareProblem problem = compare_problem(options);
+  const bool pulley = problem.pulley.has_value();
+  const bool edge = problem.exact();  // against an exact solution
   const std::filesystem::path dir =
       options.out.empty() ? std::filesystem::path("results") / "compare" / options.problem
                           : std::filesystem::path(options.out);
   const RunDirectory run_dir(dir);  // held until the outputs are written
   run_dir.clear();
-  std::optional<Comparison> c;
-  std::optional<ExactComparison> e;
-  if (edge) {
-    e = pulley                                                ? compare_pulley_with_exact(*pulley_case)
-        : edge_case->problem == PointContactProblem::kPeg ? compare_peg_with_exact(*edge_case)
-                                                          : compare_edge_with_exact(*edge_case);
-    samples_table(e->run).write(dir / "string_series.csv");
-    e->exact.write(dir / "exact_series.csv");
-  } else {
-    c = compare_with_reduced(options.setup);
-    samples_table(c->string.run).write(dir / "string_series.csv");
-    c->reduced.series.write(dir / "reduced_series.csv");
-  }
-  const RunSummary& run = edge ? e->run : c->string.run;
-  const nlohmann::json& s = edge ? e->summary : c->summary;
+  const CompareOutcome outcome = run_compare_problem(problem);
+  samples_table(outcome.run()).write(dir / "string_series.csv");
+  if (edge)
+    outcome.exact->exact.write(dir / "exact_series.csv");
+  else
+    outcome.reduced->reduced.series.write(dir / "reduced_series.csv");
+  const RunSummary& run = outcome.run();
+  const nlohmann::json& s = outcome.summary();
   write_json(dir / "summary.json", s);  // written last: its presence means the set is complete
   const bool failed = run.status == "failed";
   const std::string error = fmt::format("the string solver failed: {}", run.error);
@@ -194,7 +204,7 @@ int run_compare_command(CompareCommandOptions options, std::ostream& out) {
       print_edge(s, out);
     } else {
       out << fmt::format("{} chain, f = {}, {} nodes: string solver vs reduced ODE\n", options.problem,
-                         options.setup.chain.dissipation, options.setup.nodes);
+                         problem.reduced->chain.dissipation, problem.reduced->nodes);
       out << fmt::format("  t_stop/t0        string {:.12g}   reduced {:.12g}   rel. error {:.3g}\n",
                          s["t_stop_over_t0"].get<double>(), s["t_stop_over_t0_reduced"].get<double>(),
                          s["rel_err_t_stop"].get<double>());

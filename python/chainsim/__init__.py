@@ -8,6 +8,7 @@
     result.to_xarray(), result.to_dataframe("energy")      # xarray and pandas; result.to_netcdf("run.nc")
     result.write("results/falling")                        # the CLI's run directory (chainsim plot works)
     df = chainsim.sweep(scene, {"f": [0, 0.5, 1], "string.nodes": [51, 101]})   # pandas DataFrame
+    c = chainsim.compare("edge", x0=0.2, f=0.5)            # as `chainsim compare edge`: c.exact_series, c.summary
 
 Every number comes from the C++ library (the extension chainsim._core), through the code the command-line
 tool runs; nothing of the solver is written again in Python. Results, scenes and errors pickle (Dask).
@@ -322,35 +323,57 @@ def reduced(problem: str, *, f: Optional[float] = None, eta0: Optional[float] = 
 def compare(problem: str, *, nodes: Optional[int] = None, f: Optional[float] = None, eta0: Optional[float] = None,
             eps: Optional[float] = None, force: Optional[float] = None, length: Optional[float] = None,
             density: Optional[float] = None, gravity: Optional[float] = None, t_max: Optional[float] = None,
-            tilt_deg: Optional[float] = None, bend_deg: Optional[float] = None, method: Optional[str] = None,
+            tilt_deg: Optional[float] = None, bend_deg: Optional[float] = None, x0: Optional[float] = None,
+            u0: Optional[float] = None, R: Optional[float] = None, method: Optional[str] = None,
             rtol: Optional[float] = None, atol: Optional[float] = None, max_step: Optional[float] = None,
             max_steps: Optional[int] = None) -> Comparison:
-    """A canonical problem on the string solver with front tracking and as its reduced ODE, as ``chainsim compare``.
+    """A canonical problem on the string solver against its reduced ODE (falling, folded, sliding) or its exact
+    solution (edge, peg, pulley), as ``chainsim compare PROBLEM``: the same run (one C++ implementation) for the
+    same options, without the files.
 
     Parameters
     ----------
-    problem : {"falling", "folded", "sliding"}
+    problem : {"falling", "folded", "sliding", "edge", "peg", "pulley"}
         The canonical problem.
     nodes : int, optional
         The string's nodes.
     {common}
     tilt_deg, bend_deg : float, optional
-        Release the chain tilted or curved (degrees).
+        Release the chain tilted or curved (degrees; falling, folded, sliding).
+    x0 : float, optional
+        edge: the hanging fraction at release (0 < x0 < 1, default 0.2); peg: the longer side's fraction
+        (0.5 < x0 < 1, default 0.6).
+    u0, R : float, optional
+        pulley: the offset at release and the pulley's radius (m; defaults 0.05 and 0.1).
+
+    Parameters left at None take the command's defaults; those a problem has no use for are refused as the
+    command refuses them (eta0, eps, force for edge and peg; f too for pulley; x0, u0, R for the others).
 
     Returns
     -------
     Comparison
+        ``string_series`` and ``summary`` (string_series.csv and summary.json), and ``reduced_series``
+        (falling, folded, sliding) or ``exact_series`` (edge, peg, pulley).
 
     Raises
     ------
+    ChainsimInputError
+        A keyword of the wrong type, out of range, or of no use to the problem, naming it.
     NumericalError
         The string run failed; its ``comparison`` holds what was done.
+
+    Warns
+    -----
+    ResolutionWarning
+        pulley: a pulley thinner than 4 links (the summary's ``resolution_warning``).
     """
-    string_series, reduced_series, summary, error = _core.compare(problem, _settings(
+    string_series, reduced_series, exact_series, summary, error = _core.compare(problem, _settings(
         nodes=nodes, f=f, eta0=eta0, eps=eps, force=force, length=length, density=density, gravity=gravity,
-        t_max=t_max, tilt_deg=tilt_deg, bend_deg=bend_deg, method=method, rtol=rtol, atol=atol, max_step=max_step,
-        max_steps=max_steps))
-    comparison = Comparison(string_series, reduced_series, json.loads(summary))
+        t_max=t_max, tilt_deg=tilt_deg, bend_deg=bend_deg, x0=x0, u0=u0, R=R, method=method, rtol=rtol, atol=atol,
+        max_step=max_step, max_steps=max_steps))
+    comparison = Comparison(string_series, reduced_series, json.loads(summary), exact_series=exact_series)
+    if "resolution_warning" in comparison.summary:  # a pulley thinner than the links
+        warnings.warn(comparison.summary["resolution_warning"], ResolutionWarning, stacklevel=2)
     if error:
         e = NumericalError(f"the string solver failed: {error}")
         e.comparison = comparison  # type: ignore[attr-defined]

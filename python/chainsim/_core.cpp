@@ -1,7 +1,7 @@
 // chainsim._core: the compiled half of the Python module (python/chainsim/__init__.py is the other).
 // Only bindings: every number comes from the C++ library, through the code the command-line tool runs
-// (SceneRun = `chainsim run`, solve_reduced = `chainsim reduced`, compare_with_reduced = `chainsim
-// compare`, run_sweep / run_sweep_point = `chainsim sweep`). JSON documents cross as text (json.loads
+// (SceneRun = `chainsim run`, solve_reduced = `chainsim reduced`, compare_problem and run_compare_problem =
+// `chainsim compare`, run_sweep / run_sweep_point = `chainsim sweep`). JSON documents cross as text (json.loads
 // on the Python side: doubles round-trip exactly); arrays as numpy arrays (copies).
 #include <algorithm>
 #include <atomic>
@@ -24,6 +24,7 @@
 #include <nlohmann/json.hpp>
 
 #include "cases/canonical/canonical_string.hpp"
+#include "cases/cli/compare_problem.hpp"
 #include "cases/reduced/reduced_models.hpp"
 #include "cases/scene/reduced_scene.hpp"
 #include "cases/scene/scene.hpp"
@@ -395,9 +396,10 @@ nlohmann::json scene_value(py::handle value, const std::string& at, int depth = 
                                where, shown(value)));
 }
 
-/// The chain's and the integrator's settings shared by reduced() and compare(): keyword -> field.
+/// The chain's and the integrator's settings shared by reduced() and compare(): keyword -> field; compare()'s
+/// keywords of the problems' own (x0, u0, R) into `options`.
 template <class Setup>
-void set_common(Setup& s, const py::dict& kw) {
+void set_common(Setup& s, const py::dict& kw, CompareCommandOptions* options = nullptr) {
   constexpr bool string_case = std::is_same_v<Setup, StringCaseSetup>;
   const std::string fn = string_case ? "compare" : "reduced";
   for (const auto& [key, value] : kw) {
@@ -417,7 +419,16 @@ void set_common(Setup& s, const py::dict& kw) {
     else if (k == "max_step") s.integrator.max_step = real();
     else if (k == "max_steps") s.integrator.max_steps = integer_arg<long>(fn, k, value);
     else if constexpr (string_case) {
+      const bool exact =  // against an exact solution: edge, peg, pulley
+          options && (options->problem == "edge" || options->problem == "peg" || options->problem == "pulley");
       if (k == "nodes") s.nodes = integer_arg<int>(fn, k, value);
+      else if (k == "x0" && options) options->x0 = real();
+      else if (k == "u0" && options) options->u0 = real();
+      else if (k == "R" && options) options->radius = real();
+      else if ((k == "tilt_deg" || k == "bend_deg" || k == "frame_interval") && exact)
+        throw InputError(fmt::format("compare(): {} = {}: compare {} releases the chain straight and records every "
+                                     "step (tilt_deg, bend_deg and frame_interval are falling, folded and sliding's)",
+                                     k, shown(value), options->problem));
       else if (k == "tilt_deg") s.tilt_deg = real();
       else if (k == "bend_deg") s.bend_deg = real();
       else if (k == "frame_interval") s.frame_interval = real();
@@ -447,18 +458,27 @@ py::tuple reduced(py::handle problem, const py::dict& kw) {
   return py::make_tuple(table_dict(r.series), r.summary.dump());
 }
 
+/// `chainsim compare PROBLEM` with the keywords as its options (compare_problem checks them as it checks the
+/// command's): (string series, reduced series, exact series, summary JSON text, the string run's error); the
+/// series the problem has no use for is empty (reduced for edge, peg, pulley; exact for the others).
 py::tuple compare(py::handle problem, const py::dict& kw) {
-  StringCaseSetup setup;
-  setup.problem = problem_arg("compare", problem);
-  set_common(setup, kw);
-  setup.validate();
-  std::optional<Comparison> c;
+  CompareCommandOptions options;
+  if (!PyUnicode_Check(problem.ptr()))
+    throw InputError(fmt::format("compare(): problem = {} is not a known problem: allowed falling, folded, sliding, "
+                                 "edge, peg, pulley", shown(problem)));
+  options.problem = utf8(problem, "compare(): problem");
+  set_common(options.setup, kw, &options);
+  const CompareProblem setup = compare_problem(options);
+  std::optional<CompareOutcome> c;
   {
     py::gil_scoped_release release;
-    c = compare_with_reduced(setup);
+    c = run_compare_problem(setup);
   }
-  return py::make_tuple(table_dict(samples_table(c->string.run)), table_dict(c->reduced.series), c->summary.dump(),
-                        c->string.run.status == "failed" ? c->string.run.error : std::string());
+  const RunSummary& run = c->run();
+  return py::make_tuple(table_dict(samples_table(run)),
+                        c->reduced ? table_dict(c->reduced->reduced.series) : py::dict(),
+                        c->exact ? table_dict(c->exact->exact) : py::dict(), c->summary().dump(),
+                        run.status == "failed" ? run.error : std::string());
 }
 
 SweepScene sweep_scene(const std::string& text, const std::string& source, const std::vector<std::string>& overrides,
@@ -509,7 +529,8 @@ PYBIND11_MODULE(_core, m) {
   m.def("reduced", &reduced, py::arg("problem"), py::arg("kwargs"),
         "`chainsim reduced`: returns (series columns, summary JSON text)");
   m.def("compare", &compare, py::arg("problem"), py::arg("kwargs"),
-        "`chainsim compare`: returns (string series, reduced series, summary JSON text, the string run's error)");
+        "`chainsim compare`: returns (string series, reduced series, exact series, summary JSON text, the string run's "
+        "error); the series a problem has no use for is empty");
   m.def("sweep_points",
         [](const std::vector<std::pair<std::string, std::vector<std::string>>>& grid) {
           std::vector<SweepAxis> axes;

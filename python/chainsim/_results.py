@@ -1,8 +1,9 @@
 """The results of chainsim runs as ordinary Python objects (docs/python.md): `Result` (a run of a scene on the
 string solver, from `Scene.run()`, `read_run()` or a sweep with ``results=True``), `ReducedResult` and
-`Comparison`. They hold numpy arrays and dicts only, so they pickle (Dask sends them between processes), and
-they export to pandas, xarray and netCDF. A `Result` made by `Scene.run()` also keeps the C++ run, for
-`write()`: that part is left behind when it is pickled.
+`Comparison` (from `chainsim.compare()`, or `read_run()` of a directory of `chainsim compare`). They hold numpy
+arrays and dicts only, so they pickle (Dask sends them between processes), and they export to pandas, xarray and
+netCDF. A `Result` made by `Scene.run()` also keeps the C++ run, for `write()`: that part is left behind when it
+is pickled.
 """
 from __future__ import annotations
 
@@ -527,36 +528,63 @@ class ReducedResult:
 
 
 class Comparison:
-    """`chainsim compare`: a canonical problem on the string solver and as its reduced ODE.
+    """`chainsim compare`: a canonical problem on the string solver against its reduced ODE (falling, folded,
+    sliding) or its exact solution (edge, peg, pulley).
 
     Parameters
     ----------
     string_series : dict of numpy.ndarray
-        string_series.csv (the string solver's samples).
+        string_series.csv (the string solver's samples, one per accepted step).
     reduced_series : dict of numpy.ndarray
-        reduced_series.csv.
+        reduced_series.csv (falling, folded, sliding; empty for edge, peg, pulley).
     summary : dict
-        summary.json: ``t_stop_over_t0``, ``t_stop_over_t0_reduced``, ``rel_err_t_stop``, ...
+        summary.json: ``t_stop_over_t0``, ``t_stop_over_t0_reduced``, ``rel_err_t_stop``, ...; for edge, peg and
+        pulley ``t_lift_off``, ``t_lift_off_exact``, ``abs_err_t_lift_off``, ``max_abs_err_x``, ... (docs/cli.md).
     path : str, optional
         The directory it was read from, if any.
+    exact_series : dict of numpy.ndarray, optional
+        exact_series.csv (edge, peg, pulley: the exact solution at the string's step times; empty for the
+        others).
 
     Attributes
     ----------
-    string_series, reduced_series, summary, path
+    string_series, reduced_series, exact_series, summary, path
         As given; `kind` is ``"compare"``.
+    problem : str
+        ``summary["problem"]``: falling, folded, sliding, edge, peg or pulley.
+    reference : dict of numpy.ndarray
+        What the string is compared with: `exact_series` for edge, peg and pulley, else `reduced_series`.
     """
 
     kind = "compare"
 
     def __init__(self, string_series: Arrays, reduced_series: Arrays, summary: Dict[str, Any],
-                 path: Optional[str] = None) -> None:
+                 path: Optional[str] = None, exact_series: Optional[Arrays] = None) -> None:
         self.string_series = dict(string_series)
         self.reduced_series = dict(reduced_series)
+        self.exact_series: Arrays = dict(exact_series or {})
         self.summary = summary
         self.path = path
 
+    def __setstate__(self, state: Dict[str, Any]) -> None:
+        state.setdefault("exact_series", {})  # pickled before compare() took edge, peg and pulley
+        self.__dict__.update(state)
+
+    @property
+    def problem(self) -> str:
+        """The problem's name (``summary["problem"]``)."""
+        return str(self.summary.get("problem", ""))
+
+    @property
+    def reference(self) -> Arrays:
+        """The series the string is compared with: `exact_series` (edge, peg, pulley) or `reduced_series`."""
+        return self.exact_series if self.exact_series else self.reduced_series
+
     def __repr__(self) -> str:
-        return f"<Comparison {self.summary.get('problem')} rel_err_t_stop={self.summary.get('rel_err_t_stop')}>"
+        if self.exact_series:
+            return (f"<Comparison {self.problem} t_lift_off={self.summary.get('t_lift_off')} "
+                    f"abs_err_t_lift_off={self.summary.get('abs_err_t_lift_off')}>")
+        return f"<Comparison {self.problem} rel_err_t_stop={self.summary.get('rel_err_t_stop')}>"
 
 
 def columns_of(table: Any) -> Arrays:
@@ -581,5 +609,6 @@ def read_directory(directory: PathLike) -> Union[Result, ReducedResult, Comparis
     if run.kind == "reduced":
         return ReducedResult(columns_of(run.reduced), run.summary, path=path)
     if run.kind == "compare":
-        return Comparison(columns_of(run.series), columns_of(run.reduced), run.summary, path=path)
+        return Comparison(columns_of(run.series), columns_of(run.reduced), run.summary, path=path,
+                          exact_series=columns_of(run.exact))
     return Result.from_reader_run(run)

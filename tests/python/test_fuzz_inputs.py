@@ -16,6 +16,7 @@ on each run (by default the draws are fixed, so that a CI run is reproducible).
 import math
 import os
 import tempfile
+import warnings
 
 import numpy as np
 import pytest
@@ -248,18 +249,54 @@ def test_reduced_with_any_keywords(problem, kwargs):
     ends_well(lambda: chainsim.reduced(problem, **kwargs), keyword_names(kwargs) + ["problem"])
 
 
+def cheap(kwargs):
+    """compare()'s keywords with a small mesh, a short run and a step budget unless they set them."""
+    if "nodes" in kwargs and isinstance(kwargs["nodes"], (int, np.integer)) and 13 <= kwargs["nodes"] <= 200001:
+        kwargs["nodes"] = 13  # a valid but large mesh: keep the run cheap
+    kwargs.setdefault("nodes", 9)
+    kwargs.setdefault("t_max", 0.05)
+    kwargs.setdefault("max_steps", 20000)
+    return kwargs
+
+
 @fuzz_settings(60)
 @given(problem=st.sampled_from(["falling", "folded", "sliding"]),
        kwargs=st.dictionaries(st.sampled_from(COMPARE_KEYWORDS), st.one_of(numbers, text, st.none()), max_size=3))
 @example(problem="falling", kwargs={"nodes": 10**20})
 @example(problem="falling", kwargs={"tilt_deg": 1, "bend_deg": 2.1316282072803006e-14})
 def test_compare_with_any_keywords(problem, kwargs):
-    if "nodes" in kwargs and isinstance(kwargs["nodes"], (int, np.integer)) and 13 <= kwargs["nodes"] <= 200001:
-        kwargs["nodes"] = 13  # a valid but large mesh: keep the run cheap
-    kwargs.setdefault("nodes", 9)
-    kwargs.setdefault("t_max", 0.05)
-    kwargs.setdefault("max_steps", 20000)
+    cheap(kwargs)
     ends_well(lambda: chainsim.compare(problem, **kwargs), keyword_names(kwargs) + ["problem"])
+
+
+# compare() of the contact problems: their own keywords (x0, u0, R) with the shared ones, and those they refuse
+# (eta0, eps, force, tilt_deg; f for pulley). The pulley's R and u0 are checked against the length and each other.
+CONTACT_KEYWORDS = COMPARE_KEYWORDS + ["x0", "u0", "R"]
+CONTACT_RELATED = {**RELATED, "length": RELATED["length"] + ["R", "u0", "x0"], "R": ["u0"]}
+
+
+@fuzz_settings(60)
+@given(problem=st.sampled_from(["edge", "peg", "pulley"]),
+       kwargs=st.dictionaries(st.sampled_from(CONTACT_KEYWORDS), st.one_of(numbers, text, st.none()), max_size=3))
+@example(problem="pulley", kwargs={"R": 0.5})
+@example(problem="edge", kwargs={"t_max": 0})   # was "t_max_over_t0 = 0 is out of range", naming no keyword
+@example(problem="edge", kwargs={"t_max": 5e-324})   # was "stop.t_end = 0 is out of range"
+@example(problem="edge", kwargs={"x0": 5e-324})   # was "the polyline's points 1 and 2 coincide"
+@example(problem="edge", kwargs={"x0": 1e-100})   # was "the edge point is on an end node of the string"
+@example(problem="pulley", kwargs={"R": 5.695819295555511e-160})   # was "shape.corner_radius = ... is too large"
+@example(problem="pulley", kwargs={"length": 10000001, "R": 5e-324})
+@example(problem="pulley", kwargs={"length": 0.2})
+@example(problem="edge", kwargs={"u0": 0.1, "x0": "0.2"})
+@example(problem="peg", kwargs={"x0": np.float32(0.7), "tilt_deg": 0})
+def test_contact_compare_with_any_keywords(problem, kwargs):
+    cheap(kwargs)
+    names = []
+    for k in kwargs:
+        for name in [k] + CONTACT_RELATED.get(k, []):
+            names += [name, CLI_NAMES.get(name, "--" + name)]
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", chainsim.ResolutionWarning)  # a pulley thinner than 9 nodes' links
+        ends_well(lambda: chainsim.compare(problem, **kwargs), names + ["problem"])
 
 
 @fuzz_settings(60)
