@@ -46,6 +46,10 @@ constexpr double kWrapLand = 0.05;
 /// Links along the arc: a node lands at kWrapLand h from its tangent point, on the circle at that arc behind
 /// it, so the link behind it starts with an arc of about −kWrapLand h: its arc runs out at −kWrapEnter h.
 constexpr double kWrapEnter = 3 * kWrapLand;
+/// Links along the arc: a free end has passed its tangent point (its landing root function signed negative)
+/// only where the link from the node beyond it runs within 60° of that node's tangent line (cos 60°), as an
+/// edge's side is signed (solver/string_model.cpp, kPassedCone).
+constexpr double kWrapPassedCone = 0.5;
 /// A sliding node whose tangential speed is within kStopWindow of the speed scale √(a ℓ) at a located
 /// stop has stopped (the state recomputed to the event is within the integration error of the root).
 constexpr double kStopWindow = 1e-5;
@@ -1153,8 +1157,44 @@ class ContactModule final : public WrappingModule<dim> {
     const double per_mass = model.contact_force(c) / model.masses()[i];
     return (per_mass + (length > 0 ? force / (model.chain().density() * length) : 0.0)) / a;
   }
+  /// Links along the arc: the landing root function of the free end of link j (its end node if `at_end`, else its
+  /// start node), which runs round circle k (wrapped in the sense sense_[k]): its straight part s per h, less
+  /// kWrapLand, with s signed: negative where the end has passed its tangent point along its side. Unsigned, a
+  /// step that carried a free end through its tangent point ended with s as long again on the other side (the
+  /// link then runs round the circle from a tangent point ahead of the node, its length smooth through there
+  /// to third order): no sign change, the landing lost, the node gone on off the circle, the tension several
+  /// times, up to 10⁵ times, off (issue #23: compare pulley --R 0.005 --u0 0.1 on 801 nodes with erk8, 3·10⁶
+  /// N). The side is the straight link beyond the end i, to node `far`: the end has passed where it lies beyond
+  /// far's own tangent point along far's tangent line t_far, s_far − (x_i − x_far)·t_far < 0 (on a straight side
+  /// −s, and continuous through zero), that link within 60° of t_far (kWrapPassedCone). An end with no straight
+  /// link beyond it (the string's end, a neighbour held or on the circle) keeps s unsigned.
+  double wrap_land_gap(const StringModel<dim>& model, int j, bool at_end, int k) const {
+    const Chain<dim>& chain = model.chain();
+    const double h = chain.link_length(j), s = model.bend_straight(j, at_end);
+    double sign = 1;
+    if constexpr (dim == 2) {
+      const int beyond = at_end ? j + 1 : j - 1;  // the link from the end away from the circle
+      const Obstacle<dim>& o = obstacles_[static_cast<std::size_t>(k)];
+      if (!chain.closed() && beyond >= 0 && beyond < chain.num_links() && !model.link_bent(beyond)) {
+        const int i = at_end ? chain.link_end(j) : chain.link_start(j);
+        const int far = at_end ? chain.link_end(beyond) : chain.link_start(beyond);
+        const Vec<2> r = Vec<2>(model.x().col(far)) - o.point;
+        const double d2 = r.squaredNorm(), R = o.radius;
+        if (free_node(model, far) && d2 > R * R) {
+          // From node `far` towards its tangent point (the one the string runs onto, as bend_link_on_circle's):
+          // (−s_far r + σ R r⊥)/|r|², σ the sense, reversed at a link's end node (the string leaves the circle).
+          const double s_far = std::sqrt(d2 - R * R), turn = at_end ? -sense_[static_cast<std::size_t>(k)]
+                                                                    : sense_[static_cast<std::size_t>(k)];
+          const Vec<2> t = (-s_far * r + turn * R * Vec<2>(-r[1], r[0])) / d2;
+          const double along = (Vec<2>(model.x().col(i)) - Vec<2>(model.x().col(far))).dot(t);
+          if (s_far - along < 0 && along > kWrapPassedCone * h) sign = -1;
+        }
+      }
+    }
+    return sign * s / h - kWrapLand;
+  }
   /// Links along the arc, two root functions: the smallest straight part of a free end of a link that
-  /// runs round a circle, per h, less kWrapLand (the end lands), and the smallest arc of a link with a
+  /// runs round a circle, per h, less kWrapLand (the end lands: wrap_land_gap), and the smallest arc of a link with a
   /// free end, per h (it runs out: its held end leaves the circle, or a link with two free ends is
   /// straight again; a link entering from a free start at −kWrapEnter).
   void wrap_events(const StringModel<dim>& model, Eigen::Ref<Eigen::VectorXd> g) const {
@@ -1169,9 +1209,9 @@ class ContactModule final : public WrappingModule<dim> {
       const int a = chain.link_start(j), b = chain.link_end(j);
       const double h = chain.link_length(j);
       if (!a_on && !no_wrap_land_[static_cast<std::size_t>(a)] && free_node(model, a))
-        g[0] = std::min(g[0], model.bend_straight(j, false) / h - kWrapLand);
+        g[0] = std::min(g[0], wrap_land_gap(model, j, false, k));
       if (!b_on && !no_wrap_land_[static_cast<std::size_t>(b)] && free_node(model, b))
-        g[0] = std::min(g[0], model.bend_straight(j, true) / h - kWrapLand);
+        g[0] = std::min(g[0], wrap_land_gap(model, j, true, k));
       if (a_on && b_on) continue;
       g[1] = std::min(g[1], arc / h + (entering_[static_cast<std::size_t>(j)] ? kWrapEnter : 0.0));
     }
@@ -1202,11 +1242,10 @@ class ContactModule final : public WrappingModule<dim> {
     for (int j = 0; j < chain.num_links(); ++j) {
       const auto [k, a_on, b_on] = link_wrap(model, j);
       if (k < 0 || !model.link_bent(j)) continue;
-      const double h = chain.link_length(j);
       for (const bool at_end : {false, true}) {
         const int i = at_end ? chain.link_end(j) : chain.link_start(j);
         if ((at_end ? b_on : a_on) || no_wrap_land_[static_cast<std::size_t>(i)] || !free_node(model, i)) continue;
-        const double g = model.bend_straight(j, at_end) / h - kWrapLand;
+        const double g = wrap_land_gap(model, j, at_end, k);
         if (g <= kLandWindow) {
           if (std::none_of(landing.begin(), landing.end(), [&](const auto& p) { return p.first == i; }))
             landing.emplace_back(i, k);

@@ -104,15 +104,16 @@ std::unique_ptr<StringModule<dim>> make_contact_module(std::vector<Obstacle<dim>
 /// A cylinder of radius R is resolved by links no longer than R: with thinner links in node contact it is a
 /// polygon of one or two nodes, and with links along the arc it is wrapped exactly but its lift-off, where the
 /// tension falls to λ v² over a curvature 1/R, is read on a link that spans the whole contact (measured with
-/// `chainsim compare pulley`, links along the arc: the lift-off 4-7 % early at R = h/2, 0.3-0.5 % late at R = h,
-/// 2e-5 to 2.5e-3 at R = 2h, 4e-6 at R = 4h; docs/model.md §10). The fewest nodes of a string of `length` m whose links are no longer than
+/// `chainsim compare pulley`, links along the arc: the lift-off 0.6-7 % early at R = h/2, within 6e-4 at R = h,
+/// 3e-5 at R = 2h, 4e-6 at R = 4h; docs/model.md §10). The fewest nodes of a string of `length` m whose links are no longer than
 /// R / `per_radius`: ceil(per_radius · length / R) links, one node more on an open string.
 inline long nodes_resolving_radius(double radius, double length, bool closed, double per_radius = 1) {
   return static_cast<long>(std::ceil(per_radius * length / radius)) + (closed ? 0 : 1);
 }
-/// Links along the arc resolve a cylinder's lift-off with links no longer than R / kArcLinksPerRadius: at R = 2h the
-/// heavy Atwood chain's lift-off was 2.5e-3 off on 201 nodes (u0 = 0.05 m), and with u0 = 0.1 m it was 1.2e-3 s late
-/// on 201 nodes and not found on 401; at R = 4h, within 4e-6 (docs/model.md §10, "A pulley thinner than the links").
+/// Links along the arc resolve a cylinder's lift-off with links no longer than R / kArcLinksPerRadius: at R = h the
+/// heavy Atwood chain's lift-off is within 6e-4 of t* on 51 to 201 nodes, at R = 2h within 3e-5 (u0 = 0.05 m; with
+/// u0 = 0.1 m, 7e-6 s), at R = 4h within 4e-6 (docs/model.md §10, "A pulley thinner than the links"; the 2.5e-3 and
+/// 1.2e-3 s once measured at R = 2h were compare pulley's, which read the string past the pulley's release).
 inline constexpr double kArcLinksPerRadius = 4;
 
 /// A node this share of a link length from a surface at the start is on it (the discretized shape is

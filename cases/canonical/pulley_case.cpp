@@ -51,15 +51,38 @@ double tension_at_pulley(const Points<2>& x, const Eigen::VectorXd& tension, int
 
 void PulleyLiftOff::add(double t_step, double margin, double u) {
   if (t) return;
-  if (have_prev_ && margin_prev_ > 0 && margin <= 0) {
-    const double w = margin_prev_ / (margin_prev_ - margin);
-    t = t_prev_ + w * (t_step - t_prev_);
-    x = x_offset + u_prev_ + w * (u - u_prev_);
+  const Step& prev = last_[0];
+  if (have_prev_ > 0 && prev.margin > 0 && margin <= 0) {
+    const double w = prev.margin / (prev.margin - margin);
+    t = prev.t + w * (t_step - prev.t);
+    x = x_offset + prev.u + w * (u - prev.u);
   }
-  t_prev_ = t_step;
-  margin_prev_ = margin;
-  u_prev_ = u;
-  have_prev_ = true;
+  last_ = {Step{t_step, margin, u}, last_[0], last_[1]};
+  have_prev_ = std::min(have_prev_ + 1, 3);
+}
+
+void PulleyLiftOff::released() {
+  if (t || have_prev_ == 0) return;
+  // The margin's zero past the last step: on the parabola through the last three (Newton's method from the
+  // line through the last two), or on that line; at the last step where the margins do not fall.
+  const Step &s0 = last_[0], &s1 = last_[1], &s2 = last_[2];
+  double at = s0.t;
+  if (have_prev_ >= 2 && s1.margin > s0.margin) {
+    at = s0.t + s0.margin * (s0.t - s1.t) / (s1.margin - s0.margin);
+    if (have_prev_ == 3) {
+      const double d01 = (s0.margin - s1.margin) / (s0.t - s1.t), d12 = (s1.margin - s2.margin) / (s1.t - s2.t);
+      const double c2 = (d01 - d12) / (s0.t - s2.t);  // m(τ) = m0 + d01 (τ − t0) + c2 (τ − t0)(τ − t1)
+      for (int iteration = 0; iteration < 8; ++iteration) {
+        const double m = s0.margin + d01 * (at - s0.t) + c2 * (at - s0.t) * (at - s1.t);
+        const double slope = d01 + c2 * (2 * at - s0.t - s1.t);
+        if (!(slope < 0)) break;
+        at -= m / slope;
+      }
+    }
+  }
+  t = at;
+  // u along the line through the last two steps (its error is the step's second order, as the run's x error).
+  x = x_offset + s0.u + (have_prev_ >= 2 ? (at - s0.t) * (s0.u - s1.u) / (s0.t - s1.t) : 0.0);
 }
 
 PulleyComparison compare_pulley_with_exact(const PulleyCaseSetup& setup) {
@@ -108,11 +131,30 @@ PulleyComparison compare_pulley_with_exact(const PulleyCaseSetup& setup) {
   // The lift-off: the first zero of the string's margin τ2 − λ ẋ² (its tension where the shorter side
   // meets the pulley, its speed), interpolated linearly between the steps where it changes sign. The
   // shorter side runs onto the pulley along its tangent (links along the arc, Obstacle::arc_links): no
-  // landing shakes the tension, so the margin needs no average over the landings.
+  // landing shakes the tension, so the margin needs no average over the landings. Where the pulley lets go of
+  // the shorter side before the margin's zero (a pulley of a few links per radius: the contact module reads
+  // the node's share of the arc), the run unwraps from there and the steps after it are not compared.
   PulleyLiftOff lift;
   lift.x_offset = 0.5 * free;
+  // The pulley's release of the shorter side (PulleyLiftOff::released): a lift-off that is no node leaving
+  // the longer side. Each of those lowers the last held index by one (the material moves towards it); a node
+  // of the shorter side let go may land again within the same step, so the first held index does not tell.
+  long lift_offs_base = -1;
+  int last_held_base = -1;
   auto compare_at = [&](double t, const Points<2>& x, const Points<2>& v, const Eigen::VectorXd& tension) {
     if (lift.t) return;  // the exact solution holds up to the lift-off
+    int last_held = -1;
+    for (const NodeContact<2>& contact : model.contacts()) last_held = std::max(last_held, contact.node);
+    long lift_offs = 0;
+    for (const LiftOffTotal& total : model.module()->lift_off_totals()) lift_offs += total.total;
+    if (lift_offs_base < 0) {
+      lift_offs_base = lift_offs;
+      last_held_base = last_held;
+    }
+    if (lift_offs - lift_offs_base > last_held_base - last_held) {
+      lift.released();
+      return;
+    }
     const auto [u, u_dot, tau2, tau1] = exact_at(t);
     const double u_string = u_of(x);
     err_x = std::max(err_x, std::abs(u_string - u));

@@ -9,6 +9,8 @@
 /// the exact lift-off, 1.005 t* (or the safety stop t_max_over_t0 t0): u = u0 cosh(√(2g/ℓ) t), the tensions
 /// λ x2 (g + ẍ) and λ x1 (g − ẍ) where the sides meet the pulley, and the lift-off where the shorter
 /// side's falls to λ ẋ².
+#include <array>
+
 #include "cases/canonical/canonical_string.hpp"
 #include "cases/canonical/contact_compare.hpp"
 
@@ -41,7 +43,10 @@ struct PulleyCaseSetup {
 ///   mean_err_tension_short, mean_err_tension_long   the means of the signed errors (N),
 ///   max_rel_err_tension         the larger maximum over λ g ℓ,
 ///   tension_steps               the steps at which both were measured (each side needs two hanging links
-///                               below the pulley).
+///                               below the pulley), up to the string's lift-off (PulleyLiftOff: the zero of
+///                               its margin, or the pulley's release of the shorter side's first held node
+///                               if sooner; the exact solution holds up to t* only, and the string's
+///                               unwrapping after its release is no wrapped chain).
 /// exact: at the string's step times, t, x, x_dot, u, tension_short, tension_long (N), and
 /// lift_off_margin = (τ2 − λ ẋ²)/R (N/m), the contact force per length where the shorter side meets the
 /// pulley: it reaches zero at the lift-off.
@@ -56,17 +61,26 @@ double tension_at_pulley(const Points<2>& x, const Eigen::VectorXd& tension, int
 /// The string's lift-off off the pulley as `compare pulley` measures it: the first zero of its margin
 /// τ2 − λ ẋ² (its tension where the shorter side meets the pulley, its speed), interpolated linearly
 /// between the accepted steps where it changes sign. Fed step by step (a scene's run measures it too:
-/// tests/convergence/test_contact.cpp).
+/// tests/convergence/test_contact.cpp). Where the pulley lets go of the shorter side's first held node
+/// before a step shows that zero (`released`: the contact module's lift-off, which reads the node's share
+/// of the arc), the margin after it is the unwrapping string's, not the wrapped chain's: the zero is then
+/// extrapolated from the last three steps before the release (the parabola through their margins; the
+/// line through the last two where there are only two).
 struct PulleyLiftOff {
   double x_offset = 0;      ///< ℓ_free/2 (m): the longer side's hanging length is x_offset + u
   std::optional<double> t;  ///< the lift-off time (s), once found
   std::optional<double> x;  ///< the longer side's hanging length there, interpolated as t (m)
   /// The step at time `t_step` with margin τ2 − λ ẋ² (N) and u (m, half the difference of the ends' heights).
   void add(double t_step, double margin, double u);
+  /// The shorter side's first held node has been let go since the last step added.
+  void released();
 
  private:
-  double t_prev_ = 0, margin_prev_ = 0, u_prev_ = 0;
-  bool have_prev_ = false;
+  struct Step {
+    double t = 0, margin = 0, u = 0;
+  };
+  std::array<Step, 3> last_{};  // the last steps added, the latest first
+  int have_prev_ = 0;           // how many (up to 3)
 };
 PulleyComparison compare_pulley_with_exact(const PulleyCaseSetup& setup);
 
