@@ -265,7 +265,8 @@ class ContactModule final : public WrappingModule<dim> {
     }
   }
 
-  // Ledgers: [ the inner module's | W_contact | W_impacts | impulse (dim) | W_friction (with friction) ]. Without an inner module
+  // Ledgers: [ the inner module's | W_contact | W_impacts | impulse (dim) | W_friction (with friction) |
+  // W_impacts_supports ]. Without an inner module
   // the impulse is that of all external forces (the contact forces among them); with one (fronts), the
   // inner module integrates the external forces' impulse (StringModel::external_force has the contact
   // forces) and this one holds only the impacts' momentum jumps, added to it in fill().
@@ -426,7 +427,7 @@ class ContactModule final : public WrappingModule<dim> {
       }
     }
   }
-  int num_ledgers() const override { return inner_ledgers() + 2 + dim + (friction_ ? 1 : 0); }
+  int num_ledgers() const override { return inner_ledgers() + supports_index() + 1; }
   void ledger_rates(const StringModel<dim>& model, Eigen::Ref<Eigen::VectorXd> rates) const override {
     const int k = inner_ledgers();
     if (inner_) inner_->ledger_rates(model, rates.head(k));
@@ -437,6 +438,7 @@ class ContactModule final : public WrappingModule<dim> {
     else
       rates.template segment<dim>(k + 2) = model.external_force();
     if (friction_) rates[k + kFriction] = model.friction_power();
+    rates[k + supports_index()] = 0;  // jumps at impacts only
   }
   Eigen::VectorXd ledger_scale(double mass, double speed, double length) const override {
     const int k = inner_ledgers();
@@ -445,6 +447,7 @@ class ContactModule final : public WrappingModule<dim> {
     scale.segment(k, 2).setConstant(mass * speed * speed);
     scale.template segment<dim>(k + 2).setConstant(mass * speed);
     if (friction_) scale[k + kFriction] = mass * speed * speed;
+    scale[k + supports_index()] = mass * speed * speed;
     return scale;
   }
   double potential_correction(const StringModel<dim>& model, const Eigen::Ref<const Eigen::VectorXd>& ledger) const override {
@@ -454,7 +457,11 @@ class ContactModule final : public WrappingModule<dim> {
     using K = LedgerTerm::Kind;
     std::vector<LedgerTerm> terms = inner_ ? inner_->ledger_terms() : std::vector<LedgerTerm>{};
     terms.insert(terms.end(),
-                 {{"W_contact", K::kWork}, {"W_impacts", K::kWork}, {"impacts", K::kQuantity}, {"lift_offs", K::kQuantity}});
+                 {{"W_contact", K::kWork},
+                  {"W_impacts", K::kWork},
+                  {"W_impacts_supports", K::kWork},
+                  {"impacts", K::kQuantity},
+                  {"lift_offs", K::kQuantity}});
     if (friction_)
       terms.insert(terms.end(), {{"W_friction", K::kWork}, {"sticks", K::kQuantity}, {"slips", K::kQuantity}});
     return terms;
@@ -464,7 +471,8 @@ class ContactModule final : public WrappingModule<dim> {
     const int k = inner_ledgers();
     this->fill_inner(model, ledger, ledger.template segment<dim>(k + 2), out);
     out.terms.insert(out.terms.end(),
-                     {ledger[k], ledger[k + 1], static_cast<double>(impacts_), static_cast<double>(lift_offs_)});
+                     {ledger[k], ledger[k + 1], ledger[k + supports_index()], static_cast<double>(impacts_),
+                      static_cast<double>(lift_offs_)});
     if (friction_)
       out.terms.insert(out.terms.end(),
                        {ledger[k + kFriction], static_cast<double>(sticks_), static_cast<double>(slips_)});
@@ -589,6 +597,9 @@ class ContactModule final : public WrappingModule<dim> {
   // Friction: whether an obstacle has μ > 0; per node, whether it sticks, and the direction it slides
   // in (its coordinates in the obstacle's tangents(); zero: not yet classified, or no friction).
   static constexpr int kFriction = 2 + dim;  // W_friction's place in the module's own ledger (after the inner's)
+  /// W_impacts_supports' place in the module's own ledger: the work of the driven supports' impulses in the
+  /// impacts (zero at fixed ends), kept out of W_impacts, which is then what the impacts dissipated (≤ 0).
+  int supports_index() const { return kFriction + (friction_ ? 1 : 0); }
   bool friction_ = false;
   bool side_faces_ = false;  ///< some obstacle is a table that ends at an edge: the side-face event
   std::vector<char> stuck_;
@@ -1478,9 +1489,10 @@ class ContactModule final : public WrappingModule<dim> {
     const double K_before = model.kinetic_energy();
     const Vec<dim> p_before = model.momentum();
     refresh(model);
-    model.impact(t);
+    const double work = model.impact(t);
     refresh(model);
-    ledger[1] += model.kinetic_energy() - K_before;
+    ledger[1] += model.kinetic_energy() - K_before - work;
+    ledger[supports_index()] += work;
     ledger.template segment<dim>(2) += model.momentum() - p_before;
     ++impacts_;
     std::vector<double> let_go_before;
@@ -1539,9 +1551,10 @@ class ContactModule final : public WrappingModule<dim> {
     }
     if (!applied) return;
     refresh(model);
-    model.project(t);
+    const double work = model.project(t);
     refresh(model);
-    ledger[kFriction] += model.kinetic_energy() - K_before;
+    ledger[kFriction] += model.kinetic_energy() - K_before - work;
+    ledger[supports_index()] += work;
     ledger.template segment<dim>(2) += model.momentum() - p_before;
   }
   /// After the inner module changed the layout (a front crossing): the held nodes a front took (into a

@@ -14,9 +14,10 @@
 ///     normal force of a held node (a lift-off: the node is let go, and so is every other held node
 ///     whose force would then pull, one at a time, most negative first);
 ///   - the ledgers W_contact (J: the work of the contact forces, zero on the exact solution; it books
-///     the drift control's share), W_impacts (J, ≤ 0: the kinetic energy the landings took) and the
-///     impulse of all external forces (the momentum ledger p − p0 − impulse, closed across impacts); with a
-///     driven end W_impacts also holds its support's work in the impacts, and may be positive (docs/model.md §10);
+///     the drift control's share), W_impacts (J, ≤ 0: what the impacts dissipated, Carnot's loss
+///     −½ Σ m_i |Δv_i|²), W_impacts_supports (J: the work of the driven supports' impulses in the impacts, which
+///     keep the driven nodes on their paths; zero at fixed ends: docs/model.md §10) and the impulse of all
+///     external forces (the momentum ledger p − p0 − impulse, closed across impacts);
 ///   - the recorded quantities impacts and lift_offs (series.csv): how many landings and lift-offs; each
 ///     lift-off is also a run event (StringModule::run_events: the summary's `events`, the first 100 of each
 ///     obstacle, merged in time order with the inner module's) and counted per obstacle

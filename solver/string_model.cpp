@@ -1074,11 +1074,10 @@ Eigen::VectorXd StringModel<dim>::state_scale() const {
 }
 
 template <int dim>
-void StringModel<dim>::project(double t) {
-  if (!system_) return;
-  if (quadratic_) return project_positions(t);
+double StringModel<dim>::project(double t) {
+  if (!system_) return 0.0;
   project_positions(t);
-  project_velocities(t);
+  return quadratic_ ? 0.0 : project_velocities(t);
 }
 
 template <int dim>
@@ -1180,7 +1179,7 @@ double StringModel<dim>::constraint_violation() const {
 }
 
 template <int dim>
-void StringModel<dim>::project_onto_links(double t, Points<dim>& z) {
+Eigen::VectorXd StringModel<dim>::project_onto_links(double t, Points<dim>& z) {
   for_each_link([&](int j, int u, int) {
     system_->rhs(u) = e_.col(j).dot(z.col(chain_.link_end(j)) - z.col(chain_.link_start(j)));
   });
@@ -1191,13 +1190,16 @@ void StringModel<dim>::project_onto_links(double t, Points<dim>& z) {
                         e_.col(bend.link).dot(z.col(chain_.link_start(bend.link)));
   }
   exclude_slack_links();
-  add_link_responses(z, system_->solve(t));
+  Eigen::VectorXd nu = system_->solve(t);
+  add_link_responses(z, nu);
+  return nu;
 }
 
 template <int dim>
-void StringModel<dim>::correct_constraints(double t, const Eigen::VectorXd& target, Points<dim>& field) {
+double StringModel<dim>::correct_constraints(double t, const Eigen::VectorXd& target, Points<dim>& field) {
   const int K = static_cast<int>(constraints_.size()), n = chain_.num_nodes();
   std::vector<Points<dim>> z(static_cast<std::size_t>(K));
+  std::vector<Eigen::VectorXd> nu(static_cast<std::size_t>(K));
   Eigen::MatrixXd M(K, K);
   for (int k = 0; k < K; ++k) {
     const NodeConstraint<dim>& c = constraints_[static_cast<std::size_t>(k)];
@@ -1207,7 +1209,7 @@ void StringModel<dim>::correct_constraints(double t, const Eigen::VectorXd& targ
       const int i = c.nodes[q];
       if (arc_of_[i] >= 0 && path_of_[i] < 0) zk.col(i) += w_[i] * c.gradient.col(static_cast<Eigen::Index>(q));
     }
-    project_onto_links(t, zk);
+    nu[static_cast<std::size_t>(k)] = project_onto_links(t, zk);
   }
   for (int l = 0; l < K; ++l) {
     const NodeConstraint<dim>& c = constraints_[static_cast<std::size_t>(l)];
@@ -1221,7 +1223,33 @@ void StringModel<dim>::correct_constraints(double t, const Eigen::VectorXd& targ
   const Eigen::VectorXd mu = M.fullPivLu().solve(-target);
   if (!mu.allFinite())
     throw NumericalError(fmt::format("at t = {:.9g} s the kink's constraint cannot be met: its nodes cannot move", t), t);
-  for (int k = 0; k < K; ++k) field += mu[k] * z[static_cast<std::size_t>(k)];
+  // The supports' work: of the links' share (ν_k) and of the constraints' own impulses μ_k ∂C_k/∂x_i at
+  // prescribed nodes, which their supports take.
+  double work = 0;
+  for (int k = 0; k < K; ++k) {
+    field += mu[k] * z[static_cast<std::size_t>(k)];
+    work += mu[k] * supports_work(nu[static_cast<std::size_t>(k)]);
+    const NodeConstraint<dim>& c = constraints_[static_cast<std::size_t>(k)];
+    for (std::size_t q = 0; q < c.nodes.size(); ++q) {
+      const int i = c.nodes[q];
+      if (arc_of_[i] >= 0 && path_of_[i] >= 0) work -= mu[k] * c.gradient.col(static_cast<Eigen::Index>(q)).dot(v_.col(i));
+    }
+  }
+  return work;
+}
+
+template <int dim>
+double StringModel<dim>::supports_work(const Eigen::VectorXd& nu) const {
+  double work = 0;
+  for_each_link([&](int j, int u, int) {
+    const int a = chain_.link_start(j), b = chain_.link_end(j);
+    if (path_of_[a] >= 0) work += nu[u] * e_.col(j).dot(v_.col(a));
+    if (path_of_[b] >= 0) {
+      const Bend* bend = bends_.empty() ? nullptr : bend_of(j);
+      work -= nu[u] * (bend ? Vec<dim>(bend->e_plus) : Vec<dim>(e_.col(j))).dot(v_.col(b));
+    }
+  });
+  return work;
 }
 
 template <int dim>
@@ -1308,7 +1336,7 @@ void StringModel<dim>::impose_constraints(double t) {
 }
 
 template <int dim>
-void StringModel<dim>::project_velocities(double t) {
+double StringModel<dim>::project_velocities(double t) {
   auto correct = [&](Points<dim>& target, const Eigen::VectorXd& nu) { add_link_responses(target, nu); };
   // Velocities: one linear projection onto e_j·Δv_j = 0 (held nodes: onto n·v = 0 first, then with
   // their responses w_i P: the mass-weighted projection onto both).
@@ -1322,12 +1350,14 @@ void StringModel<dim>::project_velocities(double t) {
     if (u >= 0) system_->rhs(u) = bend_rate(bend);
   }
   exclude_slack_links();
-  correct(v_, system_->solve(t));
+  const Eigen::VectorXd nu = system_->solve(t);
+  correct(v_, nu);
+  double work = supports_work(nu);
   if (module_) {
     constraints_.clear();
     module_->node_constraints(*this, constraints_);
   }
-  if (constraints_.empty()) return;
+  if (constraints_.empty()) return work;
   // The module's constraints: Ċ_k = Σ ∂C_k/∂x_i · v_i = 0 as well (the mass-weighted projection onto
   // both: the links' projection of the constraints' gradients, combined).
   // As for the positions, a rate at its round-off (ε Σ |∂C/∂x_i| |v_i|) is left as it is.
@@ -1342,7 +1372,8 @@ void StringModel<dim>::project_velocities(double t) {
     }
     off = off || std::abs(rate[static_cast<Eigen::Index>(k)]) > kRoundoffUlps * std::numeric_limits<double>::epsilon() * scale;
   }
-  if (off) correct_constraints(t, rate, v_);
+  if (off) work += correct_constraints(t, rate, v_);
+  return work;
 }
 
 template <int dim>
@@ -1936,9 +1967,9 @@ bool StringModel<dim>::rebounds_accumulate(int j, double t, double e) const {
 }
 
 template <int dim>
-void StringModel<dim>::impact(double t, double e) {
+double StringModel<dim>::impact(double t, double e) {
   if (!allows_slack()) {
-    project(t);
+    return project(t);
   } else {
     // Unilateral links: the positions onto the constraints, the held nodes' normal velocity taken
     // (Moreau's law, restitution 0), and the links' impulses the snap's complementarity problem at
@@ -1951,7 +1982,7 @@ void StringModel<dim>::impact(double t, double e) {
       speed = std::max(speed, v_.col(c.node).norm());
       v_.col(c.node) -= c.normal.dot(v_.col(c.node)) * c.normal;
     }
-    link_impulses(t, e, speed);
+    return link_impulses(t, e, speed).support_work;
   }
 }
 
@@ -1996,15 +2027,10 @@ typename StringModel<dim>::SnapResult StringModel<dim>::link_impulses(double t, 
     if (bend) result.support_impulse += J - Jb;
     link_impulse.col(a) += J;
     link_impulse.col(b) -= Jb;
-    if (path_of_[a] >= 0) {
-      result.support_impulse -= J;
-      result.support_work -= J.dot(v_.col(a));
-    }
-    if (path_of_[b] >= 0) {
-      result.support_impulse += Jb;
-      result.support_work += Jb.dot(v_.col(b));
-    }
+    if (path_of_[a] >= 0) result.support_impulse -= J;
+    if (path_of_[b] >= 0) result.support_impulse += Jb;
   });
+  result.support_work = supports_work(-P);
   for (const NodeContact<dim>& c : contacts_)
     result.support_impulse += m_[c.node] * (v_.col(c.node) - v_before.col(c.node)) - link_impulse.col(c.node);
   // 4. The energy dissipated, Σ P_j (u⁻_j + u⁺_j)/2, and the links that separate go slack.
@@ -2038,9 +2064,9 @@ typename StringModel<dim>::SnapResult StringModel<dim>::link_impulses(double t, 
   //    #27). Their impulses are part of every impulse problem (a snap, a landing, the start): the mass-weighted
   //    projection onto Ċ = 0 with the links that stay taut held at zero rate (a bilateral projection; the links that
   //    separated above are slack by now and free, so a separation is kept, and their rebound speed is read again).
-  //    Its change of kinetic energy is booked with the links' dissipation (with a driven support it includes the
-  //    support's work, which is then in W_snap rather than W_snap_supports: the ledger closes either way), and the
-  //    momentum it gives the string is the supports' impulse (the constraints' own impulses sum to zero).
+  //    Its change of kinetic energy less the driven supports' work in it is booked with the links' dissipation,
+  //    that work with the supports' (review of #27: it was all in W_snap, which a driven end could make positive),
+  //    and the momentum it gives the string is the supports' impulse (the constraints' own impulses sum to zero).
   if (module_) {
     constraints_.clear();
     module_->node_constraints(*this, constraints_);
@@ -2048,8 +2074,9 @@ typename StringModel<dim>::SnapResult StringModel<dim>::link_impulses(double t, 
   if (held || (module_ && !constraints_.empty())) {
     const double before = kinetic_energy();
     const Vec<dim> p_before = momentum();
-    project_velocities(t);
-    result.dissipated += before - kinetic_energy();
+    const double work = project_velocities(t);
+    result.dissipated += before + work - kinetic_energy();
+    result.support_work += work;
     result.support_impulse += momentum() - p_before;
     links();
     for (std::size_t j = 0; j < rebound_time_.size(); ++j)

@@ -252,7 +252,9 @@ class StringModel final : public OdeSystem {
   /// e = 0 on the contact-reduced matrix (a link the landing would push goes slack).
   /// `e`: Newton's restitution of the links' impulses (slack = allow; a front absorbed at a held end takes the
   /// scene's snap_restitution, shocks/front_tracker.cpp).
-  void impact(double t, double e = 0);
+  /// Returns the work (J) of the impulses the driven supports take in the impact (zero at fixed ends): the
+  /// kinetic energy's change less it is what the impact dissipated.
+  double impact(double t, double e = 0);
   /// At an accepted step (t, y): the taut links shorter than (1 − kSlackGap) h_j (released by the
   /// complementarity problem during the step) become slack; a slack link past its length (a snap not
   /// located) throws NumericalError. O(N), no tension solve.
@@ -448,8 +450,9 @@ class StringModel final : public OdeSystem {
   /// Projects x(), v() of the moving nodes onto the link constraints (prescribed nodes on their paths
   /// at t): the smallest mass-weighted correction onto |Δx_j| = h_j (Newton's method, until every link
   /// is right to the round-off of its coordinates), then onto e_j·Δv_j = 0. Throws NumericalError
-  /// naming t and the residual if it does not converge.
-  void project(double t);
+  /// naming t and the residual if it does not converge. Returns the work (J) of the driven supports'
+  /// impulses in the velocities' projection (project_velocities).
+  double project(double t);
   /// The state y at t with its positions and velocities projected onto the link constraints by
   /// project() (the ledgers unchanged): an interpolated output frame made consistent.
   Eigen::VectorXd projected_state(double t, const Eigen::Ref<const Eigen::VectorXd>& y);
@@ -489,9 +492,10 @@ class StringModel final : public OdeSystem {
   /// e⁺): the mass-weighted response to link multipliers ν (projection: corrections; snap: −P).
   void add_link_responses(Points<dim>& target, const Eigen::VectorXd& nu) const;
   /// project(t) in two steps: the positions onto the links' lengths and the held nodes' surfaces;
-  /// the velocities onto e_j·Δv_j = 0 and n_i·v_i = 0 (mass-weighted, linear).
+  /// the velocities onto e_j·Δv_j = 0 and n_i·v_i = 0 (mass-weighted, linear), returning the work (J) of
+  /// the driven supports' impulses in it (supports_work).
   void project_positions(double t);
-  void project_velocities(double t);
+  double project_velocities(double t);
   /// The initial velocities of the string sliding along itself at `speed` (m/s, towards larger s):
   /// every node of an arc moves along the string, so that every link's rate of lengthening is ≥ 0 and
   /// exactly 0 where the string is straight, on a circle, and over a point a link is bent over (each
@@ -511,10 +515,16 @@ class StringModel final : public OdeSystem {
   void impose_constraints(double t);
   /// z + W Gᵀ ν with G (z + W Gᵀ ν) = 0: a field's mass-weighted projection onto the links' rates
   /// (the system assembled at the current positions).
-  void project_onto_links(double t, Points<dim>& z);
+  /// Returns ν, the links' multipliers (add_link_responses' sign).
+  Eigen::VectorXd project_onto_links(double t, Points<dim>& z);
   /// Adds to `field` the combination Σ μ_k P(W ∂C_k) (P: project_onto_links) with ∂C_l · (the
   /// correction) = −target_l for every constraint l: the projections' share of the constraints.
-  void correct_constraints(double t, const Eigen::VectorXd& target, Points<dim>& field);
+  /// Returns the work (J) that the driven supports' impulses would do if `field` were the velocities.
+  double correct_constraints(double t, const Eigen::VectorXd& target, Points<dim>& field);
+  /// The work (J) of the impulses that the prescribed nodes' supports take, at their velocities, when the
+  /// links act with the multipliers ν of add_link_responses (a link's impulse −ν e_j on its start node, ν e⁺_j
+  /// on its end node): a support takes the opposite of what the links give its node. Zero at fixed ends.
+  double supports_work(const Eigen::VectorXd& nu) const;
   /// The largest |C_k| (m) at the last refresh().
   double constraint_violation() const;
   /// The impulsive tensions P ≥ 0 of the taut links for restitution e (the snap's complementarity
