@@ -60,8 +60,8 @@ class SlackModule final : public WrappingModule<dim> {
   /// its root function would start at or below zero, where ARKODE never finds the snap, and the link would go on
   /// stretching unseen. Such links are taut again and the start's law acts once more (StringModel::impact with the
   /// scene's restitution: the positions onto the taut links' lengths and the surfaces, the velocities by the snap's
-  /// problem, the links it leaves shortening slack again), its change of K booked in W_snap and of momentum in the
-  /// supports' impulse, counted as a snap; the held nodes it would pull off are let go and the free nodes its
+  /// problem, the links it leaves shortening slack again), its change of K less the driven supports' work booked in
+  /// W_snap, that work in W_snap_supports and the change of momentum in the supports' impulse, counted as a snap; the held nodes it would pull off are let go and the free nodes its
   /// projection carried into a surface land, which may stretch another slack link (at most one round per link).
   bool start(StringModel<dim>& model, double t0, Eigen::Ref<Eigen::VectorXd> ledger) override {
     const int kl = inner_ledgers();
@@ -89,10 +89,11 @@ class SlackModule final : public WrappingModule<dim> {
       const double K_before = model.kinetic_energy();
       const Vec<dim> p_before = model.momentum();
       model.refresh();
-      model.impact(t0, model.options().snap_restitution);
+      const double work = model.impact(t0, model.options().snap_restitution);
       model.refresh();
       typename StringModel<dim>::SnapResult snap;
-      snap.dissipated = K_before - model.kinetic_energy();  // with a driven end, its support's work too
+      snap.dissipated = K_before + work - model.kinetic_energy();  // the driven supports' work booked apart
+      snap.support_work = work;
       snap.support_impulse = model.momentum() - p_before;
       book(snap, ledger);
       if (!inner_) break;
