@@ -1832,10 +1832,34 @@ double StringModel<dim>::slack_gap() const {
   if (num_slack_ == 0) return g;
   for (int j = 0; j < chain_.num_links(); ++j) {
     if (!slack_[static_cast<std::size_t>(j)]) continue;
-    const double h = chain_.link_length(j);
-    g = std::min(g, (h - current_length(j)) / h + slack_offset_[static_cast<std::size_t>(j)]);
+    g = std::min(g, slack_root(j));
   }
   return g;
+}
+
+template <int dim>
+double StringModel<dim>::slack_root(int j) const {
+  // A link that separated at a snap starts with its root function at +kSlackGap, never at zero (link_impulses,
+  // step 4: ARKODE deactivates a root function that is zero at a restart). The offset is needed only until the
+  // link has started opening: from the top of its flight (l̇ ≥ 0) on it is dropped, so that the return is
+  // located at the link's length itself, not kSlackGap of it past (which every rebound added to the taut
+  // length: taut links up to 2.8e-6 h too long, W_links ~1e-8 J at every rtol; docs/model.md §9). The root
+  // function then jumps down at the top but stays > 0 there (the link is shorter than its length): ARKODE
+  // looks only for sign changes, at a step's ends and, in a step that has one, at the points its rootfinder
+  // brackets it with, so a jump between positive values neither makes a root nor hides the return. A link
+  // that never got shorter than its length (its excess at the separation, from the drift of the taut lengths,
+  // deeper than its flight) drops to ≤ 0 at its top: the root is located there and snap() catches it at rest.
+  // A flight cannot end before its top (the link shortens until then); one too shallow to resolve is held
+  // taut at the snap (hold_unresolved_flights) and has no offset. A bent link's rate is not e·Δv: it keeps its
+  // offset.
+  const auto k = static_cast<std::size_t>(j);
+  const double h = chain_.link_length(j);
+  double offset = slack_offset_[k];
+  if (offset > 0 && (bends_.empty() || bend_of(j) == nullptr)) {
+    const int a = chain_.link_start(j), b = chain_.link_end(j);
+    if ((x_.col(b) - x_.col(a)).dot(v_.col(b) - v_.col(a)) >= 0) offset = 0;
+  }
+  return (h - current_length(j)) / h + offset;
 }
 
 template <int dim>
@@ -1878,7 +1902,7 @@ typename StringModel<dim>::SnapResult StringModel<dim>::snap(double t) {
   // 1. The slack links at their length are caught: taut again.
   std::vector<int> caught;
   for (int j = 0; j < L; ++j)
-    if (link_slack(j) && (chain_.link_length(j) - l_[j]) / chain_.link_length(j) + slack_offset_[static_cast<std::size_t>(j)] <= kSnapWindow) {
+    if (link_slack(j) && slack_root(j) <= kSnapWindow) {
       set_slack(j, false);
       ++result.caught;
       caught.push_back(j);
@@ -1891,7 +1915,7 @@ typename StringModel<dim>::SnapResult StringModel<dim>::snap(double t) {
     double nearest_gap = INFINITY;
     for (int j = 0; j < L; ++j) {
       if (!link_slack(j)) continue;
-      const double gap = (chain_.link_length(j) - l_[j]) / chain_.link_length(j) + slack_offset_[static_cast<std::size_t>(j)];
+      const double gap = slack_root(j);
       if (gap < nearest_gap) {
         nearest_gap = gap;
         nearest = j;
@@ -2048,7 +2072,8 @@ typename StringModel<dim>::SnapResult StringModel<dim>::link_impulses(double t, 
     const double u_after = link_rate(j);
     set_slack(j, true);
     // Its root function starts at +kSlackGap, never at zero: ARKODE deactivates a root function that
-    // is zero at a restart, and would miss the link's return to its length if it came at once.
+    // is zero at a restart, and would miss the link's return to its length if it came at once. The offset
+    // lasts until the top of its flight (slack_root).
     slack_offset_[static_cast<std::size_t>(j)] =
         std::max(0.0, (l_[j] - chain_.link_length(j)) / chain_.link_length(j)) + kSlackGap;
     // A rebound of snap() is recorded for the accumulation rule; a link that separates at the start or

@@ -227,10 +227,9 @@ class StringModel final : public OdeSystem {
   /// Declares link j slack before the run (a string laid shorter than its length); slack = allow
   /// only. make_consistent() then leaves its length alone and refuses it if it is not shorter than h_j.
   void set_slack(int j, bool slack);
-  /// The snap root function at the current positions: min over the slack links of (h_j − l_j)/h_j
-  /// (plus the link's offset, ≥ 0, when it went slack at full length), 1 with none. One root function
-  /// for all links (ARKODE evaluates every root function at every step: N per-link functions cost N
-  /// times more evaluations of the same numbers).
+  /// The snap root function at the current positions: min over the slack links of slack_root(j), 1 with
+  /// none. One root function for all links (ARKODE evaluates every root function at every step: N
+  /// per-link functions cost N times more evaluations of the same numbers).
   double slack_gap() const;
   /// What a snap did: the energy it dissipated (J, ≥ 0), the work and impulse of the supports'
   /// impulses (J, N s), and how many links it caught.
@@ -654,6 +653,9 @@ class StringModel final : public OdeSystem {
   }
   /// Link j's length at x_ (a bent link's runs over its point: l⁻ + l⁺), without links().
   double current_length(int j) const;
+  /// Slack link j's root: (h_j − l_j)/h_j at the current positions, plus its offset (≥ 0, when it went slack
+  /// at a snap at full length) while it is still shortening.
+  double slack_root(int j) const;
   Eigen::VectorXd base_mass_;    // lumped masses of the arcs' links
   Eigen::VectorXd m_;            // current masses (base + module)
   Eigen::VectorXd w_;            // 1/m_i for free nodes, 0 otherwise
