@@ -411,7 +411,7 @@ TEST_CASE("slack: frames interpolated inside a step leave a released link free (
   // docs/data/driven_top_slack.toml: 7 nodes (h = 1/6 m, λ = 1 kg/m) hanging straight from y = 1 at rest, no
   // support but the top node 0, driven down at V = 3 m/s from t = 0. Every link but the top one falls freely
   // (zero tension), and the top link goes slack at the start (its end moves towards node 1). The top passes node 1
-  // and the link reaches its length inverted when (1 − h − g t²/2) − (1 − V t) = h (to kSlackGap, below); the
+  // and the link reaches its length inverted when (1 − h − g t²/2) − (1 − V t) = h (below); the
   // perfectly inelastic snap gives node 1 the top's velocity along the link (vertical), −V, and loses
   // Carnot's ½ m₁ (V − g t_s)² (the top is driven); node 1 then falls freely from there, its link released. The
   // erk5 steps of these free falls are long (22 to 0.3 s), so that the frames every 0.01 s are interpolated inside
@@ -427,9 +427,11 @@ TEST_CASE("slack: frames interpolated inside a step leave a released link free (
   r.frames = solver.frames();
   r.masses = scene.model->masses();
   REQUIRE(r.summary.status == "completed");
-  // The link snaps kSlackGap past its length (it went slack at the start at its length, its root function offset
-  // by +kSlackGap, docs/model.md §9 "The snap"): (1 − h − g t²/2) − (1 − V t) = h (1 + kSlackGap).
-  const double V = 3.0, h = 1.0 / 6, gap = StringModel<2>::kSlackGap;
+  // The link snaps at its length: it went slack at the start at its length, its root function offset by
+  // +kSlackGap, and the offset ends at the top of its flight, where the top passes node 1 and the link stops
+  // shortening (docs/model.md §9, "The offset ends at the top of the flight"; before, it snapped kSlackGap past
+  // its length, (1 − h − g t²/2) − (1 − V t) = h (1 + kSlackGap)).
+  const double V = 3.0, h = 1.0 / 6, gap = 0.0;
   const double ts = (V - std::sqrt(V * V - 2 * kG * h * (2 + gap))) / kG;
   const double m1 = r.masses[1];
   double worst = 0, worst_v = 0;
