@@ -138,7 +138,7 @@ std::vector<std::string> laid_on(const Steady& shape, double content, double spe
 }
 
 
-TEST_CASE("the steady chain fountain: speed, rise and shape converge to the closed form", "[fountain]") {
+TEST_CASE("the steady chain fountain: speed, rise and shape converge to the closed form", "[fountain][convergence]") {
   // Four meshes (h = 4, 2, 1, 0.5 cm; 24 to 196 nodes in the air), 0.4 s each: the chain in the air is replaced
   // 1.4 times. The pot's direction is imposed on the nodes it gives out (docs/shocks.md, "A pot"), a condition of
   // first order in h. Measured (erk5, rtol 1e-9), errors at the end (the speed: the largest over the run, at
@@ -208,7 +208,7 @@ TEST_CASE("a chain fountain started off its steady state converges to it", "[fou
   CHECK(std::abs(s.x_floor - r.floor_x.back()) < 0.6 * (s.x_floor - off.x_floor));  // the floor contact: 0.45
 }
 
-TEST_CASE("the chain fountain stays on its steady state, which the mesh approaches at first order", "[fountain]") {
+TEST_CASE("the chain fountain stays on its steady state, which the mesh approaches at first order", "[fountain][convergence]") {
   // 12 m in the pot, 3 s (the chain in the air is replaced 11 times, the slow wave crosses once): h = 2 and 1 cm.
   // Between 2 s and 3 s the floor contact moves by 6.7e-4 m (2 cm) and 3.7e-4 m (1 cm), the speed by 9e-5 m/s: the
   // discrete fountain is steady (the bounds: 1e-3 m, 2e-3 m/s). It differs from the closed form by O(h), the pot's direction being imposed on the nodes

@@ -328,7 +328,7 @@ TEST_CASE("contact: the heavy Atwood chain lifts off the pulley where its contac
 }
 
 TEST_CASE("contact: compare pulley, the heavy Atwood chain released at rest, against its exact solution",
-          "[contact][pulley]") {
+          "[contact][pulley][convergence]") {
   // The closed form of the lift-off (exact::pulley_lift_off_u, the root of 4u² + πRu − (ℓ ℓ_free/2 + 2u0²))
   // against a bisection of its condition x2 (g + ẍ) = ẋ² (Atwood::u_lift, v0 = 0).
   PulleyCaseSetup setup;
@@ -397,7 +397,7 @@ TEST_CASE("contact: compare pulley, the heavy Atwood chain released at rest, aga
 }
 
 TEST_CASE("contact: compare pulley at rtol 1e-12 converges at second order in the lift-off time on four meshes",
-          "[contact][pulley]") {
+          "[contact][pulley][convergence]") {
   // At the default rtol 1e-9 the lift-off error floors at about 1e-7 s from 101 nodes (the test above),
   // so its order shows on one pair of meshes only. At rtol 1e-12 (atol 1e-14) the floor is below the
   // finest mesh's error: measured 5.77e-6, -1.53e-6, 3.01e-7, 3.40e-8 s on 31, 61, 121, 241 nodes (local
@@ -425,7 +425,7 @@ TEST_CASE("contact: compare pulley at rtol 1e-12 converges at second order in th
 }
 
 TEST_CASE("contact: compare pulley over a pulley of four links per radius, erk8 and erk5, against its exact solution",
-          "[contact][pulley]") {
+          "[contact][pulley][convergence]") {
   // Issue #23: `chainsim compare pulley --R 0.005 --u0 0.1 --nodes 801 --method erk8` reported a tension error
   // of 3.1e6 N (3.1e5 lambda g l) and a lift-off 0.028 s early. (1) A step of erk8 (7e-4 s, half a link of
   // travel) carried a node of the shorter side through its tangent point: the landing root function, its
@@ -588,7 +588,7 @@ TEST_CASE("contact: a cylinder in 3D holds the Atwood chain as the circle does i
 }
 
 TEST_CASE("contact: the Atwood scene with contact = \"arc\" lifts off at the exact time at second order",
-          "[contact][pulley][scene]") {
+          "[contact][pulley][scene][convergence]") {
   // cases/scenes/atwood_pulley.toml with its cylinder's contact = "arc" (links along the arc), run to just
   // past the exact lift-off t* (the reference of `compare pulley`: exact::pulley_lift_off_u, pulley_time),
   // its lift-off measured as `compare pulley` measures it (PulleyLiftOff: the zero of τ2 − λẋ²). With the

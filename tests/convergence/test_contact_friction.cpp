@@ -317,7 +317,7 @@ RoughAtwoodRun rough_atwood_run(const RoughAtwood& a, int links, double t_end) {
 }  // namespace
 
 TEST_CASE("friction: the heavy Atwood chain over a rough pulley follows the capstan ODE at second order",
-          "[contact][friction]") {
+          "[contact][friction][convergence]") {
   // Beyond the capstan bound (x1 = 0.45 m > 0.4162 m for μ = 0.1), moving towards the heavier side.
   const RoughAtwood a = rough_atwood(0.45, 0.5);
   const double T = 0.2;
@@ -535,7 +535,7 @@ TEST_CASE("friction: in 3D a straight chain at any angle to a rough slope slips 
 }
 
 TEST_CASE("friction: in 3D a half circle on a rough table pulled at an end slips and converges on refinement",
-          "[contact][friction]") {
+          "[contact][friction][convergence]") {
   // docs/model.md §10, *The onset of slip in 3D*: a half circle (radius about 0.2 m, length 0.2π m,
   // λ = 1) at rest on a rough table (μ = 0.3, gravity −g z), its last node pulled by 5 N (> μ M g =
   // 1.85 N) along the chain's tangent, away from it. At t = 0 the pulled end slips with the nodes

@@ -434,7 +434,7 @@ PickUp pick_up(int links, double lambda, double v, double T) {
 }  // namespace
 
 TEST_CASE("slack: a slack chain pulled at constant speed: force -> lambda v^2, power lost -> lambda v^3 / 2",
-          "[slack]") {
+          "[slack][convergence]") {
   const double lambda = 0.3, v = 2.0, T = 0.25;
   std::printf("\npick-up from a heap: lambda = %g kg/m, v = %g m/s, over %g s\n", lambda, v, T);
   std::printf("  %6s  %6s  %14s  %14s  %10s  %10s\n", "links", "snaps", "F/(lam v^2)-1", "P/(lam v^3/2)-1",
@@ -479,7 +479,7 @@ Points<2> swinging_u(int nodes, double t_end, RunSummary& summary, double& w_sna
 
 }  // namespace
 
-TEST_CASE("slack: the swinging U on 51 to 401 nodes: the differences of the state at t = 1 s fall", "[slack]") {
+TEST_CASE("slack: the swinging U on 51 to 401 nodes: the differences of the state at t = 1 s fall", "[slack][convergence]") {
   // The U: polyline [[0,0],[0.3,-0.4],[0.6,-0.4],[0.3,0]], corner_radius 0.12, lambda 0.1,
   // g 9.81, both ends fixed, slack = "allow", perfectly inelastic snaps. With slack = "stop" it stopped
   // at t = 0.38..0.46 s (not converged); here it runs to t = 1 s, and on these meshes the differences of

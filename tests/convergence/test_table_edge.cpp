@@ -584,7 +584,7 @@ TEST_CASE("rough table and edge: with a dissipative edge (f > 0) the chain meets
 }
 
 TEST_CASE("table and edge: the real table's chain slides off as x0 cosh ωt at every explicit method and tolerance",
-          "[contact][edge]") {
+          "[contact][edge][convergence]") {
   // cases/scenes/chain_off_real_table.toml (101 nodes) at other solver settings. A trial stage of the step
   // that holds a crossing of the edge may carry the table's last held node a little past the edge; its
   // contact then took the edge's distance as its gap, its normal turned and its normal force went negative

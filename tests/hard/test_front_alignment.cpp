@@ -31,7 +31,7 @@ std::vector<double> starts(Problem problem, int nodes) {
 
 }  // namespace
 
-TEST_CASE("fronts cross on every mesh from 4 to 40 nodes, from starts on a node and at h/2", "[hard][shocks]") {
+TEST_CASE("fronts cross on every mesh from 4 to 40 nodes, from starts on a node and at h/2", "[hard][shocks][convergence]") {
   // The erk5 runs of `chainsim compare` at rtol 1e-9 (the canonical default). Measured: 555 runs in
   // 13 s (Release, 2 cores), all stopped at the cutoff or the empty heap; rel_err_t_stop <= 2.1e-11,
   // max_abs_err_eta <= 8.5e-9, max_rel_err_P <= 3.7e-6, energy <= 1.7e-9, momentum <= 1.0e-9.

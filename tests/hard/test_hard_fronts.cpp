@@ -73,7 +73,7 @@ TEST_CASE("front tracking with eps = 1e-4 at the edges of f agrees with the redu
 }
 
 TEST_CASE("front tracking on 3200 and 6400 nodes agrees with the reduced ODEs over its first 30 crossings",
-          "[hard][shocks]") {
+          "[hard][shocks][convergence]") {
   // The finest meshes the suite runs: h = ℓ/6399. Fine meshes used to fail in the projection
   // (docs/shocks.md) and, at 3,300 and 6,400 nodes, the falling chain stopped at t ≈ 0 with "the heap
   // has run empty" (its empty heap's content started at ±1 ulp). Thirty crossings each: the falling

@@ -179,7 +179,7 @@ TEST_CASE("the implicit ARK437L2SA DIRK at rtol 1e-2 on the 111-link chain witho
 }
 
 TEST_CASE("1000 periods of a small hanging chain's small oscillation: energy and constraint drift stay bounded",
-          "[hard][string]") {
+          "[hard][string][convergence]") {
   // 6 links, 0.01 rad; period of the first mode 2π/ω1, ω1 = 1.2024 sqrt(g/ℓ) for the continuous chain.
   const double period = 2 * M_PI / (1.2024 * std::sqrt(9.81));
   auto run_for = [&](double periods) {
