@@ -74,9 +74,9 @@ void FoldFront<dim>::evaluate(const StringModel<dim>& model, FrontState<dim>& s,
 }
 
 template <int dim>
-void FoldFront<dim>::crossings(const StringModel<dim>& /*model*/, const FrontState<dim>& s, double* g) const {
-  g[0] = s.l_plus + kCrossingHysteresis * this->m_.h;
-  g[1] = s.l_minus + kCrossingHysteresis * this->m_.h;
+void FoldFront<dim>::crossings(const StringModel<dim>& model, const FrontState<dim>& s, double* g) const {
+  g[0] = s.l_plus + kCrossingHysteresis * this->m_.h - this->end_margin(model, true);
+  g[1] = s.l_minus + kCrossingHysteresis * this->m_.h - this->end_margin(model, false);
 }
 
 template <int dim>

@@ -38,7 +38,7 @@ class FoldFront final : public SplitLinkFront<dim> {
   /// a crossing leaves the new split link's other partial link at about 0, and a fold placed on a node starts
   /// there, so a fold at rest on a node (a folded chain in free fall, ṡ0 = 0) sits kCrossingHysteresis h from
   /// either threshold instead of on one, where round-off of 1e-17 m decided the crossings (docs/shocks.md,
-  /// "A fold at rest on a node").
+  /// "A fold at rest on a node"). At a free end of the string both stop kLastPartial h before it (end_margin).
   void crossings(const StringModel<dim>& model, const FrontState<dim>& state, double* g) const override;
   void evaluate(const StringModel<dim>& model, FrontState<dim>& state, Eigen::VectorXd& mass,
                 Points<dim>& force) override;

@@ -34,6 +34,12 @@ namespace chainsim {
 /// (fold_front.hpp; docs/shocks.md, "A fold at rest on a node").
 inline constexpr double kCrossingHysteresis = 1e-6;
 
+/// A front cannot cross a free end of the string: the end node's mass is the partial link's, λ l, which vanishes as
+/// the front reaches it (the trial states past it are refused, "a node has lost its mass", until the steps stall).
+/// The run stops when that partial link is this short, in links: a heap whose last node cannot be taken in
+/// (heap_front.cpp), a fold or a kink that reaches a free end (split_link_front.hpp).
+inline constexpr double kLastPartial = 1e-3;
+
 /// The material the fronts cut: set once the chain is known.
 struct FrontMaterial {
   double h = 0;       ///< material length of a link (m)

@@ -27,8 +27,6 @@ namespace {
 /// t = 1.5e-9 s (14 nodes). A band wider by a quarter link avoided both but used the end interpolant
 /// further from the nodes and cost the swinging sliding chain its convergence (order -1.08).
 constexpr double kRemove = 0.5 - kCrossingHysteresis, kInsert = 1.5 + kCrossingHysteresis;
-/// The last node of an arc cannot be taken in; the run stops when its partial link is this short.
-constexpr double kLastPartial = 1e-3;
 /// A heap whose content is below this fraction of the string's length (64 ε) is empty.
 constexpr double kEmptyHeap = 64 * std::numeric_limits<double>::epsilon();
 /// With an edge on the string (a bent link), also below kEmptyLinks h: above the material the edge's

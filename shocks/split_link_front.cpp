@@ -62,9 +62,17 @@ double SplitLinkFront<dim>::potential_moment(const StringModel<dim>& model, cons
 }
 
 template <int dim>
-void SplitLinkFront<dim>::crossings(const StringModel<dim>& /*model*/, const FrontState<dim>& s, double* g) const {
-  g[0] = s.l_plus;   // the front reaches arc B's first node
-  g[1] = s.l_minus;  // the front reaches arc A's last node
+void SplitLinkFront<dim>::crossings(const StringModel<dim>& model, const FrontState<dim>& s, double* g) const {
+  g[0] = s.l_plus - end_margin(model, true);    // the front reaches arc B's first node
+  g[1] = s.l_minus - end_margin(model, false);  // the front reaches arc A's last node
+}
+
+template <int dim>
+double SplitLinkFront<dim>::end_margin(const StringModel<dim>& model, bool plus) const {
+  // The split link is the string's last (first) and its end node moves: that node's mass is λ l⁺ (λ l⁻) alone.
+  const ArcRange& arc = model.arcs()[static_cast<std::size_t>(plus ? this->arc_plus : this->arc_minus)];
+  const int end = plus ? arc.first : arc.last;
+  return arc.num_links() == 0 && !model.is_prescribed(end) ? kLastPartial * this->m_.h : 0.0;
 }
 
 template <int dim>

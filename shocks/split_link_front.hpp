@@ -21,7 +21,7 @@ class SplitLinkFront : public FrontKind<dim> {
                                    int node) const override;
   /// The partial links as straight segments from their nodes to x0 (state.position).
   double potential_moment(const StringModel<dim>& model, const FrontState<dim>& state, const Vec<dim>& g) const override;
-  /// g[0] = l⁺ (the front reaches arc B's first node), g[1] = l⁻ (arc A's last node).
+  /// g[0] = l⁺ (the front reaches arc B's first node), g[1] = l⁻ (arc A's last node), less end_margin.
   void crossings(const StringModel<dim>& model, const FrontState<dim>& state, double* g) const override;
   int second_direction() const override { return -1; }
   /// The node the front reaches moves to the other arc; the mass of the two links whose split changes
@@ -41,6 +41,11 @@ class SplitLinkFront : public FrontKind<dim> {
                                  Points<dim>& force);
 
  protected:
+  /// kLastPartial h where the front's node on that side (B's first for `plus`, A's last otherwise) is a free end of
+  /// the string, whose mass vanishes with its partial link: the crossing there is the stop "has reached the end"
+  /// (cross), taken that far before the end. 0 elsewhere (a node inside the string keeps its other link's mass; a
+  /// prescribed end has no mass to lose).
+  double end_margin(const StringModel<dim>& model, bool plus) const;
   /// The unit tangent of the link i → j and its rate (the part of (v_j − v_i) across it over its length).
   static Vec<dim> link_tangent(const StringModel<dim>& model, int i, int j, const char* what, Vec<dim>& rate);
   /// Mass parcels: link j's share on its start node changes by `delta` (kg), the material moving with the

@@ -19,6 +19,7 @@
 #include "cases/cli/run_command.hpp"
 #include "mesh/errors.hpp"
 #include "solver/string_solver.hpp"
+#include "shocks/front_kind.hpp"
 #include "solver/tension_system.hpp"
 #include "test_scene_support.hpp"
 
@@ -393,6 +394,33 @@ TEST_CASE("a tilted falling chain with f = 1 falls freely while its contact slid
   CHECK(worst_s0 < 1e-12);
   CHECK(worst_x < 1e-12);
   CHECK(run.samples.back().fronts[0].position[0] > 0.4);  // it slid about 0.42 m along the table
+}
+
+TEST_CASE("a fold without a cutoff stops just before the free end, when the exact quadrature says", "[unit][scene]") {
+  // The folded chain without [[stop.front]]: the end node's mass is the partial link's, λ l⁺, which vanishes as the
+  // fold reaches it, so the steps past it were refused ("node 100 has lost its mass") until the integration stalled
+  // (exit 3 at t = 0.63855 s for f = 1, 101 nodes). The run now stops where l⁺ = (kLastPartial − kCrossingHysteresis) h
+  // (a fold's crossings lie kCrossingHysteresis h past the node), "the fold has reached the end of the string", at the
+  // time the exact quadrature gives there (the straight problem is exact on the mesh, docs/shocks.md). f = 1: the tip
+  // falls freely, ξ = √(2(η − η0)); f = 0.5 and 0: the tip's speed diverges at the end (ξ from the quadrature).
+  // Measured at rtol 1e-10: 3.9e-16, 1.2e-11, 6.3e-12 relative.
+  const std::string text = test::edit(test::kFoldedBase, "[[stop.front]]\nfront = \"fold\"\ns0 = 0.99\n", "");
+  const double ell = 1.0, h = ell / 20, eta0 = 0.2, t0 = std::sqrt(2 * ell / kG);
+  const double eta = 1 - (kLastPartial - kCrossingHysteresis) * h / ell;
+  for (const double f : {1.0, 0.5, 0.0}) {
+    CAPTURE(f);
+    SceneSpec spec = parse_scene_text(test::edit(text, "f = 0.5", fmt::format("f = {}", f)), "fold_to_the_end.toml");
+    spec.solver.rtol = 1e-10;
+    spec.solver.atol = 1e-12;
+    const RunSummary run = test::run_front_spec(spec);
+    REQUIRE(run.status == "stopped");
+    CHECK_THAT(run.stop_reason, Contains("the fold has reached the end of the string"));
+    const double exact = t0 * exact::folded_xi(f, eta, eta0);
+    if (f == 1.0) CHECK_THAT(exact, WithinRel(t0 * std::sqrt(2 * (eta - eta0)), 1e-13));
+    std::printf("fold to the free end, f = %.1f: t_stop %.12f s, exact %.12f s, relative error %.2e\n", f, run.t_stop, exact,
+                std::abs(run.t_stop - exact) / exact);
+    CHECK_THAT(run.t_stop, WithinRel(exact, 1e-9));
+  }
 }
 
 TEST_CASE("chainsim run on a front scene writes its outputs, stats.json last, and says why it stopped",
