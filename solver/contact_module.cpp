@@ -46,9 +46,9 @@ constexpr double kWrapLand = 0.05;
 /// Links along the arc: a node lands at kWrapLand h from its tangent point, on the circle at that arc behind
 /// it, so the link behind it starts with an arc of about −kWrapLand h: its arc runs out at −kWrapEnter h.
 constexpr double kWrapEnter = 3 * kWrapLand;
-/// Links along the arc: a free end has passed its tangent point (its landing root function signed negative)
-/// only where the link from the node beyond it runs within 60° of that node's tangent line (cos 60°), as an
-/// edge's side is signed (solver/string_model.cpp, kPassedCone).
+/// Links along the arc: a free end has passed its tangent point (its landing root function read on its side's
+/// line, ContactModule::wrap_land_gap) only where the link from the node beyond it runs within 60° of that
+/// node's tangent line (cos 60°), as an edge's side is signed (solver/string_model.cpp, kPassedCone).
 constexpr double kWrapPassedCone = 0.5;
 /// A sliding node whose tangential speed is within kStopWindow of the speed scale √(a ℓ) at a located
 /// stop has stopped (the state recomputed to the event is within the integration error of the root).
@@ -1170,19 +1170,24 @@ class ContactModule final : public WrappingModule<dim> {
   }
   /// Links along the arc: the landing root function of the free end of link j (its end node if `at_end`, else its
   /// start node), which runs round circle k (wrapped in the sense sense_[k]): its straight part s per h, less
-  /// kWrapLand, with s signed: negative where the end has passed its tangent point along its side. Unsigned, a
-  /// step that carried a free end through its tangent point ended with s as long again on the other side (the
-  /// link then runs round the circle from a tangent point ahead of the node, its length smooth through there
-  /// to third order): no sign change, the landing lost, the node gone on off the circle, the tension several
-  /// times, up to 10⁵ times, off (issue #23: compare pulley --R 0.005 --u0 0.1 on 801 nodes with erk8, 3·10⁶
-  /// N). The side is the straight link beyond the end i, to node `far`: the end has passed where it lies beyond
-  /// far's own tangent point along far's tangent line t_far, s_far − (x_i − x_far)·t_far < 0 (on a straight side
-  /// −s, and continuous through zero), that link within 60° of t_far (kWrapPassedCone). An end with no straight
-  /// link beyond it (the string's end, a neighbour held or on the circle) keeps s unsigned.
+  /// kWrapLand, zero where the node is at kWrapLand h from its tangent point. Past its tangent point along its side
+  /// it is negative where the node went through that distance. Unsigned, a step that carried a free end through its
+  /// tangent point ended with s as long again on the other side (the link then runs round the circle from a tangent
+  /// point ahead of the node, its length smooth through there to third order): no sign change, the landing lost,
+  /// the node gone on off the circle, the tension several times, up to 10⁵ times, off (issue #23: compare pulley
+  /// --R 0.005 --u0 0.1 on 801 nodes with erk8, 3·10⁶ N). The side is the straight link beyond the end i, to node
+  /// `far`, with far's tangent line t_far (its line were it straight). Once i lies beyond far's tangent point along
+  /// it, q = (c − x_i)·t_far < 0 (c the centre; that link within 60° of t_far, kWrapPassedCone), the value is that
+  /// at q = 0 on the line through x_i along t_far: s* = √(D² − R²) (D the centre's distance from that line; −√(R² −
+  /// D²) where the line cuts the circle), so the value is continuous at q = 0 (there s = s*; both negative where
+  /// D < R, where s is 0): negative exactly where that line passes within kWrapLand h of its tangent point, where a
+  /// node moving along it went through its landing distance. (Signing −s there instead, as before, jumped from
+  /// +s* to −s* at q = 0: a root of a node off the line, s* = √(2Rp + p²) for a node p off it, one that never came
+  /// within kWrapLand h: R = 4h, p = 0.01 h, +0.23 → −0.33.) An end with no straight link beyond it (the string's
+  /// end, a neighbour held or on the circle) keeps s unsigned.
   double wrap_land_gap(const StringModel<dim>& model, int j, bool at_end, int k) const {
     const Chain<dim>& chain = model.chain();
     const double h = chain.link_length(j), s = model.bend_straight(j, at_end);
-    double sign = 1;
     if constexpr (dim == 2) {
       const int beyond = at_end ? j + 1 : j - 1;  // the link from the end away from the circle
       const Obstacle<dim>& o = obstacles_[static_cast<std::size_t>(k)];
@@ -1198,11 +1203,15 @@ class ContactModule final : public WrappingModule<dim> {
                                                                     : sense_[static_cast<std::size_t>(k)];
           const Vec<2> t = (-s_far * r + turn * R * Vec<2>(-r[1], r[0])) / d2;
           const double along = (Vec<2>(model.x().col(i)) - Vec<2>(model.x().col(far))).dot(t);
-          if (s_far - along < 0 && along > kWrapPassedCone * h) sign = -1;
+          if (s_far - along < 0 && along > kWrapPassedCone * h) {
+            const Vec<2> ri = Vec<2>(model.x().col(i)) - o.point;
+            const double u = ri.dot(t), m2 = ri.squaredNorm() - u * u - R * R;  // u = −q; m2 = D² − R²
+            return std::copysign(std::sqrt(std::abs(m2)), m2) / h - kWrapLand;
+          }
         }
       }
     }
-    return sign * s / h - kWrapLand;
+    return s / h - kWrapLand;
   }
   /// Links along the arc, two root functions: the smallest straight part of a free end of a link that
   /// runs round a circle, per h, less kWrapLand (the end lands: wrap_land_gap), and the smallest arc of a link with a

@@ -430,8 +430,9 @@ TEST_CASE("contact: compare pulley over a pulley of four links per radius, erk8 
   // of 3.1e6 N (3.1e5 lambda g l) and a lift-off 0.028 s early. (1) A step of erk8 (7e-4 s, half a link of
   // travel) carried a node of the shorter side through its tangent point: the landing root function, its
   // straight part s unsigned, ended the step as positive as it began, the landing was lost, the node went on
-  // off the pulley, and the tension swung by factors from there on (ContactModule::wrap_land_gap now signs s:
-  // negative past the tangent point along the side). (2) With erk5 (and erk8 after (1)) the pulley let go of
+  // off the pulley, and the tension swung by factors from there on (ContactModule::wrap_land_gap now reads s
+  // past the tangent point on the side's line: negative where the node went through its landing distance).
+  // (2) With erk5 (and erk8 after (1)) the pulley let go of
   // the shorter side's first held node 2e-5 s before t*, just before the margin's zero; the steps after it, the
   // string unwrapping with its tension up to 3.5 times the wrapped chain's, were compared with the exact
   // solution, which holds to t* only: 5.7 N, and the margin's zero came 1.45e-3 s late (PulleyLiftOff::released
@@ -464,6 +465,110 @@ TEST_CASE("contact: compare pulley over a pulley of four links per radius, erk8 
     // To 1.005 t*, past the release (the unwrapping closes its ledger less well, docs/model.md §10): measured
     // 5.4e-7 with both (before: 2.1e-4 with erk8, the node gone through the pulley).
     CHECK(s["energy_residual"].get<double>() < 5e-6);
+  }
+}
+
+TEST_CASE("contact: links along the arc, a side bent off its line lands only where its node reaches the circle",
+          "[contact][pulley]") {
+  // The landing root function of a free node i at the end of a side running onto a circle (links along the
+  // arc; ContactModule::wrap_land_gap) is its straight part s_i per link length h, less c = 0.05: zero where
+  // s_i = c h, i.e. |x_i − centre|² = R² + c² h². It is signed (negative once the node has passed its
+  // tangent point along its side, so that a step that carries the node through its landing distance still
+  // ends with the root function negative). The review found the sign read from the tangent point of the
+  // node `far` beyond i: a node a distance p off far's tangent line jumped from +s_i/h − c to −s_i/h − c as
+  // it crossed the plane through far's tangent point, s_i = √(2Rp + p²) there: a root for a node that never
+  // comes within c h of its tangent point (R = 4h, p = 0.01 h: +0.233 → −0.333).
+  //
+  // The chain over a pulley of radius R = 4h (40 links, the Atwood chain at rest, the left side's last free
+  // node i = 13 half a link below the circle), and its left side (nodes 0 to 13) moved rigidly up by δ,
+  // node i set a distance p off the side's line x = −R (away from the pulley for p > 0): i moves along
+  // the line x = −R − p, so its s_i² = (R + p)² + y_i² − R². It lands (s_i = c h) at y* = −√(c²h² − 2Rp −
+  // p²) where 2Rp + p² < c²h², and nowhere where it is not. The root function is sampled along the
+  // motion and each sign change located by bisection; a node carried past its tangent point by a step
+  // that went through y* must read negative up to the end of the motion (y_i = 0.2 h). Measured: p = 0,
+  // 1e-4 h, −0.01 h land at y* = −0.05, −0.0412309, −0.287054 h to the bisection's round-off; p = 0.01 h and
+  // 0.003 h (the side's last link turned 0.57° and 0.17°) do not land (before, each had a root at y_i = 0,
+  // its straight part 0.283 h and 0.155 h there).
+  const double ell = 1, R = 0.1, c = 0.05;
+  const int links = 40, i = 13;
+  const double h = ell / links, x2 = (i + 0.5) * h;
+  Chain<2> chain = test::pulley_chain(1.0, ell, R, x2, 0.0, links);
+  std::vector<std::unique_ptr<Force<2>>> forces;
+  forces.push_back(std::make_unique<Gravity<2>>(Vec<2>(0.0, -kG)));
+  Obstacle<2> pulley = test::pulley(R);
+  pulley.arc_links = true;
+  StringModel<2> model(std::move(chain), std::move(forces), {}, contact_options(), make_contact_module<2>({pulley}));
+  model.make_consistent(0.0);  // the start of a run (StringSolver::run)
+  Eigen::VectorXd y0 = model.state_from_chain();
+  model.start_module(0.0, y0.tail(y0.size() - model.work_index() - 1));
+  y0.head(model.work_index()) = model.state_from_chain().head(model.work_index());
+  bool i_held = false, next_held = false;
+  for (const auto& contact : model.contacts()) {
+    i_held = i_held || contact.node == i;
+    next_held = next_held || contact.node == i + 1;
+  }
+  REQUIRE((!i_held && next_held));  // node i free, the link from it to the held node i + 1 bent over the circle
+  REQUIRE(model.num_events() == 4);  // landing, lift-off, links along the arc: landing, arc run out
+  const int land = 2;
+  // The state with the side moved up by δ and node i a distance p off its line; the landing root function.
+  Eigen::VectorXd g(model.num_events());
+  auto at = [&](double p, double delta) {
+    Eigen::VectorXd y = y0;
+    for (int k = 0; k <= i; ++k) y[2 * k + 1] += delta;
+    const double beta = std::asin(p / h);  // the link from node i − 1 to i turned by β off the side's line
+    y[2 * i] = y[2 * (i - 1)] - h * std::sin(beta);
+    y[2 * i + 1] = y[2 * (i - 1) + 1] + h * std::cos(beta);
+    model.events(0.0, y, g);
+    return std::pair<double, double>(g[land], y[2 * i + 1]);  // the root function, y_i
+  };
+  // δ for a given y_i.
+  const double y_before = y0[2 * (i - 1) + 1];
+  auto delta_of = [&](double p, double yi) { return yi - y_before - h * std::cos(std::asin(p / h)); };
+  for (const double p_h : {0.0, 1e-4, -1e-2, 1e-2, 3e-3}) {
+    const double p = p_h * h;
+    const double m2 = c * c * h * h - 2 * R * p - p * p;  // y*² where it lands
+    const bool lands = m2 > 0;
+    const double y_star = lands ? -std::sqrt(m2) : NAN;
+    const double d0 = delta_of(p, -0.45 * h), d1 = delta_of(p, 0.2 * h);
+    const int samples = 2600;
+    std::vector<double> roots;
+    double g_after = -INFINITY, g_prev = at(p, d0).first;
+    double g_last_before = NAN, g_first_after = NAN;
+    for (int n = 1; n <= samples; ++n) {
+      const double d = d0 + (d1 - d0) * n / samples, dp = d0 + (d1 - d0) * (n - 1) / samples;
+      const double gn = at(p, d).first;
+      if ((gn > 0) != (g_prev > 0)) {
+        double lo = dp, hi = d;  // bisection to round-off
+        for (int it = 0; it < 60; ++it) {
+          const double mid = 0.5 * (lo + hi);
+          ((at(p, mid).first > 0) == (g_prev > 0) ? lo : hi) = mid;
+        }
+        roots.push_back(at(p, 0.5 * (lo + hi)).second);
+        if (roots.size() == 1) {
+          g_last_before = g_prev;
+          g_first_after = gn;
+        }
+      }
+      if (!roots.empty()) g_after = std::max(g_after, gn);
+      g_prev = gn;
+    }
+    std::printf("  side's last link turned %.3g deg, node %d at p = %g h: %zu sign change(s) of the landing root function",
+                std::asin(p / h) * 180 / kPulleyPi, i, p_h, roots.size());
+    if (!roots.empty())
+      std::printf(", the first at y_i = %.6g h (root function %.3g -> %.3g), s_i = %.4g h there", roots[0] / h,
+                  g_last_before, g_first_after, std::sqrt((R + p) * (R + p) + roots[0] * roots[0] - R * R) / h);
+    if (lands)
+      std::printf("; exact landing at y* = %.6g h\n", y_star / h);
+    else
+      std::printf("; exact: no landing (s_i >= %.6g h)\n", std::sqrt(2 * R * p + p * p) / h);
+    INFO("p = " << p_h << " h");
+    if (lands) {
+      REQUIRE(roots.size() == 1);
+      CHECK(std::abs(roots[0] - y_star) < 1e-9 * h);
+      CHECK(g_after < 0);  // past its tangent point, still caught
+    } else {
+      CHECK(roots.empty());
+    }
   }
 }
 
