@@ -40,6 +40,18 @@ constexpr double kRoundoffUlps = 64;
 /// may take (evaluate_current).
 constexpr double kDriftRoundoff = 1e-6;
 constexpr int kProjectionIterations = 60;
+// Arcs in increasing order of their nodes, disjoint, within the string's n nodes, and a closed arc only as the
+// whole of a closed string: what tension_forces_of_string's pass needs.
+bool arcs_in_order(const std::vector<ArcRange>& arcs, int n, bool closed_string) {
+  int previous_last = -1;
+  for (const ArcRange& arc : arcs) {
+    if (arc.first <= previous_last || arc.last < arc.first || arc.last >= n) return false;
+    if (arc.closed && !(closed_string && arc.first == 0 && arc.last == n - 1)) return false;
+    previous_last = arc.last;
+  }
+  return true;
+}
+
 /// slack = allow: whether a taut link goes slack at a state where it is `gap` (of h) short of its length (accept_step,
 /// and the frames interpolated inside a step, projected_state): short by more than `slack_gap` (kSlackGap) and
 /// released, by the last evaluation (no tension) or by any since the last accepted step (`released`).
@@ -837,32 +849,41 @@ void StringModel<dim>::refresh() {
 
 template <int dim>
 void StringModel<dim>::tension_forces_of_string(const Eigen::VectorXd& T) {
-  // The whole string is one arc, link j = unknown j from node j to node j + 1 (to node 0 for the last
-  // link of a closed string). Node by node, with each node's two terms in the order of the link-by-link
-  // sum T_j e_j at the start, −T_j e_j at the end from zero (for_each_link): the same numbers, without
-  // zeroing the array and writing every node twice.
-  const int n = chain_.num_nodes(), L = chain_.num_links();
-  if (L == 0) {
-    tension_force_.setZero();
-    return;
-  }
+  // Arc by arc (link q of arc k = unknown first_unknown_[k] + q, from node first + q to the next; without a
+  // module one arc, the whole string), node by node, with each node's two terms in the order of the
+  // link-by-link sum T_j e_j at the start, −T_j e_j at the end from zero (for_each_link): the same numbers,
+  // without zeroing the array (but for the nodes in no arc) and writing every node of the arcs twice. For
+  // arcs in order (arcs_in_order).
+  const int n = chain_.num_nodes();
+  int covered = 0;
+  for (const ArcRange& arc : arcs_) covered += arc.num_nodes();
+  if (covered < n) tension_force_.setZero();  // the nodes in no arc
   // Raw pointers in locals, as in links(); T_j e_j carried from one node to the next.
   using CMap = Eigen::Map<const Vec<dim>>;
   const double* const e = e_.data();
   const double* const tension = T.data();
   double* const out = tension_force_.data();
-  const auto te = [&](int j) { return Vec<dim>(tension[j] * CMap(e + dim * j)); };
-  Vec<dim> previous = te(0);
-  Eigen::Map<Vec<dim>> first(out);
-  first = Vec<dim>::Zero() + previous;
-  if (chain_.closed()) first -= te(L - 1);
-  for (int i = 1; i < n; ++i) {
-    Vec<dim> f = Vec<dim>::Zero() - previous;
-    if (i < L) {
-      previous = te(i);
-      f += previous;
+  for (std::size_t k = 0; k < arcs_.size(); ++k) {
+    const ArcRange& arc = arcs_[k];
+    const int nl = arc.num_links(), u0 = first_unknown_[k];
+    Eigen::Map<Vec<dim>> first(out + dim * arc.first);
+    if (nl == 0) {
+      first.setZero();
+      continue;
     }
-    Eigen::Map<Vec<dim>>(out + dim * i) = f;
+    // link q of the arc: unknown u0 + q, direction e of link arc.first + q
+    const auto te = [&](int q) { return Vec<dim>(tension[u0 + q] * CMap(e + dim * (arc.first + q))); };
+    Vec<dim> previous = te(0);
+    first = Vec<dim>::Zero() + previous;
+    if (arc.closed) first -= te(nl - 1);
+    for (int q = 1; q < arc.num_nodes(); ++q) {
+      Vec<dim> f = Vec<dim>::Zero() - previous;
+      if (q < nl) {
+        previous = te(q);
+        f += previous;
+      }
+      Eigen::Map<Vec<dim>>(out + dim * (arc.first + q)) = f;
+    }
   }
 }
 
@@ -953,7 +974,7 @@ double StringModel<dim>::evaluate_current(double t) {
       last_tension_.resize(static_cast<std::size_t>(chain_.num_links()), 0.0);
       for_each_link([&](int j, int u, int) { last_tension_[static_cast<std::size_t>(j)] = T[u]; });
     }
-    if (!module_ && bends_.empty()) {
+    if (bends_.empty() && arcs_in_order(arcs_, chain_.num_nodes(), chain_.closed())) {
       tension_forces_of_string(T);
     } else {
       tension_force_.setZero();
@@ -980,7 +1001,7 @@ double StringModel<dim>::evaluate_current(double t) {
     if (module_) reaction -= module_force_.col(i);
     power += (reaction + force_nc(i)).dot(v_.col(i));
   };
-  if (!module_ && !quadratic_ && force_nc_.cols() == 0) {
+  if (!quadratic_ && force_nc_.cols() == 0) {
     // A free node's power term is force_nc·v = ±0 here, which leaves the sum as it is (it starts at
     // +0 and is never −0): the free nodes' accelerations in runs, then the prescribed nodes in order.
     const double* const tf = tension_force_.data();
@@ -988,7 +1009,26 @@ double StringModel<dim>::evaluate_current(double t) {
     for (const FreeRun& run : free_runs_)
       for (int i = run.node, end = run.node + run.count; i < end; ++i)
         Map(a_of + dim * i) = CMap(b_of + dim * i) + w[i] * CMap(tf + dim * i);
-    for (const int i : prescribed_in_arcs_) prescribed_node(i);
+    if (!module_) {
+      for (const int i : prescribed_in_arcs_) prescribed_node(i);
+    } else {
+      // The external force Σ F_i (+ R_i at a prescribed node) over the nodes of the arcs in the order of
+      // the nodes, as the loop below sums it: the free runs and the prescribed nodes merged (both in that
+      // order). A free node's F_nc + 0 terms are ±0, which leave a sum that is never −0 as it is.
+      Vec<dim> external = Vec<dim>::Zero();
+      std::size_t p = 0;
+      const std::size_t np = prescribed_in_arcs_.size();
+      const auto prescribed_external = [&](int i) {
+        prescribed_node(i);
+        external += force_.col(i) + force_nc(i) + Vec<dim>(reaction_.col(path_of_[i]));
+      };
+      for (const FreeRun& run : free_runs_) {
+        for (; p < np && prescribed_in_arcs_[p] < run.node; ++p) prescribed_external(prescribed_in_arcs_[p]);
+        for (int i = run.node, end = run.node + run.count; i < end; ++i) external += CMap(f + dim * i);
+      }
+      for (; p < np; ++p) prescribed_external(prescribed_in_arcs_[p]);
+      external_ = external;
+    }
   } else {
     for (int i = 0; i < n; ++i) {
       if (arc_of_[i] < 0) continue;

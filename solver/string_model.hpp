@@ -481,8 +481,8 @@ class StringModel final : public OdeSystem {
   double evaluate_current(double t);
   /// rhs()'s output from the evaluation just made (evaluate_current, which returned `power`).
   void write_rates(double power, Eigen::Ref<Eigen::VectorXd> ydot);
-  /// evaluate_current without a module or bent links: the tension forces T_j e_j − T_{j−1} e_{j−1} of
-  /// the nodes from the tensions T (per link), in one pass.
+  /// evaluate_current without bent links, for arcs in order: the tension forces T_j e_j − T_{j−1} e_{j−1}
+  /// of the nodes from the tensions T (per unknown), arc by arc in one pass (zero at the nodes in no arc).
   void tension_forces_of_string(const Eigen::VectorXd& T);
   /// The tension solve of an evaluation: the linear system, or with slack = allow the
   /// complementarity problem on the taut links (slack ones excluded).
