@@ -1519,7 +1519,14 @@ Eigen::VectorXd StringModel<dim>::projected_state(double t, const Eigen::Ref<con
   // frame's K + V off by the work that takes (a chain's top driven down, the node below it flying after a snap:
   // −0.069 J in a frame at 0.16 s, docs/model.md §9 "Frames inside a step"). The frame leaves such links free,
   // as the step's end will; their flags are restored for the run.
-  std::vector<int> freed;
+  // The flags are restored however the projection ends (it throws when it does not converge).
+  struct Restore {
+    StringModel& model;
+    std::vector<int> freed;
+    ~Restore() {
+      for (const int j : freed) model.set_slack(j, false);
+    }
+  } restore{*this, {}};
   if (allows_slack() && system_ && !quadratic_)
     for (int j = 0; j < chain_.num_links(); ++j) {
       if (link_slack(j) || link_unknown_[static_cast<std::size_t>(j)] < 0) continue;
@@ -1527,12 +1534,11 @@ Eigen::VectorXd StringModel<dim>::projected_state(double t, const Eigen::Ref<con
       if (goes_slack((h - current_length(j)) / h, kSlackGap, link_tension(j),
                      any_released_ && released_[static_cast<std::size_t>(j)])) {
         set_slack(j, true);
-        freed.push_back(j);
+        restore.freed.push_back(j);
       }
     }
   refresh();
   project(t);
-  for (const int j : freed) set_slack(j, false);
   return pack(y.tail(1 + num_ledgers_));
 }
 
@@ -1921,10 +1927,12 @@ void StringModel<dim>::accept_step(double t, const Eigen::Ref<const Eigen::Vecto
         set_slack(j, true);
         rebound_time_[static_cast<std::size_t>(j)] = NAN;  // released by the tensions: a flight, not a rebound
       }
-    } else if (gap + slack_offset_[static_cast<std::size_t>(j)] < -kSlackGap) {
+    } else if (const double root = slack_root(j); root < -kSlackGap) {
+      // The snap's own root function (its offset dropped from the top of the flight on): a link past its top that
+      // had gone 4e-7 h past its length passed unflagged when the check added the offset regardless.
       throw NumericalError(fmt::format("at t = {:.9g} s slack link {} (s = {:.6g} m) is {:.3g} of its length past it: "
                                        "its snap taut was not located",
-                                       t, j, chain_.link_midpoint(j), -(gap + slack_offset_[static_cast<std::size_t>(j)])),
+                                       t, j, chain_.link_midpoint(j), -root),
                            t);
     }
   }
