@@ -178,6 +178,17 @@ class SlackModule final : public WrappingModule<dim> {
     const typename StringModel<dim>::SnapResult snap = model.snap(t);
     if (snap.caught == 0) return action;
     book(snap, ledger);
+    // The snap's impulses can leave another slack link at or past its length with its root function at or below
+    // zero at the restart, where ARKODE would never find its snap: one already past its length whose offset the
+    // impulse ended (it turned to lengthening, slack_root), or one whose rate is a rounding zero. Every later snap
+    // would then go unseen, and accept_step stops the run ("its snap taut was not located": contact = "arc" on a
+    // shaken pulley, 51 to 401 nodes). Such links are caught now, by the same law, until none is left (each round
+    // catches at least one link: at most one round per link).
+    for (int round = 0; round < model.chain().num_links() && model.slack_gap() <= 0; ++round) {
+      const typename StringModel<dim>::SnapResult again = model.snap(t);
+      if (again.caught == 0) break;
+      book(again, ledger);
+    }
     if (inner_) {
       inner_->release_contacts(model, t);  // held nodes the snap would pull off a surface
       // ARKODE restarts from the state after the snap and finds only sign changes from there: a check of
