@@ -82,6 +82,8 @@ void StringModelOptions::validate() const {
   require_in_range("solver.stabilization_time", stabilization_time, 0.0, INFINITY);
   require_in_range("solver.slack_tolerance", slack_tolerance, 0.0, 1.0);
   require_in_range("solver.snap_restitution", snap_restitution, 0.0, 1.0);
+  if (rotation && !(rotation->omega.allFinite() && rotation->center.allFinite()))
+    throw InputError("velocity.omega and velocity.center of a rigid rotation must be finite numbers");
   if (backend != "auto") make_tension_backend(backend);  // throws InputError for an unknown name
   if (linear_solver != "auto" && linear_solver != "banded" && linear_solver != "klu")
     throw InputError(fmt::format("solver.linear_solver = \"{}\" is not allowed; valid values: \"auto\", \"banded\", \"klu\"",
@@ -1436,6 +1438,12 @@ void StringModel<dim>::start_impulses(double t0) {
 }
 
 template <int dim>
+void StringModel<dim>::set_rotation_velocities() {
+  for (int i = 0; i < chain_.num_nodes(); ++i)
+    if (in_arc(i) && path_of_[i] < 0) v_.col(i) = options_.rotation->template velocity<dim>(x_.col(i));
+}
+
+template <int dim>
 void StringModel<dim>::set_sliding_velocities(double speed) {
   // The string sliding along itself (docs/scenes.md, "The velocity kinds"). Along the direction of
   // motion each node has an incoming direction a (the string before it) and an outgoing one b, turned
@@ -1556,10 +1564,21 @@ double StringModel<dim>::make_consistent(double t0) {
         !(current_length(j) < (1 - kSlackGap) * chain_.link_length(j)))
       throw InputError(fmt::format("link {} is declared slack but is not shorter than its length {:g} m",
                                    j, chain_.link_length(j)));
-  const Points<dim> x_start = x_, v_start = v_;
+  const Points<dim> x_start = x_;
+  Points<dim> v_start = v_;
   double K_start = 0;
   try {
     refresh();
+    if (options_.rotation && system_) {
+      // A rigid rotation (StringModelOptions::rotation) is the rotation of the projected shape: the positions onto
+      // the links' lengths first, then v = ω × (x − c) there. It is the scene's velocities the start's jump is
+      // measured from, and it keeps every link's length: the start's projection (or snap) below changes it by
+      // round-off (the positions' projection again, a no-op now).
+      project_positions(t0);
+      set_rotation_velocities();
+      refresh();
+      v_start = v_;
+    }
     K_start = kinetic_energy();
     if (allows_slack() && system_ && !quadratic_) {
       start_impulses(t0);

@@ -40,6 +40,7 @@
 #include <vector>
 
 #include <Eigen/Core>
+#include <Eigen/Geometry>
 
 #include "mesh/chain.hpp"
 #include "forces.hpp"
@@ -92,6 +93,25 @@ struct StringModelOptions {
   /// sliding along itself, whose initial velocities the model sets once its module has bent its links
   /// (StringModel::set_sliding_velocities; docs/scenes.md, the velocity kinds). Unset: the chain's own.
   std::optional<double> sliding_speed;
+  /// `[velocity] kind = "rotation"`: a rigid rotation v = ω × (x − c). The model gives it to the free nodes in its
+  /// arcs at the start, after the positions' projection onto the links' lengths (make_consistent), so that it is
+  /// the rigid rotation of the projected shape: compatible with every link, no snap at t = 0 (docs/scenes.md, the
+  /// velocity kinds). Unset: the chain's own velocities.
+  struct RigidRotation {
+    Eigen::Vector3d omega = Eigen::Vector3d::Zero();   ///< rad/s; in 2D omega.z() only (out of the plane)
+    Eigen::Vector3d center = Eigen::Vector3d::Zero();  ///< m; in 2D its first two components
+    /// ω × (x − c) at x.
+    template <int dim>
+    Vec<dim> velocity(const Vec<dim>& x) const {
+      if constexpr (dim == 2) {
+        const Vec<dim> r = x - center.head<2>();
+        return omega.z() * Vec<dim>(-r[1], r[0]);
+      } else {
+        return omega.cross(Eigen::Vector3d(x - center));
+      }
+    }
+  };
+  std::optional<RigidRotation> rotation;
   void validate() const;
 };
 
@@ -503,6 +523,9 @@ class StringModel final : public OdeSystem {
   /// make_consistent with slack = allow: the positions projected, the velocities by the snap's law at
   /// t0 (link_impulses with the scene's restitution; links shortening at the start go slack).
   void start_impulses(double t0);
+  /// make_consistent with options_.rotation, after the positions' projection: v = ω × (x − c) at the free nodes
+  /// in the arcs (the prescribed ones keep their paths' velocities, nodes in no arc the chain's).
+  void set_rotation_velocities();
   /// project_positions' Newton iteration onto the links' lengths and the held nodes' surfaces.
   void project_link_lengths(double t);
   /// The module's constraints beyond the links (NodeConstraint): evaluate_current, after the tension

@@ -48,6 +48,9 @@ struct CompareCommandOptions {
   std::optional<double> x0;  ///< edge: the hanging fraction at release (default 0.2); peg: the longer side's (0.6)
   std::optional<double> u0;      ///< pulley: the offset at release (m; default 0.05)
   std::optional<double> radius;  ///< pulley: the pulley's radius R (m; default 0.1)
+  /// --f and --eps were given (whatever their value: setup holds their defaults otherwise). The command sets them from
+  /// the options' counts, compare() from its keywords; compare pulley refuses both, edge and peg --eps.
+  bool f_given = false, eps_given = false;
   std::string out;        ///< output directory; "" = results/compare/<problem>
   bool json = false;
 };

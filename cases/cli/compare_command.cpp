@@ -47,7 +47,7 @@ EdgeCaseSetup edge_setup(const CompareCommandOptions& options, PointContactProbl
     throw InputError(fmt::format("--eta0 = {}: compare {} starts from --x0, {}", *s.eta0, name, x0_range));
   if (s.force != 0)
     throw InputError(fmt::format("--force = {}: only the folded chain has an end force (compare {}: 0)", s.force, name));
-  if (s.eps != StringCaseSetup{}.eps)
+  if (options.eps_given)
     throw InputError(fmt::format("--eps = {}: compare {} stops at the lift-off and has no cutoff", s.eps, name));
   refuse_pulley_options(options);
   refuse_implicit_method(s, name);
@@ -69,9 +69,9 @@ PulleyCaseSetup pulley_setup(const CompareCommandOptions& options) {
   if (options.x0) throw InputError(fmt::format("--x0 = {}: compare pulley starts from --u0 (m, 0 < u0 < (l - pi R)/2)", *options.x0));
   if (s.force != 0)
     throw InputError(fmt::format("--force = {}: only the folded chain has an end force (compare pulley: 0)", s.force));
-  if (s.eps != StringCaseSetup{}.eps)
+  if (options.eps_given)
     throw InputError(fmt::format("--eps = {}: compare pulley stops at the lift-off and has no cutoff", s.eps));
-  if (s.chain.dissipation != StringCaseSetup{}.chain.dissipation)
+  if (options.f_given)  // even at the default value: the pulley's exact solution has no f
     throw InputError(fmt::format("--f = {}: compare pulley has no f (a smooth pulley; its touchdowns are perfectly "
                                  "inelastic node impacts, docs/model.md section 10)", s.chain.dissipation));
   refuse_implicit_method(s, "pulley");

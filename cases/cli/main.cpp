@@ -145,8 +145,9 @@ int main(int argc, char** argv) {
   cmd_compare->add_option("problem", compare.problem, "falling | folded | sliding | edge | peg | pulley")->required();
   auto& cs = compare.setup;
   cmd_compare->add_option("--nodes", cs.nodes, "nodes of the string, 4 <= N <= 200001")->capture_default_str();
-  cmd_compare->add_option("--f", cs.chain.dissipation, "shock dissipation parameter f, 0 <= f <= 1")->capture_default_str();
-  cmd_compare->add_option("--eps", cs.eps, "cutoff eps, 0 < eps < 1")->capture_default_str();
+  auto* opt_compare_f =
+      cmd_compare->add_option("--f", cs.chain.dissipation, "shock dissipation parameter f, 0 <= f <= 1")->capture_default_str();
+  auto* opt_compare_eps = cmd_compare->add_option("--eps", cs.eps, "cutoff eps, 0 < eps < 1")->capture_default_str();
   cmd_compare->add_option("--eta0", cs.eta0, "initial eta = y(0)/l (defaults: falling 1, folded 0, sliding 0)");
   cmd_compare->add_option("--force", cs.force, "upward force F on the free end of the folded chain (N), F >= 0")
       ->capture_default_str();
@@ -261,7 +262,11 @@ int main(int argc, char** argv) {
     int code = 1;
     if (*cmd_reduced) code = chainsim::run_reduced_command(reduced, out);
     if (*cmd_canonical) code = chainsim::run_canonical_command(canonical, out);
-    if (*cmd_compare) code = chainsim::run_compare_command(compare, out);
+    if (*cmd_compare) {
+      compare.f_given = opt_compare_f->count() > 0;
+      compare.eps_given = opt_compare_eps->count() > 0;
+      code = chainsim::run_compare_command(compare, out);
+    }
     if (*cmd_run) {
       if (opt_t_end->count() > 0) run.t_end = run_t_end;
       if (opt_max_wall->count() > 0) run.max_wall = run_max_wall;

@@ -206,7 +206,11 @@ SceneParts<dim> build_scene_parts(const SceneSpec& spec) {
     const Points<dim> values = as_points<dim>(spec, vel.values, "velocity.values");
     at_key(spec, "velocity.values", [&] { set_node_velocities(chain, values); });
   }
-  if (vel.kind == "rotation") {  // a rigid rotation: v_i = ω × (x_i − c)
+  // A rigid rotation, v_i = ω × (x_i − c): the model sets it once the start has projected the positions onto the
+  // links' lengths (StringModelOptions::rotation), so that it is rigid for the projected shape; the chain carries it
+  // at the shape's nodes until then (the scales below, a module's set-up).
+  std::optional<StringModelOptions::RigidRotation> rotation;
+  if (vel.kind == "rotation") {
     const Vec<dim> center = as_vec<dim>(spec, vel.center, "velocity.center");
     const std::size_t components = dim == 2 ? 1 : 3;
     if (vel.omega.size() != components)
@@ -214,15 +218,14 @@ SceneParts<dim> build_scene_parts(const SceneSpec& spec) {
               fmt::format("velocity.omega = {} has {} component{} but string.dimension = {}: allowed {}",
                           text_of(spec, "velocity.omega"), vel.omega.size(), vel.omega.size() == 1 ? "" : "s",
                           spec.dimension, dim == 2 ? "a number (rad/s about the out-of-plane axis)" : "[wx, wy, wz]"));
+    rotation.emplace();
+    rotation->center.head<dim>() = center;
+    if constexpr (dim == 2)
+      rotation->omega.z() = vel.omega[0];
+    else
+      rotation->omega = Eigen::Vector3d(vel.omega[0], vel.omega[1], vel.omega[2]);
     Points<dim> values(dim, chain.num_nodes());
-    for (int i = 0; i < chain.num_nodes(); ++i) {
-      const Vec<dim> r = chain.positions().col(i) - center;
-      if constexpr (dim == 2) {
-        values.col(i) = vel.omega[0] * Vec<dim>(-r[1], r[0]);
-      } else {
-        values.col(i) = Eigen::Vector3d(vel.omega[0], vel.omega[1], vel.omega[2]).cross(Eigen::Vector3d(r));
-      }
-    }
+    for (int i = 0; i < chain.num_nodes(); ++i) values.col(i) = rotation->velocity<dim>(chain.positions().col(i));
     at_key(spec, "velocity.omega", [&] { set_node_velocities(chain, values); });
   }
 
@@ -323,6 +326,7 @@ SceneParts<dim> build_scene_parts(const SceneSpec& spec) {
                                     : SlackPolicy::kStop;
   mo.snap_restitution = so.snap_restitution;
   if (spec.velocity.kind == "tangential" && slides_exactly(spec)) mo.sliding_speed = spec.velocity.speed;
+  mo.rotation = rotation;
   if (mo.slack == SlackPolicy::kAllow) {
     if (spec.elements == "quadratic")
       at_key(spec, "solver.slack", [&] {

@@ -405,9 +405,14 @@ void set_common(Setup& s, const py::dict& kw, CompareCommandOptions* options = n
   for (const auto& [key, value] : kw) {
     const std::string k = utf8(key, fn + "() keyword");
     auto real = [&] { return real_arg(fn, k, value); };
-    if (k == "f") s.chain.dissipation = real();
-    else if (k == "eta0") { if (!value.is_none()) s.eta0 = real(); }
-    else if (k == "eps") s.eps = real();
+    if (k == "f") {
+      s.chain.dissipation = real();
+      if (options) options->f_given = true;  // (compare pulley refuses f at any value, as the command's --f)
+    } else if (k == "eta0") { if (!value.is_none()) s.eta0 = real(); }
+    else if (k == "eps") {
+      s.eps = real();
+      if (options) options->eps_given = true;
+    }
     else if (k == "force") s.force = real();
     else if (k == "length") s.chain.length = real();
     else if (k == "density") s.chain.density = real();

@@ -763,8 +763,12 @@ t_end = 1.0
   CHECK(std::abs(r.t_stop - 0.4227) < 1e-3);  // measured 0.422698 s
   CHECK_THAT(r.stop_reason, Catch::Matchers::Contains("outside its kinked link, beyond node 1, and moves on away") &&
                                 Catch::Matchers::Contains("it has in effect reached the start of the string"));
-  CHECK(std::abs(r.relative_energy_residual()) < 3e-9);  // measured 9.4e-10
-  CHECK(r.relative_momentum_residual() < 5e-10);         // measured 1.4e-10
+  // Measured 5.9e-9 and 2.0e-9 since the rotation is the rigid rotation of the projected shape
+  // (StringModelOptions::rotation: no snap at t = 0, none in the run; 9.4e-10 and 1.4e-10 with the start's snap of
+  // 6e-12 J and 3 snaps before): the energy drift is below 1.1e-11 J at every frame to 0.4 s in both, and the
+  // difference is the located stop's last step (1.5e-9 J before, -8.3e-9 J now).
+  CHECK(std::abs(r.relative_energy_residual()) < 2e-8);
+  CHECK(r.relative_momentum_residual() < 8e-9);
 }
 
 TEST_CASE("a kink whose crossing would leave a node less than half its mass stops there", "[kink][slack]") {

@@ -203,6 +203,9 @@ def test_a_pulley_thinner_than_its_links_warns():
                               r"is below 1.49e-154 m"),
     ("pulley", {"t_max": -1}, r"--t-max = -1 is out of range: allowed t_max > 0"),
     ("pulley", {"f": 0.5}, r"--f = 0.5: compare pulley has no f"),
+    ("pulley", {"f": 0.83}, r"--f = 0.83: compare pulley has no f"),   # the default, given: refused as the command's
+    ("pulley", {"eps": 0.01}, r"--eps = 0.01: compare pulley stops at the lift-off and has no cutoff"),
+    ("edge", {"eps": 0.01}, r"--eps = 0.01: compare edge stops at the lift-off and has no cutoff"),
     ("pulley", {"x0": 0.3}, r"--x0 = 0.3: compare pulley starts from --u0"),
     ("edge", {"u0": 0.1}, r"--u0 = 0.1: only compare pulley takes --u0 \(compare edge\)"),
     ("peg", {"R": 0.1}, r"--R = 0.1: only compare pulley takes --R \(compare peg\)"),

@@ -497,6 +497,11 @@ TEST_CASE("chainsim compare pulley --json: the heavy Atwood chain over a pulley 
       {"compare pulley --R 0.4", "chainsim: error: --R = 0.4 is out of range: allowed 0 < R < 0.31830"},
       {"compare pulley --x0 0.3", "chainsim: error: --x0 = 0.3: compare pulley starts from --u0"},
       {"compare pulley --f 0.5", "chainsim: error: --f = 0.5: compare pulley has no f"},
+      // refused when given, at the default value too (they were taken silently)
+      {"compare pulley --f 0.83", "chainsim: error: --f = 0.83: compare pulley has no f"},
+      {"compare pulley --eps 0.01", "chainsim: error: --eps = 0.01: compare pulley stops at the lift-off and has no cutoff"},
+      {"compare edge --eps 0.01", "chainsim: error: --eps = 0.01: compare edge stops at the lift-off and has no cutoff"},
+      {"compare peg --eps 0.01", "chainsim: error: --eps = 0.01: compare peg stops at the lift-off and has no cutoff"},
       {"compare pulley --nodes 2", "chainsim: error: --nodes = 2 is out of range: allowed 3 <= nodes <= 200001"},
       {"compare edge --u0 0.1", "chainsim: error: --u0 = 0.1: only compare pulley takes --u0"},
       {"compare folded --R 0.1", "chainsim: error: --R = 0.1: only compare pulley takes --R"},
