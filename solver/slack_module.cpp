@@ -175,6 +175,7 @@ class SlackModule final : public WrappingModule<dim> {
     // would never find it (a loop round a pulley: the link then went on stretching unseen).
     const bool stretched = action.kind == EventAction::Kind::kTransfer && model.slack_gap() <= 0;
     if (found[static_cast<std::size_t>(k)] == 0 && !stretched) return action;
+    const long snaps_before = snaps_;
     const typename StringModel<dim>::SnapResult snap = model.snap(t);
     if (snap.caught == 0) return action;
     book(snap, ledger);
@@ -182,15 +183,22 @@ class SlackModule final : public WrappingModule<dim> {
     // zero at the restart, where ARKODE would never find its snap: one already past its length whose offset the
     // impulse ended (it turned to lengthening, slack_root), or one whose rate is a rounding zero. Every later snap
     // would then go unseen, and accept_step stops the run ("its snap taut was not located": contact = "arc" on a
-    // shaken pulley, 51 to 401 nodes). Such links are caught now, by the same law, until none is left (each round
-    // catches at least one link: at most one round per link).
-    for (int round = 0; round < model.chain().num_links() && model.slack_gap() <= 0; ++round) {
-      const typename StringModel<dim>::SnapResult again = model.snap(t);
-      if (again.caught == 0) break;
-      book(again, ledger);
+    // shaken pulley, 51 to 401 nodes). Such links are caught now, by the same law, round after round (each catches a
+    // link at least; a link can be caught again if a later round's impulses set it slack, so the rounds are capped
+    // at the number of links). The held nodes the snaps would pull off a surface are let go between rounds: a
+    // lift-off re-routes a link along an arc, which changes its length at once.
+    const int max_rounds = model.chain().num_links();
+    for (int round = 0;; ++round) {
+      while (round < max_rounds && model.slack_gap() <= 0) {
+        const typename StringModel<dim>::SnapResult again = model.snap(t);
+        if (again.caught == 0) break;
+        book(again, ledger);
+        ++round;
+      }
+      if (!inner_ || !inner_->release_contacts(model, t) || round >= max_rounds) break;
+      model.refresh();
     }
     if (inner_) {
-      inner_->release_contacts(model, t);  // held nodes the snap would pull off a surface
       // ARKODE restarts from the state after the snap and finds only sign changes from there: a check of
       // the fronts that the snap has made fail (an edge that would now have to pull the string) is acted
       // on here, as at the start of a run.
@@ -202,7 +210,7 @@ class SlackModule final : public WrappingModule<dim> {
         if (!failed.empty()) {
           EventAction stop = inner_->handle_events(model, t, ledger.head(kl), failed);
           if (stop.kind == EventAction::Kind::kStop) {
-            --snaps_;  // the run stops on the state before it (the runner records that state)
+            snaps_ = snaps_before;  // the run stops on the state before them (the runner records that state)
             stop.reason = fmt::format("at the snap taut at t = {:.9g} s: {}", t, stop.reason);
             return stop;
           }

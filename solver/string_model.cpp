@@ -1578,6 +1578,10 @@ double StringModel<dim>::make_consistent(double t0) {
       set_rotation_velocities();
       refresh();
       v_start = v_;
+      // Once: the later calls (the solver's start calls make_consistent again on the scene's consistent state) start
+      // from the velocities this start left; setting the rotation again would book its jump once more (a fixed end
+      // off the centre: the start's ΔK twice, −4.78 instead of −2.39 J; review).
+      options_.rotation.reset();
     }
     K_start = kinetic_energy();
     if (allows_slack() && system_ && !quadratic_) {
