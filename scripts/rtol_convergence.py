@@ -14,6 +14,7 @@ import csv
 import json
 import math
 import subprocess
+import sys
 import tempfile
 
 
@@ -41,14 +42,25 @@ def main():
             out = f"{tmp}/{r:g}"
             res = subprocess.run([a.chainsim, "run", a.scene, "--out", out, "--json", "--set", f"solver.rtol={r:g}",
                                   "--set", f"solver.atol={r * 1e-2:g}"], capture_output=True, text=True)
-            summary = json.loads(res.stdout)
+            try:
+                summary = json.loads(res.stdout)
+            except json.JSONDecodeError:
+                sys.exit(f"rtol_convergence: the run at rtol {r:g} wrote no summary (exit {res.returncode}): "
+                         f"{res.stderr.strip()}")
+            if "steps" not in summary:
+                sys.exit(f"rtol_convergence: the run at rtol {r:g} did not start (exit {res.returncode}): "
+                         f"{summary.get('error') or res.stderr.strip()}")
             print(f"rtol {r:g}: {summary['status']}, {summary['steps']} steps")
             runs.append(positions(f"{out}/nodes.csv", a.times))
+            missing = [t for t in a.times if not runs[-1][t]]
+            if missing:
+                sys.exit(f"rtol_convergence: no frame at t = {', '.join(f'{t:g}' for t in missing)} s in the run at rtol "
+                         f"{r:g} (the times must be frame times of the scene, before its end)")
     for k in range(1, len(runs)):
         cells = []
         for t in a.times:
             x0, x1 = runs[k - 1][t], runs[k][t]
-            d = max(math.dist(x0[i], x1[i]) for i in x0)
+            d = max(math.dist(x0[i], x1[i]) for i in x0 if i in x1)
             cells.append(f"{d:.2e} m at {t:g} s")
         print(f"rtol {a.rtols[k - 1]:g} -> {a.rtols[k]:g}: " + ", ".join(cells))
 
