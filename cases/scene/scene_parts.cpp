@@ -218,12 +218,15 @@ SceneParts<dim> build_scene_parts(const SceneSpec& spec) {
               fmt::format("velocity.omega = {} has {} component{} but string.dimension = {}: allowed {}",
                           text_of(spec, "velocity.omega"), vel.omega.size(), vel.omega.size() == 1 ? "" : "s",
                           spec.dimension, dim == 2 ? "a number (rad/s about the out-of-plane axis)" : "[wx, wy, wz]"));
-    rotation.emplace();
-    rotation->center.head<dim>() = center;
+    // Built apart and copied in: clang (14) judges the nested struct, whose members have default initializers, not
+    // default-constructible for std::optional::emplace() (its trait was fixed inside the enclosing class).
+    StringModelOptions::RigidRotation rigid;
+    rigid.center.head<dim>() = center;
     if constexpr (dim == 2)
-      rotation->omega.z() = vel.omega[0];
+      rigid.omega.z() = vel.omega[0];
     else
-      rotation->omega = Eigen::Vector3d(vel.omega[0], vel.omega[1], vel.omega[2]);
+      rigid.omega = Eigen::Vector3d(vel.omega[0], vel.omega[1], vel.omega[2]);
+    rotation = rigid;
     Points<dim> values(dim, chain.num_nodes());
     for (int i = 0; i < chain.num_nodes(); ++i) values.col(i) = rotation->velocity<dim>(chain.positions().col(i));
     at_key(spec, "velocity.omega", [&] { set_node_velocities(chain, values); });
