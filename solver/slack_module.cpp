@@ -146,14 +146,16 @@ class SlackModule final : public WrappingModule<dim> {
     out.terms.insert(out.terms.end(), {ledger[k], ledger[k + 1], ledger[k + 2], static_cast<double>(snaps_)});
     out.has_momentum_ledger = true;
   }
-  int num_events() const override { return inner_events() + 1; }
+  int num_events() const override { return inner_events() + 2; }
   void events(const StringModel<dim>& model, Eigen::Ref<Eigen::VectorXd> g) const override {
     const int k = inner_events();
     if (inner_) inner_->events(model, g.head(k));
     g[k] = model.slack_gap();
+    g[k + 1] = model.release_root();
   }
   std::vector<int> event_directions() const override {
     std::vector<int> directions = inner_ ? inner_->event_directions() : std::vector<int>{};
+    directions.push_back(-1);
     directions.push_back(-1);
     return directions;
   }
@@ -174,6 +176,11 @@ class SlackModule final : public WrappingModule<dim> {
     // past its length: its snap is now, with the root function below zero at the restart, where ARKODE
     // would never find it (a loop round a pulley: the link then went on stretching unseen).
     const bool stretched = action.kind == EventAction::Kind::kTransfer && model.slack_gap() <= 0;
+    // A located release: the links whose tension has reached the release threshold are slack from this instant.
+    if (found[static_cast<std::size_t>(k) + 1] != 0) {
+      model.evaluate(t, model.x(), model.v());
+      if (model.release_links() > 0) action = {EventAction::Kind::kTransfer, ""};
+    }
     if (found[static_cast<std::size_t>(k)] == 0 && !stretched) return action;
     const long snaps_before = snaps_;
     const typename StringModel<dim>::SnapResult snap = model.snap(t);
@@ -219,7 +226,7 @@ class SlackModule final : public WrappingModule<dim> {
     }
     return {EventAction::Kind::kTransfer, ""};  // the velocities changed: the integrator restarts
   }
-  bool events_need_tensions() const override { return inner_ && inner_->events_need_tensions(); }
+  bool events_need_tensions() const override { return true; }
   void node_contacts(const StringModel<dim>& model, std::vector<NodeContact<dim>>& out) const override {
     if (inner_) inner_->node_contacts(model, out);
   }

@@ -113,6 +113,7 @@ StringModel<dim>::StringModel(Chain<dim> chain, std::vector<std::unique_ptr<Forc
     module_ = make_slack_module<dim>(std::move(module_));
     slack_.assign(static_cast<std::size_t>(L), 0);
     slack_offset_.assign(static_cast<std::size_t>(L), 0.0);
+    release_flight_.assign(static_cast<std::size_t>(L), 0);
     rebound_time_.assign(static_cast<std::size_t>(L), NAN);
     rebound_speed_.assign(static_cast<std::size_t>(L), NAN);
     released_.assign(static_cast<std::size_t>(L), 0);
@@ -1893,6 +1894,43 @@ void StringModel<dim>::set_slack(int j, bool slack) {
   if ((flag != 0) != slack) num_slack_ += slack ? 1 : -1;
   flag = slack ? 1 : 0;
   slack_offset_[static_cast<std::size_t>(j)] = 0;
+  if (!release_flight_.empty()) release_flight_[static_cast<std::size_t>(j)] = 0;
+}
+
+template <int dim>
+double StringModel<dim>::release_root() const {
+  double g = 1;
+  if (!allows_slack() || !system_) return g;
+  const Eigen::VectorXd& T = system_->solution();
+  const double scale = std::max(T.size() ? T.cwiseAbs().maxCoeff() : 0.0, physical_scales().tension);
+  if (!(scale > 0)) return g;
+  for_each_link([&](int j, int u, int) {
+    if (link_slack(j) || link_bent(j)) return;
+    const double gj = system_->excluded(u) ? -options_.slack_tolerance : T[u] / scale + options_.slack_tolerance;
+    g = std::min(g, gj);
+  });
+  return g;
+}
+
+template <int dim>
+int StringModel<dim>::release_links() {
+  if (!allows_slack() || !system_) return 0;
+  const Eigen::VectorXd& T = system_->solution();
+  const double scale = std::max(T.size() ? T.cwiseAbs().maxCoeff() : 0.0, physical_scales().tension);
+  if (!(scale > 0)) return 0;
+  std::vector<int> released;
+  for_each_link([&](int j, int u, int) {
+    if (link_slack(j) || link_bent(j)) return;
+    if (system_->excluded(u) || T[u] / scale + options_.slack_tolerance <= 0) released.push_back(j);
+  });
+  for (const int j : released) {
+    const double h = chain_.link_length(j);
+    set_slack(j, true);
+    slack_offset_[static_cast<std::size_t>(j)] = std::max(0.0, (current_length(j) - h) / h) + kSlackGap;
+    release_flight_[static_cast<std::size_t>(j)] = 1;
+    rebound_time_[static_cast<std::size_t>(j)] = NAN;
+  }
+  return static_cast<int>(released.size());
 }
 
 template <int dim>
@@ -1926,7 +1964,15 @@ double StringModel<dim>::slack_root(int j) const {
   double offset = slack_offset_[k];
   if (offset > 0 && (bends_.empty() || bend_of(j) == nullptr)) {
     const int a = chain_.link_start(j), b = chain_.link_end(j);
-    if ((x_.col(b) - x_.col(a)).dot(v_.col(b) - v_.col(a)) >= 0) offset = 0;
+    if ((x_.col(b) - x_.col(a)).dot(v_.col(b) - v_.col(a)) >= 0) {
+      // A release flight (release_links) starts at rest at its length l_r, its rate a drift's: its offset
+      // (l_r − h)⁺/h + kSlackGap drops to (l_r − h)⁺/h once the link is shorter than l_r, so that its return
+      // is located at l_r (within the drift of h), not kSlackGap past it, and not at its start.
+      if (!release_flight_[k])
+        offset = 0;
+      else if ((h - current_length(j)) / h + offset - kSlackGap > 0)
+        offset -= kSlackGap;
+    }
   }
   return (h - current_length(j)) / h + offset;
 }

@@ -251,6 +251,14 @@ class StringModel final : public OdeSystem {
   /// none. One root function for all links (ARKODE evaluates every root function at every step: N
   /// per-link functions cost N times more evaluations of the same numbers).
   double slack_gap() const;
+  /// The release root function at the last evaluation: min over the taut links in an arc, not bent, of
+  /// T_j / scale + slack_tolerance (scale as solve_tensions judges a release), −slack_tolerance for a link the
+  /// complementarity problem released; 1 with none. It crosses zero where the first tension reaches the
+  /// release threshold, so the release is located and the link declared slack at that instant.
+  double release_root() const;
+  /// Declares slack the links whose term of release_root() is ≤ 0 at the last evaluation, each with its root
+  /// offset (a release flight, slack_root); returns how many.
+  int release_links();
   /// What a snap did: the energy it dissipated (J, ≥ 0), the work and impulse of the supports'
   /// impulses (J, N s), and how many links it caught.
   struct SnapResult {
@@ -700,6 +708,7 @@ class StringModel final : public OdeSystem {
   ImpulsiveStart impulsive_start_;
   std::vector<char> slack_;            // per link: slack (slack = allow)
   std::vector<double> slack_offset_;   // per link: its root function's offset
+  std::vector<char> release_flight_;   // per link: slack since a located release (slack_root)
   std::vector<double> rebound_time_, rebound_speed_;  // per link: when and how fast it separated at its last snap (NaN: it did not)
   // per link: released by the complementarity problem at some evaluation since the last accepted step (accept_step)
   std::vector<char> released_;
