@@ -123,6 +123,20 @@ void FrontTracker<dim>::initialize(StringModel<dim>& model) {
           fronts_[k]->name(), fronts_[k]->expected_s0, fs_[k].s0, fronts_[k]->placed()));
   for (std::size_t k = 0; k < fronts_.size(); ++k)
     if (fronts_[k]->active) fronts_[k]->check_initial(fs_[k]);
+  // ARKODE finds a root only where its function changes sign in the watched direction: a front that starts
+  // past one of its crossings (within kLastPartial of a link of a free end, or on a node) would never cross it.
+  for (std::size_t k = 0; k < fronts_.size(); ++k) {
+    if (!fronts_[k]->active) continue;
+    double g[2];
+    fronts_[k]->crossings(model, fs_[k], g);
+    if (!(g[0] > 0) || !(fronts_[k]->second_direction() * g[1] < 0))
+      throw InputError(fmt::format(
+          "the {} front starts at s0 = {:.9g} m, past one of its crossings (root functions {:.3g} and {:.3g} "
+          "of a link): it lies on a node of the mesh or within {} of a link of a free end; move s0 by {:.3g} m "
+          "(a thousandth of a link) or more",
+          fronts_[k]->name(), fs_[k].s0, g[0] / material_.h, g[1] / material_.h, kLastPartial,
+          kLastPartial * material_.h));
+  }
   heap_moment0_.setZero();
   for (std::size_t k = 0; k < fronts_.size(); ++k) fronts_[k]->add_held_moment(fs_[k], 0.0, heap_moment0_);
 }
