@@ -863,7 +863,8 @@ TEST_CASE("kinks form in taut windows only: a pendulum released above the horizo
   // slack link meant nothing and inserted a kink at once: the run stopped at 0.054, 0.038 s on 81, 161 nodes ("a
   // kink formed ... and no link there fits it"), or stalled on 41. Formation is now looked for over taut links
   // only: the first snap comes at t*, and a kink forms later in the taut chain and runs to the free end, where the
-  // run stops, located, at times that converge with the mesh (0.52426, 0.52255, 0.52143 s on 81, 161, 321 nodes).
+  // run stops, located, at times that converge with the mesh (0.52426, 0.52255, 0.52143 s on 81, 161, 321 nodes; on
+  // 161 and 321 nodes the kink now comes to rest just before the end and dissolves, at 0.52244 and 0.52142 s).
   // The formation itself is not yet one event on every mesh: 0.2602 s on 81 nodes, 0.5216 and 0.5211 s on 161 and
   // 321 (the whip's kink near the free end).
   const std::string text = R"([string]
@@ -898,9 +899,14 @@ t_end = 0.8
                 "%.5f s\n", nodes, t_snap, r.events[0].t, r.t_stop);
     CHECK(r.events[0].t > 3 * t_snap);  // long after the free fall: measured 0.260 s against t* = 0.066 s (81 nodes)
     CHECK(r.status == "stopped");
-    CHECK_THAT(r.stop_reason, Catch::Matchers::Contains("has reached the end of the string"));
-    CHECK(std::abs(r.relative_energy_residual()) < 5e-10);  // measured 1.1e-10
-    t_stop.push_back(r.t_stop);
+    // The first kink ends at the free end, where the tension and with it the kink's speed λ ṡ0² = τ vanish: on 81
+    // nodes it reaches the end of the string (a located stop), on 161 it comes to rest a link before and dissolves
+    // (docs/model.md §9, "A kink that comes to rest"; a kink forms again and the run stops later, at 0.6554 s, where a
+    // kink meets a second corner).
+    const bool dissolved = r.events.size() > 1 && r.events[1].kind == "kink_dissolved";
+    if (!dissolved) CHECK_THAT(r.stop_reason, Catch::Matchers::Contains("has reached the end of the string"));
+    CHECK(std::abs(r.relative_energy_residual()) < 5e-10);  // measured 3.7e-11, 3.8e-10
+    t_stop.push_back(dissolved ? r.events[1].t : r.t_stop);
   }
-  CHECK(std::abs(t_stop[0] - t_stop[1]) < 5e-3);  // measured 1.7e-3 s
+  CHECK(std::abs(t_stop[0] - t_stop[1]) < 5e-3);  // measured 0.52426 and 0.52244 s (0.52142 s on 321 nodes)
 }
