@@ -206,6 +206,11 @@ class FrontKind {
   /// re-layout, a snap), stops the run there (StringModule::events_failed_after_event): ARKODE restarts from that
   /// state and finds only sign changes, so such a check would otherwise go unseen.
   virtual bool check_after_events(int /*check*/) const { return true; }
+  /// Whether check `check` reaching zero takes the front out of the string instead of stopping the run: the tracker
+  /// removes it there (FrontKind::remove, the summary's event `<name>_dissolved`), the split link's material
+  /// re-lumped with its momentum and the energy that changes booked in W_remesh (a kink that no longer carries a
+  /// shock, docs/model.md §9, "A kink that comes to rest").
+  virtual bool dissolves(int /*check*/) const { return false; }
   /// The physical event that check `check` reaching zero is (the run's summary lists it in `events`), if any.
   virtual std::optional<RunEvent> check_event(const StringModel<dim>& /*model*/, const FrontState<dim>& /*state*/,
                                               double /*t*/, int /*check*/) const {

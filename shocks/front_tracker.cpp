@@ -383,7 +383,11 @@ EventAction FrontTracker<dim>::handle_events(StringModel<dim>& model, double t, 
             kStopWindow * material_.h)
       return {EventAction::Kind::kStop,
               fmt::format("front {} reached s0 = {:.9g} m", options_.stop_at[k].front, options_.stop_at[k].s)};
-  std::optional<std::size_t> forming;  // a front not yet in the string whose formation was found
+  std::optional<std::size_t> forming;     // a front not yet in the string whose formation was found
+  std::optional<std::size_t> dissolving;  // a front whose check found that it leaves the string (FrontKind::dissolves)
+  for (std::size_t k = 0, q = static_cast<std::size_t>(2 * nf) + options_.stop_at.size(); k < fronts_.size(); ++k)
+    for (int c = 0; c < fronts_[k]->num_checks(); ++c)
+      if (found[q++] != 0 && fronts_[k]->active && fronts_[k]->dissolves(c) && !dissolving) dissolving = k;
   for (std::size_t k = 0, q = static_cast<std::size_t>(2 * nf) + options_.stop_at.size(); k < fronts_.size(); ++k)
     for (int c = 0; c < fronts_[k]->num_checks(); ++c)
       if (found[q++] != 0) {
@@ -391,6 +395,9 @@ EventAction FrontTracker<dim>::handle_events(StringModel<dim>& model, double t, 
           forming = k;
           continue;
         }
+        // A front that dissolves stops nothing: its other checks found at the same root (a kink at rest outside
+        // its kinked link: the outside check's sign follows ṡ0's) go with it.
+        if (dissolving == k) continue;
         if (std::optional<RunEvent> event = fronts_[k]->check_event(model, fs_[k], t, c)) {
           event->front = static_cast<int>(k);
           events_.push_back(std::move(*event));
@@ -404,12 +411,12 @@ EventAction FrontTracker<dim>::handle_events(StringModel<dim>& model, double t, 
   std::vector<double> held_before(fronts_.size());
   for (std::size_t k = 0; k < fronts_.size(); ++k) held_before[k] = fronts_[k]->held_mass(fs_[k]);
   bool absorbed = false;
-  std::optional<std::size_t> acted = forming;  // the front the event moved
+  std::optional<std::size_t> acted = forming ? forming : dissolving;  // the front the event moved
   // |v_a − v_(a−1)| on the front's stencil (a−1, a, b, b+1) before the event, for event_energies_ (only when
   // they are recorded, as the arm's corner and K + V between the re-layout and the projection below).
   double jump_before = 0;
   std::pair<double, double> corner_before{0.0, 0.0};
-  if (record_ && !forming)
+  if (record_ && !forming && !dissolving)
     for (int f = 0; f < nf; ++f)
       if ((found[static_cast<std::size_t>(2 * f)] != 0 || found[static_cast<std::size_t>(2 * f + 1)] != 0) &&
           fronts_[static_cast<std::size_t>(f)]->active) {
@@ -423,7 +430,12 @@ EventAction FrontTracker<dim>::handle_events(StringModel<dim>& model, double t, 
             fmt::format("a {} formed at t = {:.9g} s{}, and no link there fits it (its arms need a full link on either "
                         "side, and the arms' meeting point inside the kinked link)",
                         fronts_[*forming]->name(), t, fronts_[*forming]->where_formed(model))};
-  for (int f = 0; f < nf && !forming; ++f) {
+  bool dissolved = false;
+  if (dissolving && !forming) {
+    dissolve_front(model, *dissolving, t);
+    dissolved = true;
+  }
+  for (int f = 0; f < nf && !forming && !dissolved; ++f) {
     const int e0 = found[static_cast<std::size_t>(2 * f)], e1 = found[static_cast<std::size_t>(2 * f + 1)];
     if (e0 == 0 && e1 == 0) continue;
     const auto k = static_cast<std::size_t>(f);
@@ -437,6 +449,17 @@ EventAction FrontTracker<dim>::handle_events(StringModel<dim>& model, double t, 
     const EventAction action = fronts_[k]->cross(model, fs_[k], e0);
     if (action.kind == EventAction::Kind::kStop) return action;
     ++transfers_;
+    // A check that dissolves the front, already negative after the crossing (a kink whose new arm is a slack link):
+    // ARKODE would find no sign change from here, so it dissolves now.
+    model.refresh();
+    std::vector<double> checks(static_cast<std::size_t>(fronts_[k]->num_checks()));
+    if (!checks.empty()) fronts_[k]->checks(model, fs_[k], checks.data());
+    for (int c = 0; c < fronts_[k]->num_checks(); ++c)
+      if (fronts_[k]->dissolves(c) && checks[static_cast<std::size_t>(c)] < 0) {
+        dissolve_front(model, k, t);
+        dissolved = true;
+        break;
+      }
     break;  // one crossing per event; a simultaneous one is found again right after
   }
   // The new links are brought back to their lengths (a fold's arms are never exactly antiparallel
@@ -446,7 +469,7 @@ EventAction FrontTracker<dim>::handle_events(StringModel<dim>& model, double t, 
   // allowed (perfectly inelastic otherwise), and the energy it changes is the front's last dissipation,
   // booked in W_shocks (docs/model.md §2.5, "A kink at a held end").
   model.refresh();
-  const bool exact = acted && !forming && !absorbed && fronts_[*acted]->exact_crossing();
+  const bool exact = acted && !forming && !absorbed && !dissolved && fronts_[*acted]->exact_crossing();
   const double K_moved = record_ || exact ? model.kinetic_energy() : 0.0;
   const double E_moved = record_ || exact ? K_moved + model.potential_energy(ledger) : 0.0;
   try {
@@ -486,12 +509,12 @@ EventAction FrontTracker<dim>::handle_events(StringModel<dim>& model, double t, 
   }
   const double changed = model.kinetic_energy() + model.potential_energy(ledger) - E_before;
   double corner_after = 0;
-  if (record_ && acted && !forming && !absorbed) {
+  if (record_ && acted && !forming && !absorbed && !dissolved) {
     const std::vector<int> nodes = fronts_[*acted]->stencil(model);
     if (nodes.size() == 4) corner_after = arm_corner(model, *acted, nodes[0], t, "after").first;
   }
   if (record_ && acted) {
-    const EventEnergy record{t, forming ? "insert" : absorbed ? "absorb" : "cross", static_cast<int>(*acted),
+    const EventEnergy record{t, forming ? "insert" : absorbed ? "absorb" : dissolved ? "dissolve" : "cross", static_cast<int>(*acted),
                              E_moved - E_before, K_moved - K_before, changed - (E_moved - E_before), jump_before,
                              corner_before.first, corner_after, corner_before.second};
     event_energies_.push_back(record);
@@ -530,7 +553,20 @@ bool FrontTracker<dim>::insert_front(StringModel<dim>& model, std::size_t k, dou
 }
 
 template <int dim>
-void FrontTracker<dim>::remove_front(StringModel<dim>& model, std::size_t k, double t) {
+void FrontTracker<dim>::dissolve_front(StringModel<dim>& model, std::size_t k, double t) {
+  const int a = model.arcs()[static_cast<std::size_t>(fronts_[k]->arc_minus)].last;  // the split link (a, a + 1)
+  remove_front(model, k, t, "dissolved");
+  if (!model.allows_slack()) return;
+  const Chain<dim>& chain = model.chain();
+  for (int j = std::max(0, a - 1); j <= std::min(chain.num_links() - 1, a + 1); ++j) {
+    const double length = (model.x().col(chain.link_end(j)) - model.x().col(chain.link_start(j))).norm();
+    if (length < (1 - StringModel<dim>::kSlackGap) * chain.link_length(j)) model.set_slack(j, true);
+  }
+  model.rebuild();
+}
+
+template <int dim>
+void FrontTracker<dim>::remove_front(StringModel<dim>& model, std::size_t k, double t, const char* what) {
   FrontKind<dim>& front = *fronts_[k];
   const int gone = front.arc_plus;  // arcs A and B become one: the arcs after B shift down by one
   front.active = false;
@@ -541,7 +577,7 @@ void FrontTracker<dim>::remove_front(StringModel<dim>& model, std::size_t k, dou
     if (other->arc_plus >= gone) --other->arc_plus;
   }
   FrontState<dim>& s = fs_[k];
-  RunEvent event{fmt::format("{}_absorbed", front.name()), t, static_cast<int>(k), {}, {{"s0", s.s0}, {"s0_dot", s.s0_dot}}};
+  RunEvent event{fmt::format("{}_{}", front.name(), what), t, static_cast<int>(k), {}, {{"s0", s.s0}, {"s0_dot", s.s0_dot}}};
   for (int d = 0; d < dim; ++d) event.position.push_back(s.position[d]);
   events_.push_back(std::move(event));
   // Its record from now on: where it left, at rest in the material, carrying nothing.

@@ -196,10 +196,14 @@ class FrontTracker final : public StringModule<dim> {
   std::vector<int> failed_checks(const Eigen::Ref<const Eigen::VectorXd>& g, bool after_event) const;
 
   int num_checks() const;
-  /// Takes front k out of the string at t (FrontKind::absorbed: a kink at a held end): its arcs merge
-  /// (FrontKind::remove), the other fronts' arc indices follow, it becomes inactive, and the run's events
-  /// list "<kind>_absorbed".
-  void remove_front(StringModel<dim>& model, std::size_t k, double t);
+  /// Takes front k out of the string at t (FrontKind::absorbed: a kink at a held end; FrontKind::dissolves: a kink
+  /// that carries no shock any more): its arcs merge (FrontKind::remove), the other fronts' arc indices follow, it
+  /// becomes inactive, and the run's events list "<kind>_<what>" ("absorbed", "dissolved").
+  void remove_front(StringModel<dim>& model, std::size_t k, double t, const char* what = "absorbed");
+  /// remove_front for a front that dissolves: where slack is allowed, the links of its stencil shorter than their
+  /// length by more than the slack gap (the merged split link's chord across a corner, a released arm that has
+  /// shortened) are slack, not projected back to their lengths.
+  void dissolve_front(StringModel<dim>& model, std::size_t k, double t);
   /// Puts front k, not yet in the string, where it formed (FrontKind::insert: a kink where the tangent turns
   /// sharply), the other fronts' arc indices following; the run's events list "<kind>_inserted". False if no
   /// place fits.
