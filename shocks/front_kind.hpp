@@ -191,6 +191,10 @@ class FrontKind {
   /// FrontTracker::kCrossingProjectionTolerance of the energy scale (a crossing that left the string far
   /// from its constraints), rather than run on with a motion that is not the string's.
   virtual bool exact_crossing() const { return false; }
+  /// Holds (`hold`) the front drawn as at its last evaluation while an impulse changes which links are slack
+  /// (the snaps of the slack module: a heap's curve on a plane stops at a slack link), or lets it be drawn on the
+  /// links as they are again (FrontTracker::redraw_fronts, which books what the re-drawing moves).
+  virtual void hold_drawing(bool /*hold*/) {}
   /// Root functions of the front's own that stop the run (positive while it may go on).
   virtual int num_checks() const { return 0; }
   virtual void checks(const StringModel<dim>& /*model*/, const FrontState<dim>& /*state*/, double* /*g*/) const {}

@@ -189,8 +189,23 @@ class FrontTracker final : public StringModule<dim> {
     return failed_checks(g, true);
   }
   bool checks_at_start() const override { return num_checks() > 0; }
+  void hold_fronts() override;
+  /// The fronts drawn on the links as they are after a snap (FrontKind::hold_drawing): the material the
+  /// re-drawing moves between an arc and a heap goes with its momentum (the supports' impulse) and is laid at
+  /// the front, the energy it changes in W_remesh, as at a crossing (docs/model.md §9, "Slack next to a front").
+  void redraw_fronts(StringModel<dim>& model, Eigen::Ref<Eigen::VectorXd> ledger) override;
 
  private:
+  /// K + V, the momentum and each front's held mass before an event re-draws the fronts (a crossing, a snap).
+  struct Drawn {
+    double energy = 0;
+    Vec<dim> momentum = Vec<dim>::Zero();
+    std::vector<double> held;
+  };
+  Drawn drawn(const StringModel<dim>& model, const Eigen::Ref<const Eigen::VectorXd>& ledger) const;
+  /// Books the momentum the event changed since `before` as the supports' impulse and the held masses' change at
+  /// the fronts' points in their first moment; returns the change of K + V (the caller books it).
+  double book_redrawing(const StringModel<dim>& model, Eigen::Ref<Eigen::VectorXd> ledger, const Drawn& before) const;
   /// The active fronts' checks that are negative in g (after an event: of the kinds that watch them there);
   /// an inactive front's check slot holds its formation, which is not a failure.
   std::vector<int> failed_checks(const Eigen::Ref<const Eigen::VectorXd>& g, bool after_event) const;
