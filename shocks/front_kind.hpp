@@ -211,7 +211,7 @@ class FrontKind {
   /// state and finds only sign changes, so such a check would otherwise go unseen.
   virtual bool check_after_events(int /*check*/) const { return true; }
   /// Whether check `check` reaching zero takes the front out of the string instead of stopping the run: the tracker
-  /// removes it there (FrontKind::remove, the summary's event `<name>_dissolved`), the split link's material
+  /// removes it there (FrontKind::remove, the summary's event named after the front with `_dissolved`, e.g. `kink_dissolved`), the split link's material
   /// re-lumped with its momentum and the energy that changes booked in W_remesh (a kink that no longer carries a
   /// shock, docs/model.md §9, "A kink that comes to rest").
   virtual bool dissolves(int /*check*/) const { return false; }

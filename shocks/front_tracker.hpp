@@ -213,7 +213,7 @@ class FrontTracker final : public StringModule<dim> {
   int num_checks() const;
   /// Takes front k out of the string at t (FrontKind::absorbed: a kink at a held end; FrontKind::dissolves: a kink
   /// that carries no shock any more): its arcs merge (FrontKind::remove), the other fronts' arc indices follow, it
-  /// becomes inactive, and the run's events list "<kind>_<what>" ("absorbed", "dissolved").
+  /// becomes inactive, and the run's events list the front's name with `_` and `what` ("absorbed", "dissolved"), e.g. `kink_absorbed`.
   void remove_front(StringModel<dim>& model, std::size_t k, double t, const char* what = "absorbed");
   /// remove_front for a front that dissolves: where slack is allowed, the links of its stencil shorter than their
   /// length by more than the slack gap (the merged split link's chord across a corner, a released arm that has
