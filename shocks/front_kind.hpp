@@ -191,6 +191,10 @@ class FrontKind {
   /// FrontTracker::kCrossingProjectionTolerance of the energy scale (a crossing that left the string far
   /// from its constraints), rather than run on with a motion that is not the string's.
   virtual bool exact_crossing() const { return false; }
+  /// Holds (`hold`) the front drawn as at its last evaluation while an impulse changes which links are slack
+  /// (the snaps of the slack module: a heap's curve on a plane stops at a slack link), or lets it be drawn on the
+  /// links as they are again (FrontTracker::redraw_fronts, which books what the re-drawing moves).
+  virtual void hold_drawing(bool /*hold*/) {}
   /// Root functions of the front's own that stop the run (positive while it may go on).
   virtual int num_checks() const { return 0; }
   virtual void checks(const StringModel<dim>& /*model*/, const FrontState<dim>& /*state*/, double* /*g*/) const {}
@@ -206,6 +210,11 @@ class FrontKind {
   /// re-layout, a snap), stops the run there (StringModule::events_failed_after_event): ARKODE restarts from that
   /// state and finds only sign changes, so such a check would otherwise go unseen.
   virtual bool check_after_events(int /*check*/) const { return true; }
+  /// Whether check `check` reaching zero takes the front out of the string instead of stopping the run: the tracker
+  /// removes it there (FrontKind::remove, the summary's event named after the front with `_dissolved`, e.g. `kink_dissolved`), the split link's material
+  /// re-lumped with its momentum and the energy that changes booked in W_remesh (a kink that no longer carries a
+  /// shock, docs/model.md §9, "A kink that comes to rest").
+  virtual bool dissolves(int /*check*/) const { return false; }
   /// The physical event that check `check` reaching zero is (the run's summary lists it in `events`), if any.
   virtual std::optional<RunEvent> check_event(const StringModel<dim>& /*model*/, const FrontState<dim>& /*state*/,
                                               double /*t*/, int /*check*/) const {

@@ -123,6 +123,20 @@ void FrontTracker<dim>::initialize(StringModel<dim>& model) {
           fronts_[k]->name(), fronts_[k]->expected_s0, fs_[k].s0, fronts_[k]->placed()));
   for (std::size_t k = 0; k < fronts_.size(); ++k)
     if (fronts_[k]->active) fronts_[k]->check_initial(fs_[k]);
+  // ARKODE finds a root only where its function changes sign in the watched direction: a front that starts
+  // past one of its crossings (within kLastPartial of a link of a free end, or on a node) would never cross it.
+  for (std::size_t k = 0; k < fronts_.size(); ++k) {
+    if (!fronts_[k]->active) continue;
+    double g[2];
+    fronts_[k]->crossings(model, fs_[k], g);
+    if (!(g[0] > 0) || !(fronts_[k]->second_direction() * g[1] < 0))
+      throw InputError(fmt::format(
+          "the {} front starts at s0 = {:.9g} m, past one of its crossings (root functions {:.3g} and {:.3g} "
+          "of a link): it lies on a node of the mesh or within {} of a link of a free end; move s0 by {:.3g} m "
+          "(a thousandth of a link) or more",
+          fronts_[k]->name(), fs_[k].s0, g[0] / material_.h, g[1] / material_.h, kLastPartial,
+          kLastPartial * material_.h));
+  }
   heap_moment0_.setZero();
   for (std::size_t k = 0; k < fronts_.size(); ++k) fronts_[k]->add_held_moment(fs_[k], 0.0, heap_moment0_);
 }
@@ -369,7 +383,11 @@ EventAction FrontTracker<dim>::handle_events(StringModel<dim>& model, double t, 
             kStopWindow * material_.h)
       return {EventAction::Kind::kStop,
               fmt::format("front {} reached s0 = {:.9g} m", options_.stop_at[k].front, options_.stop_at[k].s)};
-  std::optional<std::size_t> forming;  // a front not yet in the string whose formation was found
+  std::optional<std::size_t> forming;     // a front not yet in the string whose formation was found
+  std::optional<std::size_t> dissolving;  // a front whose check found that it leaves the string (FrontKind::dissolves)
+  for (std::size_t k = 0, q = static_cast<std::size_t>(2 * nf) + options_.stop_at.size(); k < fronts_.size(); ++k)
+    for (int c = 0; c < fronts_[k]->num_checks(); ++c)
+      if (found[q++] != 0 && fronts_[k]->active && fronts_[k]->dissolves(c) && !dissolving) dissolving = k;
   for (std::size_t k = 0, q = static_cast<std::size_t>(2 * nf) + options_.stop_at.size(); k < fronts_.size(); ++k)
     for (int c = 0; c < fronts_[k]->num_checks(); ++c)
       if (found[q++] != 0) {
@@ -377,6 +395,9 @@ EventAction FrontTracker<dim>::handle_events(StringModel<dim>& model, double t, 
           forming = k;
           continue;
         }
+        // A front that dissolves stops nothing: its other checks found at the same root (a kink at rest outside
+        // its kinked link: the outside check's sign follows ṡ0's) go with it.
+        if (dissolving == k) continue;
         if (std::optional<RunEvent> event = fronts_[k]->check_event(model, fs_[k], t, c)) {
           event->front = static_cast<int>(k);
           events_.push_back(std::move(*event));
@@ -385,17 +406,15 @@ EventAction FrontTracker<dim>::handle_events(StringModel<dim>& model, double t, 
       }
   // Energy, momentum and held masses before, to book what the crossing changes.
   const double K_before = model.kinetic_energy();
-  const double E_before = K_before + model.potential_energy(ledger);
-  const Vec<dim> p_before = model.momentum();
-  std::vector<double> held_before(fronts_.size());
-  for (std::size_t k = 0; k < fronts_.size(); ++k) held_before[k] = fronts_[k]->held_mass(fs_[k]);
+  const Drawn before = drawn(model, ledger);
+  const double E_before = before.energy;
   bool absorbed = false;
-  std::optional<std::size_t> acted = forming;  // the front the event moved
+  std::optional<std::size_t> acted = forming ? forming : dissolving;  // the front the event moved
   // |v_a − v_(a−1)| on the front's stencil (a−1, a, b, b+1) before the event, for event_energies_ (only when
   // they are recorded, as the arm's corner and K + V between the re-layout and the projection below).
   double jump_before = 0;
   std::pair<double, double> corner_before{0.0, 0.0};
-  if (record_ && !forming)
+  if (record_ && !forming && !dissolving)
     for (int f = 0; f < nf; ++f)
       if ((found[static_cast<std::size_t>(2 * f)] != 0 || found[static_cast<std::size_t>(2 * f + 1)] != 0) &&
           fronts_[static_cast<std::size_t>(f)]->active) {
@@ -409,7 +428,12 @@ EventAction FrontTracker<dim>::handle_events(StringModel<dim>& model, double t, 
             fmt::format("a {} formed at t = {:.9g} s{}, and no link there fits it (its arms need a full link on either "
                         "side, and the arms' meeting point inside the kinked link)",
                         fronts_[*forming]->name(), t, fronts_[*forming]->where_formed(model))};
-  for (int f = 0; f < nf && !forming; ++f) {
+  bool dissolved = false;
+  if (dissolving && !forming) {
+    dissolve_front(model, *dissolving, t);
+    dissolved = true;
+  }
+  for (int f = 0; f < nf && !forming && !dissolved; ++f) {
     const int e0 = found[static_cast<std::size_t>(2 * f)], e1 = found[static_cast<std::size_t>(2 * f + 1)];
     if (e0 == 0 && e1 == 0) continue;
     const auto k = static_cast<std::size_t>(f);
@@ -423,6 +447,17 @@ EventAction FrontTracker<dim>::handle_events(StringModel<dim>& model, double t, 
     const EventAction action = fronts_[k]->cross(model, fs_[k], e0);
     if (action.kind == EventAction::Kind::kStop) return action;
     ++transfers_;
+    // A check that dissolves the front, already negative after the crossing (a kink whose new arm is a slack link):
+    // ARKODE would find no sign change from here, so it dissolves now.
+    model.refresh();
+    std::vector<double> checks(static_cast<std::size_t>(fronts_[k]->num_checks()));
+    if (!checks.empty()) fronts_[k]->checks(model, fs_[k], checks.data());
+    for (int c = 0; c < fronts_[k]->num_checks(); ++c)
+      if (fronts_[k]->dissolves(c) && checks[static_cast<std::size_t>(c)] < 0) {
+        dissolve_front(model, k, t);
+        dissolved = true;
+        break;
+      }
     break;  // one crossing per event; a simultaneous one is found again right after
   }
   // The new links are brought back to their lengths (a fold's arms are never exactly antiparallel
@@ -432,7 +467,7 @@ EventAction FrontTracker<dim>::handle_events(StringModel<dim>& model, double t, 
   // allowed (perfectly inelastic otherwise), and the energy it changes is the front's last dissipation,
   // booked in W_shocks (docs/model.md §2.5, "A kink at a held end").
   model.refresh();
-  const bool exact = acted && !forming && !absorbed && fronts_[*acted]->exact_crossing();
+  const bool exact = acted && !forming && !absorbed && !dissolved && fronts_[*acted]->exact_crossing();
   const double K_moved = record_ || exact ? model.kinetic_energy() : 0.0;
   const double E_moved = record_ || exact ? K_moved + model.potential_energy(ledger) : 0.0;
   try {
@@ -464,20 +499,14 @@ EventAction FrontTracker<dim>::handle_events(StringModel<dim>& model, double t, 
   // also re-lumps the end's material on the nodes with their own velocities (the lumped momentum
   // changes by O(h²), what the lumped partial link missed, docs/shocks.md), and the projection
   // acts through fixed nodes. All of it is the supports' impulse; the energy it changes is W_remesh.
-  ledger.template segment<dim>(2) += model.momentum() - p_before;
-  for (std::size_t k = 0; k < fronts_.size(); ++k) {
-    Vec<dim> moment = ledger.template segment<dim>(2 + dim);
-    fronts_[k]->add_held_moment(fs_[k], held_before[k], moment);
-    ledger.template segment<dim>(2 + dim) = moment;
-  }
-  const double changed = model.kinetic_energy() + model.potential_energy(ledger) - E_before;
+  const double changed = book_redrawing(model, ledger, before);
   double corner_after = 0;
-  if (record_ && acted && !forming && !absorbed) {
+  if (record_ && acted && !forming && !absorbed && !dissolved) {
     const std::vector<int> nodes = fronts_[*acted]->stencil(model);
     if (nodes.size() == 4) corner_after = arm_corner(model, *acted, nodes[0], t, "after").first;
   }
   if (record_ && acted) {
-    const EventEnergy record{t, forming ? "insert" : absorbed ? "absorb" : "cross", static_cast<int>(*acted),
+    const EventEnergy record{t, forming ? "insert" : absorbed ? "absorb" : dissolved ? "dissolve" : "cross", static_cast<int>(*acted),
                              E_moved - E_before, K_moved - K_before, changed - (E_moved - E_before), jump_before,
                              corner_before.first, corner_after, corner_before.second};
     event_energies_.push_back(record);
@@ -494,6 +523,50 @@ EventAction FrontTracker<dim>::handle_events(StringModel<dim>& model, double t, 
   else
     w_remesh_ += changed;
   return {EventAction::Kind::kTransfer, {}};
+}
+
+template <int dim>
+typename FrontTracker<dim>::Drawn FrontTracker<dim>::drawn(const StringModel<dim>& model,
+                                                           const Eigen::Ref<const Eigen::VectorXd>& ledger) const {
+  Drawn d;
+  d.energy = model.kinetic_energy() + model.potential_energy(ledger);
+  d.momentum = model.momentum();
+  d.held.resize(fronts_.size());
+  for (std::size_t k = 0; k < fronts_.size(); ++k) d.held[k] = fronts_[k]->held_mass(fs_[k]);
+  return d;
+}
+
+template <int dim>
+double FrontTracker<dim>::book_redrawing(const StringModel<dim>& model, Eigen::Ref<Eigen::VectorXd> ledger,
+                                         const Drawn& before) const {
+  ledger.template segment<dim>(2) += model.momentum() - before.momentum;
+  for (std::size_t k = 0; k < fronts_.size(); ++k) {
+    Vec<dim> moment = ledger.template segment<dim>(2 + dim);
+    fronts_[k]->add_held_moment(fs_[k], before.held[k], moment);
+    ledger.template segment<dim>(2 + dim) = moment;
+  }
+  return model.kinetic_energy() + model.potential_energy(ledger) - before.energy;
+}
+
+template <int dim>
+void FrontTracker<dim>::hold_fronts() {
+  for (auto& front : fronts_)
+    if (front->active) front->hold_drawing(true);
+}
+
+template <int dim>
+void FrontTracker<dim>::redraw_fronts(StringModel<dim>& model, Eigen::Ref<Eigen::VectorXd> ledger) {
+  // A heap's curve to its plane runs through the arc's links up to the first slack one (curve_links in
+  // heap_front.cpp). A snap that makes the link next to the end node taut again (or separates it) changes that
+  // curve, and the front jumps to where the new one meets the plane: the partial link's length, the end node's
+  // mass and the heap's content jump at fixed positions and velocities. Unbooked, each such snap took
+  // ½ λ δl |v|² and λ δl v out of the ledgers (the falling chain with shortening links on 161 nodes: 4.3e-4 J and
+  // 3.1e-5 of the momentum, the same at every rtol).
+  model.refresh();  // the state after the impulse, the fronts as held
+  const Drawn before = drawn(model, ledger);
+  for (auto& front : fronts_) front->hold_drawing(false);
+  model.refresh();
+  w_remesh_ += book_redrawing(model, ledger, before);
 }
 
 template <int dim>
@@ -516,7 +589,20 @@ bool FrontTracker<dim>::insert_front(StringModel<dim>& model, std::size_t k, dou
 }
 
 template <int dim>
-void FrontTracker<dim>::remove_front(StringModel<dim>& model, std::size_t k, double t) {
+void FrontTracker<dim>::dissolve_front(StringModel<dim>& model, std::size_t k, double t) {
+  const int a = model.arcs()[static_cast<std::size_t>(fronts_[k]->arc_minus)].last;  // the split link (a, a + 1)
+  remove_front(model, k, t, "dissolved");
+  if (!model.allows_slack()) return;
+  const Chain<dim>& chain = model.chain();
+  for (int j = std::max(0, a - 1); j <= std::min(chain.num_links() - 1, a + 1); ++j) {
+    const double length = (model.x().col(chain.link_end(j)) - model.x().col(chain.link_start(j))).norm();
+    if (length < (1 - StringModel<dim>::kSlackGap) * chain.link_length(j)) model.set_slack(j, true);
+  }
+  model.rebuild();
+}
+
+template <int dim>
+void FrontTracker<dim>::remove_front(StringModel<dim>& model, std::size_t k, double t, const char* what) {
   FrontKind<dim>& front = *fronts_[k];
   const int gone = front.arc_plus;  // arcs A and B become one: the arcs after B shift down by one
   front.active = false;
@@ -527,7 +613,7 @@ void FrontTracker<dim>::remove_front(StringModel<dim>& model, std::size_t k, dou
     if (other->arc_plus >= gone) --other->arc_plus;
   }
   FrontState<dim>& s = fs_[k];
-  RunEvent event{fmt::format("{}_absorbed", front.name()), t, static_cast<int>(k), {}, {{"s0", s.s0}, {"s0_dot", s.s0_dot}}};
+  RunEvent event{fmt::format("{}_{}", front.name(), what), t, static_cast<int>(k), {}, {{"s0", s.s0}, {"s0_dot", s.s0_dot}}};
   for (int d = 0; d < dim; ++d) event.position.push_back(s.position[d]);
   events_.push_back(std::move(event));
   // Its record from now on: where it left, at rest in the material, carrying nothing.

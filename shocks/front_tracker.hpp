@@ -189,17 +189,36 @@ class FrontTracker final : public StringModule<dim> {
     return failed_checks(g, true);
   }
   bool checks_at_start() const override { return num_checks() > 0; }
+  void hold_fronts() override;
+  /// The fronts drawn on the links as they are after a snap (FrontKind::hold_drawing): the material the
+  /// re-drawing moves between an arc and a heap goes with its momentum (the supports' impulse) and is laid at
+  /// the front, the energy it changes in W_remesh, as at a crossing (docs/model.md §9, "Slack next to a front").
+  void redraw_fronts(StringModel<dim>& model, Eigen::Ref<Eigen::VectorXd> ledger) override;
 
  private:
+  /// K + V, the momentum and each front's held mass before an event re-draws the fronts (a crossing, a snap).
+  struct Drawn {
+    double energy = 0;
+    Vec<dim> momentum = Vec<dim>::Zero();
+    std::vector<double> held;
+  };
+  Drawn drawn(const StringModel<dim>& model, const Eigen::Ref<const Eigen::VectorXd>& ledger) const;
+  /// Books the momentum the event changed since `before` as the supports' impulse and the held masses' change at
+  /// the fronts' points in their first moment; returns the change of K + V (the caller books it).
+  double book_redrawing(const StringModel<dim>& model, Eigen::Ref<Eigen::VectorXd> ledger, const Drawn& before) const;
   /// The active fronts' checks that are negative in g (after an event: of the kinds that watch them there);
   /// an inactive front's check slot holds its formation, which is not a failure.
   std::vector<int> failed_checks(const Eigen::Ref<const Eigen::VectorXd>& g, bool after_event) const;
 
   int num_checks() const;
-  /// Takes front k out of the string at t (FrontKind::absorbed: a kink at a held end): its arcs merge
-  /// (FrontKind::remove), the other fronts' arc indices follow, it becomes inactive, and the run's events
-  /// list "<kind>_absorbed".
-  void remove_front(StringModel<dim>& model, std::size_t k, double t);
+  /// Takes front k out of the string at t (FrontKind::absorbed: a kink at a held end; FrontKind::dissolves: a kink
+  /// that carries no shock any more): its arcs merge (FrontKind::remove), the other fronts' arc indices follow, it
+  /// becomes inactive, and the run's events list the front's name with `_` and `what` ("absorbed", "dissolved"), e.g. `kink_absorbed`.
+  void remove_front(StringModel<dim>& model, std::size_t k, double t, const char* what = "absorbed");
+  /// remove_front for a front that dissolves: where slack is allowed, the links of its stencil shorter than their
+  /// length by more than the slack gap (the merged split link's chord across a corner, a released arm that has
+  /// shortened) are slack, not projected back to their lengths.
+  void dissolve_front(StringModel<dim>& model, std::size_t k, double t);
   /// Puts front k, not yet in the string, where it formed (FrontKind::insert: a kink where the tangent turns
   /// sharply), the other fronts' arc indices following; the run's events list "<kind>_inserted". False if no
   /// place fits.

@@ -327,7 +327,9 @@ void HeapFront<dim>::evaluate(const StringModel<dim>& model, FrontState<dim>& s,
   // The string from the end node to the front (docs/shocks.md): its material length l, the tangent e
   // at the front (from the arc into the heap), the front point and w = dl/dt, the rate at which the
   // arc gains material (w < 0: it runs into the heap).
-  const int links = curve_links(model, e_.arc, node, after_);
+  const int links = held_links_ >= 0 ? std::min(held_links_, model.arcs()[static_cast<std::size_t>(e_.arc)].num_links())
+                                     : curve_links(model, e_.arc, node, after_);
+  last_links_ = links;
   const HeapGeometry<dim> geo =
       heap_geometry<dim>(x, v, on_plane_, point_, normal_, last_direction_, last_curvature_, node, after_, links, h);
   const double l = geo.l, w = geo.w;

@@ -67,6 +67,9 @@ class HeapFront final : public FrontKind<dim> {
   void crossings(const StringModel<dim>& model, const FrontState<dim>& state, double* g) const override;
   int second_direction() const override { return +1; }
   EventAction cross(StringModel<dim>& model, const FrontState<dim>& state, int e0) override;
+  /// Held: the curve to the plane keeps the links it was drawn through at the last evaluation (curve_links), when
+  /// a snap makes a link next to the end taut again or a separation makes one slack.
+  void hold_drawing(bool hold) override { held_links_ = hold ? last_links_ : -1; }
 
  private:
   /// The arc end at the heap: its end node, the node inside the arc next to it, the node that comes
@@ -89,6 +92,8 @@ class HeapFront final : public FrontKind<dim> {
                                                 ///< the second derivative x'' its end keeps
   Vec<dim> partial_mid_ = Vec<dim>::Zero();     ///< the midpoint of the string from the end node to the front
   bool pot_ = false;
+  int last_links_ = 0;   ///< the full links the curve to the front took at the last evaluation
+  int held_links_ = -1;  ///< >= 0: held (hold_drawing), the curve takes that many links
   Vec<dim> pot_direction_ = Vec<dim>::Zero();   ///< a pinned pot: the direction the string leaves it in (unit)
 };
 

@@ -92,6 +92,7 @@ bool KinkFront<dim>::insert(StringModel<dim>& model) {
   this->arc_minus = k;
   this->arc_plus = k + 1;
   this->expected_s0 = model.chain().node_coordinate(best) + best_l;
+  sense_ = 0;
   model.rebuild();
   return true;
 }
@@ -271,20 +272,44 @@ EventAction KinkFront<dim>::cross(StringModel<dim>& model, const FrontState<dim>
                         outside < 0.5 ? fmt::format("{:.0f} % of its mass", 100 * (1 - 2 * outside)) : "no mass")};
   }
   EventAction action = SplitLinkFront<dim>::cross(model, state, e0);
-  if (action.kind != EventAction::Kind::kStop) this->watch_outside();  // the arms may meet outside the new link
+  if (action.kind != EventAction::Kind::kStop) {
+    this->watch_outside();  // the arms may meet outside the new link
+    sense_ = 0;             // ṡ0 from the new stencil
+  }
   return action;
 }
 
 template <int dim>
-void KinkFront<dim>::checks(const StringModel<dim>& /*model*/, const FrontState<dim>& s, double* g) const {
+double KinkFront<dim>::shock_margin(const StringModel<dim>& model, const FrontState<dim>& s) const {
+  if (sense_ == 0 && s.s0_dot != 0) sense_ = s.s0_dot > 0 ? 1 : -1;
+  // ṡ0 in units of the speed of a wave along a link under its own weight over h: the margin is O(1) where the
+  // arms' is.
+  const double g_field = model.uniform_field().norm();
+  const double speed = std::sqrt(std::max(g_field, 1.0) * this->m_.h);
+  double margin = sense_ == 0 ? 1.0 : sense_ * s.s0_dot / speed;
+  if (model.allows_slack()) {
+    const Points<dim>& x = model.x();
+    const int a = this->node_a(model), b = this->node_b(model);
+    for (const int j : {a - 1, b}) {  // the arms' links (a − 1, a) and (b, b + 1)
+      if (!model.link_slack(j) && model.link_tension(j) > 0) continue;
+      const double length = (x.col(j + 1) - x.col(j)).norm() / model.chain().link_length(j);
+      margin = std::min(margin, length - (1 - StringModel<dim>::kSlackGap));
+    }
+  }
+  return margin;
+}
+
+template <int dim>
+void KinkFront<dim>::checks(const StringModel<dim>& model, const FrontState<dim>& s, double* g) const {
   g[0] = std::min(turn_margin(s), kMaxChord - chord_);
-  g[1] = this->outside_margin(s);
+  g[1] = shock_margin(model, s);
+  g[2] = this->outside_margin(s);
 }
 
 template <int dim>
 std::string KinkFront<dim>::check_failed(const StringModel<dim>& model, const FrontState<dim>& s, double t, int check) const {
   const int a = this->node_a(model), b = this->node_b(model);
-  if (check == 1) {
+  if (check == 2) {
     // Moving out on A's side (towards the start) or on B's (towards the end), with the links left on that side.
     const bool start = s.l_minus < s.l_plus;
     const int links = model.arcs()[static_cast<std::size_t>(start ? this->arc_minus : this->arc_plus)].num_links();

@@ -73,22 +73,36 @@ class KinkFront final : public SplitLinkFront<dim> {
   bool absorbed(const StringModel<dim>& model, const FrontState<dim>& state, int e0) const override;
   /// Stops where an arc would be left without a full link (its direction t∓ is that link's).
   EventAction cross(StringModel<dim>& model, const FrontState<dim>& state, int e0) override;
-  /// Two: (0) positive while the arms turn by more than kMinTurnDeg and the chord is within kMaxChord h; (1) the
-  /// front inside its kinked link or moving back into it after a crossing (SplitLinkFront::outside_margin: where
-  /// the string turns sharply next to the new kinked link its arms meet beyond the node just crossed, and a kink
-  /// that then turns back would run on past the crossing's root until a node lost its mass).
-  int num_checks() const override { return 2; }
+  /// Three: (0) positive while the arms turn by more than kMinTurnDeg and the chord is within kMaxChord h; (1) the
+  /// kink carries a shock (shock_margin; where it reaches zero the kink dissolves, `dissolves`); (2) the front
+  /// inside its kinked link or moving back into it after a crossing (SplitLinkFront::outside_margin: where the
+  /// string turns sharply next to the new kinked link its arms meet beyond the node just crossed, and a kink that
+  /// then turns back would run on past the crossing's root until a node lost its mass).
+  int num_checks() const override { return 3; }
   void checks(const StringModel<dim>& model, const FrontState<dim>& state, double* g) const override;
+  /// Check 1's arms read the tension solve (a released arm).
+  bool checks_need_tensions() const override { return true; }
   /// Check 0 no: a crossing re-lays the kinked link with its arms not meeting (the least squares of §2.5; on the
   /// swinging U, 201 nodes, its chord is 1.035 h right after the crossing at t = 0.4285 s), and the drift
   /// control brings the chord back within kMaxChord h; the check is watched from the next sign change
-  /// (docs/model.md §9, "The crossing breaks the jump conditions"). Check 1 yes.
-  bool check_after_events(int check) const override { return check != 0; }
+  /// (docs/model.md §9, "The crossing breaks the jump conditions"). Check 1 no: it dissolves the kink, and the
+  /// tracker dissolves a kink whose check 1 a crossing leaves negative at once. Check 2 yes.
+  bool check_after_events(int check) const override { return check == 2; }
+  /// Check 1 takes the kink out of the string: it carries no shock any more (docs/model.md §9, "A kink that comes
+  /// to rest").
+  bool dissolves(int check) const override { return check == 1; }
   std::string check_failed(const StringModel<dim>& model, const FrontState<dim>& state, double t,
                            int check) const override;
 
  private:
   double turn_margin(const FrontState<dim>& state) const;
+  /// Positive while the kink carries a shock: its speed ṡ0 keeps the sign it had after its insertion or last
+  /// crossing (τ = λ ṡ0², so where ṡ0 passes zero the tension at the kink does, the jumps [v] = −ṡ0 [t] and
+  /// [τ t] vanish, and the kink is a corner at rest that needs no front), and, where slack is allowed, each arm's
+  /// link is taut or, released by the tension solve, within the slack gap of its length (an arm that goes slack
+  /// carries no τ = λ ṡ0², and the kink's geometry, straight arms of full links, no longer holds: its arms met
+  /// 0.4 h apart on the driven catenary of issue 27, and the energy drifted by 9.2e-6 J).
+  double shock_margin(const StringModel<dim>& model, const FrontState<dim>& state) const;
   /// Where the arms meet in the kinked link (a, b): l⁻ = w·d / |d|², the least-squares solution of
   /// x_b − x_a = l⁻ t_A + (h − l⁻) t_B, with d = t_A − t_B (dd = |d|²) and w = x_b − x_a − h t_B.
   static double meeting_point(const Vec<dim>& d, double dd, const Vec<dim>& w) { return w.dot(d) / dd; }
@@ -97,6 +111,8 @@ class KinkFront final : public SplitLinkFront<dim> {
   KinkSpec spec_;
   /// The links at either end of the sharpest window at the last formation_margin (−1: none).
   mutable int sharpest_ = -1;
+  /// The sign of ṡ0 after the insertion or the last crossing (0: not yet seen), for shock_margin.
+  mutable int sense_ = 0;
 };
 
 }  // namespace chainsim

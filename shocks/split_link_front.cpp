@@ -72,7 +72,14 @@ double SplitLinkFront<dim>::end_margin(const StringModel<dim>& model, bool plus)
   // The split link is the string's last (first) and its end node moves: that node's mass is λ l⁺ (λ l⁻) alone.
   const ArcRange& arc = model.arcs()[static_cast<std::size_t>(plus ? this->arc_plus : this->arc_minus)];
   const int end = plus ? arc.first : arc.last;
-  return arc.num_links() == 0 && !model.is_prescribed(end) ? kLastPartial * this->m_.h : 0.0;
+  return is_free_end(model, end) ? kLastPartial * this->m_.h : 0.0;
+}
+
+template <int dim>
+bool SplitLinkFront<dim>::is_free_end(const StringModel<dim>& model, int node) {
+  // An arc of no links is not always at an end: it can lie between two fronts.
+  const Chain<dim>& chain = model.chain();
+  return !chain.closed() && (node == 0 || node == chain.num_nodes() - 1) && !model.is_prescribed(node);
 }
 
 template <int dim>
@@ -91,8 +98,18 @@ EventAction SplitLinkFront<dim>::cross(StringModel<dim>& model, const FrontState
   ArcRange& B = model.arcs()[static_cast<std::size_t>(this->arc_plus)];
   // e0: the front reached B's first node (it joins A); e1: it reached A's last node (it joins B).
   const bool to_A = e0 != 0;
+  // An arc of no links ends the string or meets the next front (two fronts in one link are not modelled).
+  const int last_node = model.chain().num_nodes() - 1;
   if (to_A && B.num_links() == 0)
-    return {EventAction::Kind::kStop, fmt::format("the {} has reached the end of the string", this->name())};
+    return {EventAction::Kind::kStop,
+            B.first == last_node && !model.chain().closed()
+                ? fmt::format("the {} has reached the end of the string", this->name())
+                : fmt::format("the {} has reached the link of the next front at node {} (two fronts in one link "
+                              "are not modelled)", this->name(), B.first)};
+  if (!to_A && A.num_links() == 0 && !(A.last == 0 && !model.chain().closed()))
+    return {EventAction::Kind::kStop,
+            fmt::format("the {} has reached the link of the previous front at node {} (two fronts in one link are "
+                        "not modelled)", this->name(), A.last)};
   if (!to_A && (A.num_links() == 0 || model.is_prescribed(A.last)))
     return {EventAction::Kind::kStop, fmt::format("the {} has reached the start of the string", this->name())};
   // Mass parcels: each link's mass is split between its two nodes (½–½ for a full link, l⁻–l⁺ for

@@ -46,6 +46,8 @@ class SplitLinkFront : public FrontKind<dim> {
   /// (cross), taken that far before the end. 0 elsewhere (a node inside the string keeps its other link's mass; a
   /// prescribed end has no mass to lose).
   double end_margin(const StringModel<dim>& model, bool plus) const;
+  /// Whether `node` is a free (not prescribed) end of an open string.
+  static bool is_free_end(const StringModel<dim>& model, int node);
   /// The unit tangent of the link i → j and its rate (the part of (v_j − v_i) across it over its length).
   static Vec<dim> link_tangent(const StringModel<dim>& model, int i, int j, const char* what, Vec<dim>& rate);
   /// Mass parcels: link j's share on its start node changes by `delta` (kg), the material moving with the

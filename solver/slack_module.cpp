@@ -183,8 +183,14 @@ class SlackModule final : public WrappingModule<dim> {
     }
     if (found[static_cast<std::size_t>(k)] == 0 && !stretched) return action;
     const long snaps_before = snaps_;
+    // The fronts keep their drawing through the impulses, and are drawn on the links they leave afterwards, what
+    // that moves booked (a heap's curve to its plane stops at a slack link: FrontTracker::redraw_fronts).
+    if (inner_) inner_->hold_fronts();
     const typename StringModel<dim>::SnapResult snap = model.snap(t);
-    if (snap.caught == 0) return action;
+    if (snap.caught == 0) {
+      if (inner_) inner_->redraw_fronts(model, ledger.head(kl));
+      return action;
+    }
     book(snap, ledger);
     // The snap's impulses can leave another slack link at or past its length with its root function at or below
     // zero at the restart, where ARKODE would never find its snap: one already past its length whose offset the
@@ -205,6 +211,7 @@ class SlackModule final : public WrappingModule<dim> {
       if (!inner_ || !inner_->release_contacts(model, t) || round >= max_rounds) break;
       model.refresh();
     }
+    if (inner_) inner_->redraw_fronts(model, ledger.head(kl));
     if (inner_) {
       // ARKODE restarts from the state after the snap and finds only sign changes from there: a check of
       // the fronts that the snap has made fail (an edge that would now have to pull the string) is acted

@@ -274,6 +274,12 @@ class StringModule {
   /// passed a surface unseen (their landing function below zero at the event's state, where ARKODE, restarting,
   /// would find no root), with the impact booked in `ledger` (the module's ledgers); returns whether one landed.
   virtual bool land_passed(StringModel<dim>&, double, Eigen::Ref<Eigen::VectorXd>) { return false; }
+  /// Around an impulse the module did not make (the snaps of the slack module around it), which may change which
+  /// links are slack: hold_fronts() keeps the fronts drawn as at the last evaluation (a heap's curve to its plane
+  /// stops at a slack link), redraw_fronts() draws them on the links as they are now and books what that moves
+  /// between the arcs and the heaps in `ledger` (the module's ledgers), as a crossing's re-drawing is booked.
+  virtual void hold_fronts() {}
+  virtual void redraw_fronts(StringModel<dim>&, Eigen::Ref<Eigen::VectorXd>) {}
   /// The physical events of the run so far (e.g. a chain lifting off an edge), for the run's summary,
   /// in time order.
   virtual std::vector<RunEvent> run_events() const { return {}; }

@@ -66,6 +66,12 @@ class WrappingModule : public StringModule<dim> {
     return found;
   }
   bool checks_at_start() const override { return inner_ && inner_->checks_at_start(); }
+  void hold_fronts() override {
+    if (inner_) inner_->hold_fronts();
+  }
+  void redraw_fronts(StringModel<dim>& model, Eigen::Ref<Eigen::VectorXd> ledger) override {
+    if (inner_) inner_->redraw_fronts(model, ledger.head(inner_ledgers()));
+  }
 
  protected:
   int inner_ledgers() const { return inner_ ? inner_->num_ledgers() : 0; }

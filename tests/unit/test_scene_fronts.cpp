@@ -423,6 +423,29 @@ TEST_CASE("a fold without a cutoff stops just before the free end, when the exac
   }
 }
 
+TEST_CASE("a fold placed within a thousandth of a link of the free end is refused at the start", "[unit][scene]") {
+  // Its crossing at the end lies kLastPartial h before the end node (the test above): a fold closer than that starts
+  // with that root function ≤ 0, where ARKODE finds no root, and ran on until the end node lost its mass. It is now
+  // refused; a fold twice as far from the end starts and stops there at once.
+  const double h = 1.0 / 20;
+  auto fold_at = [&](double gap) {  // the fold gap·h before the free end: the free arm is gap·h long
+    const double s0 = 1.0 - gap * h;
+    const std::string text =
+        test::edit(test::edit(test::edit(test::kFoldedBase, "[[stop.front]]\nfront = \"fold\"\ns0 = 0.99\n", ""),
+                              "points = [[0.0, 0.0], [0.0, -0.2], [0.0, 0.6]]",
+                              fmt::format("points = [[0.0, 0.0], [0.0, {:.17g}], [0.0, {:.17g}]]", -s0, -s0 + gap * h)),
+                   "s0 = 0.2", fmt::format("s0 = {:.17g}", s0));
+    return parse_scene_text(text, "fold_at_the_end.toml");
+  };
+  CHECK_THROWS_WITH(test::run_front_spec(fold_at(0.5 * kLastPartial)),
+                    Contains("the fold front starts at s0 = ") && Contains("past one of its crossings") &&
+                        Contains("move s0 by 5e-05 m (a thousandth of a link) or more"));
+  const RunSummary run = test::run_front_spec(fold_at(2 * kLastPartial));
+  REQUIRE(run.status == "stopped");
+  CHECK_THAT(run.stop_reason, Contains("the fold has reached the end of the string"));
+  CHECK(run.t_stop < 1e-2);  // 5e-5 m of material at about ¼ g t²: 4.5 ms
+}
+
 TEST_CASE("chainsim run on a front scene writes its outputs, stats.json last, and says why it stopped",
           "[unit][scene]") {
   const auto dir = temp_dir("scene_fronts_run");
