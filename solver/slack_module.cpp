@@ -176,10 +176,15 @@ class SlackModule final : public WrappingModule<dim> {
     // past its length: its snap is now, with the root function below zero at the restart, where ARKODE
     // would never find it (a loop round a pulley: the link then went on stretching unseen).
     const bool stretched = action.kind == EventAction::Kind::kTransfer && model.slack_gap() <= 0;
-    // A located release: the links whose tension has reached the release threshold are slack from this instant.
-    if (found[static_cast<std::size_t>(k) + 1] != 0) {
+    // A located release: the links whose tension has reached the release threshold are slack from this instant;
+    // so are those the tension problem releases at the state another event left (their release term would restart
+    // at or below zero, where ARKODE finds no root). Inside the fronts' held drawing, as a snap is: a heap's curve
+    // to its plane stops at the first slack link.
+    if (found[static_cast<std::size_t>(k) + 1] != 0 || action.kind == EventAction::Kind::kTransfer) {
+      if (inner_) inner_->hold_fronts();
       model.evaluate(t, model.x(), model.v());
       if (model.release_links() > 0) action = {EventAction::Kind::kTransfer, ""};
+      if (inner_) inner_->redraw_fronts(model, ledger.head(kl));
     }
     if (found[static_cast<std::size_t>(k)] == 0 && !stretched) return action;
     const long snaps_before = snaps_;
@@ -211,6 +216,10 @@ class SlackModule final : public WrappingModule<dim> {
       if (!inner_ || !inner_->release_contacts(model, t) || round >= max_rounds) break;
       model.refresh();
     }
+    // The links the tension problem releases at the state the snaps leave are slack from here (their release term
+    // would restart below zero).
+    model.evaluate(t, model.x(), model.v());
+    model.release_links();
     if (inner_) inner_->redraw_fronts(model, ledger.head(kl));
     if (inner_) {
       // ARKODE restarts from the state after the snap and finds only sign changes from there: a check of

@@ -1905,7 +1905,7 @@ double StringModel<dim>::release_root() const {
   const double scale = std::max(T.size() ? T.cwiseAbs().maxCoeff() : 0.0, physical_scales().tension);
   if (!(scale > 0)) return g;
   for_each_link([&](int j, int u, int) {
-    if (link_slack(j) || link_bent(j)) return;
+    if (link_slack(j) || link_bent(j) || borders_front(j)) return;
     const double gj = system_->excluded(u) ? -options_.slack_tolerance : T[u] / scale + options_.slack_tolerance;
     g = std::min(g, gj);
   });
@@ -1920,7 +1920,7 @@ int StringModel<dim>::release_links() {
   if (!(scale > 0)) return 0;
   std::vector<int> released;
   for_each_link([&](int j, int u, int) {
-    if (link_slack(j) || link_bent(j)) return;
+    if (link_slack(j) || link_bent(j) || borders_front(j)) return;
     if (system_->excluded(u) || T[u] / scale + options_.slack_tolerance <= 0) released.push_back(j);
   });
   for (const int j : released) {
@@ -1931,6 +1931,16 @@ int StringModel<dim>::release_links() {
     rebound_time_[static_cast<std::size_t>(j)] = NAN;
   }
   return static_cast<int>(released.size());
+}
+
+template <int dim>
+bool StringModel<dim>::borders_front(int j) const {
+  const int L = chain_.num_links();
+  const auto held = [&](int i) {
+    if (chain_.closed()) i = (i + L) % L;
+    return i >= 0 && i < L && link_unknown_[static_cast<std::size_t>(i)] < 0;
+  };
+  return held(j - 1) || held(j + 1);
 }
 
 template <int dim>
@@ -1963,15 +1973,15 @@ double StringModel<dim>::slack_root(int j) const {
   const double h = chain_.link_length(j);
   double offset = slack_offset_[k];
   if (offset > 0 && (bends_.empty() || bend_of(j) == nullptr)) {
-    const int a = chain_.link_start(j), b = chain_.link_end(j);
-    if ((x_.col(b) - x_.col(a)).dot(v_.col(b) - v_.col(a)) >= 0) {
-      // A release flight (release_links) starts at rest at its length l_r, its rate a drift's: its offset
-      // (l_r − h)⁺/h + kSlackGap drops to (l_r − h)⁺/h once the link is shorter than l_r, so that its return
-      // is located at l_r (within the drift of h), not kSlackGap past it, and not at its start.
-      if (!release_flight_[k])
-        offset = 0;
-      else if ((h - current_length(j)) / h + offset - kSlackGap > 0)
-        offset -= kSlackGap;
+    // A release flight (release_links) starts at rest at its length l_r, its rate a drift's: its offset
+    // (l_r − h)⁺/h + kSlackGap drops to (l_r − h)⁺/h once an accepted step has found the link shorter than l_r
+    // (accept_step), so that its return is located at l_r (within the drift of h), not kSlackGap past it, and
+    // not at its start; until then it keeps the whole offset.
+    if (release_flight_[k] == 2) {
+      offset -= kSlackGap;
+    } else if (release_flight_[k] == 0) {
+      const int a = chain_.link_start(j), b = chain_.link_end(j);
+      if ((x_.col(b) - x_.col(a)).dot(v_.col(b) - v_.col(a)) >= 0) offset = 0;
     }
   }
   return (h - current_length(j)) / h + offset;
@@ -1996,7 +2006,12 @@ void StringModel<dim>::accept_step(double t, const Eigen::Ref<const Eigen::Vecto
         set_slack(j, true);
         rebound_time_[static_cast<std::size_t>(j)] = NAN;  // released by the tensions: a flight, not a rebound
       }
-    } else if (const double root = slack_root(j); root < -kSlackGap) {
+    } else {
+      // A release flight shorter than its length at the release: its return is now a crossing of l_r (slack_root).
+      const auto k = static_cast<std::size_t>(j);
+      if (release_flight_[k] == 1 && gap + slack_offset_[k] - kSlackGap > 0) release_flight_[k] = 2;
+      const double root = slack_root(j);
+      if (!(root < -kSlackGap)) continue;
       // The snap's own root function (its offset dropped from the top of the flight on): a link past its top that
       // had gone 4e-7 h past its length passed unflagged when the check added the offset regardless.
       throw NumericalError(fmt::format("at t = {:.9g} s slack link {} (s = {:.6g} m) is {:.3g} of its length past it: "

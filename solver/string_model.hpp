@@ -708,7 +708,11 @@ class StringModel final : public OdeSystem {
   ImpulsiveStart impulsive_start_;
   std::vector<char> slack_;            // per link: slack (slack = allow)
   std::vector<double> slack_offset_;   // per link: its root function's offset
-  std::vector<char> release_flight_;   // per link: slack since a located release (slack_root)
+  // per link: 0, no release flight; 1, slack since a located release at length l_r; 2, and since then shorter
+  // than l_r at an accepted step (its root function is (l_r − l)/h from then on: slack_root)
+  std::vector<char> release_flight_;
+  /// Link j borders a link that no arc holds (a front's split link): a front's arm, whose release the front judges.
+  bool borders_front(int j) const;
   std::vector<double> rebound_time_, rebound_speed_;  // per link: when and how fast it separated at its last snap (NaN: it did not)
   // per link: released by the complementarity problem at some evaluation since the last accepted step (accept_step)
   std::vector<char> released_;
