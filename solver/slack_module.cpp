@@ -180,12 +180,8 @@ class SlackModule final : public WrappingModule<dim> {
     // so are those the tension problem releases at the state another event left (their release term would restart
     // at or below zero, where ARKODE finds no root). Inside the fronts' held drawing, as a snap is: a heap's curve
     // to its plane stops at the first slack link.
-    if (found[static_cast<std::size_t>(k) + 1] != 0 || action.kind == EventAction::Kind::kTransfer) {
-      if (inner_) inner_->hold_fronts();
-      model.evaluate(t, model.x(), model.v());
-      if (model.release_links() > 0) action = {EventAction::Kind::kTransfer, ""};
-      if (inner_) inner_->redraw_fronts(model, ledger.head(kl));
-    }
+    if (found[static_cast<std::size_t>(k) + 1] != 0 || action.kind == EventAction::Kind::kTransfer)
+      release(model, t, ledger.head(kl), action);
     if (found[static_cast<std::size_t>(k)] == 0 && !stretched) return action;
     const long snaps_before = snaps_;
     // The fronts keep their drawing through the impulses, and are drawn on the links they leave afterwards, what
@@ -208,7 +204,10 @@ class SlackModule final : public WrappingModule<dim> {
     const int max_rounds = model.chain().num_links();
     for (int round = 0;; ++round) {
       while (round < max_rounds && model.slack_gap() <= 0) {
-        const typename StringModel<dim>::SnapResult again = model.snap(t);
+        // Judged against the first snap's speed: the links these rounds catch were left at their length by its
+        // impulses, at round-off rates, and would separate and be caught again for ever when judged against those
+        // rates (a folded chain jerked down: two links at rest in free fall, 100 rounds, the root left below zero).
+        const typename StringModel<dim>::SnapResult again = model.snap(t, snap.speed);
         if (again.caught == 0) break;
         book(again, ledger);
         ++round;
@@ -216,11 +215,10 @@ class SlackModule final : public WrappingModule<dim> {
       if (!inner_ || !inner_->release_contacts(model, t) || round >= max_rounds) break;
       model.refresh();
     }
+    if (inner_) inner_->redraw_fronts(model, ledger.head(kl));
     // The links the tension problem releases at the state the snaps leave are slack from here (their release term
     // would restart below zero).
-    model.evaluate(t, model.x(), model.v());
-    model.release_links();
-    if (inner_) inner_->redraw_fronts(model, ledger.head(kl));
+    release(model, t, ledger.head(kl), action);
     if (inner_) {
       // ARKODE restarts from the state after the snap and finds only sign changes from there: a check of
       // the fronts that the snap has made fail (an edge that would now have to pull the string) is acted
@@ -252,6 +250,19 @@ class SlackModule final : public WrappingModule<dim> {
  private:
   long snaps_ = 0;
   mutable bool counting_ = false;  // W_links: a link has been released (found by the const ledger_rates)
+
+  /// The links the tension problem releases at the current state (their terms of release_root() ≤ 0) are slack
+  /// from here: at a located release, and at the state another event leaves, where their release term would
+  /// restart at or below zero and ARKODE would find no root. Inside the fronts' held drawing, as a snap is (a
+  /// heap's curve to its plane stops at the first slack link); with no link released nothing is drawn again.
+  void release(StringModel<dim>& model, double t, Eigen::Ref<Eigen::VectorXd> inner_ledger, EventAction& action) {
+    model.evaluate(t, model.x(), model.v());
+    if (model.release_root() > 0) return;
+    if (inner_) inner_->hold_fronts();
+    model.release_links();
+    if (inner_) inner_->redraw_fronts(model, inner_ledger);
+    if (action.kind != EventAction::Kind::kStop) action = {EventAction::Kind::kTransfer, ""};
+  }
 
   /// A snap's terms in the ledgers (the whole module's `ledger`), counted.
   void book(const typename StringModel<dim>::SnapResult& snap, Eigen::Ref<Eigen::VectorXd> ledger) {

@@ -1975,8 +1975,8 @@ double StringModel<dim>::slack_root(int j) const {
   if (offset > 0 && (bends_.empty() || bend_of(j) == nullptr)) {
     // A release flight (release_links) starts at rest at its length l_r, its rate a drift's: its offset
     // (l_r − h)⁺/h + kSlackGap drops to (l_r − h)⁺/h once an accepted step has found the link shorter than l_r
-    // (accept_step), so that its return is located at l_r (within the drift of h), not kSlackGap past it, and
-    // not at its start; until then it keeps the whole offset.
+    // by kFlightDepth h (accept_step), so that its return is located at l_r (within the drift of h), not
+    // kSlackGap past it, and not at its start; until then it keeps the whole offset.
     if (release_flight_[k] == 2) {
       offset -= kSlackGap;
     } else if (release_flight_[k] == 0) {
@@ -2007,9 +2007,12 @@ void StringModel<dim>::accept_step(double t, const Eigen::Ref<const Eigen::Vecto
         rebound_time_[static_cast<std::size_t>(j)] = NAN;  // released by the tensions: a flight, not a rebound
       }
     } else {
-      // A release flight shorter than its length at the release: its return is now a crossing of l_r (slack_root).
+      // A release flight shorter than its length at the release by more than round-off (kFlightDepth): its return
+      // is now a crossing of l_r (slack_root). Without the depth, links at rest at their length in free fall took
+      // (l_r − l)/h = round-off as their root, and snapped at once by dozens, at rates of round-off that the
+      // impulses turned into separations and back (a folded chain jerked down, 401 nodes).
       const auto k = static_cast<std::size_t>(j);
-      if (release_flight_[k] == 1 && gap + slack_offset_[k] - kSlackGap > 0) release_flight_[k] = 2;
+      if (release_flight_[k] == 1 && gap + slack_offset_[k] - kSlackGap > kFlightDepth) release_flight_[k] = 2;
       const double root = slack_root(j);
       if (!(root < -kSlackGap)) continue;
       // The snap's own root function (its offset dropped from the top of the flight on): a link past its top that
@@ -2027,7 +2030,7 @@ void StringModel<dim>::accept_step(double t, const Eigen::Ref<const Eigen::Vecto
 }
 
 template <int dim>
-typename StringModel<dim>::SnapResult StringModel<dim>::snap(double t) {
+typename StringModel<dim>::SnapResult StringModel<dim>::snap(double t, double speed_floor) {
   SnapResult result;
   links();
   const int L = chain_.num_links();
@@ -2068,7 +2071,8 @@ typename StringModel<dim>::SnapResult StringModel<dim>::snap(double t) {
     for (int j : caught)
       if (rebounds_accumulate(j, t, e)) inelastic[static_cast<std::size_t>(j)] = 1;
   }
-  const SnapResult impulses = link_impulses(t, e, 0, inelastic.empty() ? nullptr : &inelastic, true);
+  const SnapResult impulses = link_impulses(t, e, speed_floor, inelastic.empty() ? nullptr : &inelastic, true);
+  result.speed = impulses.speed;
   result.dissipated = impulses.dissipated;
   result.support_work = impulses.support_work;
   result.support_impulse = impulses.support_impulse;
@@ -2197,6 +2201,7 @@ typename StringModel<dim>::SnapResult StringModel<dim>::link_impulses(double t, 
     result.dissipated += 0.5 * P[u] * (u_before[j] + u_after);
     if (!link_slack(j) && u_after < -kSeparation * u_scale) separating.push_back(j);
   });
+  result.speed = u_scale;
   // 4a. At a snap, a separation whose flight would not open the link beyond kSlackGap of its length is held
   //     taut (hold_unresolved_flights): the velocities are then projected onto the taut links' lengths below.
   const bool held = rebounds && hold_unresolved_flights(t, separating);
