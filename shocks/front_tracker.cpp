@@ -145,20 +145,8 @@ template <int dim>
 void FrontTracker<dim>::add_mass_and_forces(const StringModel<dim>& model, Eigen::VectorXd& mass, Points<dim>& force) {
   for (std::size_t k = 0; k < fronts_.size(); ++k)
     if (fronts_[k]->active) fronts_[k]->evaluate(model, fs_[k], mass, force);
-  const double lambda = material_.lambda, h = material_.h;
-  // The mass first (a comparison; in_arc and is_prescribed are calls into the solver's library, and this
-  // scan runs at every right-hand side: 4.8 % of the folded compare's instructions on 800 nodes).
-  const double floor = 1e-12 * lambda * h;
-  const double* const m = mass.data();
-  // Whether any node of the arcs is at or below the floor first, arc by arc in branch-free passes (the nodes
-  // out of the arcs, e.g. in a heap, have no mass); the node-by-node scan below only if one is.
-  bool any_light = false;
-  for (const ArcRange& arc : model.arcs())
-    for (int i = arc.first; i <= arc.last; ++i) any_light |= !(m[i] > floor);
-  if (!any_light) return;
-  for (int i = 0; i < material_.n; ++i)
-    if (!(m[i] > floor) && model.in_arc(i) && !model.is_prescribed(i))
-      throw RecoverableError(fmt::format("node {} has lost its mass (a front overshot it)", i));
+  // A node of the arcs whose mass the fronts took (a front overshot it) is refused by the model's refresh(),
+  // in its pass over the free nodes (StringModel::lost_mass_floor_).
 }
 
 template <int dim>

@@ -701,6 +701,9 @@ class StringModel final : public OdeSystem {
   Eigen::VectorXd m_;            // current masses (base + module)
   Eigen::VectorXd w_;            // 1/m_i for free nodes, 0 otherwise
   Eigen::VectorXd base_w_;       // w_ of the base masses (rebuild(), with a module): refresh() takes it where m_i is the base mass
+  /// refresh() (with a module): a free node whose mass m_i (the module's partial links included) is not above
+  /// this has lost its mass, a RecoverableError (a front overshot it; 1e-12 λ h, rebuild()).
+  double lost_mass_floor_ = 0;
   int num_free_ = 0;
   double alpha_ = 0, beta_ = 0;
   /// β² of the last evaluation: 1/τ_b², capped where its response to round-off would exceed the

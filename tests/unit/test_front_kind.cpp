@@ -8,6 +8,7 @@
 #include <string>
 
 #include "cases/scene/front_scene.hpp"
+#include "mesh/errors.hpp"
 #include "cases/scene/scene.hpp"
 #include "shocks/front_tracker.hpp"
 #include "shocks/jump_conditions.hpp"
@@ -126,4 +127,28 @@ TEST_CASE("a running pot's state is the jump conditions at that state: a sliding
   CHECK_THAT(s.tension_plus, WithinAbs((1 + f) * lam * y2, 1e-12 * scale));
   CHECK_THAT((s.reaction - f * lam * y2 * ey).norm(), WithinAbs(0.0, 1e-12 * scale));
   CHECK_THAT(s.power_heap, WithinAbs(-(0.5 + f) * lam * std::abs(ydot) * y2, 1e-12 * scale * std::abs(ydot)));
+}
+
+TEST_CASE("a node whose mass a front took is refused by the model: the fold's partial link past its node",
+          "[unit][shocks]") {
+  // The folded chain running at 0.25 s: arc A (the resting arm) hangs from the fixed end down to node a, arc B (the
+  // falling arm) runs from node b up. The fold lumps λ l⁻ on a and λ l⁺ on b, l± = ½ (h ∓ c), c the chord along the
+  // fold direction e. Node b moved to x_a + 2.5 h e (its link to b + 1 still points up, e stays): c = 2.5 h, so
+  // m_b = λ h/2 (its link of arc B) + λ (h − 2.5 h)/2 = −λ h/4: the front has overshot b, and a trial state like this
+  // is refused with a RecoverableError naming b (StringModel::refresh, a pass over the free nodes), never a NaN.
+  const Running run(test::kFoldedBase, 0.25);
+  StringModel<2>& model = *run.scene.model;
+  const FrontKind<2>& front = run.tracker->fronts()[0];
+  const int a = model.arcs()[static_cast<std::size_t>(front.arc_minus)].last;
+  const int b = model.arcs()[static_cast<std::size_t>(front.arc_plus)].first;
+  REQUIRE(model.arcs()[static_cast<std::size_t>(front.arc_plus)].num_links() > 2);
+  const double h = model.chain().link_length(0), t = 0.25;
+  Points<2> x = model.x(), v = model.v();
+  const Vec<2> e = run.tracker->front_state(0).direction;
+  REQUIRE(e.dot(Vec<2>(0.0, -1.0)) > 0.99);  // the bight points down
+  CHECK_NOTHROW(model.evaluate(t, x, v));      // the running state itself: every node keeps its mass
+  x.col(b) = x.col(a) + 2.5 * h * e;
+  const std::string expected = "node " + std::to_string(b) + " has lost its mass";
+  CHECK_THROWS_AS(model.evaluate(t, x, v), RecoverableError);
+  CHECK_THROWS_WITH(model.evaluate(t, x, v), Catch::Matchers::Contains(expected));
 }
