@@ -251,7 +251,8 @@ class StringModel final : public OdeSystem {
   /// none. One root function for all links (ARKODE evaluates every root function at every step: N
   /// per-link functions cost N times more evaluations of the same numbers).
   double slack_gap() const;
-  /// The release root function at the last evaluation: min over the taut links in an arc, not bent, of
+  /// The release root function at the last evaluation: min over the taut links in an arc, not bent and not the
+  /// arm of a front's split link (the front's own checks judge those: a kink whose arm is released dissolves), of
   /// T_j / scale + slack_tolerance (scale as solve_tensions judges a release), −slack_tolerance for a link the
   /// complementarity problem released; 1 with none. It crosses zero where the first tension reaches the
   /// release threshold, so the release is located and the link declared slack at that instant.
