@@ -25,9 +25,9 @@ class KinkFront final : public SplitLinkFront<dim> {
  public:
   explicit KinkFront(const KinkSpec& spec);
 
-  /// The kink's arms turn by at least this angle: its geometry divides by |t⁻ − t⁺|², and a kink that
-  /// straightens out has no place (the run stops when it turns less; a kink that starts straighter is
-  /// refused).
+  /// The kink's arms turn by at least this angle: its geometry divides by |t⁻ − t⁺|², and its jump
+  /// [v] = −ṡ0 [t], |[t]| = 2 sin(turn/2), vanishes with the turn. A kink that straightens out to it dissolves
+  /// (check 1), as one at rest does; a kink that starts straighter is refused.
   static constexpr double kMinTurnDeg = 1;
   /// The kinked link's chord |x_b − x_a| is at most h for arms that meet at x0; the run stops when it
   /// passes this (in units of h): the link's material no longer reaches across.
@@ -73,8 +73,8 @@ class KinkFront final : public SplitLinkFront<dim> {
   bool absorbed(const StringModel<dim>& model, const FrontState<dim>& state, int e0) const override;
   /// Stops where an arc would be left without a full link (its direction t∓ is that link's).
   EventAction cross(StringModel<dim>& model, const FrontState<dim>& state, int e0) override;
-  /// Three: (0) positive while the arms turn by more than kMinTurnDeg and the chord is within kMaxChord h; (1) the
-  /// kink carries a shock (shock_margin; where it reaches zero the kink dissolves, `dissolves`); (2) the front
+  /// Three: (0) positive while the chord is within kMaxChord h; (1) the kink carries a shock (shock_margin) and
+  /// its arms turn by more than kMinTurnDeg (where either reaches zero the kink dissolves, `dissolves`); (2) the front
   /// inside its kinked link or moving back into it after a crossing (SplitLinkFront::outside_margin: where the
   /// string turns sharply next to the new kinked link its arms meet beyond the node just crossed, and a kink that
   /// then turns back would run on past the crossing's root until a node lost its mass).

@@ -113,6 +113,7 @@ StringModel<dim>::StringModel(Chain<dim> chain, std::vector<std::unique_ptr<Forc
     module_ = make_slack_module<dim>(std::move(module_));
     slack_.assign(static_cast<std::size_t>(L), 0);
     slack_offset_.assign(static_cast<std::size_t>(L), 0.0);
+    release_flight_.assign(static_cast<std::size_t>(L), 0);
     rebound_time_.assign(static_cast<std::size_t>(L), NAN);
     rebound_speed_.assign(static_cast<std::size_t>(L), NAN);
     released_.assign(static_cast<std::size_t>(L), 0);
@@ -1907,6 +1908,53 @@ void StringModel<dim>::set_slack(int j, bool slack) {
   if ((flag != 0) != slack) num_slack_ += slack ? 1 : -1;
   flag = slack ? 1 : 0;
   slack_offset_[static_cast<std::size_t>(j)] = 0;
+  if (!release_flight_.empty()) release_flight_[static_cast<std::size_t>(j)] = 0;
+}
+
+template <int dim>
+double StringModel<dim>::release_root() const {
+  double g = 1;
+  if (!allows_slack() || !system_) return g;
+  const Eigen::VectorXd& T = system_->solution();
+  const double scale = std::max(T.size() ? T.cwiseAbs().maxCoeff() : 0.0, physical_scales().tension);
+  if (!(scale > 0)) return g;
+  for_each_link([&](int j, int u, int) {
+    if (link_slack(j) || link_bent(j) || borders_front(j)) return;
+    const double gj = system_->excluded(u) ? -options_.slack_tolerance : T[u] / scale + options_.slack_tolerance;
+    g = std::min(g, gj);
+  });
+  return g;
+}
+
+template <int dim>
+int StringModel<dim>::release_links() {
+  if (!allows_slack() || !system_) return 0;
+  const Eigen::VectorXd& T = system_->solution();
+  const double scale = std::max(T.size() ? T.cwiseAbs().maxCoeff() : 0.0, physical_scales().tension);
+  if (!(scale > 0)) return 0;
+  std::vector<int> released;
+  for_each_link([&](int j, int u, int) {
+    if (link_slack(j) || link_bent(j) || borders_front(j)) return;
+    if (system_->excluded(u) || T[u] / scale + options_.slack_tolerance <= 0) released.push_back(j);
+  });
+  for (const int j : released) {
+    const double h = chain_.link_length(j);
+    set_slack(j, true);
+    slack_offset_[static_cast<std::size_t>(j)] = std::max(0.0, (current_length(j) - h) / h) + kSlackGap;
+    release_flight_[static_cast<std::size_t>(j)] = 1;
+    rebound_time_[static_cast<std::size_t>(j)] = NAN;
+  }
+  return static_cast<int>(released.size());
+}
+
+template <int dim>
+bool StringModel<dim>::borders_front(int j) const {
+  const int L = chain_.num_links();
+  const auto held = [&](int i) {
+    if (chain_.closed()) i = (i + L) % L;
+    return i >= 0 && i < L && link_unknown_[static_cast<std::size_t>(i)] < 0;
+  };
+  return held(j - 1) || held(j + 1);
 }
 
 template <int dim>
@@ -1939,8 +1987,16 @@ double StringModel<dim>::slack_root(int j) const {
   const double h = chain_.link_length(j);
   double offset = slack_offset_[k];
   if (offset > 0 && (bends_.empty() || bend_of(j) == nullptr)) {
-    const int a = chain_.link_start(j), b = chain_.link_end(j);
-    if ((x_.col(b) - x_.col(a)).dot(v_.col(b) - v_.col(a)) >= 0) offset = 0;
+    // A release flight (release_links) starts at rest at its length l_r, its rate a drift's: its offset
+    // (l_r − h)⁺/h + kSlackGap drops to (l_r − h)⁺/h once an accepted step has found the link shorter than l_r
+    // by kFlightDepth h (accept_step), so that its return is located at l_r (within the drift of h), not
+    // kSlackGap past it, and not at its start; until then it keeps the whole offset.
+    if (release_flight_[k] == 2) {
+      offset -= kSlackGap;
+    } else if (release_flight_[k] == 0) {
+      const int a = chain_.link_start(j), b = chain_.link_end(j);
+      if ((x_.col(b) - x_.col(a)).dot(v_.col(b) - v_.col(a)) >= 0) offset = 0;
+    }
   }
   return (h - current_length(j)) / h + offset;
 }
@@ -1964,7 +2020,15 @@ void StringModel<dim>::accept_step(double t, const Eigen::Ref<const Eigen::Vecto
         set_slack(j, true);
         rebound_time_[static_cast<std::size_t>(j)] = NAN;  // released by the tensions: a flight, not a rebound
       }
-    } else if (const double root = slack_root(j); root < -kSlackGap) {
+    } else {
+      // A release flight shorter than its length at the release by more than round-off (kFlightDepth): its return
+      // is now a crossing of l_r (slack_root). Without the depth, links at rest at their length in free fall took
+      // (l_r − l)/h = round-off as their root, and snapped at once by dozens, at rates of round-off that the
+      // impulses turned into separations and back (a folded chain jerked down, 401 nodes).
+      const auto k = static_cast<std::size_t>(j);
+      if (release_flight_[k] == 1 && gap + slack_offset_[k] - kSlackGap > kFlightDepth) release_flight_[k] = 2;
+      const double root = slack_root(j);
+      if (!(root < -kSlackGap)) continue;
       // The snap's own root function (its offset dropped from the top of the flight on): a link past its top that
       // had gone 4e-7 h past its length passed unflagged when the check added the offset regardless.
       throw NumericalError(fmt::format("at t = {:.9g} s slack link {} (s = {:.6g} m) is {:.3g} of its length past it: "
@@ -1980,7 +2044,7 @@ void StringModel<dim>::accept_step(double t, const Eigen::Ref<const Eigen::Vecto
 }
 
 template <int dim>
-typename StringModel<dim>::SnapResult StringModel<dim>::snap(double t) {
+typename StringModel<dim>::SnapResult StringModel<dim>::snap(double t, double speed_floor) {
   SnapResult result;
   links();
   const int L = chain_.num_links();
@@ -2021,7 +2085,8 @@ typename StringModel<dim>::SnapResult StringModel<dim>::snap(double t) {
     for (int j : caught)
       if (rebounds_accumulate(j, t, e)) inelastic[static_cast<std::size_t>(j)] = 1;
   }
-  const SnapResult impulses = link_impulses(t, e, 0, inelastic.empty() ? nullptr : &inelastic, true);
+  const SnapResult impulses = link_impulses(t, e, speed_floor, inelastic.empty() ? nullptr : &inelastic, true);
+  result.speed = impulses.speed;
   result.dissipated = impulses.dissipated;
   result.support_work = impulses.support_work;
   result.support_impulse = impulses.support_impulse;
@@ -2150,6 +2215,7 @@ typename StringModel<dim>::SnapResult StringModel<dim>::link_impulses(double t, 
     result.dissipated += 0.5 * P[u] * (u_before[j] + u_after);
     if (!link_slack(j) && u_after < -kSeparation * u_scale) separating.push_back(j);
   });
+  result.speed = u_scale;
   // 4a. At a snap, a separation whose flight would not open the link beyond kSlackGap of its length is held
   //     taut (hold_unresolved_flights): the velocities are then projected onto the taut links' lengths below.
   const bool held = rebounds && hold_unresolved_flights(t, separating);

@@ -251,19 +251,33 @@ class StringModel final : public OdeSystem {
   /// none. One root function for all links (ARKODE evaluates every root function at every step: N
   /// per-link functions cost N times more evaluations of the same numbers).
   double slack_gap() const;
+  /// The release root function at the last evaluation: min over the taut links in an arc, not bent and not the
+  /// arm of a front's split link (the front's own checks judge those: a kink whose arm is released dissolves), of
+  /// T_j / scale + slack_tolerance (scale as solve_tensions judges a release), −slack_tolerance for a link the
+  /// complementarity problem released; 1 with none. It crosses zero where the first tension reaches the
+  /// release threshold, so the release is located and the link declared slack at that instant.
+  double release_root() const;
+  /// Declares slack the links whose term of release_root() is ≤ 0 at the last evaluation, each with its root
+  /// offset (a release flight, slack_root); returns how many.
+  int release_links();
   /// What a snap did: the energy it dissipated (J, ≥ 0), the work and impulse of the supports'
   /// impulses (J, N s), and how many links it caught.
   struct SnapResult {
     double dissipated = 0, support_work = 0;
     Vec<dim> support_impulse = Vec<dim>::Zero();
     int caught = 0;
+    /// The speed a separation is judged against (m/s): the largest rate of a taut link before the impulses, or
+    /// the floor passed in; a link that opens slower than kSeparation of it is round-off and stays taut.
+    double speed = 0;
   };
   /// The impact at the current state (a slack link reached its length): the links within
   /// kSnapWindow of their length become taut, and the impulsive tensions P ≥ 0 of the taut links
   /// solve the complementarity problem u⁺ = u⁻ + A P ≤ −e u⁻, P (u⁺ + e u⁻) = 0 (u: rate of
   /// lengthening); the velocities jump, and links that separate afterwards go slack. A caught link whose
-  /// rebounds would accumulate (rebounds_accumulate) takes e = 0.
-  SnapResult snap(double t);
+  /// rebounds would accumulate (rebounds_accumulate) takes e = 0. `speed_floor`: the least speed a
+  /// separation is judged against (m/s); the catch rounds after a snap pass its speed (SnapResult::speed), where
+  /// the links caught approach at round-off rates.
+  SnapResult snap(double t, double speed_floor = 0);
   /// The impact of nodes landing on obstacles (a contact module has just held them): the state onto
   /// the constraints of the links and the held nodes, the velocities by a perfectly inelastic impact.
   /// Bilateral links: the mass-weighted projection (project()). With slack = allow: the held nodes'
@@ -286,6 +300,11 @@ class StringModel final : public OdeSystem {
   /// kCatchWindow.
   static constexpr double kSnapWindow = 1e-7;
   static constexpr double kCatchWindow = 1e-5;
+  /// A release flight is located on its return to its length at the release once it has flown shorter than
+  /// that length by this share of h at an accepted step (slack_root): deeper than the round-off of the positions
+  /// (ε |x| / h, 4e-14 on a 1 m chain of 400 links), which a link that stays at rest at its length in free fall
+  /// reaches at once; shallower, it keeps the offset kSlackGap.
+  static constexpr double kFlightDepth = 1e-10;
   /// After a snap, a taut link goes slack when it separates faster than this share of the largest
   /// approach speed of the snap (slower, it stays taut and the tension solve releases it if it must).
   static constexpr double kSeparation = 1e-6;
@@ -703,6 +722,11 @@ class StringModel final : public OdeSystem {
   ImpulsiveStart impulsive_start_;
   std::vector<char> slack_;            // per link: slack (slack = allow)
   std::vector<double> slack_offset_;   // per link: its root function's offset
+  // per link: 0, no release flight; 1, slack since a located release at length l_r; 2, and since then shorter
+  // than l_r by kFlightDepth h at an accepted step (its root function is (l_r − l)/h from then on: slack_root)
+  std::vector<char> release_flight_;
+  /// Link j borders a link that no arc holds (a front's split link): a front's arm, whose release the front judges.
+  bool borders_front(int j) const;
   std::vector<double> rebound_time_, rebound_speed_;  // per link: when and how fast it separated at its last snap (NaN: it did not)
   // per link: released by the complementarity problem at some evaluation since the last accepted step (accept_step)
   std::vector<char> released_;
